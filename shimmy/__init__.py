@@ -1,0 +1,18 @@
+"""shimmy: nose-landing-gear shimmy with a torsional NES and an annular particle damper.
+
+The model (MODEL.md) and its first analyses: parameters, devices, equations with
+analytic Jacobians, time histories, linear stability with Hopf points, calibration.
+"""
+
+__version__ = "0.1.0"
+
+from .configurations import ALL_CONFIGURATIONS, Configuration  # noqa: E402
+from .errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError  # noqa: E402
+from .parameters import MATERIALS, PARAMETER_SPECS, Parameters  # noqa: E402
+from .simulation import SimulationOptions, SimulationResult, simulate  # noqa: E402
+
+__all__ = [
+    "ALL_CONFIGURATIONS", "Configuration", "ConvergenceError", "GeometryError",
+    "InvalidParameterError", "MATERIALS", "PARAMETER_SPECS", "Parameters", "ShimmyError",
+    "SimulationOptions", "SimulationResult", "simulate", "__version__",
+]

@@ -1,0 +1,50 @@
+"""The four configurations of the gear: which devices are fitted."""
+
+from __future__ import annotations
+
+from enum import Enum
+
+from .parameters import unknown_name_error
+
+
+class Configuration(str, Enum):
+    """A gear configuration; the value is the canonical name used by CLI, API and UI."""
+
+    ORIGINAL = "original"
+    NES = "nes"
+    PD = "pd"
+    NES_PD = "nes_pd"
+
+    @property
+    def has_nes(self) -> bool:
+        return self in (Configuration.NES, Configuration.NES_PD)
+
+    @property
+    def has_pd(self) -> bool:
+        return self in (Configuration.PD, Configuration.NES_PD)
+
+    @property
+    def n_states(self) -> int:
+        """5 gear/tyre states, plus the absorber's rotation and rate with an NES."""
+        return 7 if self.has_nes else 5
+
+    @property
+    def is_smooth(self) -> bool:
+        """False where the vector field is not C^3 at dpsi = 0 (the PD's |dpsi|^(1/2) dpsi)."""
+        return not self.has_pd
+
+    @classmethod
+    def parse(cls, value: "Configuration | str") -> "Configuration":
+        if isinstance(value, cls):
+            return value
+        try:
+            return cls(str(value))
+        except ValueError:
+            raise unknown_name_error(value, [c.value for c in cls], "config") from None
+
+
+ALL_CONFIGURATIONS = tuple(Configuration)
+
+#: State names in order; an NES adds the last two.
+STATE_NAMES = ("psi", "dpsi", "delta", "ddelta", "lam", "psis", "dpsis")
+STATE_UNITS = ("rad", "rad/s", "rad", "rad/s", "m", "rad", "rad/s")

@@ -1,0 +1,244 @@
+"""Equations of motion of MODEL.md: right-hand side and analytic Jacobians.
+
+The state is ``x = [psi, dpsi, delta, ddelta, lam]`` plus ``[psis, dpsis]`` with an NES.
+All functions are vectorised: ``x`` may be one state ``(n,)`` or many columns ``(n, m)``,
+with ``V`` and ``Fz`` scalars or arrays broadcastable to ``(m,)``. Jacobians come back
+as ``(n, n)`` for one state and ``(m, n, n)`` for many (ready for batched ``eig``).
+
+:func:`vector_field` is plain arithmetic so that numba can compile it into the
+integrator (one source for the equations, compiled and vectorised) and numpy can
+evaluate it on arrays, including complex ones (the Jacobian is complex-analytic
+away from the PD's |dpsi|; the stability module uses complex steps on it).
+
+Model coefficients are packed once per (parameters, configuration) into a float
+vector by :func:`model_coefficients`, indexed by the module constants below.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba.extending import register_jitable
+
+from . import nes as nes_device
+from . import particle_damper
+from .configurations import Configuration
+from .parameters import Parameters
+
+# Indices into the coefficient vector.
+(I_PSI, IX, COS_PHI, SIN_PHI, E_EFF, K_PSI, C_PSI, K_DELTA, C_DELTA, K_A, ALPHA_M, C_LAM,
+ L_G, H, L, K_LAM, K1, K3, I_NES, C_NES, NES_A, NES_RHO, NES_DELTA0, K_S, E_P,
+ PD_N_R2, PD_R, PD_S12, PD_S1, PD_S32, PD_S2, PD_S3) = range(32)
+N_COEFFICIENTS = 32
+
+
+def effective_caster(R: float, phi: float, e: float) -> float:
+    """e_eff = e cos(phi) + (R + e sin(phi)) tan(phi), in m."""
+    return e * math.cos(phi) + (R + e * math.sin(phi)) * math.tan(phi)
+
+
+@dataclass(frozen=True)
+class Model:
+    """A configuration with its parameters, packed for the numerics.
+
+    ``exact_nes`` switches the NES torque from the cubic fit (default) to the exact
+    geometry M(a); the latter is undefined for |psi - psis| >= pi/6.
+    """
+
+    config: Configuration
+    params: Parameters
+    coefficients: np.ndarray
+    exact_nes: bool = False
+
+    @property
+    def n_states(self) -> int:
+        return self.config.n_states
+
+    @property
+    def flags(self) -> tuple[bool, bool, bool]:
+        return self.config.has_nes, self.config.has_pd, self.exact_nes
+
+    def rhs(self, x, V, Fz):
+        return rhs(self, x, V, Fz)
+
+    def jacobian(self, x, V, Fz):
+        return jacobian(self, x, V, Fz)
+
+
+def build_model(config: Configuration | str, params: Parameters | None = None,
+                exact_nes: bool = False) -> Model:
+    config = Configuration.parse(config)
+    params = params if params is not None else Parameters()
+    return Model(config, params, model_coefficients(config, params), bool(exact_nes))
+
+
+def model_coefficients(config: Configuration, params: Parameters) -> np.ndarray:
+    g, n, p = params.gear, params.nes, params.pd
+    c = np.zeros(N_COEFFICIENTS)
+    c[I_PSI] = g.Iz + (p.I_pd if config.has_pd else 0.0)
+    c[IX] = g.Ix
+    c[COS_PHI], c[SIN_PHI] = math.cos(g.phi), math.sin(g.phi)
+    c[E_EFF] = effective_caster(g.R, g.phi, g.e)
+    c[K_PSI], c[C_PSI], c[K_DELTA], c[C_DELTA] = g.k_psi, g.c_psi, g.k_delta, g.c_delta
+    c[K_A], c[ALPHA_M], c[C_LAM] = g.k_a, g.alpha_m, g.c_lam
+    c[L_G], c[H], c[L], c[K_LAM] = g.l_g, g.h, g.L, g.k_lam
+    c[K1], c[K3] = nes_device.cubic_coefficients(n.r1, n.r2, n.r3, n.k_s, n.e_p)
+    c[I_NES], c[C_NES] = n.I_nes, n.c_nes
+    c[NES_A], c[NES_RHO], c[NES_DELTA0] = nes_device.geometry(n.r1, n.r2, n.r3)
+    c[K_S], c[E_P] = n.k_s, n.e_p
+    c[PD_N_R2], c[PD_R] = p.n * p.r * p.r, p.r
+    c[PD_S12], c[PD_S1], c[PD_S32], c[PD_S2], c[PD_S3] = particle_damper.damping_coefficients(p).series
+    return c
+
+
+@register_jitable
+def vector_field(psi, dpsi, delta, ddelta, lam, psis, dpsis, V, Fz, c, has_nes, has_pd, exact_nes):
+    """Time derivatives of the seven states (the NES pair is zero without an NES)."""
+    cos_phi = c[COS_PHI]
+    e_eff = c[E_EFF]
+    theta = psi * cos_phi
+    sin_theta = np.sin(theta)
+    cos_theta = np.cos(theta)
+    # Tyre: tan(alpha) = lam / L, so atan(7 tan alpha) = atan(7 lam / L).
+    w = np.arctan(7.0 * lam / c[L])
+    force = c[K_LAM] * Fz * w * np.cos(0.95 * w)
+    alpha = np.arctan(lam / c[L])
+    alpha_m = c[ALPHA_M]
+    aligning = (c[K_A] * alpha_m / np.pi * np.sin(np.pi * alpha / alpha_m) * Fz
+                * (np.abs(alpha) <= alpha_m))
+    torque = (c[C_PSI] * dpsi + c[K_PSI] * psi + aligning + e_eff * force
+              + c[C_LAM] * dpsi * cos_phi / V - Fz * c[SIN_PHI] * e_eff * sin_theta)
+    absorber = 0.0 * psi
+    if has_nes:
+        u = psi - psis
+        if exact_nes:
+            restoring = nes_device.torque_core(u, c[NES_A], c[NES_RHO], c[NES_DELTA0], c[K_S], c[E_P])
+        else:
+            restoring = c[K1] * u + c[K3] * u * u * u
+        absorber = c[C_NES] * (dpsi - dpsis) + restoring
+        torque = torque + absorber
+    if has_pd:
+        v = c[PD_R] * np.abs(dpsi)
+        root = np.sqrt(v)
+        c_star = c[PD_S12] * root + c[PD_S1] * v + c[PD_S32] * v * root + c[PD_S2] * v * v + c[PD_S3] * v * v * v
+        torque = torque + c[PD_N_R2] * c_star * dpsi
+    psi_dd = -torque / c[I_PSI]
+    delta_dd = -(c[C_DELTA] * ddelta + c[K_DELTA] * delta + c[L_G] * force * cos_theta * cos_phi
+                 - Fz * e_eff * sin_theta) / c[IX]
+    lam_d = (-(V / c[L]) * lam + V * sin_theta + c[L_G] * ddelta * np.cos(delta)
+             + (e_eff - c[H]) * cos_theta * dpsi * cos_phi)
+    psis_dd = absorber / c[I_NES]
+    return dpsi, psi_dd, ddelta, delta_dd, lam_d, dpsis, psis_dd
+
+
+def _columns(model: Model, x):
+    x = np.asarray(x)
+    if x.shape[0] != model.n_states:
+        raise ValueError(f"state has {x.shape[0]} rows; configuration {model.config.value} "
+                         f"has {model.n_states} states")
+    zero = np.zeros_like(x[0])
+    psis, dpsis = (x[5], x[6]) if model.config.has_nes else (zero, zero)
+    return x[0], x[1], x[2], x[3], x[4], psis, dpsis
+
+
+def rhs(model: Model, x, V, Fz):
+    """f(x; V, Fz), same shape as ``x``."""
+    cols = _columns(model, x)
+    out = vector_field(*cols, V, Fz, model.coefficients, *model.flags)
+    out = np.broadcast_arrays(*out, cols[0] + 0 * np.asarray(V) + 0 * np.asarray(Fz))[:-1]
+    return np.stack(out[:model.n_states])
+
+
+def _tyre_derivatives(lam, Fz, c):
+    """F_lam, dF_lam/dlam, M_ka and dM_ka/dlam (arrays, complex-safe)."""
+    L_ = c[L]
+    w = np.arctan(7.0 * lam / L_)
+    force = c[K_LAM] * Fz * w * np.cos(0.95 * w)
+    u = 7.0 * lam / L_
+    dforce = c[K_LAM] * Fz * (7.0 / L_) * (np.cos(0.95 * w) - 0.95 * w * np.sin(0.95 * w)) / (1.0 + u * u)
+    alpha = np.arctan(lam / L_)
+    alpha_m = c[ALPHA_M]
+    inside = np.abs(np.real(alpha)) <= alpha_m
+    aligning = c[K_A] * alpha_m / np.pi * np.sin(np.pi * alpha / alpha_m) * Fz * inside
+    dalpha = (1.0 / L_) / (1.0 + (lam / L_) ** 2)
+    daligning = c[K_A] * np.cos(np.pi * alpha / alpha_m) * Fz * inside * dalpha
+    return force, dforce, aligning, daligning
+
+
+def _pd_slope(dpsi, c):
+    """d M_pd / d dpsi = n r^2 (3/2 s12 v^1/2 + 2 s1 v + 5/2 s32 v^3/2 + 3 s2 v^2 + 4 s3 v^3)."""
+    v = c[PD_R] * np.abs(dpsi)
+    root = np.sqrt(v)
+    return c[PD_N_R2] * (1.5 * c[PD_S12] * root + 2.0 * c[PD_S1] * v + 2.5 * c[PD_S32] * v * root
+                         + 3.0 * c[PD_S2] * v * v + 4.0 * c[PD_S3] * v ** 3)
+
+
+def jacobian(model: Model, x, V, Fz):
+    """Analytic d f / d x: ``(n, n)`` for one state, ``(m, n, n)`` for columns."""
+    c = model.coefficients
+    psi, dpsi, delta, ddelta, lam, psis, dpsis = _columns(model, x)
+    shape = np.broadcast(psi, np.asarray(V), np.asarray(Fz)).shape
+    n = model.n_states
+    dtype = np.result_type(psi, V, Fz, float)
+    J = np.zeros(shape + (n, n), dtype=dtype)
+    cos_phi, e_eff = c[COS_PHI], c[E_EFF]
+    theta = psi * cos_phi
+    sin_theta, cos_theta = np.sin(theta), np.cos(theta)
+    force, dforce, _, daligning = _tyre_derivatives(lam, Fz, c)
+    i_psi, ix = c[I_PSI], c[IX]
+
+    J[..., 0, 1] = 1.0
+    J[..., 1, 0] = (-c[K_PSI] + Fz * c[SIN_PHI] * e_eff * cos_theta * cos_phi) / i_psi
+    J[..., 1, 1] = (-c[C_PSI] - c[C_LAM] * cos_phi / V) / i_psi
+    J[..., 1, 4] = (-daligning - e_eff * dforce) / i_psi
+    J[..., 2, 3] = 1.0
+    J[..., 3, 0] = (c[L_G] * force * sin_theta * cos_phi * cos_phi + Fz * e_eff * cos_theta * cos_phi) / ix
+    J[..., 3, 2] = -c[K_DELTA] / ix
+    J[..., 3, 3] = -c[C_DELTA] / ix
+    J[..., 3, 4] = -c[L_G] * dforce * cos_theta * cos_phi / ix
+    J[..., 4, 0] = V * cos_theta * cos_phi - (e_eff - c[H]) * sin_theta * cos_phi * dpsi * cos_phi
+    J[..., 4, 1] = (e_eff - c[H]) * cos_theta * cos_phi
+    J[..., 4, 2] = -c[L_G] * ddelta * np.sin(delta)
+    J[..., 4, 3] = c[L_G] * np.cos(delta)
+    J[..., 4, 4] = -V / c[L]
+    if model.config.has_pd:
+        J[..., 1, 1] -= _pd_slope(dpsi, c) / i_psi
+    if model.config.has_nes:
+        u = psi - psis
+        if model.exact_nes:
+            k_u = nes_device.stiffness_core(u, c[NES_A], c[NES_RHO], c[NES_DELTA0], c[K_S], c[E_P])
+        else:
+            k_u = c[K1] + 3.0 * c[K3] * u * u
+        c_nes, i_nes = c[C_NES], c[I_NES]
+        J[..., 1, 0] -= k_u / i_psi
+        J[..., 1, 1] -= c_nes / i_psi
+        J[..., 1, 5] = k_u / i_psi
+        J[..., 1, 6] = c_nes / i_psi
+        J[..., 5, 6] = 1.0
+        J[..., 6, 0] = k_u / i_nes
+        J[..., 6, 1] = c_nes / i_nes
+        J[..., 6, 5] = -k_u / i_nes
+        J[..., 6, 6] = -c_nes / i_nes
+    return J
+
+
+def parameter_jacobian(model: Model, x, V, Fz):
+    """(d f / d V, d f / d Fz), each shaped like ``x``."""
+    c = model.coefficients
+    psi, dpsi, delta, ddelta, lam, psis, dpsis = _columns(model, x)
+    cos_phi, e_eff = c[COS_PHI], c[E_EFF]
+    theta = psi * cos_phi
+    sin_theta, cos_theta = np.sin(theta), np.cos(theta)
+    force, _, aligning, _ = _tyre_derivatives(lam, Fz, c)
+    shape = np.broadcast(psi, np.asarray(V), np.asarray(Fz)).shape
+    n = model.n_states
+    dtype = np.result_type(psi, V, Fz, float)
+    dV = np.zeros((n,) + shape, dtype=dtype)
+    dFz = np.zeros((n,) + shape, dtype=dtype)
+    dV[1] = c[C_LAM] * dpsi * cos_phi / (V * V) / c[I_PSI]
+    dV[4] = -lam / c[L] + sin_theta
+    dFz[1] = (-aligning / Fz - e_eff * force / Fz + c[SIN_PHI] * e_eff * sin_theta) / c[I_PSI]
+    dFz[3] = (-c[L_G] * (force / Fz) * cos_theta * cos_phi + e_eff * sin_theta) / c[IX]
+    return dV, dFz

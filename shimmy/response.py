@@ -1,0 +1,92 @@
+"""Measures of a sampled response: amplitudes, dominant frequency, response type.
+
+Criteria (documented here because every caller shares them):
+
+* Steady window: the last ``window`` seconds of the run; the ``window`` before it is
+  the previous window, used to judge whether the response has settled.
+* Amplitude: max |x| over the steady window, refined by a parabola through the largest
+  sample and its neighbours (sampling error O(dt^2) -> O(dt^4)).
+* Modal energies: E_t = k_psi psi_amp^2 / 2 (torsion), E_l = k_delta delta_amp^2 / 2
+  (lateral bending); torsional and lateral amplitudes are in different units, the
+  elastic energies put them on one scale.
+* Response type of one run:
+    - ``Stable`` if the motion decays: sqrt(E_t + E_l) over the steady window is below
+      1e-3 of its initial value, or it is smaller than its initial value and still
+      falling (by more than 1 % against the previous window);
+    - otherwise, with torsional share s = E_t / (E_t + E_l): ``Torsion`` if s >= 0.8,
+      ``Lateral`` if s <= 0.2, ``Both`` in between.
+* Dominant frequency: the peak of the summed power spectra of sqrt(k_psi) psi and
+  sqrt(k_delta) delta over the steady window (Hann window, mean removed, 8x zero
+  padding), refined by a parabola through the log power at the peak bin and its
+  neighbours. For a pure tone the error is well below 0.01 Hz with a 20 s window.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+
+import numpy as np
+
+
+class ResponseType(str, Enum):
+    STABLE = "Stable"
+    TORSION = "Torsion"
+    LATERAL = "Lateral"
+    BOTH = "Both"
+
+
+TORSION_SHARE = 0.8
+LATERAL_SHARE = 0.2
+DECAY_RATIO = 0.99
+DECAYED_FRACTION = 1e-3
+
+
+def peak_amplitude(signal: np.ndarray) -> float:
+    """max |signal|, refined by a parabola through the largest sample and its neighbours."""
+    a = np.abs(np.asarray(signal, dtype=float))
+    i = int(np.argmax(a))
+    if 0 < i < a.size - 1:
+        y0, y1, y2 = a[i - 1], a[i], a[i + 1]
+        denom = y0 - 2.0 * y1 + y2
+        if denom < 0.0:
+            return float(y1 - 0.125 * (y2 - y0) ** 2 / denom)
+    return float(a[i])
+
+
+def dominant_frequency(signals: list[np.ndarray], dt: float) -> float:
+    """Peak frequency (Hz) of the summed power spectra of equally sampled signals."""
+    n = signals[0].size
+    if n < 8:
+        return float("nan")
+    window = np.hanning(n)
+    n_fft = 8 * int(2 ** np.ceil(np.log2(n)))
+    power = np.zeros(n_fft // 2 + 1)
+    for s in signals:
+        s = np.asarray(s, dtype=float)
+        power += np.abs(np.fft.rfft((s - s.mean()) * window, n_fft)) ** 2
+    k = int(np.argmax(power[1:])) + 1
+    if power[k] <= 0.0:
+        return float("nan")
+    offset = 0.0
+    if k < power.size - 1:
+        l0, l1, l2 = np.log(power[k - 1:k + 2] + 1e-300)
+        denom = l0 - 2.0 * l1 + l2
+        if denom < 0.0:
+            offset = 0.5 * (l0 - l2) / denom
+    return float((k + offset) / (n_fft * dt))
+
+
+def classify_run(energy_initial: float, torsional_energy: float, lateral_energy: float,
+                 previous_energy: float) -> ResponseType:
+    """Response type of one run from modal energies (see the module docstring)."""
+    total = torsional_energy + lateral_energy
+    if total <= (DECAYED_FRACTION ** 2) * energy_initial:
+        return ResponseType.STABLE
+    if total < energy_initial and np.sqrt(total) < DECAY_RATIO * np.sqrt(previous_energy):
+        return ResponseType.STABLE
+    share = torsional_energy / total
+    if share >= TORSION_SHARE:
+        return ResponseType.TORSION
+    if share <= LATERAL_SHARE:
+        return ResponseType.LATERAL
+    return ResponseType.BOTH
