@@ -113,7 +113,7 @@ class GearParameters:
     l_g: float = _param(2.5, 0.5, 5.0, "m", "gear height (attachment to ground)", ENVELOPE)
     h: float = _param(0.1, 0.0, 0.3, "m", "contact patch length", ENVELOPE)
     L: float = _param(0.3, 0.05, 1.0, "m", "tyre relaxation length", ENVELOPE)
-    k_lam: float = _param(0.0019951, 1e-4, 0.02, "1/rad", "tyre lateral force coefficient", CALIBRATED)
+    k_lam: float = _param(0.002022, 1e-4, 0.02, "1/rad", "tyre lateral force coefficient", CALIBRATED)
 
     def __post_init__(self):
         _validate_fields(self)
@@ -128,8 +128,8 @@ class NESParameters:
     r3: float = _param(0.01, 0.005, 0.02, "m", "roller radius")
     k_s: float = _param(1.2e6, 1.0e6, 1.4e6, "N/m", "spring stiffness")
     e_p: float = _param(0.001, 0.0005, 0.005, "m", "spring pre-stretch")
-    I_nes: float = _param(4.842, 0.1, 50.0, "kg m^2", "absorber inertia", CALIBRATED)
-    c_nes: float = _param(80.08, 0.0, 1000.0, "N m s/rad", "absorber damping", CALIBRATED)
+    I_nes: float = _param(4.6746, 0.1, 50.0, "kg m^2", "absorber inertia", CALIBRATED)
+    c_nes: float = _param(80.396, 0.0, 1000.0, "N m s/rad", "absorber damping", CALIBRATED)
 
     def __post_init__(self):
         _validate_fields(self)
@@ -154,13 +154,13 @@ class PDParameters:
     a_p: float = _param(0.9, 0.5, 0.95, "", "mass filling ratio")
     rho_p: float = _param(7800.0, 7800.0, 17000.0, "kg/m^3", "particle density")
     rho_m_frac: float = _param(0.9, 0.8, 0.95, "", "mixture density as a fraction of rho_p")
-    g_p: float = _param(1.0, 1.0, 5.0, "", "radial distribution function", CALIBRATED)
+    g_p: float = _param(5.0, 1.0, 5.0, "", "radial distribution function", CALIBRATED)
     e_r: float = _param(0.8, 0.5, 0.9, "", "coefficient of restitution")
     d_p: float = _param(0.001, 0.0003, 0.002, "m", "mean particle diameter")
-    f: float = _param(20.0, 10.0, 30.0, "", "correction factor")
+    f: float = _param(30.0, 10.0, 30.0, "", "correction factor", CALIBRATED)
     phi_f: float = _param(0.6109, 0.4363, 0.6981, "rad", "internal friction angle (25 to 40 deg)")
     I2D: float = _param(1.0, 0.1, 10.0, "", "second invariant I_2D of the deviatoric strain rate", ENVELOPE)
-    I_pd: float = _param(4.91, 0.0, 50.0, "kg m^2", "rotational inertia added by the damper", CALIBRATED)
+    I_pd: float = _param(4.9037, 0.0, 50.0, "kg m^2", "rotational inertia added by the damper", CALIBRATED)
 
     def __post_init__(self):
         _validate_fields(self)
