@@ -19,12 +19,13 @@ class InvalidParameterError(ShimmyError, ValueError):
     ``allowed`` describes what is accepted (a range, or a list of names).
     """
 
-    def __init__(self, field: str, value: object, allowed: str, reason: str | None = None):
+    def __init__(self, field: str, value: object, allowed: str, reason: str | None = None,
+                 message: str | None = None):
         self.field = field
         self.value = value
         self.allowed = allowed
         head = reason or "is out of range"
-        super().__init__(f"{field}={value!r} {head}; allowed: {allowed}")
+        super().__init__(message or f"{field}={value!r} {head}; allowed: {allowed}")
 
     def to_dict(self) -> dict:
         return {"error": str(self), "field": self.field, "allowed": self.allowed}

@@ -20,7 +20,7 @@ from typing import Callable
 import numpy as np
 
 
-def _hopf_eigenvectors(A: np.ndarray):
+def hopf_eigenvectors(A: np.ndarray):
     """q, p with A q = i w q, A^T p = -i w p, <q, q> = 1, <p, q> = 1 (<a, b> = a^H b)."""
     ev, vecs = np.linalg.eig(A)
     i = np.argmin(np.abs(ev.real) + np.where(ev.imag > 0, 0.0, np.inf))
@@ -42,7 +42,7 @@ def first_lyapunov_coefficient(jacobian: Callable[[np.ndarray], np.ndarray], n: 
     """
     zero = np.zeros(n)
     A = jacobian(zero).real
-    omega, q, p = _hopf_eigenvectors(A)
+    omega, q, p = hopf_eigenvectors(A)
 
     def B_matrix(u, base=zero):
         # d/dt J(base + t u) at t = 0, by a complex step on the analytic Jacobian.

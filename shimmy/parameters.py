@@ -190,10 +190,13 @@ PARAMETER_SPECS: dict[str, ParameterSpec] = _specs()
 
 
 def unknown_name_error(name: str, choices, field_name: str | None = None) -> InvalidParameterError:
+    """Error for a name that is not among ``choices`` (a parameter, configuration, material)."""
     close = difflib.get_close_matches(str(name), list(choices), n=3)
     hint = f" (did you mean {', '.join(close)}?)" if close else ""
-    return InvalidParameterError(field_name or str(name), name, f"one of {', '.join(choices)}",
-                                 f"is not a known name{hint}")
+    allowed = f"one of {', '.join(choices)}"
+    what = field_name or "parameter"
+    return InvalidParameterError(field_name or str(name), name, allowed,
+                                 message=f"unknown {what} {name!r}{hint}; allowed: {allowed}")
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,158 @@
+"""Command line: ``python -m shimmy {params,hopf,simulate,calibrate} ...``.
+
+Results go to stdout (JSON with ``--json``, a short table otherwise). Bad input exits
+with status 2 and a message on stderr naming the field, its value and what is allowed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any, Sequence
+
+from .configurations import Configuration
+from .errors import GeometryError, InvalidParameterError, ShimmyError
+from .parameters import MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters
+
+EXIT_BAD_INPUT = 2
+EXIT_FAILED = 1
+
+
+def _parse_sets(items: Sequence[str] | None) -> dict[str, str]:
+    overrides: dict[str, str] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise InvalidParameterError("--set", item, "NAME=VALUE with NAME from 'python -m shimmy params'",
+                                        "is not of the form NAME=VALUE")
+        overrides[name.strip()] = value.strip()
+    return overrides
+
+
+def _params(args) -> Parameters:
+    params = Parameters()
+    if getattr(args, "material", None):
+        params = params.with_material(args.material)
+    return params.with_overrides(_parse_sets(args.set))
+
+
+def _emit(payload: dict[str, Any], as_json: bool, text: str) -> None:
+    if as_json:
+        json.dump(payload, sys.stdout, indent=2, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(text)
+
+
+def _cmd_params(args) -> int:
+    rows = [spec.to_dict() for spec in PARAMETER_SPECS.values()]
+    lines = [f"{'name':<11}{'group':<6}{'unit':<11}{'default':>12}{'low':>11}{'high':>11}  description"]
+    for s in PARAMETER_SPECS.values():
+        lines.append(f"{s.name:<11}{s.group:<6}{s.unit:<11}{s.default:>12.6g}{s.low:>11.4g}{s.high:>11.4g}  "
+                     f"{s.description}")
+    _emit({"parameters": rows}, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_hopf(args) -> int:
+    from .stability import hopf_points
+
+    result = hopf_points(args.config, args.Fz, _params(args), v_min=args.v_min, v_max=args.v_max)
+    payload = result.to_dict()
+    lines = [f"{result.config.value} at Fz = {result.Fz:g} N, V in [{result.v_min:g}, {result.v_max:g}] m/s"]
+    if not result.hopf_points:
+        lines.append("  no Hopf point")
+    for h in result.hopf_points:
+        lines.append(f"  Hopf V = {h.V:.6f} m/s  f = {h.frequency_hz:.4f} Hz  {h.criticality.value}"
+                     f"  ({'loses' if h.destabilising else 'regains'} stability as V increases)")
+    for iv in result.unstable_intervals:
+        lines.append(f"  x = 0 unstable for V in [{iv[0]:.6g}, {iv[1]:.6g}] m/s")
+    _emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_simulate(args) -> int:
+    from .simulation import simulate
+
+    result = simulate(args.config, args.V, args.Fz, _params(args), t_end=args.t_end,
+                      exact_nes=args.exact_nes)
+    if args.csv:
+        result.write_csv(args.csv)
+    payload = result.to_dict()
+    amp = result.amplitude
+    freq = "-" if result.frequency_hz != result.frequency_hz else f"{result.frequency_hz:.4f} Hz"
+    text = (f"{result.config.value} at V = {result.V:g} m/s, Fz = {result.Fz:g} N, {result.options.t_end:g} s\n"
+            f"  response        {result.response_type.value}{'' if result.steady else ' (not yet steady)'}\n"
+            f"  max |psi|       {amp['psi']:.6g} rad\n"
+            f"  max |l_g delta| {amp['lateral']:.6g} m\n"
+            f"  frequency       {freq}\n"
+            f"  {result.message}")
+    _emit(payload, args.json, text)
+    return 0 if result.success else EXIT_FAILED
+
+
+def _cmd_calibrate(args) -> int:
+    from .calibration import calibrate, format_report
+
+    result = calibrate(_params(args))
+    _emit(result.to_dict(), args.json, format_report(result))
+    return 0
+
+
+def _add_common(p: argparse.ArgumentParser, design: bool = True) -> None:
+    p.add_argument("--json", action="store_true", help="write JSON to stdout")
+    if design:
+        p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                       help="override a parameter (repeatable); see 'params' for names and ranges")
+        p.add_argument("--material", choices=sorted(MATERIALS), help="particle-damper material preset")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m shimmy", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    configs = [c.value for c in Configuration]
+
+    p = sub.add_parser("params", help="list every parameter with unit, default, range")
+    _add_common(p, design=False)
+    p.set_defaults(func=_cmd_params)
+
+    p = sub.add_parser("hopf", help="Hopf points of straight rolling in V at one load")
+    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--Fz", required=True, help="vertical load (N)")
+    p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
+    p.add_argument("--v-max", default=V_RANGE[1], help="highest speed (m/s)")
+    _add_common(p)
+    p.set_defaults(func=_cmd_hopf)
+
+    p = sub.add_parser("simulate", help="time history at one operating point")
+    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--V", required=True, help="forward speed (m/s)")
+    p.add_argument("--Fz", required=True, help="vertical load (N)")
+    p.add_argument("--t-end", default=60.0, help="simulated time (s)")
+    p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
+    p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
+    _add_common(p)
+    p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser("calibrate", help="refit the unpublished constants and print residuals")
+    _add_common(p)
+    p.set_defaults(func=_cmd_calibrate)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (InvalidParameterError, GeometryError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except ShimmyError as exc:
+        print(f"failed: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    except BrokenPipeError:  # stdout closed early (| head): not an error of ours
+        return 0
+    except OSError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
