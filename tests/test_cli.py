@@ -1,0 +1,64 @@
+import csv
+import json
+import subprocess
+import sys
+
+import pytest
+
+from shimmy.parameters import PARAMETER_SPECS
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "shimmy", *args], capture_output=True, text=True, timeout=120)
+
+
+def test_params_lists_every_parameter():
+    out = run("params", "--json")
+    assert out.returncode == 0
+    rows = json.loads(out.stdout)["parameters"]
+    assert [r["name"] for r in rows] == list(PARAMETER_SPECS)
+    assert {"name", "unit", "default", "low", "high", "description"} <= set(rows[0])
+    text = run("params")
+    assert "k_lam" in text.stdout and "concave-track radius" in text.stdout
+
+
+def test_hopf_json():
+    out = run("hopf", "--config", "nes", "--Fz", "150000", "--json", "--set", "e_p=0.001")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["config"] == "nes" and data["Fz"] == 150000.0 and data["params"]["e_p"] == 0.001
+    speeds = [h["V"] for h in data["hopf_points"]]
+    assert speeds == pytest.approx([6.730, 71.255], rel=2e-3)
+    assert {h["criticality"] for h in data["hopf_points"]} == {"supercritical"}
+
+
+def test_simulate_json_and_csv(tmp_path):
+    path = tmp_path / "a.csv"
+    out = run("simulate", "--config", "nes_pd", "--V", "30", "--Fz", "150000", "--t-end", "20",
+              "--json", "--csv", str(path))
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert set(data["amplitude"]) >= {"psi", "lateral"}
+    assert data["response_type"] == "Torsion" and 10 < data["frequency_hz"] < 13
+    assert data["params"]["g_p"] == PARAMETER_SPECS["g_p"].default
+    with open(path) as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0] == ["t", "psi", "dpsi", "delta", "ddelta", "lam", "psis", "dpsis", "lateral"]
+    assert len(rows) == 20001 + 1
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["hopf", "--config", "nes", "--Fz", "1e9"], "Fz=1000000000.0 is out of range; allowed: a number in [10000, 900000] N"),
+    (["hopf", "--config", "nes", "--Fz", "150000", "--set", "r2=0.2"], "r2=0.2 is out of range"),
+    (["hopf", "--config", "nes", "--Fz", "150000", "--set", "zeta=1"], "unknown parameter 'zeta'"),
+    (["hopf", "--config", "nes", "--Fz", "150000", "--set", "r2"], "--set='r2' is not of the form NAME=VALUE"),
+    (["simulate", "--config", "pd", "--V", "fast", "--Fz", "150000"], "V='fast' is not a number"),
+    (["simulate", "--config", "pd", "--V", "30", "--Fz", "nan"], "Fz=nan is not finite"),
+    (["simulate", "--config", "pd", "--V", "30", "--Fz", "150000", "--t-end", "1e9"], "t_end=1000000000.0 is out of range"),
+    (["simulate", "--config", "gear", "--V", "30", "--Fz", "150000"], "argument --config: invalid choice"),
+])
+def test_bad_input_exits_2_naming_the_field(args, needle):
+    out = run(*args)
+    assert out.returncode == 2
+    assert needle in out.stderr
+    assert out.stdout == ""
