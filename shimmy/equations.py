@@ -39,7 +39,7 @@ def effective_caster(R: float, phi: float, e: float) -> float:
     return e * math.cos(phi) + (R + e * math.sin(phi)) * math.tan(phi)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Model:
     """A configuration with its parameters, packed for the numerics.
 

@@ -56,13 +56,7 @@ def _check_angle(a) -> np.ndarray:
 
 def torque_exact(a, r1: float, r2: float, r3: float, k_s: float, e_p: float):
     """Exact restoring torque M(a) in N m for relative rotation(s) ``a`` in rad."""
-    a = _check_angle(a)
-    return _torque(a, r1, r2, r3, k_s, e_p)
-
-
-def _torque(a, r1, r2, r3, k_s, e_p):
-    A, rho, delta0 = geometry(r1, r2, r3)
-    return torque_core(a, A, rho, delta0, k_s, e_p)
+    return torque_core(_check_angle(a), *geometry(r1, r2, r3), k_s, e_p)
 
 
 @register_jitable
@@ -78,13 +72,7 @@ def torque_core(a, A, rho, delta0, k_s, e_p):
 
 def stiffness_exact(a, r1: float, r2: float, r3: float, k_s: float, e_p: float):
     """Exact tangent stiffness k_nes(a) = dM/da in N m/rad (analytic derivative)."""
-    a = _check_angle(a)
-    return _stiffness(a, r1, r2, r3, k_s, e_p)
-
-
-def _stiffness(a, r1, r2, r3, k_s, e_p):
-    A, rho, delta0 = geometry(r1, r2, r3)
-    return stiffness_core(a, A, rho, delta0, k_s, e_p)
+    return stiffness_core(_check_angle(a), *geometry(r1, r2, r3), k_s, e_p)
 
 
 def stiffness_core(a, A, rho, delta0, k_s, e_p):

@@ -139,3 +139,16 @@ def test_unknown_configuration_is_refused():
 def test_options_are_frozen_and_validated():
     with pytest.raises(InvalidParameterError, match="dt_out"):
         SimulationOptions(dt_out=1.0)
+
+
+@pytest.mark.parametrize("energies,expected", [
+    ((1.0, 1e-9, 1e-9, 1.0), ResponseType.STABLE),      # decayed to below 1e-3 of the start
+    ((1.0, 0.5, 0.01, 0.6), ResponseType.STABLE),       # below the start and still falling
+    ((1.0, 50.0, 1.0, 51.0), ResponseType.TORSION),
+    ((1.0, 1.0, 50.0, 51.0), ResponseType.LATERAL),
+    ((1.0, 20.0, 30.0, 50.0), ResponseType.BOTH),
+    ((1.0, 0.5, 0.0, 0.5), ResponseType.TORSION),       # small but not decaying: a small cycle
+])
+def test_response_type_criteria(energies, expected):
+    from shimmy.response import classify_run
+    assert classify_run(*energies) is expected
