@@ -11,7 +11,8 @@ psi = 0.001 rad:
   median of N runs in the same process;
 * their ratio, and the relative difference of the steady amplitudes (max |psi| and
   max |l_g delta| over the last 20 s);
-* hopf_points over V in [1, 500] m/s at Fz = 150 kN: median of N runs.
+* hopf_points over V in [1, 500] m/s at Fz = 150 kN: median of N runs;
+* rhs and jacobian evaluated at once on 10 000 state columns.
 
 Targets: simulate <= 0.3 s and >= 5x faster than the reference, amplitudes agreeing to
 0.5 %, Hopf points <= 20 ms.
@@ -30,11 +31,13 @@ from scipy.integrate import solve_ivp
 
 from shimmy import simulate
 from shimmy.configurations import ALL_CONFIGURATIONS
+from shimmy.equations import build_model, jacobian, rhs
 from shimmy.reference_model import make_rhs
 from shimmy.response import peak_amplitude
 from shimmy.stability import hopf_points
 
 V_A, FZ_A, T_END, WINDOW = 30.0, 150_000.0, 60.0, 20.0
+N_COLUMNS = 10_000
 
 
 def _median_time(fn, repeats: int) -> tuple[float, object]:
@@ -79,6 +82,18 @@ def main() -> None:
         d_lat = fast.amplitude["lateral"] / ref["lateral"] - 1.0
         print(f"{config.value:<8}{first:>13.3f}{t_fast:>10.3f}{t_ref:>13.3f}{t_ref / t_fast:>9.1f}x"
               f"{d_psi:>+11.2e}{d_lat:>+11.2e}{t_hopf * 1e3:>9.1f}")
+
+    print()
+    print(f"vectorised right-hand side and Jacobian on {N_COLUMNS} state columns (medians)")
+    print(f"{'config':<8}{'rhs ms':>10}{'jacobian ms':>13}{'us/column':>11}")
+    rng = np.random.default_rng(0)
+    for config in ALL_CONFIGURATIONS:
+        model = build_model(config)
+        x = rng.standard_normal((model.n_states, N_COLUMNS)) * 0.01
+        V = rng.uniform(1.0, 500.0, N_COLUMNS)
+        t_rhs, _ = _median_time(lambda: rhs(model, x, V, FZ_A), args.repeats)
+        t_jac, _ = _median_time(lambda: jacobian(model, x, V, FZ_A), args.repeats)
+        print(f"{config.value:<8}{t_rhs * 1e3:>10.2f}{t_jac * 1e3:>13.2f}{(t_rhs + t_jac) / N_COLUMNS * 1e6:>11.3f}")
 
 
 if __name__ == "__main__":

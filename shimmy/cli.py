@@ -1,4 +1,4 @@
-"""Command line: ``python -m shimmy {params,hopf,simulate,calibrate} ...``.
+"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,calibrate} ...``.
 
 Results go to stdout (JSON with ``--json``, a short table otherwise). Bad input exits
 with status 2 and a message on stderr naming the field, its value and what is allowed.
@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from typing import Any, Sequence
 
@@ -72,6 +73,27 @@ def _cmd_hopf(args) -> int:
     return 0
 
 
+def _cmd_eigen(args) -> int:
+    from .parameters import check_operating_point
+    from .stability import eigenvalues
+
+    V, Fz = check_operating_point(args.V, args.Fz)
+    params = _params(args)
+    ev = eigenvalues(args.config, V, Fz, params)
+    rows = [{"real": float(e.real), "imag": float(e.imag), "frequency_hz": float(abs(e.imag) / (2 * math.pi)),
+             "damping_ratio": float(-e.real / abs(e)) if abs(e) > 0 else None} for e in ev]
+    payload = {"config": args.config, "V": V, "Fz": Fz, "params": params.to_dict(), "eigenvalues": rows,
+               "stable": bool(ev.real.max() < 0)}
+    lines = [f"{args.config} at V = {V:g} m/s, Fz = {Fz:g} N: x = 0 is "
+             f"{'stable' if payload['stable'] else 'unstable'}",
+             f"  {'real (1/s)':>14}{'imag (rad/s)':>16}{'f (Hz)':>10}{'zeta':>10}"]
+    for r in rows:
+        zeta = "-" if r["damping_ratio"] is None else f"{r['damping_ratio']:.4f}"
+        lines.append(f"  {r['real']:>14.6g}{r['imag']:>16.6g}{r['frequency_hz']:>10.4f}{zeta:>10}")
+    _emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
 def _cmd_simulate(args) -> int:
     from .simulation import simulate
 
@@ -124,6 +146,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--v-max", default=V_RANGE[1], help="highest speed (m/s)")
     _add_common(p)
     p.set_defaults(func=_cmd_hopf)
+
+    p = sub.add_parser("eigen", help="eigenvalues of straight rolling at one operating point")
+    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--V", required=True, help="forward speed (m/s)")
+    p.add_argument("--Fz", required=True, help="vertical load (N)")
+    _add_common(p)
+    p.set_defaults(func=_cmd_eigen)
 
     p = sub.add_parser("simulate", help="time history at one operating point")
     p.add_argument("--config", required=True, choices=configs)

@@ -161,6 +161,8 @@ def hopf_points(config: Configuration | str, Fz: float, params: Parameters | Non
         raise InvalidParameterError("v_max", v_max, f"a number in ({v_min:g}, {V_RANGE[1]:g}] m/s",
                                     "must exceed v_min")
     n_grid = int(check_number("n_grid", n_grid, 10, 100_000, integer=True))
+    v_tol = check_number("v_tol", v_tol, 1e-12, 1e-3, "m/s")
+    near_axis = check_number("near_axis", near_axis, 0.0, 100.0, "1/s")
     model = build_model(config, params)
     lin = Linearisation(model, Fz)
 
@@ -174,36 +176,36 @@ def hopf_points(config: Configuration | str, Fz: float, params: Parameters | Non
 
     for i in np.nonzero(count[:-1] != count[1:])[0]:
         lo, hi = int(min(count[i], count[i + 1])), int(max(count[i], count[i + 1]))
-        for k in range(lo, hi):
-            roots.append((brentq(ordered(k), grid[i], grid[i + 1], xtol=v_tol, rtol=1e-15), k,
-                          (grid[i], grid[i + 1])))
-    # Hidden double crossings between grid points.
-    n = re.shape[1]
-    for k in range(n):
-        col = re[:, k]
-        for i in range(1, n_grid - 1):
-            is_max = col[i] >= col[i - 1] and col[i] >= col[i + 1] and -near_axis < col[i] < 0
-            is_min = col[i] <= col[i - 1] and col[i] <= col[i + 1] and 0 < col[i] < near_axis
-            if not (is_max or is_min):
-                continue
-            sign = -1.0 if is_max else 1.0
-            g = ordered(k)
-            opt = minimize_scalar(lambda v: sign * g(v), bounds=(grid[i - 1], grid[i + 1]),
-                                  method="bounded", options={"xatol": v_tol})
-            if opt.fun < 0:  # the extremum reaches across the imaginary axis
-                for a, b in ((grid[i - 1], opt.x), (opt.x, grid[i + 1])):
-                    roots.append((brentq(g, a, b, xtol=v_tol, rtol=1e-15), k, (grid[i - 1], grid[i + 1])))
+        k = lo
+        while k < hi:
+            v = brentq(ordered(k), grid[i], grid[i + 1], xtol=v_tol, rtol=1e-15)
+            roots.append((v, k, (grid[i], grid[i + 1])))
+            k += 2 if _crossing_is_complex(lin, v) else 1  # a complex pair moves two order statistics
+    # Hidden double crossings between grid points: near-axis extrema of the ordered real parts.
+    mid, left, right = re[1:-1], re[:-2], re[2:]
+    is_max = (mid >= left) & (mid >= right) & (mid < 0) & (mid > -near_axis)
+    is_min = (mid <= left) & (mid <= right) & (mid > 0) & (mid < near_axis)
+    partner = np.zeros_like(mid, dtype=bool)
+    partner[:, 1:] = mid[:, 1:] == mid[:, :-1]  # second member of a complex pair: same curve
+    for i, k in np.argwhere((is_max | is_min) & ~partner):
+        i += 1
+        sign = -1.0 if is_max[i - 1, k] else 1.0
+        g = ordered(int(k))
+        opt = minimize_scalar(lambda v: sign * g(v), bounds=(grid[i - 1], grid[i + 1]),
+                              method="bounded", options={"xatol": v_tol})
+        if opt.fun < 0:  # the extremum reaches across the imaginary axis
+            for a, b in ((grid[i - 1], opt.x), (opt.x, grid[i + 1])):
+                roots.append((brentq(g, a, b, xtol=v_tol, rtol=1e-15), int(k), (grid[i - 1], grid[i + 1])))
 
     hopf, branch, warnings = [], [], []
     for v, k, bracket in sorted(roots):
         if any(abs(v - h.V) < 1e3 * v_tol for h in hopf) or any(abs(v - b) < 1e3 * v_tol for b in branch):
             continue  # the pair partner of a crossing already found
-        ev = lin.eigenvalues(np.array([v]))[0]
-        crit = ev[np.argmin(np.abs(ev.real))]
-        if abs(crit.imag) <= 1e-6 * np.abs(ev).max():
+        if not _crossing_is_complex(lin, v):
             branch.append(float(v))
             continue
-        omega = abs(crit.imag)
+        ev = lin.eigenvalues(np.array([v]))[0]
+        omega = abs(ev[np.argmin(np.abs(ev.real))].imag)
         dv = 1e-4 * max(v, 1.0)
         destabilising = ordered(k)(min(v + dv, bracket[1])) > ordered(k)(max(v - dv, bracket[0]))
         l1, criticality = _criticality(model, v, Fz, omega, warnings)
@@ -212,6 +214,12 @@ def hopf_points(config: Configuration | str, Fz: float, params: Parameters | Non
     intervals = _unstable_intervals(grid, count, [h.V for h in hopf] + branch, v_min, v_max, lin)
     return HopfResult(config, Fz, v_min, v_max, params, hopf, branch, intervals, n_grid,
                       time.perf_counter() - clock, warnings=warnings)
+
+
+def _crossing_is_complex(lin: Linearisation, V: float) -> bool:
+    ev = lin.eigenvalues(np.array([V]))[0]
+    crit = ev[np.argmin(np.abs(ev.real))]
+    return bool(abs(crit.imag) > 1e-6 * np.abs(ev).max())
 
 
 def _ordered_real_parts(lin: Linearisation, V: np.ndarray) -> np.ndarray:

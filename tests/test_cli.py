@@ -62,3 +62,14 @@ def test_bad_input_exits_2_naming_the_field(args, needle):
     assert out.returncode == 2
     assert needle in out.stderr
     assert out.stdout == ""
+
+
+def test_eigen_json_matches_the_library():
+    from shimmy.stability import eigenvalues
+
+    out = run("eigen", "--config", "pd", "--V", "30", "--Fz", "150000", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    ev = eigenvalues("pd", 30.0, 150e3)
+    assert [e["real"] for e in data["eigenvalues"]] == pytest.approx(ev.real.tolist())
+    assert data["stable"] is False  # point A lies between the Hopf points

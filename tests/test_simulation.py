@@ -152,3 +152,16 @@ def test_options_are_frozen_and_validated():
 def test_response_type_criteria(energies, expected):
     from shimmy.response import classify_run
     assert classify_run(*energies) is expected
+
+
+@pytest.mark.parametrize("config,V,Fz", [("original", 30.0, 150e3), ("nes_pd", 30.0, 150e3),
+                                         ("original", 110.0, 550e3)])
+def test_spectral_frequency_agrees_with_the_zero_crossing_period(config, V, Fz):
+    r = simulate(config, V, Fz)
+    window = r.t >= r.t[-1] - r.options.steady_window
+    t = r.t[window]
+    signal = r.state("psi")[window] if r.response_type is ResponseType.TORSION else r.state("delta")[window]
+    up = np.nonzero((signal[:-1] < 0) & (signal[1:] >= 0))[0]
+    crossings = t[up] - signal[up] * (t[up + 1] - t[up]) / (signal[up + 1] - signal[up])
+    period = (crossings[-1] - crossings[0]) / (crossings.size - 1)
+    assert r.frequency_hz == pytest.approx(1.0 / period, abs=0.01)

@@ -128,6 +128,7 @@ def test_lyapunov_coefficient_predicts_the_simulated_cycle_amplitude():
     (dict(v_min=50.0, v_max=20.0), r"v_max=20.0 must exceed v_min"),
     (dict(v_max=float("inf")), r"v_max=inf is not finite"),
     (dict(n_grid=3), r"n_grid=3 is out of range"),
+    (dict(v_tol=0.1), r"v_tol=0.1 is out of range"),
 ])
 def test_bad_hopf_requests_are_refused(kwargs, match):
     args = {"config": "original", "Fz": 150e3, **kwargs}
