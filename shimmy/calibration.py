@@ -62,7 +62,7 @@ class CalibrationResult:
 
     @property
     def hopf_relative_errors(self) -> dict[str, list[float]]:
-        return {c: [v / t - 1.0 for v, t in zip(self.hopf_computed[c], HOPF_TARGETS[c])]
+        return {c: [v / t - 1.0 for v, t in zip(self.hopf_computed[c], HOPF_TARGETS[c], strict=True)]
                 for c in HOPF_TARGETS}
 
     def rounded(self, digits: int = 5) -> dict[str, float]:

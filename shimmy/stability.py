@@ -208,10 +208,10 @@ def hopf_points(config: Configuration | str, Fz: float, params: Parameters | Non
         omega = abs(ev[np.argmin(np.abs(ev.real))].imag)
         dv = 1e-4 * max(v, 1.0)
         destabilising = ordered(k)(min(v + dv, bracket[1])) > ordered(k)(max(v - dv, bracket[0]))
-        l1, criticality = _criticality(model, v, Fz, omega, warnings)
+        l1, criticality = _criticality(model, v, Fz, warnings)
         hopf.append(HopfPoint(float(v), Fz, float(omega), criticality, l1, bool(destabilising), bracket))
 
-    intervals = _unstable_intervals(grid, count, [h.V for h in hopf] + branch, v_min, v_max, lin)
+    intervals = _unstable_intervals([h.V for h in hopf] + branch, v_min, v_max, lin)
     return HopfResult(config, Fz, v_min, v_max, params, hopf, branch, intervals, n_grid,
                       time.perf_counter() - clock, warnings=warnings)
 
@@ -226,14 +226,15 @@ def _ordered_real_parts(lin: Linearisation, V: np.ndarray) -> np.ndarray:
     return -np.sort(-lin.eigenvalues(V).real, axis=1)
 
 
-def _unstable_intervals(grid, count, crossings, v_min, v_max, lin) -> list[tuple[float, float]]:
+def _unstable_intervals(crossings, v_min, v_max, lin) -> list[tuple[float, float]]:
+    """Maximal V intervals between crossings where x = 0 has an eigenvalue with Re > 0."""
     edges = sorted([v_min, *crossings, v_max])
     out: list[tuple[float, float]] = []
-    for a, b in zip(edges[:-1], edges[1:]):
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
         if b - a <= 0:
             continue
         mid = math.sqrt(a * b)
-        if (_ordered_real_parts(lin, np.array([mid]))[0, 0] > 0):
+        if _ordered_real_parts(lin, np.array([mid]))[0, 0] > 0:
             if out and abs(out[-1][1] - a) < 1e-12:
                 out[-1] = (out[-1][0], b)
             else:
@@ -241,7 +242,7 @@ def _unstable_intervals(grid, count, crossings, v_min, v_max, lin) -> list[tuple
     return out
 
 
-def _criticality(model: Model, V: float, Fz: float, omega: float, warnings: list[str]):
+def _criticality(model: Model, V: float, Fz: float, warnings: list[str]):
     if not model.config.is_smooth:
         return None, Criticality.NONSMOOTH
     l1 = first_lyapunov_coefficient(model, V, Fz)

@@ -48,13 +48,15 @@ def test_simulate_json_and_csv(tmp_path):
 
 
 @pytest.mark.parametrize("args,needle", [
-    (["hopf", "--config", "nes", "--Fz", "1e9"], "Fz=1000000000.0 is out of range; allowed: a number in [10000, 900000] N"),
+    (["hopf", "--config", "nes", "--Fz", "1e9"],
+     "Fz=1000000000.0 is out of range; allowed: a number in [10000, 900000] N"),
     (["hopf", "--config", "nes", "--Fz", "150000", "--set", "r2=0.2"], "r2=0.2 is out of range"),
     (["hopf", "--config", "nes", "--Fz", "150000", "--set", "zeta=1"], "unknown parameter 'zeta'"),
     (["hopf", "--config", "nes", "--Fz", "150000", "--set", "r2"], "--set='r2' is not of the form NAME=VALUE"),
     (["simulate", "--config", "pd", "--V", "fast", "--Fz", "150000"], "V='fast' is not a number"),
     (["simulate", "--config", "pd", "--V", "30", "--Fz", "nan"], "Fz=nan is not finite"),
-    (["simulate", "--config", "pd", "--V", "30", "--Fz", "150000", "--t-end", "1e9"], "t_end=1000000000.0 is out of range"),
+    (["simulate", "--config", "pd", "--V", "30", "--Fz", "150000", "--t-end", "1e9"],
+     "t_end=1000000000.0 is out of range"),
     (["simulate", "--config", "gear", "--V", "30", "--Fz", "150000"], "argument --config: invalid choice"),
 ])
 def test_bad_input_exits_2_naming_the_field(args, needle):
