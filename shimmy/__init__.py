@@ -10,9 +10,11 @@ from .configurations import ALL_CONFIGURATIONS, Configuration  # noqa: E402
 from .errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError  # noqa: E402
 from .parameters import MATERIALS, PARAMETER_SPECS, Parameters  # noqa: E402
 from .simulation import SimulationOptions, SimulationResult, simulate  # noqa: E402
+from .stability import HopfPoint, HopfResult, eigenvalues, hopf_points  # noqa: E402
 
 __all__ = [
     "ALL_CONFIGURATIONS", "Configuration", "ConvergenceError", "GeometryError",
     "InvalidParameterError", "MATERIALS", "PARAMETER_SPECS", "Parameters", "ShimmyError",
-    "SimulationOptions", "SimulationResult", "simulate", "__version__",
+    "SimulationOptions", "SimulationResult", "simulate", "HopfPoint", "HopfResult", "eigenvalues",
+    "hopf_points", "__version__",
 ]

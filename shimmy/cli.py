@@ -1,4 +1,4 @@
-"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,calibrate} ...``.
+"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,devices,calibrate} ...``.
 
 Results go to stdout (JSON with ``--json``, a short table otherwise). Bad input exits
 with status 2 and a message on stderr naming the field, its value and what is allowed.
@@ -11,6 +11,8 @@ import json
 import math
 import sys
 from typing import Any, Sequence
+
+import numpy as np
 
 from .configurations import Configuration
 from .errors import GeometryError, InvalidParameterError, ShimmyError
@@ -114,6 +116,24 @@ def _cmd_simulate(args) -> int:
     return 0 if result.success else EXIT_FAILED
 
 
+def _cmd_devices(args) -> int:
+    from .device_curves import nes_curve, pd_curves
+
+    params = _params(args)
+    nes_c = nes_curve(params)
+    pds = pd_curves(params, v_max=args.v_max)
+    payload = {"params": params.to_dict(), "nes": nes_c.to_dict(), "pd": [c.to_dict() for c in pds]}
+    err = nes_c.cubic_error_at
+    lines = [f"NES: k1 = {nes_c.k1:.6g} N m/rad, k3 = {nes_c.k3:.6g} N m/rad^3; cubic vs exact torque: "
+             + ", ".join(f"{100 * e:.2f} % for |a| <= {a} rad" for a, e in err.items()),
+             "PD torsional damping c_eq (N m s/rad) at tangential speed v (m/s):",
+             "  " + f"{'v':>8}" + "".join(f"{c.material:>12}" for c in pds)]
+    for i in np.linspace(0, pds[0].speed.size - 1, 6).astype(int):
+        lines.append("  " + f"{pds[0].speed[i]:>8.3g}" + "".join(f"{c.torsional_damping[i]:>12.5g}" for c in pds))
+    _emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
 def _cmd_calibrate(args) -> int:
     from .calibration import calibrate, format_report
 
@@ -163,6 +183,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
     _add_common(p)
     p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser("devices", help="NES torque/stiffness and PD damping curves")
+    p.add_argument("--v-max", default=2.0, help="largest PD tangential speed (m/s)")
+    _add_common(p)
+    p.set_defaults(func=_cmd_devices)
 
     p = sub.add_parser("calibrate", help="refit the unpublished constants and print residuals")
     _add_common(p)
