@@ -167,21 +167,21 @@ def build_parser() -> argparse.ArgumentParser:
     _add_common(p)
     p.set_defaults(func=_cmd_hopf)
 
+    def operating_point(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--config", required=True, choices=configs)
+        p.add_argument("--V", required=True, help="forward speed (m/s)")
+        p.add_argument("--Fz", required=True, help="vertical load (N)")
+        _add_common(p)
+
     p = sub.add_parser("eigen", help="eigenvalues of straight rolling at one operating point")
-    p.add_argument("--config", required=True, choices=configs)
-    p.add_argument("--V", required=True, help="forward speed (m/s)")
-    p.add_argument("--Fz", required=True, help="vertical load (N)")
-    _add_common(p)
+    operating_point(p)
     p.set_defaults(func=_cmd_eigen)
 
     p = sub.add_parser("simulate", help="time history at one operating point")
-    p.add_argument("--config", required=True, choices=configs)
-    p.add_argument("--V", required=True, help="forward speed (m/s)")
-    p.add_argument("--Fz", required=True, help="vertical load (N)")
+    operating_point(p)
     p.add_argument("--t-end", default=60.0, help="simulated time (s)")
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
-    _add_common(p)
     p.set_defaults(func=_cmd_simulate)
 
     p = sub.add_parser("devices", help="NES torque/stiffness and PD damping curves")
