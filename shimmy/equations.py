@@ -94,6 +94,19 @@ def model_coefficients(config: Configuration, params: Parameters) -> np.ndarray:
 
 
 @register_jitable
+def tyre_forces(lam, Fz, c):
+    """Lateral tyre force F_lam (N) and self-aligning moment M_ka (N m) for deformation lam."""
+    # tan(alpha) = lam / L, so atan(7 tan alpha) = atan(7 lam / L).
+    w = np.arctan(7.0 * lam / c[L])
+    force = c[K_LAM] * Fz * w * np.cos(0.95 * w)
+    alpha = np.arctan(lam / c[L])
+    alpha_m = c[ALPHA_M]
+    aligning = (c[K_A] * alpha_m / np.pi * np.sin(np.pi * alpha / alpha_m) * Fz
+                * (np.abs(alpha) <= alpha_m))
+    return force, aligning
+
+
+@register_jitable
 def vector_field(psi, dpsi, delta, ddelta, lam, psis, dpsis, V, Fz, c, has_nes, has_pd, exact_nes):
     """Time derivatives of the seven states (the NES pair is zero without an NES)."""
     cos_phi = c[COS_PHI]
@@ -101,13 +114,7 @@ def vector_field(psi, dpsi, delta, ddelta, lam, psis, dpsis, V, Fz, c, has_nes, 
     theta = psi * cos_phi
     sin_theta = np.sin(theta)
     cos_theta = np.cos(theta)
-    # Tyre: tan(alpha) = lam / L, so atan(7 tan alpha) = atan(7 lam / L).
-    w = np.arctan(7.0 * lam / c[L])
-    force = c[K_LAM] * Fz * w * np.cos(0.95 * w)
-    alpha = np.arctan(lam / c[L])
-    alpha_m = c[ALPHA_M]
-    aligning = (c[K_A] * alpha_m / np.pi * np.sin(np.pi * alpha / alpha_m) * Fz
-                * (np.abs(alpha) <= alpha_m))
+    force, aligning = tyre_forces(lam, Fz, c)
     torque = (c[C_PSI] * dpsi + c[K_PSI] * psi + aligning + e_eff * force
               + c[C_LAM] * dpsi * cos_phi / V - Fz * c[SIN_PHI] * e_eff * sin_theta)
     absorber = 0.0 * psi
@@ -120,9 +127,8 @@ def vector_field(psi, dpsi, delta, ddelta, lam, psis, dpsis, V, Fz, c, has_nes, 
         absorber = c[C_NES] * (dpsi - dpsis) + restoring
         torque = torque + absorber
     if has_pd:
-        v = c[PD_R] * np.abs(dpsi)
-        root = np.sqrt(v)
-        c_star = c[PD_S12] * root + c[PD_S1] * v + c[PD_S32] * v * root + c[PD_S2] * v * v + c[PD_S3] * v * v * v
+        c_star = particle_damper.series_value(c[PD_R] * np.abs(dpsi), c[PD_S12], c[PD_S1], c[PD_S32],
+                                              c[PD_S2], c[PD_S3])
         torque = torque + c[PD_N_R2] * c_star * dpsi
     psi_dd = -torque / c[I_PSI]
     delta_dd = -(c[C_DELTA] * ddelta + c[K_DELTA] * delta + c[L_G] * force * cos_theta * cos_phi
@@ -154,14 +160,13 @@ def rhs(model: Model, x, V, Fz):
 def _tyre_derivatives(lam, Fz, c):
     """F_lam, dF_lam/dlam, M_ka and dM_ka/dlam (arrays, complex-safe)."""
     L_ = c[L]
-    w = np.arctan(7.0 * lam / L_)
-    force = c[K_LAM] * Fz * w * np.cos(0.95 * w)
+    force, aligning = tyre_forces(lam, Fz, c)
     u = 7.0 * lam / L_
+    w = np.arctan(u)
     dforce = c[K_LAM] * Fz * (7.0 / L_) * (np.cos(0.95 * w) - 0.95 * w * np.sin(0.95 * w)) / (1.0 + u * u)
     alpha = np.arctan(lam / L_)
     alpha_m = c[ALPHA_M]
     inside = np.abs(np.real(alpha)) <= alpha_m
-    aligning = c[K_A] * alpha_m / np.pi * np.sin(np.pi * alpha / alpha_m) * Fz * inside
     dalpha = (1.0 / L_) / (1.0 + (lam / L_) ** 2)
     daligning = c[K_A] * np.cos(np.pi * alpha / alpha_m) * Fz * inside * dalpha
     return force, dforce, aligning, daligning

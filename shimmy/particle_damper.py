@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba.extending import register_jitable
 
 from .parameters import PDParameters
 
@@ -77,9 +78,14 @@ def damping_per_speed(v, pd: PDParameters):
     v = np.asarray(v, dtype=float)
     if np.any(v < 0) or not np.all(np.isfinite(v)):
         raise ValueError("tangential speed v must be finite and >= 0 m/s")
-    s12, s1, s32, s2, s3 = damping_coefficients(pd).series
+    return series_value(v, *damping_coefficients(pd).series)
+
+
+@register_jitable
+def series_value(v, s12, s1, s32, s2, s3):
+    """c*(v) from its series coefficients; plain arithmetic so numba can inline it."""
     root = np.sqrt(v)
-    return s12 * root + s1 * v + s32 * v * root + s2 * v * v + s3 * v ** 3
+    return s12 * root + s1 * v + s32 * v * root + s2 * v * v + s3 * v * v * v
 
 
 def torsional_damping(dpsi, pd: PDParameters):
