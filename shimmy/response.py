@@ -9,6 +9,8 @@ Criteria (documented here because every caller shares them):
 * Modal energies: E_t = k_psi psi_amp^2 / 2 (torsion), E_l = k_delta delta_amp^2 / 2
   (lateral bending); torsional and lateral amplitudes are in different units, the
   elastic energies put them on one scale.
+* Mode of a limit cycle (:func:`mode_of`): torsional share s >= 0.8 torsional,
+  s <= 0.2 lateral, both in between (the same thresholds as the response type).
 * Response type of one run:
     - ``Stable`` if the motion decays: sqrt(E_t + E_l) over the steady window is below
       1e-3 of its initial value, or it is smaller than its initial value and still
@@ -76,6 +78,31 @@ def dominant_frequency(signals: list[np.ndarray], dt: float) -> float:
     return float((k + offset) / (n_fft * dt))
 
 
+class Mode(str, Enum):
+    """Which motion dominates a limit cycle (same thresholds as the response type)."""
+
+    TORSIONAL = "torsional"
+    LATERAL = "lateral"
+    BOTH = "both"
+
+
+def torsional_share(psi_amp, delta_amp, k_psi: float, k_delta: float):
+    """E_t / (E_t + E_l) with E_t = k_psi psi_amp^2 / 2, E_l = k_delta delta_amp^2 / 2 (array-safe)."""
+    e_t = 0.5 * k_psi * np.square(psi_amp)
+    e_l = 0.5 * k_delta * np.square(delta_amp)
+    total = e_t + e_l
+    return np.divide(e_t, total, out=np.full_like(np.asarray(total, float), np.nan), where=total > 0)
+
+
+def mode_of(share: float) -> Mode:
+    """Torsional if the torsional energy share is >= 0.8, lateral if <= 0.2, both in between."""
+    if share >= TORSION_SHARE:
+        return Mode.TORSIONAL
+    if share <= LATERAL_SHARE:
+        return Mode.LATERAL
+    return Mode.BOTH
+
+
 def classify_run(energy_initial: float, torsional_energy: float, lateral_energy: float,
                  previous_energy: float) -> ResponseType:
     """Response type of one run from modal energies (see the module docstring)."""
@@ -84,9 +111,5 @@ def classify_run(energy_initial: float, torsional_energy: float, lateral_energy:
         return ResponseType.STABLE
     if total < energy_initial and np.sqrt(total) < DECAY_RATIO * np.sqrt(previous_energy):
         return ResponseType.STABLE
-    share = torsional_energy / total
-    if share >= TORSION_SHARE:
-        return ResponseType.TORSION
-    if share <= LATERAL_SHARE:
-        return ResponseType.LATERAL
-    return ResponseType.BOTH
+    mode = mode_of(torsional_energy / total)
+    return {Mode.TORSIONAL: ResponseType.TORSION, Mode.LATERAL: ResponseType.LATERAL}.get(mode, ResponseType.BOTH)

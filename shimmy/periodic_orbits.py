@@ -1,0 +1,335 @@
+"""Branches of periodic orbits: start at a Hopf point or from a sampled orbit, continue in p,
+compute Floquet multipliers, detect and locate folds (LPC), tori (NS), period doubling (PD)
+and branch points of cycles (BPC).
+
+Generic (any :class:`~shimmy.continuation.VectorField`). Detection, between two
+consecutive branch points:
+
+* LPC: the parameter component of the tangent changes sign; located by the secant
+  method on it (so a fold is found even where the stability does not change);
+* the number of nontrivial multipliers outside the unit circle changes: the multiplier
+  that crossed is the one of the more unstable point closest to the circle: a complex
+  pair -> NS, real negative -> PD, real positive without a fold -> BPC. Located by the
+  secant method on |mu| - 1 of the multipliers of that kind.
+
+Stop rules, each reported in ``stop_reason``: a parameter bound (the end point is
+located on the bound, kind EP); the step budget; the step size underflowing (Newton
+failure); the period above ``period_max`` (approach to a homoclinic orbit or a
+period blow-up); the caller's ``limits`` check (e.g. amplitude outside the model's
+validity); the amplitude shrinking back to zero (the branch ends at a Hopf point of
+the equilibrium). The mesh is re-adapted every ``adapt_every`` steps
+(:meth:`PeriodicProblem.adapted_mesh`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from .collocation import Mesh, PeriodicProblem
+from .continuation import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step,
+                           tangent, weighted_norm)
+from .errors import ConvergenceError, InvalidParameterError
+
+COMPLEX_TOL = 1e-7  # |Im mu| below this (relative) counts as a real multiplier
+
+
+@dataclass(frozen=True)
+class PeriodicOptions:
+    ntst: int = 40
+    ncol: int = 4
+    adapt_every: int = 5
+    period_max: float = math.inf
+    amplitude_min: float = 0.05  # end at x*: amplitude below this fraction of the first orbit's (Hopf starts)
+    continuation: ContinuationOptions = field(default_factory=ContinuationOptions)
+
+    def __post_init__(self):
+        if not (isinstance(self.ntst, int) and 4 <= self.ntst <= 2000):
+            raise InvalidParameterError("ntst", self.ntst, "an integer in [4, 2000]")
+        if not (isinstance(self.ncol, int) and 2 <= self.ncol <= 7):
+            raise InvalidParameterError("ncol", self.ncol, "an integer in [2, 7]")
+
+
+@dataclass
+class PeriodicBranch:
+    """Points of a branch of periodic orbits (one row per point) and its special points."""
+
+    p: np.ndarray
+    period: np.ndarray
+    x_max: np.ndarray  # (points, n) max over the orbit of every state
+    x_min: np.ndarray
+    stable: np.ndarray
+    multipliers: np.ndarray  # (points, n) trivial first, then by decreasing modulus
+    special_points: list[SpecialPoint]
+    stop_reason: str
+    steps: int
+    ntst: int
+    ncol: int
+    solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, u) per point
+    trivial_error: float  # max |mu_trivial - 1| over the branch: accuracy check
+
+    def orbit(self, i: int, system: VectorField, per_interval: int = 12) -> tuple[np.ndarray, np.ndarray]:
+        """t (s) and x (k, n) of point i over one period."""
+        mesh_points, u = self.solutions[i]
+        problem = PeriodicProblem(system, Mesh(mesh_points, self.ncol), np.ones(system.n), 1.0, 1.0)
+        tau, x = problem.sample(u, per_interval)
+        return tau * self.period[i], x
+
+
+@dataclass(frozen=True)
+class OrbitGuess:
+    """An approximate periodic orbit: node values x(tau) on a mesh, period and parameter."""
+
+    mesh: Mesh
+    X: np.ndarray  # (n_nodes, n)
+    T: float
+    p: float
+
+
+def hopf_guess(x_star: np.ndarray, p_star: float, omega: float, q: np.ndarray, mesh: Mesh,
+               amplitude: float) -> tuple[OrbitGuess, np.ndarray]:
+    """Small orbit x* + amplitude Re(q e^(2 pi i tau)) at a Hopf point, and the direction Re(q e^...)."""
+    tau = mesh.node_times
+    q = q / np.abs(q).max()
+    phi = np.real(q[None, :] * np.exp(2j * np.pi * tau)[:, None])
+    X = np.asarray(x_star, float)[None, :] + amplitude * phi
+    return OrbitGuess(mesh, X, 2.0 * np.pi / omega, float(p_star)), phi
+
+
+def orbit_from_samples(t: np.ndarray, x: np.ndarray, period: float, p: float, mesh: Mesh) -> OrbitGuess:
+    """A guess from one period of a sampled trajectory (t from t[0] to t[0] + period, x (k, n))."""
+    tau = (np.asarray(t) - t[0]) / period
+    X = np.column_stack([np.interp(mesh.node_times, tau, x[:, i]) for i in range(x.shape[1])])
+    X[-1] = X[0]
+    return OrbitGuess(mesh, X, float(period), float(p))
+
+
+def _orbit_measures(problem: PeriodicProblem, u: np.ndarray):
+    _, x = problem.sample(u)
+    return x.max(axis=0), x.min(axis=0)
+
+
+def _amplitude(problem: PeriodicProblem, x_max, x_min) -> float:
+    return float(np.max(0.5 * (x_max - x_min) / problem.scale))
+
+
+def _count_unstable(mu: np.ndarray) -> int:
+    return int((np.abs(mu[1:]) > 1.0).sum())
+
+
+def _kind_of_crossing(mu_a: np.ndarray, mu_b: np.ndarray) -> str:
+    mu = mu_a if _count_unstable(mu_a) > _count_unstable(mu_b) else mu_b
+    rest = mu[1:]
+    outside = rest[np.abs(rest) > 1.0]
+    crit = outside[np.argmin(np.abs(outside))]
+    if abs(crit.imag) > COMPLEX_TOL * abs(crit):
+        return "NS"
+    return "PD" if crit.real < 0 else "BPC"
+
+
+def _crossing_test(kind: str) -> Callable[[np.ndarray], float]:
+    def g(mu: np.ndarray) -> float:
+        rest = mu[1:]
+        if kind == "NS":
+            sel = rest[np.abs(rest.imag) > COMPLEX_TOL * np.abs(rest)]
+        elif kind == "PD":
+            sel = rest[(np.abs(rest.imag) <= COMPLEX_TOL * np.abs(rest)) & (rest.real < 0)]
+        else:
+            sel = rest[(np.abs(rest.imag) <= COMPLEX_TOL * np.abs(rest)) & (rest.real > 0)]
+        if sel.size == 0:
+            return math.nan
+        return float(np.abs(sel[np.argmin(np.abs(np.abs(sel) - 1.0))]) - 1.0)
+    return g
+
+
+def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max: float,
+                    scale: np.ndarray, p_scale: float, options: PeriodicOptions | None = None,
+                    direction: np.ndarray | None = None, p_direction: int = 1,
+                    limits: Callable[[np.ndarray, np.ndarray, float, float], str | None] | None = None,
+                    progress: Callable[[float], None] | None = None) -> PeriodicBranch:
+    """Continue the periodic orbit near ``guess`` in p over [p_min, p_max].
+
+    ``direction`` (n_nodes, n): for a Hopf start, the emerging orbit shape (the first
+    step moves along it with p and T free, so the orbit grows away from the
+    equilibrium); otherwise the first correction holds p fixed and the branch follows
+    ``p_direction`` (+1 increasing p). ``limits(x_max, x_min, T, p)`` returns a message
+    to stop the branch. ``progress`` receives the covered fraction of [p_min, p_max].
+    """
+    options = options or PeriodicOptions()
+    copts = options.continuation
+    mesh = guess.mesh if guess.mesh.ncol == options.ncol and guess.mesh.ntst == options.ntst \
+        else Mesh.uniform(options.ntst, options.ncol)
+    problem = PeriodicProblem(system, mesh, scale, guess.T, p_scale)
+    if mesh is not guess.mesh:
+        src = PeriodicProblem(system, guess.mesh, scale, guess.T, p_scale)
+        X0 = src.evaluate(guess.X, mesh.node_times)
+        D0 = None if direction is None else src.evaluate(direction, mesh.node_times)
+    else:
+        X0, D0 = guess.X, direction
+    u_base = problem.pack(X0, guess.T, guess.p)
+    problem.accept(u_base)
+    w = problem.weights
+    if D0 is not None:  # Hopf start: step of length ds along the orbit shape
+        t0 = problem.pack(D0, 0.0, 0.0)
+        t0 /= weighted_norm(t0, w)
+        problem.accept(u_base + copts.ds * t0)  # phase reference: the predicted small orbit
+        first = step(problem, CurvePoint(u_base, t0), copts.ds, copts)
+        hopf_start = True
+    else:
+        t0 = np.zeros_like(u_base)
+        t0[-1] = 1.0
+        t0 /= weighted_norm(t0, w)
+        first = step(problem, CurvePoint(u_base, t0), 0.0, copts)
+        if first is not None:  # orient along p_direction
+            t = first.tangent if first.tangent[-1] * p_direction >= 0 else -first.tangent
+            first = CurvePoint(first.u, t, first.iterations)
+        hopf_start = False
+    if first is None:
+        raise ConvergenceError("no periodic orbit converged near the starting guess "
+                               f"(p = {guess.p:g}, T = {guess.T:g})")
+    problem.accept(first.u)
+    tracer = Tracer(problem, first, copts)
+
+    mu0 = problem.multipliers(first.u)
+    xmax0, xmin0 = _orbit_measures(problem, first.u)
+    rows: dict[str, list] = {"p": [first.u[-1]], "T": [first.u[-2]], "xmax": [xmax0], "xmin": [xmin0],
+                             "mu": [mu0]}
+    solutions = [(mesh.points.copy(), first.u.copy())]
+    special: list[SpecialPoint] = []
+    amp_first = _amplitude(problem, xmax0, xmin0)
+    amp_peak = amp_last = amp_first
+    stop = f"step budget of {copts.max_steps} steps used"
+    steps = 0
+    span = p_max - p_min
+    for steps in range(1, copts.max_steps + 1):
+        prev = tracer.point
+        adv = tracer.advance()
+        if adv is None:
+            stop = tracer.failed or "Newton failed"
+            break
+        new, h = adv
+        p_new, T_new = new.u[-1], new.u[-2]
+        if progress is not None:
+            progress(min(1.0, abs(p_new - guess.p) / span))
+        if not p_min <= p_new <= p_max:
+            bound = p_max if p_new > p_max else p_min
+            hit = locate(problem, prev, h, lambda q: q.u[-1] - bound, prev.u[-1] - bound, p_new - bound, copts)
+            if hit is not None:
+                end = hit[0]
+                _record(problem, rows, solutions, end)
+                special.extend(_detect(problem, rows, prev, end, copts))
+                special.append(_special(problem, "EP", end, rows))
+            stop = f"reached the parameter bound p = {bound:g}"
+            break
+        if T_new > options.period_max:
+            stop = f"period {T_new:.4g} above the limit {options.period_max:.4g} (homoclinic approach?)"
+            break
+        if T_new <= 0:
+            stop = "period became non-positive: the continuation left the branch"
+            break
+        _record(problem, rows, solutions, new)
+        found = _detect(problem, rows, prev, new, copts)
+        ends = [s for s in found if s.kind == "LPC" and hopf_start
+                and _amplitude(problem, np.array(s.data["x_max"]), np.array(s.data["x_min"])) < amp_first]
+        if ends:  # a 'fold' at zero amplitude: the branch passed through the equilibrium
+            for key in rows:
+                rows[key].pop()
+            solutions.pop()
+            p_end = float(rows["p"][-1])
+            special.append(SpecialPoint("H", p_end, len(rows["p"]) - 1, {"amplitude": amp_last}))
+            stop = f"amplitude returned to zero near p = {p_end:.6g}: the branch ends at a Hopf point"
+            break
+        special.extend(found)
+        amp = _amplitude(problem, rows["xmax"][-1], rows["xmin"][-1])
+        amp_peak = max(amp_peak, amp)
+        amp_stop = options.amplitude_min * amp_first if hopf_start else 1e-3 * amp_peak
+        if limits is not None:
+            message = limits(rows["xmax"][-1], rows["xmin"][-1], T_new, p_new)
+            if message:
+                stop = message
+                break
+        if amp < amp_last and amp_peak > 2.0 * amp_first:  # shrinking: approach x* with care
+            if amp < amp_stop:
+                special.append(SpecialPoint("H", float(p_new), len(rows["p"]) - 1, {"amplitude": amp}))
+                stop = f"amplitude returned to zero near p = {p_new:.6g}: the branch ends at a Hopf point"
+                break
+            tracer.limit_step(0.7 * amp * h / (amp_last - amp))  # do not jump through zero amplitude
+        amp_last = amp
+        if options.adapt_every and steps % options.adapt_every == 0:
+            new_mesh = problem.adapted_mesh(new.u)
+            new_problem = PeriodicProblem(system, new_mesh, scale, problem.T_scale, p_scale)
+            u_t = problem.transfer(new_problem, new.u)
+            t_t = problem.transfer(new_problem, new.tangent)
+            t_t /= weighted_norm(t_t, new_problem.weights)
+            new_problem.accept(u_t)
+            # Re-converge on the new mesh before going on (holding the parameter fixed).
+            fixed = step(new_problem, CurvePoint(u_t, _p_direction(new_problem, u_t)), 0.0, copts)
+            if fixed is not None:
+                problem = new_problem
+                t_new = tangent(problem, fixed.u, t_t)
+                problem.accept(fixed.u)
+                tracer.problem = problem
+                tracer.point = CurvePoint(fixed.u, t_new)
+    mu = np.array(rows["mu"])
+    trivial = float(np.max(np.abs(mu[:, 0] - 1.0)))
+    return PeriodicBranch(np.array(rows["p"]), np.array(rows["T"]), np.array(rows["xmax"]),
+                          np.array(rows["xmin"]), np.abs(mu[:, 1:]).max(axis=1, initial=0.0) < 1.0, mu, special,
+                          stop, steps, problem.mesh.ntst, problem.mesh.ncol, solutions, trivial)
+
+
+def _p_direction(problem: PeriodicProblem, u: np.ndarray) -> np.ndarray:
+    t = np.zeros_like(u)
+    t[-1] = 1.0
+    return t / weighted_norm(t, problem.weights)
+
+
+def _record(problem: PeriodicProblem, rows, solutions, point: CurvePoint) -> None:
+    xmax, xmin = _orbit_measures(problem, point.u)
+    rows["p"].append(point.u[-1])
+    rows["T"].append(point.u[-2])
+    rows["xmax"].append(xmax)
+    rows["xmin"].append(xmin)
+    rows["mu"].append(problem.multipliers(point.u))
+    solutions.append((problem.mesh.points.copy(), point.u.copy()))
+
+
+def _special(problem: PeriodicProblem, kind: str, point: CurvePoint, rows, mu=None) -> SpecialPoint:
+    xmax, xmin = _orbit_measures(problem, point.u)
+    mu = problem.multipliers(point.u) if mu is None else mu
+    data: dict[str, Any] = {"period": float(point.u[-2]), "x_max": xmax.tolist(), "x_min": xmin.tolist(),
+                            "multipliers_abs": np.abs(mu[1:]).tolist()}
+    if kind == "NS":
+        rest = mu[1:]
+        cand = rest[np.abs(rest.imag) > COMPLEX_TOL * np.abs(rest)]
+        if cand.size:
+            crit = cand[np.argmin(np.abs(np.abs(cand) - 1.0))]
+            data["torus_angle"] = float(abs(np.angle(crit)))  # rad per period: the second frequency
+    return SpecialPoint(kind, float(point.u[-1]), len(rows["p"]) - 1, data)
+
+
+def _detect(problem: PeriodicProblem, rows, prev: CurvePoint, new: CurvePoint,
+            copts: ContinuationOptions) -> list[SpecialPoint]:
+    """Special points between the last two recorded points (prev -> new)."""
+    mu_a, mu_b = rows["mu"][-2], rows["mu"][-1]
+    h = weighted_norm(new.u - prev.u, problem.weights)
+    found: list[tuple[float, SpecialPoint]] = []
+    fold = prev.tangent[-1] * new.tangent[-1] < 0
+    if fold:
+        hit = locate(problem, prev, h, lambda q: q.tangent[-1], prev.tangent[-1], new.tangent[-1], copts)
+        at = hit[0] if hit is not None else new
+        found.append((weighted_norm(at.u - prev.u, problem.weights), _special(problem, "LPC", at, rows)))
+    if _count_unstable(mu_a) != _count_unstable(mu_b):
+        kind = _kind_of_crossing(mu_a, mu_b)
+        if not (kind == "BPC" and fold):
+            g_mu = _crossing_test(kind)
+            ga, gb = g_mu(mu_a), g_mu(mu_b)
+            at = new
+            if np.isfinite(ga) and np.isfinite(gb) and ga * gb < 0:
+                hit = locate(problem, prev, h, lambda q: g_mu(problem.multipliers(q.u)), ga, gb, copts)
+                if hit is not None:
+                    at = hit[0]
+            found.append((weighted_norm(at.u - prev.u, problem.weights), _special(problem, kind, at, rows)))
+    return [s for _, s in sorted(found, key=lambda item: item[0])]
