@@ -1,4 +1,4 @@
-"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,devices,calibrate} ...``.
+"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,bifurcation,hopf-curves,devices,calibrate} ...``.
 
 Results go to stdout (JSON with ``--json``, a short table otherwise). Bad input exits
 with status 2 and a message on stderr naming the field, its value and what is allowed.
@@ -16,7 +16,7 @@ import numpy as np
 
 from .configurations import Configuration
 from .errors import GeometryError, InvalidParameterError, ShimmyError
-from .parameters import MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters
+from .parameters import FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 1
@@ -134,6 +134,87 @@ def _cmd_devices(args) -> int:
     return 0
 
 
+class _ProgressBar:
+    """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
+
+    def __init__(self, stream=None, width: int = 30):
+        self.stream = stream or sys.stderr
+        self.width = width
+        self.enabled = self.stream.isatty()
+
+    def __call__(self, fraction: float, message: str) -> None:
+        if not self.enabled:
+            return
+        filled = int(round(self.width * min(max(fraction, 0.0), 1.0)))
+        self.stream.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f} % {message[:50]:<50}")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.enabled:
+            self.stream.write("\r" + " " * (self.width + 60) + "\r")
+            self.stream.flush()
+
+
+def _cmd_bifurcation(args) -> int:
+    from .bifurcation import BifurcationOptions, bifurcation
+
+    from .parameters import check_number
+
+    ntst = int(check_number("ntst", args.ntst, 4, 2000, integer=True))
+    options = BifurcationOptions(ntst=ntst, exact_nes=args.exact_nes, seeds=not args.no_seeds)
+    bar = _ProgressBar()
+    try:
+        result = bifurcation(args.config, args.Fz, args.v_min, args.v_max, _params(args), options, progress=bar)
+    finally:
+        bar.close()
+    if args.csv:
+        result.write_csv(args.csv)
+    lines = [f"{result.config.value} at Fz = {result.Fz:g} N, V in [{result.v_min:g}, {result.v_max:g}] m/s "
+             f"({result.elapsed_s:.2f} s)"]
+    for h in result.hopf.hopf_points:
+        lines.append(f"  H    V = {h.V:10.5f} m/s  {h.frequency_hz:.4f} Hz  {h.criticality.value}")
+    for i, b in enumerate(result.branches[1:], start=1):
+        stable = int(b.stable.sum())
+        lines.append(f"  branch {i}: {b.kind} from {b.origin}; {b.V.size} points ({stable} stable), "
+                     f"V {b.V.min():.4g}..{b.V.max():.4g} m/s, max |psi| {b.max_psi.max():.5g} rad; "
+                     f"modes {', '.join(sorted({m for m in b.mode if m}))}")
+        for s in b.special_points:
+            if s["kind"] != "EP":
+                lines.append(f"      {s['kind']:<4} V = {s['V']:.6g} m/s")
+        lines.append(f"      ends: {b.stop_reason}")
+    where = "" if result.max_psi_V is None else f" at V = {result.max_psi_V:.5g} m/s"
+    lines.append(f"  max torsional amplitude of stable cycles: {result.max_psi:.6g} rad{where}")
+    if result.mesh_check:
+        lines.append(f"  mesh check: ntst {result.mesh_check['ntst']} -> {result.mesh_check['ntst_fine']} changes "
+                     f"max |psi| by {result.mesh_check['change']:.2g} rad")
+    lines += [f"  warning: {w}" for w in result.warnings]
+    _emit(result.to_dict(), args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_hopf_curves(args) -> int:
+    from .hopf_curves import hopf_curves
+
+    bar = _ProgressBar()
+    try:
+        result = hopf_curves(args.config, _params(args), (args.v_min, args.v_max), (args.fz_min, args.fz_max),
+                             progress=bar)
+    finally:
+        bar.close()
+    lines = [f"{result.config.value}: {len(result.curves)} Hopf curve(s) in V {result.v_range[0]:g}..{result.v_range[1]:g}"
+             f" m/s, Fz {result.fz_range[0]:g}..{result.fz_range[1]:g} N ({result.elapsed_s:.2f} s)"]
+    for i, c in enumerate(result.curves, start=1):
+        lines.append(f"  curve {i}: {len(c.p)} points, V {c.p[:, 0].min():.4g}..{c.p[:, 0].max():.4g} m/s, "
+                     f"Fz {c.p[:, 1].min():.5g}..{c.p[:, 1].max():.5g} N, {'closed' if c.closed else 'open'}")
+        for g in c.gh_points:
+            lines.append(f"      GH  V = {g['p'][0]:.6g} m/s, Fz = {g['p'][1]:.6g} N")
+    if result.fz_minimum:
+        lines.append(f"  lowest load on a Hopf curve: Fz = {result.fz_minimum['Fz']:.6g} N "
+                     f"at V = {result.fz_minimum['V']:.6g} m/s")
+    _emit(result.to_dict(), args.json, "\n".join(lines))
+    return 0
+
+
 def _cmd_calibrate(args) -> int:
     from .calibration import calibrate, format_report
 
@@ -183,6 +264,27 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
     p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser("bifurcation", help="bifurcation diagram in V: equilibrium and periodic branches")
+    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--Fz", required=True, help="vertical load (N)")
+    p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
+    p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
+    p.add_argument("--ntst", default=40, help="collocation mesh intervals")
+    p.add_argument("--no-seeds", action="store_true", help="do not look for branches by simulation")
+    p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
+    p.add_argument("--csv", metavar="FILE", help="write the branch points to FILE")
+    _add_common(p)
+    p.set_defaults(func=_cmd_bifurcation)
+
+    p = sub.add_parser("hopf-curves", help="Hopf curves of straight rolling in (V, Fz) with GH points")
+    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
+    p.add_argument("--v-max", default=V_RANGE[1], help="highest speed (m/s)")
+    p.add_argument("--fz-min", default=FZ_RANGE[0], help="lowest load (N)")
+    p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
+    _add_common(p)
+    p.set_defaults(func=_cmd_hopf_curves)
 
     p = sub.add_parser("devices", help="NES torque/stiffness and PD damping curves")
     p.add_argument("--v-max", default=2.0, help="largest PD tangential speed (m/s)")
