@@ -201,8 +201,9 @@ def _cmd_hopf_curves(args) -> int:
                              progress=bar)
     finally:
         bar.close()
-    lines = [f"{result.config.value}: {len(result.curves)} Hopf curve(s) in V {result.v_range[0]:g}..{result.v_range[1]:g}"
-             f" m/s, Fz {result.fz_range[0]:g}..{result.fz_range[1]:g} N ({result.elapsed_s:.2f} s)"]
+    lines = [f"{result.config.value}: {len(result.curves)} Hopf curve(s) in "
+             f"V {result.v_range[0]:g}..{result.v_range[1]:g} m/s, "
+             f"Fz {result.fz_range[0]:g}..{result.fz_range[1]:g} N ({result.elapsed_s:.2f} s)"]
     for i, c in enumerate(result.curves, start=1):
         lines.append(f"  curve {i}: {len(c.p)} points, V {c.p[:, 0].min():.4g}..{c.p[:, 0].max():.4g} m/s, "
                      f"Fz {c.p[:, 1].min():.5g}..{c.p[:, 1].max():.5g} N, {'closed' if c.closed else 'open'}")

@@ -70,7 +70,8 @@ class HopfCurvesResult:
                 "closed": c.closed, "stop_reasons": c.stop_reasons, "steps": c.steps})
         return {"config": self.config.value, "params": self.params.to_dict(),
                 "v_range": list(self.v_range), "fz_range": list(self.fz_range), "curves": curves,
-                "gh_points": self.gh_points, "fz_minimum": self.fz_minimum, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
+                "gh_points": self.gh_points,
+                "fz_minimum": self.fz_minimum, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
                 "version": __version__}
 
 
