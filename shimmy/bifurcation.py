@@ -47,7 +47,7 @@ from . import __version__
 from .collocation import Mesh, PeriodicProblem
 from .configurations import Configuration
 from .continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, SpecialPoint, VectorField,
-                           equilibrium_branch, step, tangent, weighted_norm)
+                           equilibrium_branch, locate, step, tangent, weighted_norm)
 from .equations import Model, build_model, jacobian, parameter_jacobian, rhs
 from .errors import ConvergenceError, InvalidParameterError
 from .nes import VALID_ANGLE
@@ -232,7 +232,9 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
                 else:
                     warnings.append(f"branch from V = {v_h:.6g} m/s returns to x = 0 near V = {s.p:.6g} m/s, "
                                     "where no Hopf point was located")
-        branches.append(_periodic_output(raw, params, f"Hopf point at V = {v_h:.6g} m/s", starts))
+        branch = _periodic_output(raw, params, f"Hopf point at V = {v_h:.6g} m/s", starts)
+        omega = {h.V: h.omega for h in hopf.hopf_points}
+        branches.append(_with_hopf_ends(branch, v_h, omega))
 
     if options.seeds:
         for v_seed in _seed_speeds(hopf):
@@ -333,6 +335,25 @@ def _periodic_output(raw: PeriodicBranch, params: Parameters, origin: str, hopf_
         special.append(d)
     return Branch("periodic", raw.p, raw.period, psi_amp, l_g * delta_amp, raw.stable, modes, special, origin,
                   raw.stop_reason, raw.steps, raw)
+
+
+def _with_hopf_ends(branch: Branch, v_start: float, omega: dict[float, float]) -> Branch:
+    """The branch with its zero-amplitude end points at the Hopf points it joins (for plots and
+    tables: the cycles shrink to x = 0 there; with the particle damper the amplitude grows like
+    (V - V_H)^2, so the first computed orbit can lie well away from V_H)."""
+    def point(V):
+        return V, 2.0 * math.pi / omega[V]
+
+    head = [point(v_start)]
+    tail = [point(s["V"]) for s in branch.special_points if s["kind"] == "H" and s["V"] in omega]
+    V = np.concatenate([[v for v, _ in head], branch.V, [v for v, _ in tail]])
+    T = np.concatenate([[t for _, t in head], branch.period, [t for _, t in tail]])
+    zeros_h, zeros_t = np.zeros(len(head)), np.zeros(len(tail))
+    stable = np.concatenate([branch.stable[:1], branch.stable, branch.stable[-1:][:len(tail)]])
+    mode = branch.mode[:1] + branch.mode + branch.mode[-1:][:len(tail)]
+    return Branch(branch.kind, V, T, np.concatenate([zeros_h, branch.max_psi, zeros_t]),
+                  np.concatenate([zeros_h, branch.max_lateral, zeros_t]), stable, mode, branch.special_points,
+                  branch.origin, branch.stop_reason, branch.steps, branch.raw)
 
 
 def _on_branch(branches: list[Branch], V: float, period: float, psi_amp: float, lat_amp: float) -> bool:
@@ -440,25 +461,61 @@ def _restore(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray
     return problem, CurvePoint(u, tangent(problem, u, direction))
 
 
+def cycle_at(result: BifurcationResult, branch: int, V: float) -> dict[str, Any]:
+    """The periodic orbit of ``result.branches[branch]`` at speed V, located exactly on the branch
+    (secant on the step from the neighbouring branch point): period, amplitudes, stability and the
+    orbit itself (t, psi, l_g delta). Raises ValueError if the branch does not reach V."""
+    b = result.branches[branch]
+    if b.kind != "periodic" or b.raw is None:
+        raise ValueError(f"branch {branch} is not a periodic branch")
+    raw = b.raw
+    model = build_model(result.config, result.params, exact_nes=result.options.exact_nes)
+    system = gear_field(model, result.Fz)
+    scale = STATE_SCALE[:model.n_states]
+    for i in range(raw.p.size - 1):
+        if (raw.p[i] - V) * (raw.p[i + 1] - V) > 0:
+            continue
+        problem, start = _restore(system, raw, i, scale)
+        if raw.p[i] == V:
+            point = start
+        else:
+            far = PeriodicProblem(system, Mesh(raw.solutions[i + 1][0], raw.ncol), scale, T_SCALE, V_SCALE)
+            h = weighted_norm(far.transfer(problem, raw.solutions[i + 1][1]) - start.u, problem.weights)
+            hit = locate(problem, start, h, lambda q: q.u[-1] - V, raw.p[i] - V, raw.p[i + 1] - V,
+                         ContinuationOptions(locate_tol=1e-10))
+            if hit is None:
+                raise ConvergenceError(f"could not locate the orbit at V = {V:g} m/s on branch {branch}")
+            point = hit[0]
+        tau, x = problem.sample(point.u)
+        mu = problem.multipliers(point.u)
+        T = float(point.u[-2])
+        l_g = result.params.gear.l_g
+        return {"V": float(point.u[-1]), "period": T, "max_psi": float(np.abs(x[:, 0]).max()),
+                "max_lateral": float(l_g * np.abs(x[:, 2]).max()), "stable": bool(np.all(np.abs(mu[1:]) < 1.0)),
+                "multipliers": mu, "t": tau * T, "psi": x[:, 0], "lateral": l_g * x[:, 2]}
+    raise ValueError(f"branch {branch} does not reach V = {V:g} m/s")
+
+
 def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale, warnings):
     """Largest torsional amplitude of stable cycles, refined along the branch, and a mesh check."""
-    best = (0.0, None, None, None)  # amplitude, V, branch, index
+    best = (0.0, None, None, None)  # amplitude, V, branch, index into its raw points
     max_any = 0.0
     for b in branches:
-        if b.kind != "periodic" or b.V.size == 0:
+        raw = b.raw
+        if b.kind != "periodic" or raw is None or raw.p.size == 0:
             continue
-        max_any = max(max_any, float(b.max_psi.max()))
-        stable_amp = np.where(b.stable, b.max_psi, -np.inf)
+        psi_amp = np.maximum(np.abs(raw.x_max[:, 0]), np.abs(raw.x_min[:, 0]))
+        max_any = max(max_any, float(psi_amp.max()))
+        stable_amp = np.where(raw.stable, psi_amp, -np.inf)
         i = int(np.argmax(stable_amp))
         if np.isfinite(stable_amp[i]) and stable_amp[i] > best[0]:
-            best = (float(stable_amp[i]), float(b.V[i]), b, i)
-    amp, V, b, i = best
-    if b is None:
+            best = (float(stable_amp[i]), float(raw.p[i]), raw, i)
+    amp, V, raw, i = best
+    if raw is None:
         return 0.0, None, max_any, None
-    raw = b.raw
     copts = ContinuationOptions(ds=options.ds, ds_max=options.ds_max)
     lo = max(i - 1, 0)
-    if b.V.size >= 3 and 0 < i < b.V.size - 1 and b.stable[lo] and b.stable[i + 1]:
+    if 0 < i < raw.p.size - 1 and raw.stable[lo] and raw.stable[i + 1]:
         problem, start = _restore(system, raw, lo, scale)
         far = PeriodicProblem(system, Mesh(raw.solutions[i + 1][0], raw.ncol), scale, T_SCALE, V_SCALE)
         span = weighted_norm(far.transfer(problem, raw.solutions[i + 1][1]) - start.u, problem.weights)

@@ -8,7 +8,8 @@ import shimmy
 PACKAGE = pathlib.Path(shimmy.__file__).parent
 MODEL = {"errors", "parameters", "configurations", "nes", "particle_damper", "equations", "integrator",
          "reference_model", "lyapunov", "response"}
-ANALYSES = {"simulation", "stability", "calibration", "device_curves"}
+ANALYSES = {"simulation", "stability", "calibration", "device_curves", "continuation", "collocation",
+            "periodic_orbits", "bifurcation", "hopf_continuation", "hopf_curves"}
 FORBIDDEN = {"dash", "plotly", "flask", "gunicorn", "diskcache"}
 
 

@@ -1,0 +1,155 @@
+"""Landing-gear bifurcation diagrams: against simulation, the eigenvalue scan and mesh refinement."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from shimmy.bifurcation import BifurcationOptions, bifurcation, cycle_at
+from shimmy.errors import InvalidParameterError
+from shimmy.simulation import simulate
+from shimmy.stability import hopf_points
+
+FZ = 150e3
+
+
+@pytest.fixture(scope="module")
+def diagrams():
+    return {c: bifurcation(c, FZ, 1.0, 200.0) for c in ("original", "nes", "pd", "nes_pd")}
+
+
+@pytest.fixture(scope="module")
+def high_load():
+    return bifurcation("original", 850e3, 1.0, 200.0)
+
+
+# Ten speeds on the stable part of each branch (away from the Hopf points, where the
+# transients of a simulation become slow).
+CROSS_CHECK = {"original": [10, 15, 20, 30, 40, 50, 60, 70, 80, 88],
+               "nes": [10, 15, 20, 25, 30, 40, 50, 55, 60, 66],
+               "pd": [10, 30, 60],
+               "nes_pd": [10, 30, 60]}
+
+
+@pytest.mark.parametrize("config", list(CROSS_CHECK))
+def test_limit_cycles_agree_with_long_time_histories(diagrams, config):
+    result = diagrams[config]
+    for V in CROSS_CHECK[config]:
+        cycle = cycle_at(result, 1, V)
+        assert cycle["stable"] and abs(cycle["V"] - V) < 1e-8
+        run = simulate(config, V, FZ, t_end=100.0)
+        assert run.success and run.steady
+        assert cycle["max_psi"] == pytest.approx(run.amplitude["psi"], rel=0.01)
+        assert cycle["max_lateral"] == pytest.approx(run.amplitude["lateral"], rel=0.01)
+        assert cycle["period"] == pytest.approx(1.0 / run.frequency_hz, rel=0.01)
+        # Observed agreement is ~1e-5; keep a margin well inside the 1 % requirement.
+        assert abs(cycle["max_psi"] / run.amplitude["psi"] - 1) < 1e-3
+
+
+@pytest.mark.parametrize("config", ["original", "nes", "pd", "nes_pd"])
+def test_diagram_structure_at_150_kN(diagrams, config):
+    result = diagrams[config]
+    scan = hopf_points(config, FZ, v_min=1.0, v_max=200.0)
+    eq = result.branches[0]
+    assert eq.kind == "equilibrium" and not result.warnings
+    assert [s["V"] for s in eq.special_points if s["kind"] == "H"] == [h.V for h in scan.hopf_points]
+    # x = 0 is unstable exactly between the two Hopf points.
+    low, high = (h.V for h in scan.hopf_points)
+    inside = (eq.V > low + 1e-6) & (eq.V < high - 1e-6)
+    outside = (eq.V < low - 1e-6) | (eq.V > high + 1e-6)
+    assert not eq.stable[inside].any() and eq.stable[outside].all()
+    # One periodic branch joins the two Hopf points; stable, torsional.
+    periodic = [b for b in result.branches if b.kind == "periodic"]
+    assert len(periodic) == 1
+    b = periodic[0]
+    ends = [s for s in b.special_points if s["kind"] == "H"]
+    assert len(ends) == 1 and ends[0]["V"] == pytest.approx(high, abs=1e-9)
+    assert b.V.min() == pytest.approx(low, abs=1e-3) and b.V.max() == pytest.approx(high, abs=2.0)
+    assert b.stable.all() and set(b.mode) == {"torsional"}
+    # Accuracy check of the multipliers: the trivial one is 1 to 1e-6 for smooth fields; the PD's
+    # |dpsi|^(1/2) dpsi (C^1 only) limits collocation accuracy near dpsi = 0 (observed ~1e-5).
+    assert b.raw.trivial_error < (1e-6 if result.config.is_smooth else 1e-4)
+    # The refined maximum is at least every branch point and sits on a stable orbit.
+    assert result.max_psi >= b.max_psi.max() - 1e-12
+    assert low < result.max_psi_V < high
+
+
+@pytest.mark.parametrize("config", ["original", "nes", "pd", "nes_pd"])
+def test_max_amplitude_converged_under_mesh_refinement(diagrams, config):
+    check = diagrams[config].mesh_check
+    assert check["ntst_fine"] == 2 * check["ntst"]
+    assert check["change"] < 1e-4
+
+
+def test_max_amplitude_independent_of_mesh_size():
+    coarse = bifurcation("pd", FZ, 1.0, 200.0, options=BifurcationOptions(ntst=30, seeds=False))
+    fine = bifurcation("pd", FZ, 1.0, 200.0, options=BifurcationOptions(ntst=80, seeds=False))
+    assert coarse.max_psi == pytest.approx(fine.max_psi, abs=1e-4)
+    assert coarse.max_psi_V == pytest.approx(fine.max_psi_V, abs=0.5)
+
+
+def test_devices_lower_the_torsional_amplitude(diagrams):
+    amp = {c: r.max_psi for c, r in diagrams.items()}
+    assert amp["nes"] < amp["original"] and amp["pd"] < amp["original"] and amp["nes_pd"] < amp["nes"]
+
+
+def test_high_load_lateral_branch_found_by_simulation_seed(high_load):
+    result = high_load
+    assert not result.hopf.hopf_points  # x = 0 unstable over the whole range, no Hopf point in it
+    assert not result.branches[0].stable.any()
+    periodic = [b for b in result.branches if b.kind == "periodic"]
+    assert len(periodic) == 1
+    b = periodic[0]
+    assert b.origin.startswith("simulation")
+    assert b.V.min() == pytest.approx(1.0) and b.V.max() == pytest.approx(200.0)
+    assert set(b.mode) == {"lateral"} and b.stable.all()
+    run = simulate("original", 100.0, 850e3, t_end=60.0)
+    cycle = cycle_at(result, 1, 100.0)
+    assert cycle["max_lateral"] == pytest.approx(run.amplitude["lateral"], rel=0.01)
+    assert cycle["period"] == pytest.approx(1.0 / run.frequency_hz, rel=0.01)
+
+
+def test_to_dict_has_the_documented_schema(diagrams):
+    d = diagrams["nes"].to_dict()
+    json.dumps(d, allow_nan=False)
+    assert {"config", "Fz", "params", "hopf_points", "branches", "max_psi"} <= set(d)
+    kinds = [b["kind"] for b in d["branches"]]
+    assert kinds[0] == "equilibrium" and "periodic" in kinds
+    point = d["branches"][1]["points"][3]
+    assert set(point) == {"V", "period", "max_psi", "max_lateral", "stable", "mode"}
+    assert all(s["kind"] in {"H", "LPC", "NS", "PD", "BPC", "EP", "BP"} for b in d["branches"]
+               for s in b["special_points"])
+
+
+def test_bad_input_names_the_field():
+    with pytest.raises(InvalidParameterError, match="v_max"):
+        bifurcation("original", FZ, 50.0, 20.0)
+    with pytest.raises(InvalidParameterError, match="Fz"):
+        bifurcation("original", 5.0, 1.0, 20.0)
+    with pytest.raises(InvalidParameterError, match="ntst"):
+        BifurcationOptions(ntst=1)
+
+
+def test_cli_bifurcation_json_and_csv(tmp_path):
+    csv_path = tmp_path / "branches.csv"
+    out = subprocess.run([sys.executable, "-m", "shimmy", "bifurcation", "--config", "original", "--Fz", "150000",
+                          "--v-min", "1", "--v-max", "200", "--json", "--csv", str(csv_path)],
+                         capture_output=True, text=True, check=True)
+    d = json.loads(out.stdout)
+    assert d["config"] == "original" and d["max_psi"] == pytest.approx(0.2148, abs=1e-3)
+    assert out.stderr == ""  # no progress bar when stderr is not a terminal
+    rows = csv_path.read_text().splitlines()
+    assert rows[0].startswith("branch,kind,V_m_s") and len(rows) > 20
+    bad = subprocess.run([sys.executable, "-m", "shimmy", "bifurcation", "--config", "original", "--Fz", "1e9"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "Fz" in bad.stderr
+
+
+def test_cycle_at_rejects_speeds_off_the_branch(diagrams):
+    with pytest.raises(ValueError, match="does not reach"):
+        cycle_at(diagrams["original"], 1, 150.0)
+    with pytest.raises(ValueError, match="not a periodic branch"):
+        cycle_at(diagrams["original"], 0, 50.0)
+    assert np.isfinite(cycle_at(diagrams["original"], 1, 50.0)["period"])

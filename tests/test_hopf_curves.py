@@ -1,0 +1,81 @@
+"""Hopf curves in (V, Fz) against the one-parameter eigenvalue scan and the Lyapunov coefficient."""
+
+import numpy as np
+import pytest
+
+from shimmy.hopf_curves import hopf_curves
+from shimmy.stability import Criticality, Linearisation, hopf_points
+from shimmy.equations import build_model
+
+
+@pytest.fixture(scope="module")
+def original():
+    return hopf_curves("original")
+
+
+def test_every_curve_point_is_a_hopf_point(original):
+    model = build_model("original")
+    for curve in original.curves:
+        for (V, Fz), omega in zip(curve.p[::7], curve.omega[::7], strict=True):
+            ev = Linearisation(model, Fz).eigenvalues(np.array([V]))[0]
+            crit = ev[np.argmin(np.abs(ev.real))]
+            assert abs(crit.real) < 1e-7 * abs(crit)
+            assert abs(abs(crit.imag) - omega) < 1e-7 * omega
+
+
+def test_curves_cover_every_hopf_point_of_the_slices(original):
+    # At 300 kN a lateral (15.9 Hz) and a torsional (11.2 Hz) Hopf point lie 0.008 m/s apart:
+    # position and frequency together identify the curve.
+    for Fz in (100e3, 250e3, 300e3, 450e3, 800e3):
+        for h in hopf_points("original", Fz).hopf_points:
+            near = []
+            for c in original.curves:
+                i = int(np.argmin(np.hypot((c.p[:, 0] - h.V) / 10, (c.p[:, 1] - Fz) / 1e4)))
+                if _distance(c, h.V, Fz) < 0.05 and abs(c.omega[i] / h.omega - 1) < 0.02:
+                    near.append(c)
+            assert len(near) == 1, (Fz, h.V)
+
+
+def _distance(curve, V, Fz):
+    """Distance from (V, Fz) to the curve's polyline in units of (10 m/s, 10 kN)."""
+    p = curve.p / np.array([10.0, 1e4])
+    q = np.array([V / 10.0, Fz / 1e4])
+    a, d = p[:-1], np.diff(p, axis=0)
+    s = np.clip(np.sum((q - a) * d, axis=1) / np.maximum(np.sum(d * d, axis=1), 1e-300), 0, 1)
+    return float(np.min(np.linalg.norm(a + s[:, None] * d - q, axis=1)))
+
+
+def test_generalised_hopf_points_change_the_criticality(original):
+    gh = original.gh_points
+    assert len(gh) == 2
+    for g in gh:
+        crit = []
+        for dF in (-10e3, 10e3):
+            h = min(hopf_points("original", g["Fz"] + dF).hopf_points, key=lambda h: abs(h.V - g["V"]))
+            crit.append(h.criticality)
+        assert set(crit) == {Criticality.SUPERCRITICAL, Criticality.SUBCRITICAL}
+    # The one noted from the scan in the physics core: near Fz = 399 kN, V = 162 m/s.
+    assert any(abs(g["Fz"] - 398.9e3) < 1e3 and abs(g["V"] - 162.2) < 1.0 for g in gh)
+
+
+def test_lowest_load_is_a_turning_point(original):
+    low = original.fz_minimum
+    assert 5e4 < low["Fz"] < 7e4
+    assert not [h for h in hopf_points("original", low["Fz"] - 500.0).hopf_points if h.V < 200]
+    near = [h.V for h in hopf_points("original", low["Fz"] + 500.0).hopf_points]
+    assert sum(abs(v - low["V"]) < 5.0 for v in near) == 2
+
+
+def test_particle_damper_curves_have_no_criticality():
+    result = hopf_curves("pd", n_slices=6)
+    assert result.gh_points == [] and all(np.isnan(c.lyapunov).all() for c in result.curves)
+    assert result.curves and result.elapsed_s < 30
+
+
+def test_to_dict_and_bad_input():
+    from shimmy.errors import InvalidParameterError
+
+    with pytest.raises(InvalidParameterError, match="fz_max"):
+        hopf_curves("nes", fz_range=(5e5, 1e5))
+    d = hopf_curves("nes", v_range=(1, 200), fz_range=(1e5, 2e5), n_slices=3).to_dict()
+    assert d["curves"] and {"V", "Fz", "frequency_hz", "lyapunov"} == set(d["curves"][0]["points"][0])
