@@ -64,6 +64,7 @@ T_SCALE = 0.01  # s
 MAX_PSI = 1.0  # rad: beyond this a branch is stopped (far outside any physical shimmy)
 PERIOD_MAX = 2.0  # s: a period blow-up (homoclinic approach) stops a branch
 SEED_T_END = 30.0  # s of simulation per seed
+SEED_RETRIES = 2  # further runs of 2 * SEED_T_END from the last state while the motion has not settled
 
 
 @dataclass(frozen=True)
@@ -381,10 +382,16 @@ def periodic_orbit_from_simulation(config: Configuration, Fz: float, V: float, p
     from .simulation import simulate  # analyses may use analyses; kept local to keep start-up light
 
     run = simulate(config, V, Fz, params, t_end=t_end, exact_nes=exact_nes)
+    for _ in range(SEED_RETRIES):  # slow growth or decay: go on from where the run ended
+        if not run.success or run.steady:
+            break
+        run = simulate(config, V, Fz, params, t_end=2 * t_end, x0=run.states[:, -1], exact_nes=exact_nes)
     if not run.success:
         return None, f"simulation failed: {run.message}"
     if run.response_type.value == "Stable":
         return None, "the simulation decays to x = 0"
+    if not run.steady:
+        return None, f"the simulated motion did not settle within {t_end * (1 + 2 * SEED_RETRIES):g} s"
     k_psi, k_delta = params.gear.k_psi, params.gear.k_delta
     states = run.states
     window = states[:, states.shape[1] // 2:]

@@ -28,6 +28,7 @@ sign) or a branch point BP (real eigenvalue, no fold). Each is located to
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable, Protocol
 
@@ -105,7 +106,12 @@ class _Bordered:
             lu = splu(transpose, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
             self.solve = lambda rhs: lu.solve(rhs, trans="T")
         else:
-            factors = la.lu_factor(np.vstack([jac, row[None, :]]), check_finite=False)
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", la.LinAlgWarning)  # exactly singular: raise, do not warn
+                try:
+                    factors = la.lu_factor(np.vstack([jac, row[None, :]]), check_finite=False)
+                except la.LinAlgWarning as exc:
+                    raise np.linalg.LinAlgError(str(exc)) from None
             self.solve = lambda rhs: la.lu_solve(factors, rhs, check_finite=False)
 
 
@@ -228,6 +234,9 @@ def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[
         if not (min(a, b) < h < max(a, b)):
             h = 0.5 * (a + b)
         trial = step(problem, start, h, options)
+        if trial is None:  # e.g. landed exactly on a singular point (a branch point): nudge off it
+            trial = step(problem, start, h * (1.0 + 1e-7), options) or step(problem, start, h * (1.0 - 1e-7),
+                                                                             options)
         if trial is None:
             return best
         gh = g(trial)
@@ -371,9 +380,9 @@ def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: Cu
     found: list[tuple[float, SpecialPoint]] = []
     if prev.tangent[-1] * new.tangent[-1] < 0:
         hit = locate(problem, prev, h, lambda q: q.tangent[-1], prev.tangent[-1], new.tangent[-1], options)
-        if hit is not None:
-            found.append((weighted_norm(hit[0].u - prev.u, problem.weights),
-                          SpecialPoint("LP", float(hit[0].u[-1]), -1, {"x": hit[0].u[:-1].tolist()})))
+        at = hit[0] if hit is not None else (prev if abs(prev.tangent[-1]) < abs(new.tangent[-1]) else new)
+        found.append((weighted_norm(at.u - prev.u, problem.weights),
+                      SpecialPoint("LP", float(at.u[-1]), -1, {"x": at.u[:-1].tolist(), "located": hit is not None})))
     if count_old != count_new:
         k = min(count_old, count_new)  # the k-th largest real part changes sign
 
@@ -381,18 +390,18 @@ def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: Cu
             return _sorted_eigenvalues(system.dfdx(q.u[:-1], q.u[-1]))[k].real
 
         hit = locate(problem, prev, h, g, ev_old[k].real, ev_new[k].real, options)
-        if hit is not None:
-            q = hit[0]
-            ev = _sorted_eigenvalues(system.dfdx(q.u[:-1], q.u[-1]))
-            crit = ev[np.argmin(np.abs(ev.real))]
-            scale = max(np.abs(ev).max(), 1e-300)
-            if abs(crit.imag) > 1e-6 * scale:
-                found.append((weighted_norm(q.u - prev.u, problem.weights),
-                              SpecialPoint("H", float(q.u[-1]), -1,
-                                           {"omega": float(abs(crit.imag)), "x": q.u[:-1].tolist()})))
-            elif not any(s.kind == "LP" for _, s in found):
-                found.append((weighted_norm(q.u - prev.u, problem.weights),
-                              SpecialPoint("BP", float(q.u[-1]), -1, {"x": q.u[:-1].tolist()})))
+        q = hit[0] if hit is not None else (prev if abs(ev_old[k].real) < abs(ev_new[k].real) else new)
+        ev = _sorted_eigenvalues(system.dfdx(q.u[:-1], q.u[-1]))
+        crit = ev[np.argmin(np.abs(ev.real))]
+        scale = max(np.abs(ev).max(), 1e-300)
+        if abs(crit.imag) > 1e-6 * scale:
+            found.append((weighted_norm(q.u - prev.u, problem.weights),
+                          SpecialPoint("H", float(q.u[-1]), -1,
+                                       {"omega": float(abs(crit.imag)), "x": q.u[:-1].tolist(),
+                                        "located": hit is not None})))
+        elif not any(s.kind == "LP" for _, s in found):
+            found.append((weighted_norm(q.u - prev.u, problem.weights),
+                          SpecialPoint("BP", float(q.u[-1]), -1, {"x": q.u[:-1].tolist(), "located": hit is not None})))
     points.append(new)
     eigs.append(ev_new)
     for _, sp_ in sorted(found, key=lambda item: item[0]):

@@ -190,6 +190,13 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
     if first is None:
         raise ConvergenceError("no periodic orbit converged near the starting guess "
                                f"(p = {guess.p:g}, T = {guess.T:g})")
+    if not hopf_start:
+        x_first = problem.unpack(first.u)[0]
+        spread_first = np.ptp(x_first, axis=0) / problem.scale
+        spread_guess = np.ptp(X0, axis=0) / problem.scale
+        if spread_first.max() < 1e-3 * spread_guess.max():
+            raise ConvergenceError(f"the orbit guess at p = {guess.p:g} collapsed onto an equilibrium "
+                                   "(amplitude -> 0): no periodic orbit there")
     problem.accept(first.u)
     tracer = Tracer(problem, first, copts)
 

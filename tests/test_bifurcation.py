@@ -153,3 +153,49 @@ def test_cycle_at_rejects_speeds_off_the_branch(diagrams):
     with pytest.raises(ValueError, match="not a periodic branch"):
         cycle_at(diagrams["original"], 0, 50.0)
     assert np.isfinite(cycle_at(diagrams["original"], 1, 50.0)["period"])
+
+
+def test_fold_of_cycles_bounds_a_bistable_speed_range():
+    """At 450 kN the upper torsional Hopf point is subcritical: the torsional cycle branch folds
+    (LPC) above it. Between the two, the large torsional cycle is stable while the lateral mode of
+    x = 0 is unstable at every speed (its cycle, seeded by simulation, is stable too): two stable
+    limit cycles, which time simulations from two initial conditions confirm."""
+    result = bifurcation("original", 450e3, 1.0, 200.0)
+    upper = result.hopf.hopf_points[-1]
+    assert upper.criticality.value == "subcritical"
+    assert not result.branches[0].stable.any()
+    b = result.branches[1]
+    folds = [s for s in b.special_points if s["kind"] == "LPC"]
+    assert len(folds) == 1
+    v_fold = folds[0]["V"]
+    assert upper.V < v_fold < 200.0
+    # Stable before the fold, unstable after it on the way back to the subcritical Hopf point.
+    raw = b.raw
+    k = int(np.argmax(raw.p))
+    assert raw.p[k] == pytest.approx(v_fold, abs=0.5)
+    assert raw.stable[k - 3] and not raw.stable[k + 3]
+    V = 0.5 * (upper.V + v_fold)
+    torsional = cycle_at(result, 1, V)
+    lateral = cycle_at(result, 2, V)
+    assert torsional["stable"] and lateral["stable"]
+    assert {b.mode[0] for b in result.branches[1:]} >= {"torsional"}
+    from_rest = simulate("original", V, 450e3, t_end=60.0)
+    assert from_rest.response_type.value == "Lateral"
+    assert from_rest.amplitude["lateral"] == pytest.approx(lateral["max_lateral"], rel=0.01)
+    from_cycle = simulate("original", V, 450e3, t_end=60.0, x0=cycle_at_state(result, V))
+    assert from_cycle.response_type.value == "Torsion"
+    assert from_cycle.amplitude["psi"] == pytest.approx(torsional["max_psi"], rel=0.01)
+
+
+def cycle_at_state(result, V):
+    """A full state on the stable cycle at V (first orbit point of the located solution)."""
+    from shimmy.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
+    from shimmy.collocation import Mesh, PeriodicProblem
+    from shimmy.equations import build_model
+
+    raw = result.branches[1].raw
+    i = int(np.argmin(np.abs(raw.p[: int(np.argmax(raw.p))] - V)))
+    system = gear_field(build_model("original"), result.Fz)
+    mesh_points, u = raw.solutions[i]
+    problem = PeriodicProblem(system, Mesh(mesh_points, raw.ncol), STATE_SCALE[:5], T_SCALE, V_SCALE)
+    return problem.unpack(u)[0][0]

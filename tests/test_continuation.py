@@ -1,0 +1,479 @@
+"""The generic continuation engine on textbook systems with known answers.
+
+Equilibria (:func:`shimmy.continuation.equilibrium_branch`): folds, Hopf and branch points
+at their analytic places. Periodic orbits (:mod:`shimmy.periodic_orbits`): Hopf normal
+forms (amplitude, period and Floquet multiplier in closed form), a subcritical branch with
+a fold of cycles, Van der Pol against its published period and amplitude and against the
+collocation order, and two constructed 4-D systems whose Neimark-Sacker and
+period-doubling points are known exactly. Then the stop rules and option validation.
+
+The systems and their known answers are in ``textbook_systems.py``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import minimize_scalar
+
+from shimmy.collocation import Mesh, PeriodicProblem
+from shimmy.continuation import ContinuationOptions, equilibrium_branch
+from shimmy.errors import ConvergenceError, InvalidParameterError
+from shimmy.periodic_orbits import OrbitGuess, PeriodicOptions, hopf_guess, orbit_from_samples, periodic_branch
+from textbook_systems import (ALL_SYSTEMS, VDP_AMPLITUDE_MU1, VDP_PERIOD_MU1, fold_1d, fold_2d, hopf_shear,
+                              hopf_subcritical_quintic, hopf_supercritical, hopf_twice, neimark_sacker, period_doubling,
+                              pitchfork, transcritical, van_der_pol)
+
+TWO_PI = 2.0 * math.pi
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def kinds(branch) -> list[str]:
+    return [s.kind for s in branch.special_points]
+
+
+def only(branch, kind: str):
+    found = [s for s in branch.special_points if s.kind == kind]
+    assert len(found) == 1, f"expected one {kind}, got {kinds(branch)}"
+    return found[0]
+
+
+def hopf_branch(system, omega: float, p0: float, p_min: float, p_max: float, options: PeriodicOptions | None = None,
+                **kwargs):
+    """Periodic branch of a planar normal form born at its Hopf point (x* = 0, p0)."""
+    options = options or PeriodicOptions(ntst=20, ncol=4)
+    q = np.array([1.0, -1j])  # J q = i omega q for J = [[g, -omega], [omega, g]] at g = 0
+    np.testing.assert_allclose(system.dfdx(np.zeros(2), p0) @ q, 1j * omega * q, atol=1e-12)
+    guess, shape = hopf_guess(np.zeros(2), p0, omega, q, Mesh.uniform(options.ntst, options.ncol), 0.0)
+    return periodic_branch(system, guess, p_min, p_max, np.ones(2), 1.0, options, direction=shape, **kwargs)
+
+
+def node_radius(branch, i: int) -> np.ndarray:
+    """|(x, y)| at every collocation node of point i (first two states)."""
+    _, u = branch.solutions[i]
+    X = u[:-2].reshape(-1, branch.x_max.shape[1])  # u = [node values, T, p]
+    return np.hypot(X[:, 0], X[:, 1])
+
+
+def unit_cycle_guess(ntst: int, n: int, p: float, radius: float = 1.0, sign: float = 1.0) -> OrbitGuess:
+    """(radius cos t, sign radius sin t, 0, ...) over one period 2 pi, as node values."""
+    mesh = Mesh.uniform(ntst, 4)
+    theta = TWO_PI * mesh.node_times
+    X = np.zeros((mesh.n_nodes, n))
+    X[:, 0], X[:, 1] = radius * np.cos(theta), sign * radius * np.sin(theta)
+    return OrbitGuess(mesh, X, TWO_PI, p)
+
+
+def refined_max(system, branch, i: int, component: int = 0) -> float:
+    """max over the orbit of one state, from the collocation polynomial (not the sampled x_max)."""
+    mesh_points, u = branch.solutions[i]
+    problem = PeriodicProblem(system, Mesh(mesh_points, branch.ncol), np.ones(system.n), 1.0, 1.0)
+    X, _, _ = problem.unpack(u)
+    tau, x = problem.sample(u, 50)
+    k = int(np.argmax(x[:, component]))
+    dt = 2.0 * float(np.max(np.diff(tau)))
+    res = minimize_scalar(lambda s: -problem.evaluate(X, np.array([s]))[0, component],
+                          bounds=(max(tau[k] - dt, 0.0), min(tau[k] + dt, 1.0)), method="bounded",
+                          options={"xatol": 1e-12})
+    return max(-float(res.fun), float(x[k, component]))
+
+
+def central_jacobian(f, x: np.ndarray, p: float, h: float = 1e-6):
+    """d f / d x as (m, n, n) for columns x (n, m), and d f / d p (n, m), by central differences."""
+    n = x.shape[0]
+    cols = [(f(x + h * np.eye(n)[:, [k]], p) - f(x - h * np.eye(n)[:, [k]], p)) / (2 * h) for k in range(n)]
+    return np.moveaxis(np.stack(cols, axis=-1), 1, 0), (f(x, p + h) - f(x, p - h)) / (2 * h)
+
+
+# --------------------------------------------------------------------------- Jacobians
+
+
+@pytest.mark.parametrize("name", sorted(ALL_SYSTEMS))
+def test_analytic_jacobians_match_central_differences(name):
+    system = ALL_SYSTEMS[name]()
+    n = system.n
+    x = np.random.default_rng(1).normal(size=(n, 7))
+    p = 0.37
+    J_fd, Jp_fd = central_jacobian(system.f, x, p)
+    J = system.dfdx(x, p)
+    assert J.shape == (7, n, n)
+    np.testing.assert_allclose(J, J_fd, rtol=1e-6, atol=1e-7)
+    np.testing.assert_allclose(system.dfdp(x, p), Jp_fd, rtol=1e-6, atol=1e-7)
+    # 1-D input gives (n,) and (n, n), equal to the column version
+    assert system.f(x[:, 0], p).shape == (n,)
+    np.testing.assert_array_equal(system.dfdx(x[:, 0], p), J[0])
+    np.testing.assert_array_equal(system.dfdp(x[:, 0], p), system.dfdp(x, p)[:, 0])
+
+
+def test_collocation_jacobian_matches_finite_differences_of_the_residual():
+    system = period_doubling()
+    mesh = Mesh(np.array([0.0, 0.2, 0.45, 0.7, 1.0]), 3)  # non-uniform
+    problem = PeriodicProblem(system, mesh, np.ones(4), 1.0, 1.0)
+    theta = TWO_PI * mesh.node_times
+    rng = np.random.default_rng(2)
+    X = np.column_stack([np.cos(theta), np.sin(theta), 0.3 * np.sin(2 * theta), 0.2 * np.cos(theta)])
+    problem.accept(problem.pack(X, 6.0, 0.4))  # phase reference
+    u = problem.pack(X + 0.05 * rng.normal(size=X.shape), 6.1, 0.45)
+    J = problem.jacobian(u).toarray()
+    assert J.shape == (problem.n_equations, u.size) and J.shape[0] == u.size - 1
+    h = 1e-6
+    J_fd = np.column_stack([(problem.residual(u + h * e) - problem.residual(u - h * e)) / (2 * h)
+                            for e in np.eye(u.size)])
+    np.testing.assert_allclose(J, J_fd, atol=1e-7 * np.abs(J_fd).max())
+
+
+# --------------------------------------------------------------------------- equilibria
+
+
+def test_fold_1d_is_located_and_stability_changes_there():
+    br = equilibrium_branch(fold_1d(), np.array([1.0]), 1.0, -1.0, 1.0, direction=-1)
+    lp = only(br, "LP")
+    assert abs(lp.p) < 1e-7 and abs(lp.data["x"][0]) < 1e-7
+    np.testing.assert_allclose(br.p, br.x[:, 0] ** 2, atol=1e-10)  # every point on p = x^2
+    np.testing.assert_allclose(br.eigenvalues[:, 0].real, -2.0 * br.x[:, 0], atol=1e-10)
+    # x > 0 (before the fold) stable, x < 0 (after) unstable
+    assert br.stable[:lp.index].all() and not br.stable[lp.index + 1:].any()
+    assert np.all(br.stable == (br.x[:, 0] > 0))
+    # back up the lower half to the bound: an end point exactly there
+    ep = br.special_points[-1]
+    assert ep.kind == "EP" and abs(ep.p - 1.0) <= 1e-9 and abs(br.p[-1] - 1.0) <= 1e-9
+    assert abs(br.x[-1, 0] + 1.0) < 1e-8
+    assert "bound p = 1" in br.stop_reason
+
+
+def test_fold_2d_is_located_at_the_analytic_point():
+    c = 0.3
+    br = equilibrium_branch(fold_2d(c), np.array([1.0, 1.0]), 1.0 + c, -1.0, 1.3, direction=-1)
+    lp = only(br, "LP")
+    assert abs(lp.p + c ** 2 / 4) < 1e-7
+    np.testing.assert_allclose(lp.data["x"], [-c / 2, -c / 2], atol=1e-7)
+    np.testing.assert_allclose(br.p, br.x[:, 0] ** 2 + c * br.x[:, 0], atol=1e-10)
+    np.testing.assert_allclose(br.x[:, 0], br.x[:, 1], atol=1e-10)
+    assert np.all(br.stable == (br.x[:, 0] > -c / 2))
+    assert np.all(br.n_unstable == np.where(br.x[:, 0] > -c / 2, 0, 1))
+    assert kinds(br) == ["LP", "EP"] and abs(br.p[-1] - 1.3) <= 1e-9
+
+
+def test_hopf_point_of_the_normal_form():
+    br = equilibrium_branch(hopf_supercritical(omega=2.0), np.zeros(2), -1.0, -1.0, 1.0)
+    h = only(br, "H")
+    assert abs(h.p) < 1e-9 and abs(h.data["omega"] - 2.0) < 1e-9
+    np.testing.assert_allclose(br.x, 0.0, atol=1e-14)
+    np.testing.assert_allclose(br.eigenvalues[:, 0], br.p + 2j * np.sign(br.eigenvalues[:, 0].imag), atol=1e-12)
+    assert np.all(br.stable == (br.p < 0)) and kinds(br) == ["H", "EP"]
+    assert abs(br.p[-1] - 1.0) <= 1e-9
+
+
+def test_two_hopf_points_of_a_growth_rate_mu_one_minus_mu():
+    br = equilibrium_branch(hopf_twice(), np.zeros(2), -1.0, -1.0, 2.0)
+    assert kinds(br) == ["H", "H", "EP"]
+    np.testing.assert_allclose([s.p for s in br.special_points[:2]], [0.0, 1.0], atol=1e-8)
+    np.testing.assert_allclose([s.data["omega"] for s in br.special_points[:2]], 1.0, atol=1e-9)
+    assert np.all(br.stable == ((br.p < 0) | (br.p > 1)))
+
+
+@pytest.mark.parametrize("make, x0", [(pitchfork, np.zeros(2)), (transcritical, np.zeros(1))],
+                         ids=["pitchfork", "transcritical"])
+def test_branch_point_on_the_trivial_branch(make, x0):
+    br = equilibrium_branch(make(), x0, -1.0, -1.0, 1.0)
+    bp = only(br, "BP")
+    assert abs(bp.p) < 1e-9
+    assert kinds(br) == ["BP", "EP"]
+    np.testing.assert_allclose(br.x, 0.0, atol=1e-14)
+    assert np.all(br.stable == (br.p < 0))
+
+
+# Regression: the secant in locate() used to land (to rounding) on the branch point, where the
+# bordered Jacobian is singular, and the BP was dropped. locate() now nudges off a failed trial.
+
+
+def test_branch_point_on_the_nontrivial_transcritical_branch():
+    # x' = p x - x^2 on x = p: eigenvalue -p changes sign at p = 0, where x = 0 crosses.
+    br = equilibrium_branch(transcritical(), np.array([-1.0]), -1.0, -1.0, 1.0)
+    np.testing.assert_allclose(br.x[:, 0], br.p, atol=1e-10)  # stays on x = p (this part passes)
+    assert np.all(br.stable == (br.p > 0))
+    bp = only(br, "BP")
+    assert abs(bp.p) < 1e-7
+
+
+def test_branch_point_of_the_pitchfork_followed_downward():
+    # The same trivial branch as above, from p = 0.5 towards p = -0.7: the secant hits p = 0.0 exactly.
+    br = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, -0.7, 1.0, direction=-1)
+    assert np.all(br.stable == (br.p < 0))  # (passes)
+    bp = only(br, "BP")
+    assert abs(bp.p) < 1e-9
+
+
+def test_equilibrium_branch_downward_and_stop_rules():
+    br = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, -0.7, 1.0, direction=-1)
+    assert np.all(np.diff(br.p) < 0)
+    assert br.special_points[-1].kind == "EP" and abs(br.p[-1] + 0.7) <= 1e-9
+    assert "p = -0.7" in br.stop_reason
+    short = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, -10.0, 10.0, ContinuationOptions(max_steps=3))
+    assert short.steps == 3 and len(short.p) == 4 and "step budget of 3" in short.stop_reason
+    with pytest.raises(ValueError, match="no equilibrium"):
+        equilibrium_branch(fold_1d(), np.array([0.5]), -1.0, -2.0, 2.0)  # p - x^2 = 0 has no root at p = -1
+
+
+# --------------------------------------------------------------------------- Hopf normal forms
+
+
+def test_supercritical_hopf_branch_amplitude_period_and_multipliers():
+    omega = 2.0
+    br = hopf_branch(hopf_supercritical(omega), omega, 0.0, -1.0, 1.0)
+    T = math.pi
+    assert np.all(np.diff(br.p) > 0) and br.p[0] > 0
+    for i in range(len(br.p)):  # r^2 = mu at every node
+        np.testing.assert_allclose(node_radius(br, i), math.sqrt(br.p[i]), atol=1e-9)
+    np.testing.assert_allclose(br.x_max[:, 0], np.sqrt(br.p), rtol=1e-4)  # x_max is sampled (12 per interval)
+    np.testing.assert_allclose(br.period, T, atol=1e-9)
+    assert br.stable.all()
+    # Floquet: trivial 1, radial exp(-2 mu T)
+    assert br.trivial_error < 1e-8
+    np.testing.assert_allclose(br.multipliers[:, 1], np.exp(-2.0 * br.p * T), atol=1e-9)
+    assert kinds(br) == ["EP"] and abs(br.p[-1] - 1.0) <= 1e-9 and "bound p = 1" in br.stop_reason
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.5, 2.0])
+def test_multipliers_of_the_exact_circle(mu):
+    """PeriodicProblem.multipliers on the exact orbit (no continuation): [1, exp(-2 mu T)]."""
+    omega, T = 2.0, math.pi
+    mesh = Mesh.uniform(40, 4)
+    theta = TWO_PI * mesh.node_times
+    problem = PeriodicProblem(hopf_supercritical(omega), mesh, np.ones(2), 1.0, 1.0)
+    u = problem.pack(math.sqrt(mu) * np.column_stack([np.cos(theta), np.sin(theta)]), T, mu)
+    mult = problem.multipliers(u)
+    np.testing.assert_allclose(mult, [1.0, math.exp(-2.0 * mu * T)], atol=1e-8)
+
+
+def test_subcritical_quintic_fold_of_cycles():
+    br = hopf_branch(hopf_subcritical_quintic(1.0), 1.0, 0.0, -1.0, 1.0, PeriodicOptions(ntst=40, ncol=4))
+    r2 = np.array([np.mean(node_radius(br, i) ** 2) for i in range(len(br.p))])
+    np.testing.assert_allclose(br.p + r2 - r2 ** 2, 0.0, atol=1e-9)  # G(mu, r^2) = 0 on every cycle
+    np.testing.assert_allclose(br.period, TWO_PI, atol=1e-9)
+    lpc = only(br, "LPC")
+    assert abs(lpc.p + 0.25) < 1e-8
+    assert abs(lpc.data["x_max"][0] ** 2 - 0.5) < 2e-4  # sampled x_max
+    assert kinds(br) == ["LPC", "EP"]
+    # born at mu = 0 going to mu < 0 on the inner (unstable) cycle, then the outer stable one
+    assert br.p[1] < 0 and np.all(np.diff(br.p[:lpc.index]) < 0)
+    assert not br.stable[:lpc.index].any() and br.stable[lpc.index + 1:].all()
+    np.testing.assert_allclose(r2[lpc.index + 1:], (1 + np.sqrt(1 + 4 * br.p[lpc.index + 1:])) / 2, atol=1e-9)
+    np.testing.assert_allclose(r2[:lpc.index], (1 - np.sqrt(1 + 4 * br.p[:lpc.index])) / 2, atol=1e-9)
+    exact = np.exp(2 * r2 * (1 - 2 * r2) * TWO_PI)
+    np.testing.assert_allclose(np.abs(br.multipliers[:, 1]), exact, rtol=1e-7, atol=1e-12)
+    assert br.trivial_error < 1e-8
+    assert abs(br.p[-1] - 1.0) <= 1e-9
+
+
+@pytest.mark.parametrize("p0, p_end", [(0.0, 1.0), (1.0, 0.0)])
+def test_branch_between_two_hopf_points_ends_at_the_second(p0, p_end):
+    br = hopf_branch(hopf_twice(1.0), 1.0, p0, -1.0, 2.0)
+    h = br.special_points[-1]
+    assert h.kind == "H" and abs(h.p - p_end) < 1e-2
+    assert "Hopf point" in br.stop_reason
+    for i in range(len(br.p)):  # r^2 = mu (1 - mu)
+        np.testing.assert_allclose(node_radius(br, i) ** 2, br.p[i] * (1 - br.p[i]), atol=1e-9)
+    assert br.stable.all() and br.trivial_error < 1e-8
+
+
+# --------------------------------------------------------------------------- Van der Pol
+
+
+@pytest.fixture(scope="module")
+def vdp_orbit_mu1():
+    """One period of the Van der Pol cycle at mu = 1 (tight-tolerance integration), and int (1 - x^2) dt."""
+    system = van_der_pol()
+
+    def rhs(t, z):
+        return np.append(system.f(z[:2], 1.0), 1.0 - z[0] ** 2)
+
+    sol = solve_ivp(rhs, (0.0, VDP_PERIOD_MU1), [VDP_AMPLITUDE_MU1, 0.0, 0.0], method="DOP853", rtol=1e-12,
+                    atol=1e-12, dense_output=True)
+    t = np.linspace(0.0, VDP_PERIOD_MU1, 400)
+    return t, sol.sol(t)[:2].T, sol.y[:, -1]
+
+
+def test_van_der_pol_reference_values_close_the_orbit(vdp_orbit_mu1):
+    """The published (T, max x) at mu = 1: starting at (max x, 0) the flow returns there after T."""
+    _, _, end = vdp_orbit_mu1
+    np.testing.assert_allclose(end[:2], [VDP_AMPLITUDE_MU1, 0.0], atol=1e-9)
+
+
+def test_van_der_pol_branch_to_mu_1(vdp_orbit_mu1):
+    # The Hopf point of Van der Pol at mu = 0 is degenerate (the system is linear there: every circle is
+    # an orbit), so the branch is started on the cycle near the circle of radius 2 at mu = 0.2.
+    system = van_der_pol()
+    br = periodic_branch(system, unit_cycle_guess(40, 2, 0.2, radius=2.0, sign=-1.0), 0.1, 1.0, np.ones(2), 1.0,
+                         PeriodicOptions(ntst=40, ncol=4), p_direction=1)
+    assert kinds(br) == ["EP"] and abs(br.p[-1] - 1.0) <= 1e-9 and "bound p = 1" in br.stop_reason
+    assert abs(br.p[0] - 0.2) < 1e-14 and np.all(np.diff(br.p) > 0)
+    # Lindstedt: omega = 1 - mu^2/16 + 17 mu^4/3072 + 35 mu^6/884736 + O(mu^8)
+    mu = 0.2
+    omega = 1 - mu ** 2 / 16 + 17 * mu ** 4 / 3072 + 35 * mu ** 6 / 884736
+    assert abs(br.period[0] * omega / TWO_PI - 1.0) < 1e-8
+    assert np.all(np.diff(br.period) > 0)
+    # published values at mu = 1
+    assert abs(br.period[-1] / VDP_PERIOD_MU1 - 1.0) < 1e-6
+    assert abs(refined_max(system, br, len(br.p) - 1) / VDP_AMPLITUDE_MU1 - 1.0) < 1e-6
+    assert abs(br.x_max[-1, 0] / VDP_AMPLITUDE_MU1 - 1.0) < 2e-5  # sampled maximum
+    # multipliers: stable cycle; Liouville: the nontrivial one is exp(int_0^T mu (1 - x^2) dt)
+    assert br.stable.all() and br.trivial_error < 1e-8
+    liouville = math.exp(vdp_orbit_mu1[2][2])
+    assert abs(br.multipliers[-1, 1].real / liouville - 1.0) < 1e-6 and br.multipliers[-1, 1].imag == 0
+
+
+@pytest.mark.parametrize("ncol", [2, 3, 4])
+def test_van_der_pol_period_converges_at_order_2_ncol(vdp_orbit_mu1, ncol):
+    """Period at mu = 1 on uniform meshes (first point of a branch: solved with p held at 1 exactly).
+
+    Gauss collocation is superconvergent: the error of the period is O(h^(2 ncol)).
+    """
+    t, x, _ = vdp_orbit_mu1
+    ntsts = (20, 40, 80)
+    errors = []
+    for ntst in ntsts:
+        opts = PeriodicOptions(ntst=ntst, ncol=ncol, adapt_every=0,
+                               continuation=ContinuationOptions(max_steps=1, tol=1e-12, residual_tol=1e-11))
+        guess = orbit_from_samples(t, x, 1.001 * VDP_PERIOD_MU1, 1.0, Mesh.uniform(ntst, ncol))
+        br = periodic_branch(van_der_pol(), guess, 0.5, 1.5, np.ones(2), 1.0, opts, p_direction=1)
+        assert br.p[0] == 1.0
+        errors.append(abs(br.period[0] - VDP_PERIOD_MU1))
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(orders > 2 * ncol - 0.5), (errors, orders)
+    if ncol == 4:
+        assert errors[1] / VDP_PERIOD_MU1 < 1e-8  # ntst 40, ncol 4
+
+
+# --------------------------------------------------------------------------- constructed 4-D systems
+
+
+@pytest.mark.parametrize("name, p", [("neimark_sacker", 0.2), ("neimark_sacker", 0.8), ("period_doubling", 0.2),
+                                     ("period_doubling", 0.8)])
+def test_constructed_multipliers_by_integration(name, p):
+    """The claimed multipliers of the unit cycle, from the variational equation (independent of the engine)."""
+    system = ALL_SYSTEMS[name]()
+
+    def rhs(t, z):
+        M = z[4:].reshape(4, 4)
+        return np.concatenate([system.f(z[:4], p), (system.dfdx(z[:4], p) @ M).ravel()])
+
+    sol = solve_ivp(rhs, (0.0, TWO_PI), np.concatenate([[1.0, 0, 0, 0], np.eye(4).ravel()]), method="DOP853",
+                    rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(sol.y[:4, -1], [1, 0, 0, 0], atol=1e-9)
+    a = (p - 0.5) * TWO_PI
+    if name == "neimark_sacker":
+        rot = np.exp(1j * math.sqrt(2) * TWO_PI)
+        claimed = [1.0, math.exp(-2 * TWO_PI), math.exp(a) * rot, math.exp(a) * np.conj(rot)]
+    else:
+        claimed = [1.0, math.exp(-2 * TWO_PI), -math.exp(a), -math.exp(-TWO_PI)]
+    mult = np.linalg.eigvals(sol.y[4:, -1].reshape(4, 4))
+    np.testing.assert_allclose(np.sort_complex(mult), np.sort_complex(np.array(claimed, complex)), atol=1e-8)
+
+
+def test_neimark_sacker_point_of_the_constructed_system():
+    beta, w2 = 0.5, math.sqrt(2.0)
+    br = periodic_branch(neimark_sacker(beta=beta, w2=w2), unit_cycle_guess(40, 4, 0.2), 0.0, 1.0, np.ones(4), 1.0,
+                         PeriodicOptions(ntst=40, ncol=4), p_direction=1)
+    assert kinds(br) == ["NS", "EP"]
+    ns = br.special_points[0]
+    assert abs(ns.p - beta) < 1e-8
+    angle = abs(np.angle(np.exp(1j * w2 * TWO_PI)))  # w2 T mod 2 pi folded to [0, pi]: 2 pi (sqrt 2 - 1)
+    assert abs(ns.data["torus_angle"] - angle) < 1e-7
+    np.testing.assert_allclose(ns.data["multipliers_abs"][:2], 1.0, atol=1e-8)
+    assert np.all(br.stable == (br.p < beta))
+    np.testing.assert_allclose(br.period, TWO_PI, atol=1e-9)
+    assert br.trivial_error < 1e-8
+    a = (br.p - beta) * TWO_PI
+    pair = np.exp(a) * np.exp(1j * w2 * TWO_PI)
+    np.testing.assert_allclose(np.sort_complex(br.multipliers[:, 1:3]),
+                               np.sort_complex(np.column_stack([pair, pair.conj()])), atol=1e-8)
+    np.testing.assert_allclose(br.multipliers[:, 3], math.exp(-2 * TWO_PI), atol=1e-9)
+
+
+def test_period_doubling_point_of_the_constructed_system():
+    beta = 0.5
+    br = periodic_branch(period_doubling(beta=beta), unit_cycle_guess(40, 4, 0.2), 0.0, 1.0, np.ones(4), 1.0,
+                         PeriodicOptions(ntst=40, ncol=4), p_direction=1)
+    assert kinds(br) == ["PD", "EP"]
+    pd = br.special_points[0]
+    assert abs(pd.p - beta) < 1e-8
+    assert abs(pd.data["multipliers_abs"][0] - 1.0) < 1e-8
+    assert np.all(br.stable == (br.p < beta))
+    # the critical multiplier is real and equal to -exp((p - beta) T): it passes through -1 at beta
+    mult = br.multipliers
+    np.testing.assert_allclose(mult[:, 1], -np.exp((br.p - beta) * TWO_PI), rtol=1e-8)
+    assert np.all(mult[:, 1].imag == 0)
+    np.testing.assert_allclose(mult[:, 2], -math.exp(-TWO_PI), atol=1e-9)
+    np.testing.assert_allclose(node_radius(br, len(br.p) - 1), 1.0, atol=1e-9)
+    assert br.trivial_error < 1e-8
+
+
+# --------------------------------------------------------------------------- stop rules
+
+
+def test_periodic_step_budget():
+    opts = PeriodicOptions(ntst=20, ncol=4, continuation=ContinuationOptions(max_steps=3))
+    br = hopf_branch(hopf_supercritical(2.0), 2.0, 0.0, -1.0, 2.0, opts)
+    assert br.steps == 3 and len(br.p) == 4
+    assert "step budget of 3 steps" in br.stop_reason and kinds(br) == []
+
+
+def test_periodic_period_limit():
+    # rotation W = 2 - r^2 and r^2 = mu: T = 2 pi / (2 - mu) grows; T = 5 at mu = 2 - 2 pi / 5
+    br = hopf_branch(hopf_shear(2.0, -1.0), 2.0, 0.0, -1.0, 2.0, PeriodicOptions(ntst=20, ncol=4, period_max=5.0))
+    np.testing.assert_allclose(br.period, TWO_PI / (2.0 - br.p), rtol=1e-9)
+    assert "period" in br.stop_reason and "limit 5" in br.stop_reason
+    assert np.all(br.period <= 5.0) and br.p[-1] < 2.0 - TWO_PI / 5.0
+    assert br.p[-1] > 0.5  # it did go most of the way
+
+
+def test_periodic_limits_callback_message_is_the_stop_reason():
+    calls = []
+
+    def limits(x_max, x_min, T, p):
+        calls.append((np.array(x_max), np.array(x_min), T, p))
+        return "amplitude above 0.5" if x_max[0] > 0.5 else None
+
+    br = hopf_branch(hopf_supercritical(2.0), 2.0, 0.0, -1.0, 2.0, limits=limits)
+    assert br.stop_reason == "amplitude above 0.5"
+    assert br.x_max[-1, 0] > 0.5 and np.all(br.x_max[:-1, 0] <= 0.5)
+    x_max, x_min, T, p = calls[-1]
+    np.testing.assert_array_equal(x_max, br.x_max[-1])
+    np.testing.assert_array_equal(x_min, br.x_min[-1])
+    assert T == br.period[-1] and p == br.p[-1]
+
+
+def test_no_orbit_near_the_guess_raises_convergence_error():
+    # r' = r (mu - r^2) has no cycle at mu = -0.5: a unit circle does not converge
+    guess = unit_cycle_guess(10, 2, -0.5)
+    with pytest.raises(ConvergenceError, match="no periodic orbit"):
+        periodic_branch(hopf_supercritical(2.0), guess, -1.0, 1.0, np.ones(2), 1.0, PeriodicOptions(ntst=10))
+
+
+# --------------------------------------------------------------------------- options
+
+
+@pytest.mark.parametrize("cls, kwargs, name", [
+    (ContinuationOptions, {"ds": -1.0}, "ds"),
+    (ContinuationOptions, {"ds": 0.6}, "ds"),  # above ds_max
+    (ContinuationOptions, {"ds_min": 0.0}, "ds_min"),
+    (ContinuationOptions, {"tol": math.nan}, "tol"),
+    (ContinuationOptions, {"residual_tol": math.inf}, "residual_tol"),
+    (ContinuationOptions, {"max_steps": 0}, "max_steps"),
+    (ContinuationOptions, {"max_newton": 2.5}, "max_newton"),
+    (PeriodicOptions, {"ntst": 1}, "ntst"),
+    (PeriodicOptions, {"ntst": 40.0}, "ntst"),
+    (PeriodicOptions, {"ncol": 8}, "ncol"),
+    (PeriodicOptions, {"ncol": 1}, "ncol"),
+])
+def test_bad_options_raise_invalid_parameter_error_naming_the_field(cls, kwargs, name):
+    with pytest.raises(InvalidParameterError) as info:
+        cls(**kwargs)
+    assert info.value.field == name
+    assert name in str(info.value)
