@@ -529,7 +529,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
         cache: dict[float, tuple[float, CurvePoint | None]] = {}
 
         def minus_amp(h):
-            point = step(problem, start, h, copts) if h > 0 else start
+            point = step(problem, start, h, copts, with_tangent=False) if h > 0 else start
             if point is None:
                 cache[h] = (0.0, None)
                 return 0.0

@@ -148,6 +148,25 @@ class PeriodicProblem:
         self._cols = ((j * m + node) * n + b).ravel()
         self._eye = np.eye(n)[None, None, :, None, :]
         self.n_equations = N * m * n + n + 1
+        self._structure()
+
+    def _structure(self) -> None:
+        """The fixed CSR structure of the Jacobian and, for every (row, col, value) entry in the
+        order :meth:`jacobian` produces them, its slot in the CSR data (duplicates summed)."""
+        mesh, n = self.mesh, self.n
+        n_coll = mesh.ntst * mesh.ncol * n
+        idx = mesh.node_index[:, :, None] * n + np.arange(n)[None, None, :]
+        rows = np.concatenate([self._rows, np.arange(n_coll), np.arange(n_coll), n_coll + np.arange(n),
+                               n_coll + np.arange(n), np.full(idx.size, n_coll + n)])
+        cols = np.concatenate([self._cols, np.full(n_coll, self.n_x), np.full(n_coll, self.n_x + 1),
+                               np.arange(n), self.n_x - n + np.arange(n), idx.ravel()])
+        key = rows.astype(np.int64) * (self.n_x + 2) + cols
+        unique, slot = np.unique(key, return_inverse=True)
+        self._slot = slot
+        self._nnz = unique.size
+        self._indices = (unique % (self.n_x + 2)).astype(np.int32)
+        counts = np.bincount(unique // (self.n_x + 2), minlength=self.n_equations)
+        self._indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
 
     # -- unknowns ------------------------------------------------------------------------
     def unpack(self, u: np.ndarray) -> tuple[np.ndarray, float, float]:
@@ -199,23 +218,13 @@ class PeriodicProblem:
     def jacobian(self, u: np.ndarray):
         mesh, n = self.mesh, self.n
         blocks, F, Fp, T = self.collocation_blocks(u)
-        n_coll = mesh.ntst * mesh.ncol * n
-        rows = [self._rows, np.arange(n_coll), np.arange(n_coll)]
-        cols = [self._cols, np.full(n_coll, self.n_x), np.full(n_coll, self.n_x + 1)]
-        vals = [blocks.ravel(), (-mesh.h[:, None, None] * F).ravel(), (-mesh.h[:, None, None] * T * Fp).ravel()]
-        # periodicity
-        rows += [n_coll + np.arange(n)] * 2
-        cols += [np.arange(n), self.n_x - n + np.arange(n)]
-        vals += [np.ones(n), -np.ones(n)]
-        # phase: d/dx(node(j,l), b) of sum_jk h_j w_k <L_kl x_jl, xref'_jk>
-        wq = self.basis.gauss[1]
-        coeff = np.einsum("j,k,kl,jkn->jln", mesh.h, wq, self.basis.L, self.reference_derivative)
-        idx = mesh.node_index[:, :, None] * n + np.arange(n)[None, None, :]
-        rows.append(np.full(idx.size, n_coll + n))
-        cols.append(idx.ravel())
-        vals.append(coeff.ravel())
-        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                             shape=(self.n_equations, self.n_x + 2))
+        # d(phase)/d x(node(j,l), b) of sum_jk h_j w_k <L_kl x_jl, xref'_jk>
+        coeff = np.einsum("j,k,kl,jkn->jln", mesh.h, self.basis.gauss[1], self.basis.L, self.reference_derivative)
+        values = np.concatenate([blocks.ravel(), (-mesh.h[:, None, None] * F).ravel(),
+                                 (-mesh.h[:, None, None] * T * Fp).ravel(), np.ones(n), -np.ones(n),
+                                 coeff.ravel()])
+        data = np.bincount(self._slot, weights=values, minlength=self._nnz)
+        return sp.csr_matrix((data, self._indices, self._indptr), shape=(self.n_equations, self.n_x + 2))
 
     # -- results -------------------------------------------------------------------------
     def multipliers(self, u: np.ndarray) -> np.ndarray:

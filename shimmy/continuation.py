@@ -174,12 +174,19 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
     return None
 
 
-def step(problem: CurveProblem, point: CurvePoint, h: float, options: ContinuationOptions) -> CurvePoint | None:
-    """One predictor-corrector step of length h from ``point`` (None if Newton fails)."""
+def step(problem: CurveProblem, point: CurvePoint, h: float, options: ContinuationOptions,
+         with_tangent: bool = True) -> CurvePoint | None:
+    """One predictor-corrector step of length h from ``point`` (None if Newton fails).
+
+    ``with_tangent=False`` skips the new tangent (one factorisation) for trial points whose
+    tangent is not needed; the returned point then carries the old one.
+    """
     out = correct(problem, point.u + h * point.tangent, point.tangent, options)
     if out is None:
         return None
     u, iterations = out
+    if not with_tangent:
+        return CurvePoint(u, point.tangent, iterations)
     try:
         t = tangent(problem, u, point.tangent)
     except (RuntimeError, ValueError, np.linalg.LinAlgError):
