@@ -75,3 +75,38 @@ def test_eigen_json_matches_the_library():
     ev = eigenvalues("pd", 30.0, 150e3)
     assert [e["real"] for e in data["eigenvalues"]] == pytest.approx(ev.real.tolist())
     assert data["stable"] is False  # point A lies between the Hopf points
+
+
+def test_progress_bar_draws_only_on_a_terminal():
+    import io
+
+    from shimmy.cli import _ProgressBar
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    tty, pipe = Terminal(), io.StringIO()
+    for stream in (tty, pipe):
+        bar = _ProgressBar(stream, width=10)
+        bar(0.5, "periodic branch")
+        bar(1.0, "done")
+        bar.close()
+    assert pipe.getvalue() == ""
+    assert "[#####.....]  50.0 % periodic branch" in tty.getvalue()
+    assert "[##########] 100.0 % done" in tty.getvalue()
+
+
+def test_hopf_curves_command(capsys):
+    from shimmy.cli import main
+
+    assert main(["hopf-curves", "--config", "original", "--fz-min", "300000", "--fz-max", "500000",
+                 "--v-max", "200", "--json"]) == 0
+    import json
+
+    d = json.loads(capsys.readouterr().out)
+    assert d["config"] == "original" and d["curves"]
+    # End points are located on the box edges to 1e-9 relative.
+    assert all(300000 - 1e-3 <= p["Fz"] <= 500000 + 1e-3 and 1 - 1e-9 <= p["V"] <= 200 + 1e-9
+               for c in d["curves"] for p in c["points"])
+    assert main(["hopf-curves", "--config", "original", "--fz-min", "5e5", "--fz-max", "1e5"]) == 2
