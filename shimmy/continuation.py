@@ -223,6 +223,26 @@ class Tracer:
                                f"(minimum {opts.ds_min:g})")
                 return None
 
+    def advance_within(self, low: float, high: float, index: int = -1):
+        """Like :meth:`advance`, keeping unknown ``index`` in [low, high].
+
+        Returns (previous point, new point, step, bound): ``bound`` is None inside the
+        interval; if the step left it, the new point is the one located on the bound (or None
+        if locating failed) and ``bound`` the value crossed. None when the step underflows.
+        """
+        prev = self.point
+        adv = self.advance()
+        if adv is None:
+            return None
+        new, h = adv
+        value = new.u[index]
+        if low <= value <= high:
+            return prev, new, h, None
+        bound = high if value > high else low
+        hit = locate(self.problem, prev, h, lambda q: q.u[index] - bound, prev.u[index] - bound, value - bound,
+                     self.options)
+        return prev, (hit[0] if hit is not None else None), h, bound
+
     def limit_step(self, h_max: float) -> None:
         self.h = max(min(self.h, h_max), self.options.ds_min)
 
@@ -357,23 +377,18 @@ def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, p_min: fl
     stop = f"step budget of {options.max_steps} steps used"
     steps = 0
     for steps in range(1, options.max_steps + 1):  # noqa: B007 (steps is reported)
-        prev = tracer.point
-        adv = tracer.advance()
-        if adv is None:
+        out = tracer.advance_within(p_min, p_max)
+        if out is None:
             stop = tracer.failed or "failed"
             break
-        new, h = adv
-        p_new = new.u[-1]
-        if not p_min <= p_new <= p_max:
-            bound = p_max if p_new > p_max else p_min
-            hit = locate(problem, prev, h, lambda q: q.u[-1] - bound, prev.u[-1] - bound, p_new - bound, options)
-            if hit is not None:
-                end = hit[0]
-                _append_equilibrium(system, points, eigs, special, prev, end, problem, options)
-                special.append(SpecialPoint("EP", float(end.u[-1]), len(points) - 1))
+        prev, new, _, bound = out
+        if new is not None:
+            _append_equilibrium(system, points, eigs, special, prev, new, problem, options)
+        if bound is not None:
+            if new is not None:
+                special.append(SpecialPoint("EP", float(new.u[-1]), len(points) - 1))
             stop = f"reached the parameter bound p = {bound:g}"
             break
-        _append_equilibrium(system, points, eigs, special, prev, new, problem, options)
     u = np.array([q.u for q in points])
     ev = np.array(eigs)
     return EquilibriumBranch(u[:, -1], u[:, :-1], ev, ev[:, 0].real < 0, special, stop, steps)

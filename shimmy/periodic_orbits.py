@@ -211,26 +211,22 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
     stop = f"step budget of {copts.max_steps} steps used"
     steps = 0
     span = p_max - p_min
-    for steps in range(1, copts.max_steps + 1):
-        prev = tracer.point
-        adv = tracer.advance()
-        if adv is None:
+    for steps in range(1, copts.max_steps + 1):  # noqa: B007 (steps is reported)
+        out = tracer.advance_within(p_min, p_max)
+        if out is None:
             stop = tracer.failed or "Newton failed"
             break
-        new, h = adv
+        prev, new, h, bound = out
+        if bound is not None:
+            if new is not None:
+                _record(problem, rows, solutions, new)
+                special.extend(_detect(problem, rows, prev, new, copts))
+                special.append(_special(problem, "EP", new, rows))
+            stop = f"reached the parameter bound p = {bound:g}"
+            break
         p_new, T_new = new.u[-1], new.u[-2]
         if progress is not None:
             progress(min(1.0, abs(p_new - guess.p) / span))
-        if not p_min <= p_new <= p_max:
-            bound = p_max if p_new > p_max else p_min
-            hit = locate(problem, prev, h, lambda q: q.u[-1] - bound, prev.u[-1] - bound, p_new - bound, copts)
-            if hit is not None:
-                end = hit[0]
-                _record(problem, rows, solutions, end)
-                special.extend(_detect(problem, rows, prev, end, copts))
-                special.append(_special(problem, "EP", end, rows))
-            stop = f"reached the parameter bound p = {bound:g}"
-            break
         if T_new > options.period_max:
             stop = f"period {T_new:.4g} above the limit {options.period_max:.4g} (homoclinic approach?)"
             break
