@@ -69,7 +69,7 @@ def test_lowest_load_is_a_turning_point(original):
 def test_particle_damper_curves_have_no_criticality():
     result = hopf_curves("pd", n_slices=6)
     assert result.gh_points == [] and all(np.isnan(c.lyapunov).all() for c in result.curves)
-    assert result.curves and result.elapsed_s < 30
+    assert result.curves
 
 
 def test_to_dict_and_bad_input():
