@@ -1,0 +1,135 @@
+"""The analyses the service offers, as functions canonical request -> JSON-ready result.
+
+One registry used by the HTTP API, the job workers and the Dash pages (which never call the
+numerics directly). :func:`run` validates, consults the shared cache and computes on a miss.
+``progress(fraction, message)`` is called by the long analyses; it may raise to cancel.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable
+
+import numpy as np
+
+from ..configurations import Configuration
+from ..parameters import Parameters
+from . import cache, schemas
+from .settings import MAX_SERIES_POINTS
+
+Progress = Callable[[float, str], None]
+
+
+def _params(request: dict[str, Any]) -> Parameters:
+    return Parameters.from_dict(request["params"])
+
+
+def _finite(x) -> float | None:
+    return float(x) if x is not None and math.isfinite(x) else None
+
+
+def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    from ..simulation import simulate as run_simulation
+
+    result = run_simulation(request["config"], request["V"], request["Fz"], _params(request),
+                            t_end=request["t_end"], exact_nes=request["exact_nes"])
+    out = result.to_dict()
+    if request["include_series"]:
+        stride = max(1, int(round(request["series_dt"] / result.options.dt_out)))
+        n = (result.t.size + stride - 1) // stride
+        if n > MAX_SERIES_POINTS:
+            from ..errors import InvalidParameterError
+
+            raise InvalidParameterError("series_dt", request["series_dt"],
+                                        f"at least {result.t[-1] / MAX_SERIES_POINTS:g} s for t_end = "
+                                        f"{request['t_end']:g} s (at most {MAX_SERIES_POINTS} samples per series)",
+                                        "gives too many samples")
+        out["series"] = {k: v[::stride] for k, v in result.series().items()}
+        out["series_dt"] = stride * result.options.dt_out
+        spectrum = _spectrum(result)
+        out["spectrum"] = spectrum
+    return out
+
+
+def _spectrum(result) -> dict[str, Any]:
+    """Power spectrum of the steady window (psi and l_g delta, Hann window), for plots."""
+    dt = result.options.dt_out
+    span = max(8, int(round(result.options.steady_window / dt)))
+    psi = result.states[0, -span:]
+    lat = result.lateral[-span:]
+    window = np.hanning(psi.size)
+    freq = np.fft.rfftfreq(psi.size, dt)
+    keep = freq <= 60.0
+    p_psi = np.abs(np.fft.rfft((psi - psi.mean()) * window)) ** 2
+    p_lat = np.abs(np.fft.rfft((lat - lat.mean()) * window)) ** 2
+    return {"frequency_hz": freq[keep].tolist(), "psi": p_psi[keep].tolist(), "lateral": p_lat[keep].tolist(),
+            "dominant_hz": _finite(result.frequency_hz)}
+
+
+def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    from ..stability import hopf_points
+
+    return hopf_points(request["config"], request["Fz"], _params(request), request["v_min"],
+                       request["v_max"]).to_dict()
+
+
+def stability(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """Largest real part of the eigenvalues of x = 0 against V, and the Hopf points, per configuration."""
+    from ..equations import build_model
+    from ..stability import Linearisation, hopf_points
+
+    params = _params(request)
+    V = np.geomspace(request["v_min"], request["v_max"], request["n_points"])
+    out: dict[str, Any] = {"Fz": request["Fz"], "V": V.tolist(), "params": request["params"], "configs": {}}
+    for config in Configuration:
+        lin = Linearisation(build_model(config, params), request["Fz"])
+        ev = lin.eigenvalues(V)
+        k = np.argmax(ev.real, axis=1)
+        lead = ev[np.arange(V.size), k]
+        h = hopf_points(config, request["Fz"], params, request["v_min"], request["v_max"])
+        out["configs"][config.value] = {
+            "max_real": lead.real.tolist(), "frequency_hz": (np.abs(lead.imag) / (2 * np.pi)).tolist(),
+            "hopf_points": [p.to_dict() for p in h.hopf_points],
+            "unstable_intervals": [list(iv) for iv in h.unstable_intervals]}
+    return out
+
+
+def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    from ..device_curves import nes_curve, pd_curves
+
+    params = _params(request)
+    nes = nes_curve(params)
+    return {"params": request["params"], "nes": nes.to_dict(),
+            "nes_cubic_error": {str(a): e for a, e in nes.cubic_error_at.items()},
+            "pd": [c.to_dict() for c in pd_curves(params, v_max=request["v_max"])]}
+
+
+def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    from ..bifurcation import BifurcationOptions, bifurcation as run_bifurcation
+
+    options = BifurcationOptions(ntst=request["ntst"], seeds=request["seeds"])
+    return run_bifurcation(request["config"], request["Fz"], request["v_min"], request["v_max"], _params(request),
+                           options, progress=progress).to_dict()
+
+
+def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    from ..hopf_curves import hopf_curves as run_hopf_curves
+
+    return run_hopf_curves(request["config"], _params(request), (request["v_min"], request["v_max"]),
+                           (request["fz_min"], request["fz_max"]), progress=progress).to_dict()
+
+
+RUNNERS: dict[str, Callable[[dict[str, Any], Progress | None], dict[str, Any]]] = {
+    "simulate": simulate, "hopf": hopf, "stability": stability, "devices": devices,
+    "bifurcation": bifurcation, "hopf_curves": hopf_curves}
+assert set(RUNNERS) == set(schemas.SCHEMAS)
+
+
+def run(analysis: str, body: Any, progress: Progress | None = None) -> tuple[dict[str, Any], bool]:
+    """Validate ``body``, then (result, cached?) from the shared cache or by computing it."""
+    request = schemas.validate(analysis, body)
+    return run_canonical(analysis, request, progress)
+
+
+def run_canonical(analysis: str, request: dict[str, Any], progress: Progress | None = None):
+    return cache.get_or_compute(analysis, request, lambda: RUNNERS[analysis](request, progress))

@@ -1,0 +1,199 @@
+"""Request schemas: one declaration per analysis gives validation, defaults and the OpenAPI text.
+
+Validation turns a JSON body into a *canonical request*: every field present (defaults
+filled), numbers as floats, the design as the complete parameter dict (material preset
+and overrides applied). Equal questions give equal canonical requests, hence equal cache
+keys. Every refusal is an :class:`~shimmy.errors.InvalidParameterError` naming the field
+(``params.r2`` for a design parameter), the value and what is allowed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+from ..configurations import Configuration
+from ..errors import InvalidParameterError
+from ..parameters import FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters, check_number, unknown_name_error
+
+CONFIGS = tuple(c.value for c in Configuration)
+
+
+@dataclass(frozen=True)
+class Field:
+    name: str
+    kind: str  # number | integer | string | boolean | object
+    description: str
+    required: bool = False
+    default: Any = None
+    low: float | None = None
+    high: float | None = None
+    unit: str = ""
+    choices: tuple[str, ...] | None = None
+
+    @property
+    def allowed(self) -> str:
+        if self.choices:
+            return "one of " + ", ".join(self.choices)
+        if self.kind in ("number", "integer"):
+            kind = "an integer" if self.kind == "integer" else "a number"
+            return f"{kind} in [{self.low:g}, {self.high:g}] {self.unit}".rstrip()
+        if self.kind == "boolean":
+            return "true or false"
+        if self.kind == "object":
+            return "an object {parameter name: number}; names and ranges from GET /api/v1/parameters"
+        return "a string"
+
+    def check(self, value: Any) -> Any:
+        if self.kind in ("number", "integer"):
+            if isinstance(value, str):  # JSON numbers only: "30" is a type error in a body
+                raise InvalidParameterError(self.name, value, self.allowed, "is not a number")
+            number = check_number(self.name, value, self.low, self.high, self.unit, self.kind == "integer")
+            return int(number) if self.kind == "integer" else number
+        if self.kind == "boolean":
+            if not isinstance(value, bool):
+                raise InvalidParameterError(self.name, value, self.allowed, "is not a boolean")
+            return value
+        if self.kind == "string":
+            if not isinstance(value, str):
+                raise InvalidParameterError(self.name, value, self.allowed, "is not a string")
+            if self.choices and value not in self.choices:
+                raise unknown_name_error(value, self.choices, self.name)
+            return value
+        if not isinstance(value, Mapping):
+            raise InvalidParameterError(self.name, value, self.allowed, "is not an object")
+        return dict(value)
+
+    def openapi(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"type": self.kind, "description": self.description + (f" ({self.unit})" if self.unit
+                                                                                      else "")}
+        if self.low is not None:
+            out["minimum"], out["maximum"] = self.low, self.high
+        if self.choices:
+            out["enum"] = list(self.choices)
+        if self.default is not None:
+            out["default"] = self.default
+        if self.kind == "object":
+            out["additionalProperties"] = {"type": "number"}
+        return out
+
+
+@dataclass(frozen=True)
+class RequestSchema:
+    name: str
+    summary: str
+    fields: tuple[Field, ...]
+
+    def validate(self, body: Any, extra: tuple[str, ...] = ()) -> dict[str, Any]:
+        """The canonical request for ``body`` (a JSON object); ``extra`` names keys to ignore."""
+        if not isinstance(body, Mapping):
+            raise InvalidParameterError("body", type(body).__name__, "a JSON object", "is not a JSON object")
+        known = {f.name for f in self.fields}
+        for name in body:
+            if name not in known and name not in extra:
+                hint = unknown_name_error(name, sorted(known), "field")
+                raise InvalidParameterError(str(name), body[name], hint.allowed, message=str(hint))
+        out: dict[str, Any] = {}
+        for f in self.fields:
+            if f.name in body and body[f.name] is not None:
+                out[f.name] = f.check(body[f.name])
+            elif f.required:
+                raise InvalidParameterError(f.name, None, f.allowed,
+                                            message=f"{f.name} is required; allowed: {f.allowed}")
+            else:
+                out[f.name] = f.default
+        if "params" in out:
+            out["params"] = design(out.pop("params") or {}, out.pop("material", None))
+        for low, high in (("v_min", "v_max"), ("fz_min", "fz_max")):
+            if low in out and high in out and not out[high] > out[low]:
+                raise InvalidParameterError(high, out[high], f"a number above {low} = {out[low]:g}",
+                                            f"must exceed {low}")
+        return out
+
+    def openapi(self) -> dict[str, Any]:
+        return {"type": "object", "additionalProperties": False,
+                "required": [f.name for f in self.fields if f.required],
+                "properties": {f.name: f.openapi() for f in self.fields}}
+
+
+def design(overrides: Mapping[str, Any], material: str | None) -> dict[str, float]:
+    """The complete parameter dict of a design: material preset, then overrides (validated)."""
+    params = Parameters()
+    if material is not None:
+        params = params.with_material(material)
+    for name, value in overrides.items():
+        if name not in PARAMETER_SPECS:
+            err = unknown_name_error(name, PARAMETER_SPECS)
+            raise InvalidParameterError(f"params.{name}", name, err.allowed, message=str(err))
+        if isinstance(value, str) or isinstance(value, bool) or value is None:
+            spec = PARAMETER_SPECS[name]
+            raise InvalidParameterError(f"params.{name}", value, spec.allowed, "is not a number")
+    try:
+        params = params.with_overrides(overrides)
+    except InvalidParameterError as exc:
+        name = exc.field if exc.field in PARAMETER_SPECS else next(iter(overrides), exc.field)
+        raise InvalidParameterError(f"params.{name}", exc.value, exc.allowed, message=str(exc)) from None
+    return params.to_dict()
+
+
+def _config(required: bool = True) -> Field:
+    return Field("config", "string", "configuration", required=required, choices=CONFIGS)
+
+
+PARAMS = Field("params", "object", "design overrides {name: value}; the rest at their defaults", default={})
+MATERIAL = Field("material", "string", "particle-damper material preset applied before params",
+                 choices=tuple(MATERIALS))
+V = Field("V", "number", "forward speed", required=True, low=V_RANGE[0], high=V_RANGE[1], unit="m/s")
+FZ = Field("Fz", "number", "vertical load", required=True, low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N")
+
+
+def _range(name: str, default: float, bounds: tuple[float, float], unit: str, what: str) -> Field:
+    return Field(name, "number", what, default=default, low=bounds[0], high=bounds[1], unit=unit)
+
+
+SCHEMAS: dict[str, RequestSchema] = {
+    "simulate": RequestSchema("simulate", "time history at one operating point", (
+        _config(), V, FZ,
+        Field("t_end", "number", "simulated time", default=60.0, low=0.1, high=600.0, unit="s"),
+        Field("include_series", "boolean", "return the time series (t, states, lateral)", default=False),
+        Field("series_dt", "number", "sampling interval of the returned series (a multiple of 1 ms)",
+              default=0.002, low=0.001, high=0.1, unit="s"),
+        Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
+        PARAMS, MATERIAL)),
+    "hopf": RequestSchema("hopf", "Hopf points of straight rolling in V at one load", (
+        _config(), FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),
+        _range("v_max", V_RANGE[1], V_RANGE, "m/s", "highest speed"), PARAMS, MATERIAL)),
+    "stability": RequestSchema("stability", "largest eigenvalue real part of x = 0 against V, all configurations", (
+        FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),
+        _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
+        Field("n_points", "integer", "speeds on a geometric grid", default=200, low=10, high=2000),
+        PARAMS, MATERIAL)),
+    "devices": RequestSchema("devices", "NES torque/stiffness and PD damping curves", (
+        Field("v_max", "number", "largest PD tangential speed", default=2.0, low=0.01, high=20.0, unit="m/s"),
+        PARAMS, MATERIAL)),
+    "bifurcation": RequestSchema("bifurcation", "bifurcation diagram in V (equilibrium and periodic branches)", (
+        _config(), FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),
+        _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
+        Field("ntst", "integer", "collocation mesh intervals", default=40, low=10, high=200),
+        Field("seeds", "boolean", "look for branches not born at a Hopf point by simulation", default=True),
+        PARAMS, MATERIAL)),
+    "hopf_curves": RequestSchema("hopf_curves", "Hopf curves of x = 0 in (V, Fz) with generalised Hopf points", (
+        _config(), _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),
+        _range("v_max", V_RANGE[1], V_RANGE, "m/s", "highest speed"),
+        _range("fz_min", FZ_RANGE[0], FZ_RANGE, "N", "lowest load"),
+        _range("fz_max", FZ_RANGE[1], FZ_RANGE, "N", "highest load"), PARAMS, MATERIAL)),
+}
+
+#: Analyses that run as background jobs (POST /api/v1/jobs).
+JOB_ANALYSES = ("simulate", "bifurcation", "hopf_curves")
+
+
+def validate(analysis: str, body: Any, extra: tuple[str, ...] = ()) -> dict[str, Any]:
+    if analysis not in SCHEMAS:
+        raise unknown_name_error(analysis, list(SCHEMAS), "analysis")
+    return SCHEMAS[analysis].validate(body, extra)
+
+
+def finite(x: float) -> float | None:
+    return float(x) if x is not None and math.isfinite(x) else None
