@@ -1,0 +1,141 @@
+"""Overview: the four configurations side by side at the current design."""
+
+from __future__ import annotations
+
+import dash
+from dash import Input, Output, State, dcc, html, no_update
+
+from shimmy.errors import InvalidParameterError
+from shimmy.service import analyses
+from ui import components as ui
+from ui.layout import page
+from ui import style
+
+dash.register_page(__name__, path="/", name="Overview", order=0)
+
+CONFIGS = ("original", "nes", "pd", "nes_pd")
+
+
+def layout(Fz: str = "150", vmax: str = "200", **query):
+    return layout_page(dict(query, Fz=Fz), [
+        ui.header("Overview", "Linear stability of straight rolling for the four configurations at the current "
+                  "design: the largest eigenvalue real part against speed (shimmy grows where it is positive), the "
+                  "Hopf speed interval of each, and the (V, Fz) stability boundary."),
+        html.Div([
+            ui.field("Vertical load Fz (kN)", dcc.Input(id="ov-fz", type="number", value=_number(Fz, 150), min=10,
+                                                       max=900, step="any", debounce=True)),
+            ui.field("Highest speed (m/s)", dcc.Input(id="ov-vmax", type="number", value=_number(vmax, 200), min=2,
+                                                     max=500, step="any", debounce=True)),
+        ], className="controls"),
+        html.Div(id="ov-error", className="error", role="alert"),
+        ui.graph("ov-growth"),
+        html.H2("Hopf speed interval at this load"),
+        html.Div(id="ov-table"),
+        ui.downloads("ov"),
+        dcc.Store(id="ov-data"),
+        html.H2("Stability boundary in (V, Fz)"),
+        html.P("Hopf curves of straight rolling: inside a closed curve, or above the lateral one, x = 0 is "
+               "unstable. Computed by two-parameter continuation; runs in the background.", className="hint"),
+        html.Div([html.Button("Compute boundary", id="ov-boundary-run"),
+                  html.Button("Cancel", id="ov-boundary-cancel", className="secondary", disabled=True),
+                  ui.progress_bar("ov-boundary")], className="controls"),
+        ui.graph("ov-boundary-graph", figure=style.message_figure("Press 'Compute boundary' (about 3 s cold, "
+                                                                   "instant when cached)")),
+    ])
+
+
+def layout_page(query, children):
+    return page(query, *children)
+
+
+def _number(raw, default):
+    try:
+        return float(raw)
+    except (TypeError, ValueError):
+        return default
+
+
+@dash.callback(
+    Output("ov-growth", "figure"), Output("ov-table", "children"), Output("ov-data", "data"),
+    Output("ov-error", "children"), Output("ov-csv", "disabled"), Output("ov-json", "disabled"),
+    Output("url-update", "data", allow_duplicate=True),
+    Input("design", "data"), Input("ov-fz", "value"), Input("ov-vmax", "value"),
+    prevent_initial_call="initial_duplicate",
+)
+def update(design, fz_kn, v_max):
+    if fz_kn is None or v_max is None:
+        return (no_update,) * 3 + ("Fz must be a number in [10, 900] kN and the highest speed in [2, 500] m/s",
+                                   True, True, no_update)
+    try:
+        result, _ = analyses.run("stability", {"Fz": float(fz_kn) * 1e3, "v_max": float(v_max), **design})
+    except InvalidParameterError as exc:
+        return no_update, no_update, no_update, str(exc), True, True, no_update
+    fig = style.figure(f"Growth rate of straight rolling at Fz = {fz_kn:g} kN", "forward speed V (m/s)",
+                       "largest eigenvalue real part (1/s)")
+    fig.add_hline(y=0, line={"color": "#888", "width": 1})
+    rows = []
+    base = result["configs"]["original"]["unstable_intervals"]
+    for config in CONFIGS:
+        data = result["configs"][config]
+        fig.add_scatter(x=result["V"], y=data["max_real"], mode="lines", name=style.CONFIG_LABELS[config],
+                        line={"color": style.CONFIG_COLOURS[config], "width": 2})
+        hv = [h["V"] for h in data["hopf_points"]]
+        if hv:
+            fig.add_scatter(x=hv, y=[0] * len(hv), mode="markers", showlegend=False,
+                            marker={"color": style.CONFIG_COLOURS[config], "size": 9, "symbol": "diamond"},
+                            hovertext=[f"{style.CONFIG_LABELS[config]} Hopf V = {v:.4g} m/s" for v in hv])
+        intervals = data["unstable_intervals"]
+        onset = intervals[0][0] if intervals else None
+        end = intervals[-1][1] if intervals else None
+        d_onset = None if onset is None or not base else onset - base[0][0]
+        freq = data["hopf_points"][0]["frequency_hz"] if data["hopf_points"] else None
+        rows.append([style.CONFIG_LABELS[config],
+                     ", ".join(f"{a:.4g}–{b:.4g}" for a, b in intervals) or "stable",
+                     ui.fmt(onset), ui.fmt(end), "–" if d_onset is None else f"{d_onset:+.3g}", ui.fmt(freq),
+                     ", ".join(h["criticality"] for h in data["hopf_points"]) or "–"])
+    fig.update_xaxes(type="log")
+    columns = ["configuration", "unstable for V in (m/s)", "onset (m/s)", "end (m/s)", "onset vs original (m/s)",
+               "onset frequency (Hz)", "criticality"]
+    table = ui.table(columns, rows, "ov-hopf-table")
+    return (fig, table, {"columns": columns, "rows": rows, "result": result}, "", False, False,
+            {"Fz": f"{float(fz_kn):g}", "vmax": f"{float(v_max):g}"})
+
+
+@dash.callback(Output("ov-download", "data"), Input("ov-csv", "n_clicks"), Input("ov-json", "n_clicks"),
+               State("ov-data", "data"), prevent_initial_call=True)
+def download(_csv, _json, data):
+    if not data:
+        return no_update
+    if dash.ctx.triggered_id == "ov-csv":
+        return {"content": ui.csv_text(data["columns"], data["rows"]), "filename": "overview_hopf.csv"}
+    return {"content": ui.json_text(data["result"]), "filename": "overview_stability.json"}
+
+
+@dash.callback(
+    Output("ov-boundary-graph", "figure"),
+    Input("ov-boundary-run", "n_clicks"), State("design", "data"),
+    background=True, prevent_initial_call=True,
+    running=[(Output("ov-boundary-run", "disabled"), True, False),
+             (Output("ov-boundary-cancel", "disabled"), False, True)],
+    cancel=[Input("ov-boundary-cancel", "n_clicks")],
+    progress=[Output("ov-boundary-progress", "value"), Output("ov-boundary-status", "children")],
+)
+def boundary(set_progress, _n, design):
+    fig = style.figure("Hopf curves of straight rolling", "forward speed V (m/s)", "vertical load Fz (kN)", 460)
+    for k, config in enumerate(CONFIGS):
+        def report(fraction, message, k=k, config=config):
+            set_progress((str(int(100 * (k + fraction) / len(CONFIGS))), f"{config}: {message}"))
+
+        result, _ = analyses.run("hopf_curves", {"config": config, "v_max": 300.0, **design}, report)
+        for i, curve in enumerate(result["curves"]):
+            fig.add_scatter(x=[p["V"] for p in curve["points"]], y=[p["Fz"] / 1e3 for p in curve["points"]],
+                            mode="lines", name=style.CONFIG_LABELS[config], legendgroup=config, showlegend=i == 0,
+                            line={"color": style.CONFIG_COLOURS[config], "width": 2})
+        gh = result["gh_points"]
+        if gh:
+            fig.add_scatter(x=[g["V"] for g in gh], y=[g["Fz"] / 1e3 for g in gh], mode="markers",
+                            name=f"{style.CONFIG_LABELS[config]} GH", legendgroup=config,
+                            marker={"color": style.CONFIG_COLOURS[config], "size": 10, "symbol": "star"})
+    set_progress(("100", "done"))
+    fig.update_xaxes(type="log")
+    return fig

@@ -1,0 +1,66 @@
+"""Small building blocks shared by the pages."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from typing import Any, Iterable
+
+from dash import dcc, html
+
+#: REFERENCE.md's operating points: name -> (V m/s, Fz kN).
+OPERATING_POINTS = {"A": (30, 150), "B": (110, 200), "C": (170, 150), "D": (50, 350), "E": (135, 350),
+                    "F": (180, 350), "G": (50, 550), "H": (110, 550), "I": (170, 550)}
+
+GRAPH_CONFIG = {"displaylogo": False, "toImageButtonOptions": {"format": "png", "scale": 2}}
+
+
+def header(title: str, lead: str) -> html.Div:
+    return html.Div([html.H1(title), html.P(lead, className="lead")], className="page-header")
+
+
+def graph(graph_id: str, **kwargs) -> dcc.Graph:
+    return dcc.Graph(id=graph_id, config=GRAPH_CONFIG, **kwargs)
+
+
+def downloads(prefix: str) -> html.Div:
+    """CSV and JSON download buttons (ids PREFIX-csv, PREFIX-json) and their dcc.Download."""
+    return html.Div([
+        html.Button("Download CSV", id=f"{prefix}-csv", className="secondary", disabled=True),
+        html.Button("Download JSON", id=f"{prefix}-json", className="secondary", disabled=True),
+        dcc.Download(id=f"{prefix}-download"),
+    ], className="downloads")
+
+
+def progress_bar(prefix: str) -> html.Div:
+    return html.Div([html.Progress(id=f"{prefix}-progress", value="0", max="100"),
+                     html.Span(id=f"{prefix}-status", className="status")], className="progress-row")
+
+
+def field(label: str, control, hint: str | None = None) -> html.Div:
+    return html.Div([html.Label(label), control, html.Small(hint) if hint else None], className="field")
+
+
+def table(columns: list[str], rows: Iterable[Iterable[Any]], table_id: str | None = None) -> html.Table:
+    kwargs = {"id": table_id} if table_id else {}
+    return html.Table([html.Thead(html.Tr([html.Th(c) for c in columns])),
+                       html.Tbody([html.Tr([html.Td(c) for c in r]) for r in rows])], className="data-table",
+                      **kwargs)
+
+
+def csv_text(columns: list[str], rows: Iterable[Iterable[Any]]) -> str:
+    out = io.StringIO()
+    w = csv.writer(out)
+    w.writerow(columns)
+    for r in rows:
+        w.writerow(r)
+    return out.getvalue()
+
+
+def json_text(payload: Any) -> str:
+    return json.dumps(payload, indent=1, allow_nan=False)
+
+
+def fmt(x: float | None, digits: int = 4) -> str:
+    return "–" if x is None else f"{x:.{digits}g}"

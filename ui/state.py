@@ -1,0 +1,63 @@
+"""The URL carries the design and the page state: ?r2=0.085&material=tungsten&config=nes&V=30.
+
+Design keys are the parameter names (only those that differ from the material's values are
+written); everything else is page state, kept as it is when the design changes.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+from urllib.parse import parse_qsl, urlencode
+
+from shimmy.errors import InvalidParameterError
+from shimmy.parameters import MATERIALS, PARAMETER_SPECS, Parameters
+
+DEFAULT_MATERIAL = "steel"
+
+
+def parse(search: str | None) -> dict[str, str]:
+    return dict(parse_qsl((search or "").lstrip("?"), keep_blank_values=False))
+
+
+def build(query: dict[str, Any]) -> str:
+    clean = {k: v for k, v in query.items() if v is not None and v != ""}
+    return "?" + urlencode(clean) if clean else ""
+
+
+def material_params(material: str) -> dict[str, float]:
+    return Parameters().with_material(material).to_dict()
+
+
+def design_from_query(query: dict[str, str]) -> tuple[str, dict[str, float], list[str]]:
+    """(material, complete parameter values, problems) from URL keys; bad keys are reported, not applied."""
+    problems = []
+    material = query.get("material", DEFAULT_MATERIAL)
+    if material not in MATERIALS:
+        problems.append(f"material={material!r} is not one of {', '.join(MATERIALS)}; using {DEFAULT_MATERIAL}")
+        material = DEFAULT_MATERIAL
+    values = material_params(material)
+    for name, raw in query.items():
+        if name not in PARAMETER_SPECS:
+            continue
+        try:
+            Parameters().with_overrides({name: raw})
+            values[name] = float(raw)
+        except InvalidParameterError as exc:
+            problems.append(str(exc))
+    return material, values, problems
+
+
+def design_query(material: str, values: dict[str, float]) -> dict[str, Any]:
+    """The URL keys of a design: the material (if not the default) and the values that differ from it."""
+    base = material_params(material)
+    out: dict[str, Any] = {"material": None if material == DEFAULT_MATERIAL else material}
+    for name, value in values.items():
+        if value is not None and name in base and abs(float(value) - base[name]) > 1e-12 * max(1.0, abs(base[name])):
+            out[name] = f"{float(value):.10g}"
+    return out
+
+
+def design_request(material: str, values: dict[str, float]) -> dict[str, Any]:
+    """The {"material", "params"} part of a service request for this design."""
+    overrides = {k: v for k, v in design_query(material, values).items() if k != "material" and v is not None}
+    return {"material": material, "params": {k: float(v) for k, v in overrides.items()}}

@@ -1,0 +1,32 @@
+"""Colours and figure defaults shared by every page (Okabe–Ito, colour-blind safe)."""
+
+from __future__ import annotations
+
+import plotly.graph_objects as go
+
+CONFIG_COLOURS = {"original": "#000000", "nes": "#E69F00", "pd": "#0072B2", "nes_pd": "#009E73"}
+CONFIG_LABELS = {"original": "original", "nes": "NES", "pd": "PD", "nes_pd": "NES + PD"}
+SHIMMY_TYPE_COLOURS = {"Stable": "#FFFFFF", "Torsion": "#E69F00", "Lateral": "#56B4E9", "Bistable": "#CC79A7",
+                       "Both": "#D55E00"}
+ACCENT = "#0072B2"
+
+
+def figure(title: str, x: str, y: str, height: int = 380) -> go.Figure:
+    """An empty figure with axis titles (units included by the caller) and the house style."""
+    fig = go.Figure()
+    fig.update_layout(title={"text": title, "x": 0.01, "font": {"size": 15}}, height=height,
+                      margin={"l": 64, "r": 16, "t": 44, "b": 52}, template="plotly_white",
+                      legend={"orientation": "h", "y": -0.22, "x": 0}, hovermode="closest",
+                      font={"family": "system-ui, -apple-system, Segoe UI, Roboto, sans-serif", "size": 12})
+    fig.update_xaxes(title_text=x, showline=True, linecolor="#888", mirror=True, zeroline=False)
+    fig.update_yaxes(title_text=y, showline=True, linecolor="#888", mirror=True, zeroline=False)
+    return fig
+
+
+def message_figure(text: str, height: int = 300) -> go.Figure:
+    fig = go.Figure()
+    fig.add_annotation(text=text, showarrow=False, x=0.5, y=0.5, xref="paper", yref="paper",
+                       font={"size": 14, "color": "#555"})
+    fig.update_layout(height=height, template="plotly_white", xaxis={"visible": False}, yaxis={"visible": False},
+                      margin={"l": 10, "r": 10, "t": 10, "b": 10})
+    return fig
