@@ -8,7 +8,7 @@ from dash import Input, Output, State, dcc, html, no_update
 from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
-from ui.layout import page
+from ui.layout import design_id, page
 from ui import style
 
 dash.register_page(__name__, path="/", name="Overview", order=0)
@@ -45,7 +45,7 @@ def layout(Fz: str = "150", vmax: str = "200", **query):
 
 
 def layout_page(query, children):
-    return page(query, *children)
+    return page(query, "ov", *children)
 
 
 def _number(raw, default):
@@ -59,7 +59,7 @@ def _number(raw, default):
     Output("ov-growth", "figure"), Output("ov-table", "children"), Output("ov-data", "data"),
     Output("ov-error", "children"), Output("ov-csv", "disabled"), Output("ov-json", "disabled"),
     Output("url-update", "data", allow_duplicate=True),
-    Input("design", "data"), Input("ov-fz", "value"), Input("ov-vmax", "value"),
+    Input(design_id("ov"), "data"), Input("ov-fz", "value"), Input("ov-vmax", "value"),
     prevent_initial_call="initial_duplicate",
 )
 def update(design, fz_kn, v_max):
@@ -113,7 +113,7 @@ def download(_csv, _json, data):
 
 @dash.callback(
     Output("ov-boundary-graph", "figure"),
-    Input("ov-boundary-run", "n_clicks"), State("design", "data"),
+    Input("ov-boundary-run", "n_clicks"), State(design_id("ov"), "data"),
     background=True, prevent_initial_call=True,
     running=[(Output("ov-boundary-run", "disabled"), True, False),
              (Output("ov-boundary-cancel", "disabled"), False, True)],

@@ -45,10 +45,16 @@ def _number(name: str, value: float) -> html.Div:
     ], className="number-row")
 
 
-def design_panel(query: dict[str, str]) -> html.Aside:
+def design_id(page_id: str) -> dict[str, str]:
+    """Id of a page's design store. Each page has its own so that its callbacks' inputs all live
+    on that page (a callback with an input missing from the layout is an error in the browser)."""
+    return {"type": "design", "page": page_id}
+
+
+def design_panel(query: dict[str, str], page_id: str) -> html.Aside:
     material, values, problems = state.design_from_query(query)
     return html.Aside([
-        dcc.Store(id="design", data=state.design_request(material, values)),
+        dcc.Store(id=design_id(page_id), data=state.design_request(material, values)),
         dcc.Store(id="url-update"), html.Div(id="url-sink", hidden=True),
         html.H2("Design"),
         html.Div([html.Label("PD material", htmlFor="material"),
@@ -63,13 +69,13 @@ def design_panel(query: dict[str, str]) -> html.Aside:
     ], className="design-panel", id="design-panel")
 
 
-def page(query: dict[str, str], *children) -> html.Div:
+def page(query: dict[str, str], page_id: str, *children) -> html.Div:
     """A page: the design panel (always at hand, initialised from the URL) beside the content.
 
     Every page carries its own panel so that page callbacks reading the design never meet a
     layout without their inputs (Dash reports such callbacks as errors in the browser).
     """
-    return html.Div([design_panel(query), html.Main(list(children), className="page")], className="body")
+    return html.Div([design_panel(query, page_id), html.Main(list(children), className="page")], className="body")
 
 
 def navigation() -> html.Nav:
@@ -117,7 +123,7 @@ dash.clientside_callback(
     Output({"type": "param", "name": ALL}, "value"),
     Output("material", "value"),
     Output("url-update", "data", allow_duplicate=True),
-    Output("design", "data"),
+    Output({"type": "design", "page": ALL}, "data"),
     Output("design-error", "children"),
     Input({"type": "param", "name": ALL}, "value"),
     Input("material", "value"),
@@ -133,7 +139,7 @@ def sync_design(values, material, _reset, ids):
         material = state.DEFAULT_MATERIAL
         full = state.material_params(material)
         return ([full[n] for n in names], material, _url_keys(material, full),
-                state.design_request(material, full), "")
+                [state.design_request(material, full)], "")
     current = dict(zip(names, values, strict=True))
     if trigger == "material":
         current.update(MATERIALS[material])
@@ -154,7 +160,7 @@ def sync_design(values, material, _reset, ids):
     except (InvalidParameterError, ValueError) as exc:  # e.g. an NES geometry off its track
         return no_update, no_update, no_update, no_update, f"design not applied: {exc}"
     outputs = [full[n] for n in names] if trigger == "material" else [no_update] * len(names)
-    return (outputs, no_update, _url_keys(material, full), state.design_request(material, full),
+    return (outputs, no_update, _url_keys(material, full), [state.design_request(material, full)],
             "; ".join(problems))
 
 

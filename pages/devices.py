@@ -1,0 +1,77 @@
+"""Devices: the NES restoring torque and stiffness (exact against cubic) and the PD damping."""
+
+from __future__ import annotations
+
+import dash
+from dash import Input, Output, State, html, no_update
+
+from shimmy.errors import InvalidParameterError
+from shimmy.service import analyses
+from ui import components as ui
+from ui import style
+from ui.layout import design_id, page
+
+dash.register_page(__name__, path="/devices", name="Devices", order=1)
+
+MATERIAL_COLOURS = {"design": "#009E73", "steel": "#0072B2", "tungsten": "#D55E00"}
+
+
+def layout(**query):
+    return page(query, "dev",
+                ui.header("Devices", "The torsional NES: restoring torque and stiffness of the roller-spring "
+                          "geometry against the cubic fit the dynamics use, over the angle range where the roller "
+                          "stays on its track (|a| < pi/6). The particle damper: equivalent torsional damping "
+                          "against tangential speed for steel shot and tungsten powder at the current filling."),
+                html.Div(id="dev-error", className="error", role="alert"),
+                html.Div(id="dev-metrics", className="metrics"),
+                html.Div([ui.graph("dev-torque"), ui.graph("dev-stiffness")], className="grid-2"),
+                ui.graph("dev-pd"),
+                ui.downloads("dev"))
+
+
+@dash.callback(Output("dev-torque", "figure"), Output("dev-stiffness", "figure"), Output("dev-pd", "figure"),
+               Output("dev-metrics", "children"), Output("dev-error", "children"), Output("dev-csv", "disabled"),
+               Output("dev-json", "disabled"), Input(design_id("dev"), "data"))
+def update(design):
+    try:
+        result, _ = analyses.run("devices", design)
+    except InvalidParameterError as exc:
+        return no_update, no_update, no_update, no_update, str(exc), True, True
+    nes = result["nes"]
+    torque = style.figure("NES restoring torque", "relative rotation a = psi - psis (rad)", "torque M (N m)")
+    torque.add_scatter(x=nes["angle"], y=nes["torque_exact"], name="exact geometry", line={"color": "#000"})
+    torque.add_scatter(x=nes["angle"], y=nes["torque_cubic"], name="cubic fit k1 a + k3 a^3",
+                       line={"color": "#E69F00", "dash": "dash"})
+    stiff = style.figure("NES stiffness", "relative rotation a (rad)", "stiffness dM/da (N m/rad)")
+    stiff.add_scatter(x=nes["angle"], y=nes["stiffness_exact"], name="exact geometry", line={"color": "#000"})
+    stiff.add_scatter(x=nes["angle"], y=nes["stiffness_cubic"], name="cubic fit k1 + 3 k3 a^2",
+                      line={"color": "#E69F00", "dash": "dash"})
+    pd = style.figure("Particle damper: equivalent torsional damping", "tangential speed v = r |dpsi| (m/s)",
+                      "c_eq = n r^2 c*(v) (N m s/rad)")
+    for curve in result["pd"]:
+        current = curve["material"] == "design"
+        pd.add_scatter(x=curve["speed"], y=curve["torsional_damping"],
+                       name="current design" if current else f"{curve['material']} preset",
+                       line={"color": MATERIAL_COLOURS.get(curve["material"], "#555"), "width": 3 if current else 2,
+                             "dash": "solid" if current else "dot"})
+    errors = result["nes_cubic_error"]
+    metrics = [_metric("k1 (N m/rad)", f"{nes['k1']:.5g}"), _metric("k3 (N m/rad^3)", f"{nes['k3']:.5g}")]
+    metrics += [_metric(f"cubic error, |a| <= {a} rad", f"{100 * e:.2f} %") for a, e in errors.items()]
+    return torque, stiff, pd, metrics, "", False, False
+
+
+def _metric(label: str, value: str) -> html.Div:
+    return html.Div([html.Div(value, className="value"), html.Div(label, className="label")], className="metric")
+
+
+@dash.callback(Output("dev-download", "data"), Input("dev-csv", "n_clicks"), Input("dev-json", "n_clicks"),
+               State(design_id("dev"), "data"), prevent_initial_call=True)
+def download(_csv, _json, design):
+    result, _ = analyses.run("devices", design)
+    if dash.ctx.triggered_id == "dev-json":
+        return {"content": ui.json_text(result), "filename": "devices.json"}
+    nes = result["nes"]
+    rows = zip(nes["angle"], nes["torque_exact"], nes["torque_cubic"], nes["stiffness_exact"], nes["stiffness_cubic"],
+               strict=True)
+    return {"content": ui.csv_text(["angle_rad", "torque_exact_Nm", "torque_cubic_Nm", "stiffness_exact_Nm_rad",
+                                    "stiffness_cubic_Nm_rad"], rows), "filename": "nes_curves.csv"}
