@@ -15,7 +15,8 @@ MAX_T_END = 600.0  # s of simulated time per request
 MAX_SERIES_POINTS = 200_000  # samples per returned time series (t_end / dt_out)
 MAX_NTST = 200
 MAX_RUNNING_JOBS = 2  # at most this many analyses run at once on this host; others wait queued
-JOB_STALE_SECONDS = 30.0  # a running job whose heartbeat is older than this has lost its worker
+#: A queued/running job whose heartbeat is older than this has lost its worker (SHIMMY_JOB_STALE_SECONDS).
+JOB_STALE_SECONDS = float(os.environ.get("SHIMMY_JOB_STALE_SECONDS", "30"))
 
 
 def cache_dir() -> pathlib.Path:

@@ -1,0 +1,191 @@
+"""HTTP API against a real gunicorn server (2 workers, shared cache directory)."""
+
+from __future__ import annotations
+
+import concurrent.futures
+import os
+import signal
+import time
+
+import pytest
+
+OK_BODIES = {
+    "/api/v1/simulate": {"config": "nes_pd", "V": 30, "Fz": 150000, "t_end": 20},
+    "/api/v1/hopf": {"config": "nes", "Fz": 150000, "v_max": 200},
+    "/api/v1/stability": {"Fz": 150000, "v_max": 200, "n_points": 50},
+    "/api/v1/devices": {"v_max": 1.0},
+}
+
+
+def test_health_and_parameters(server):
+    status, _, body = server.request("GET", "/api/v1/health")
+    assert status == 200 and body["status"] == "ok"
+    status, _, body = server.request("GET", "/api/v1/parameters")
+    names = {p["name"] for p in body["parameters"]}
+    assert status == 200 and {"r2", "e_p", "k_s", "r3", "a_p", "rho_p", "k_lam"} <= names
+    r2 = next(p for p in body["parameters"] if p["name"] == "r2")
+    assert (r2["low"], r2["high"], r2["unit"]) == (0.07, 0.09, "m")
+
+
+def test_simulate_matches_the_package_and_is_cached(server):
+    import shimmy
+
+    body = {"config": "nes_pd", "V": 30, "Fz": 150000, "t_end": 20, "params": {"r2": 0.085}}
+    status, headers, first = server.request("POST", "/api/v1/simulate", body)
+    assert status == 200
+    direct = shimmy.simulate("nes_pd", 30, 150000, shimmy.Parameters().with_overrides(r2=0.085), t_end=20)
+    assert first["amplitude"]["psi"] == pytest.approx(direct.amplitude["psi"], rel=1e-12)
+    status, headers, second = server.request("POST", "/api/v1/simulate", body)
+    assert headers["X-Shimmy-Cache"] == "hit" and second == first
+    # Same design said differently (default values spelled out) -> same cache entry.
+    status, headers, _ = server.request("POST", "/api/v1/simulate", {**body, "params": {"r2": 0.085, "r3": 0.01}})
+    assert headers["X-Shimmy-Cache"] == "hit"
+
+
+def test_series_and_spectrum(server):
+    status, _, body = server.request("POST", "/api/v1/simulate", {**OK_BODIES["/api/v1/simulate"],
+                                                                  "include_series": True, "series_dt": 0.005})
+    assert status == 200
+    assert len(body["series"]["t"]) == pytest.approx(20 / 0.005 + 1, abs=1)
+    assert body["spectrum"]["dominant_hz"] == pytest.approx(body["frequency_hz"])
+
+
+# Bad inputs for every endpoint: (path, body or raw bytes, expected status, field named).
+BAD = [
+    (path, {**ok, **change}, status, field)
+    for path, ok in OK_BODIES.items()
+    for change, status, field in [
+        ({"params": {"r2": 0.5}}, 422, "params.r2"),
+        ({"params": {"nonsense": 1}}, 422, "params.nonsense"),
+        ({"params": {"r2": "abc"}}, 422, "params.r2"),
+        ({"params": 3}, 422, "params"),
+        ({"material": "gold"}, 422, "material"),
+        ({"surprise": 1}, 422, "surprise"),
+    ]
+] + [
+    ("/api/v1/simulate", {"config": "nes_pd", "V": 30}, 422, "Fz"),
+    ("/api/v1/simulate", {"config": "nes", "V": "fast", "Fz": 150000}, 422, "V"),
+    ("/api/v1/simulate", {"config": "nes", "V": 1e6, "Fz": 150000}, 422, "V"),
+    ("/api/v1/simulate", {"config": "nes", "V": 30, "Fz": 150000, "t_end": 1e5}, 422, "t_end"),
+    ("/api/v1/simulate", {"config": "nesx", "V": 30, "Fz": 150000}, 422, "config"),
+    ("/api/v1/simulate", {"config": "nes", "V": True, "Fz": 150000}, 422, "V"),
+    ("/api/v1/simulate", b'{"config": "nes", "V": NaN, "Fz": 150000}', 422, "V"),
+    ("/api/v1/simulate", b'{"config": "nes", "V": 30, "Fz": Infinity}', 422, "Fz"),
+    ("/api/v1/simulate", b'{"config": ', 400, "body"),
+    ("/api/v1/simulate", b"[1, 2]", 400, "body"),
+    ("/api/v1/simulate", b"", 400, "body"),
+    ("/api/v1/simulate", b" " * 70000, 413, "body"),
+    ("/api/v1/hopf", {"config": "nes", "Fz": 150000, "v_min": 100, "v_max": 50}, 422, "v_max"),
+    ("/api/v1/hopf", {"Fz": 150000}, 422, "config"),
+    ("/api/v1/stability", {"Fz": 150000, "n_points": 1e6}, 422, "n_points"),
+    ("/api/v1/stability", {"Fz": 150000, "n_points": 20.5}, 422, "n_points"),
+    ("/api/v1/devices", {"v_max": -1}, 422, "v_max"),
+    ("/api/v1/jobs", {"config": "nes", "Fz": 150000}, 422, "analysis"),
+    ("/api/v1/jobs", {"analysis": "dance"}, 422, "analysis"),
+    ("/api/v1/jobs", {"analysis": "bifurcation", "config": "nes", "Fz": 150000, "ntst": 5000}, 422, "ntst"),
+    ("/api/v1/jobs", {"analysis": "bifurcation", "config": "nes"}, 422, "Fz"),
+    ("/api/v1/jobs", {"analysis": "hopf_curves", "config": "nes", "fz_min": 5e5, "fz_max": 1e5}, 422, "fz_max"),
+    ("/api/v1/jobs", {"analysis": "simulate", "config": "nes", "V": 30, "Fz": 150000, "t_end": -1}, 422, "t_end"),
+]
+
+
+@pytest.mark.parametrize("path,body,status,field", BAD, ids=[f"{p}-{f}-{i}" for i, (p, _, _, f) in enumerate(BAD)])
+def test_bad_input_gets_4xx_naming_the_field(server, path, body, status, field):
+    raw = body if isinstance(body, bytes) else None
+    got, _, answer = server.request("POST", path, None if raw is not None else body, raw=raw)
+    assert got == status, answer
+    assert answer["field"] == field
+    assert set(answer) == {"error", "field", "allowed"} and answer["allowed"]
+    assert field.split(".")[-1] in answer["error"] or field == "body"
+
+
+def test_unknown_paths_methods_and_jobs(server):
+    status, _, body = server.request("GET", "/api/v1/nothing")
+    assert status == 404 and body["field"] == "path"
+    status, _, body = server.request("GET", "/api/v1/simulate")
+    assert status == 405 and body["allowed"] == "POST"
+    status, _, body = server.request("GET", "/api/v1/jobs/doesnotexist")
+    assert status == 404 and body["field"] == "id"
+    status, _, body = server.request("DELETE", "/api/v1/jobs/doesnotexist")
+    assert status == 404
+
+
+def test_openapi_document_lists_every_endpoint_and_field(server):
+    status, _, doc = server.request("GET", "/api/v1/openapi.json")
+    assert status == 200 and doc["openapi"].startswith("3.")
+    assert {"/health", "/parameters", "/simulate", "/hopf", "/jobs", "/jobs/{id}"} <= set(doc["paths"])
+    sim = doc["components"]["schemas"]["simulate_request"]
+    assert sim["properties"]["V"]["minimum"] == 1 and sim["properties"]["V"]["maximum"] == 500
+    assert set(sim["required"]) == {"config", "V", "Fz"}
+
+
+def test_forty_concurrent_requests_all_answered(server):
+    bodies = [{"config": c, "V": v, "Fz": 150000, "t_end": 5} for c in ("original", "nes", "pd", "nes_pd")
+              for v in (10, 20, 30, 40, 50)]
+    bodies += bodies  # half of them repeat: cache hits under concurrency
+
+    def one(body):
+        return server.request("POST", "/api/v1/simulate", body, timeout=120)
+
+    with concurrent.futures.ThreadPoolExecutor(40) as pool:
+        answers = list(pool.map(one, bodies))
+    assert len(answers) == 40 and all(status == 200 for status, _, _ in answers)
+    by_key = {}
+    for body, (_, _, result) in zip(bodies, answers, strict=True):
+        by_key.setdefault((body["config"], body["V"]), set()).add(result["amplitude"]["psi"])
+    assert all(len(v) == 1 for v in by_key.values())
+
+
+def _wait(server, job_id, until=("done", "failed", "cancelled"), timeout=120):
+    seen = []
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        _, _, job = server.request("GET", f"/api/v1/jobs/{job_id}")
+        seen.append((job["status"], job["progress"]))
+        if job["status"] in until:
+            return job, seen
+        time.sleep(0.2)
+    raise AssertionError(f"job {job_id} still {seen[-1]} after {timeout} s")
+
+
+def test_job_runs_to_completion_with_progress_and_is_cached(server):
+    body = {"analysis": "bifurcation", "config": "original", "Fz": 150000, "v_min": 1, "v_max": 200}
+    status, headers, job = server.request("POST", "/api/v1/jobs", body)
+    assert status == 202 and job["status"] in ("queued", "running") and headers["Location"].endswith(job["id"])
+    done, seen = _wait(server, job["id"])
+    assert done["status"] == "done" and done["progress"] == 1.0
+    assert done["result"]["max_psi"] == pytest.approx(0.2148, abs=1e-3)
+    progress = [p for s, p in seen if s == "running"]
+    assert progress == sorted(progress)  # monotone
+    # The same request again: done at once from the cache.
+    status, _, again = server.request("POST", "/api/v1/jobs", body)
+    assert status == 202 and again["status"] == "done"
+
+
+def test_job_cancelled(server):
+    body = {"analysis": "hopf_curves", "config": "nes", "v_max": 480}
+    status, _, job = server.request("POST", "/api/v1/jobs", body)
+    assert status == 202
+    _wait(server, job["id"], until=("running",), timeout=60)
+    status, _, cancelled = server.request("DELETE", f"/api/v1/jobs/{job['id']}")
+    assert status == 200 and cancelled["status"] == "cancelled"
+    time.sleep(1.5)
+    _, _, later = server.request("GET", f"/api/v1/jobs/{job['id']}")
+    assert later["status"] == "cancelled" and "result" not in later
+
+
+def test_job_whose_worker_dies_is_failed_not_running_forever(server):
+    """A worker killed mid-job (as by a server restart) stops its heartbeat: the job turns failed."""
+    from shimmy.service import jobs
+
+    os.environ["SHIMMY_CACHE_DIR"] = str(server.cache_dir)
+    try:
+        body = {"analysis": "hopf_curves", "config": "original", "v_max": 470}
+        _, _, job = server.request("POST", "/api/v1/jobs", body)
+        _wait(server, job["id"], until=("running",), timeout=60)
+        pid = jobs.store().get(("job", job["id"]))["pid"]
+        os.killpg(pid, signal.SIGKILL)
+        failed, _ = _wait(server, job["id"], until=("failed", "done"), timeout=30)
+        assert failed["status"] == "failed" and "heartbeat" in failed["error"]
+    finally:
+        os.environ.pop("SHIMMY_CACHE_DIR", None)

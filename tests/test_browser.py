@@ -1,0 +1,151 @@
+"""The workbench in real headless Chromium (Debian chromium + chromedriver) against gunicorn.
+
+The test setup installs the two Debian packages when they are missing (CI runs as root).
+Screenshots of every page go to screenshots/ (not committed) for a person to look at.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+selenium = pytest.importorskip("selenium")
+from selenium import webdriver  # noqa: E402
+from selenium.webdriver.chrome.service import Service  # noqa: E402
+from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.webdriver.common.keys import Keys  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+SHOTS = ROOT / "screenshots"
+CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
+PAGES = {"overview": "/", "devices": "/devices", "time-history": "/time-history", "bifurcation": "/bifurcation",
+         "validation": "/validation", "api": "/api"}
+
+
+def _ensure_chromium() -> None:
+    if os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER):
+        return
+    if os.geteuid() != 0 or not shutil.which("apt-get"):
+        pytest.fail("Debian chromium and chromium-driver are needed and cannot be installed here (not root)")
+    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
+    subprocess.run(["apt-get", "update", "-qq"], check=True, env=env)
+    subprocess.run(["apt-get", "install", "-y", "-qq", "chromium", "chromium-driver"], check=True, env=env)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    _ensure_chromium()
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = CHROMIUM
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                "--disable-dev-shm-usage", "--window-size=1500,1100"):
+        opts.add_argument(arg)
+    opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / 'chromium-profile'}")
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
+    driver.set_page_load_timeout(60)
+    SHOTS.mkdir(exist_ok=True)
+    yield driver
+    driver.quit()
+
+
+def _severe(driver) -> list[str]:
+    return [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+
+
+def _wait_for(predicate, timeout=60.0, interval=0.1, what="condition"):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(interval)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def _idle(driver, timeout=60.0):
+    """Dash has no callback in flight (the renderer sets data-dash-is-loading on busy components)."""
+    _wait_for(lambda: not driver.find_elements(By.CSS_SELECTOR, "[data-dash-is-loading='true']"), timeout,
+              what="Dash to be idle")
+
+
+@pytest.mark.parametrize("name", list(PAGES))
+def test_every_page_loads_without_console_errors(server, browser, name):
+    browser.get_log("browser")  # drop what earlier tests left
+    browser.get(server.base + PAGES[name] + "?e_p=0.002")
+    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, ".page-header h1"), what="the page header")
+    _idle(browser)
+    time.sleep(1.0)
+    browser.save_screenshot(str(SHOTS / f"{name}.png"))
+    assert _severe(browser) == []
+    # The design panel is on every page and took the design from the URL.
+    assert "Design" in browser.find_element(By.ID, "design-panel").text
+
+
+def _nes_onset(driver) -> str:
+    rows = driver.find_elements(By.CSS_SELECTOR, "#ov-hopf-table tbody tr")
+    return rows[1].find_elements(By.TAG_NAME, "td")[2].text if len(rows) > 1 else ""
+
+
+def test_slider_move_updates_the_linear_stability_figure_and_the_url(server, browser):
+    browser.get(server.base + "/")
+    before = _wait_for(lambda: _nes_onset(browser), what="the Hopf table")
+    traces_before = browser.execute_script(
+        "return document.getElementById('ov-growth').getElementsByClassName('js-plotly-plot')[0].data.find(t => t.name === 'NES').y;")
+    handle = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]  # r2
+    handle.click()
+    for _ in range(20):
+        handle.send_keys(Keys.ARROW_RIGHT)
+    after = _wait_for(lambda: (v := _nes_onset(browser)) != before and v, timeout=20, what="the table to change")
+    assert after != before
+    traces_after = browser.execute_script(
+        "return document.getElementById('ov-growth').getElementsByClassName('js-plotly-plot')[0].data.find(t => t.name === 'NES').y;")
+    assert traces_after != traces_before
+    _wait_for(lambda: "r2=" in browser.current_url, timeout=10, what="the URL to carry r2")
+    # The link reproduces the view.
+    url = browser.current_url
+    browser.get(url)
+    assert _wait_for(lambda: _nes_onset(browser), what="the table after reload") == after
+    browser.save_screenshot(str(SHOTS / "overview-after-slider.png"))
+    assert _severe(browser) == []
+
+
+def test_background_job_shows_progress_then_its_figure(server, browser):
+    browser.get(server.base + "/bifurcation?configs=original,nes&Fz=160")
+    run = _wait_for(lambda: browser.find_elements(By.ID, "bif-run"), what="the Compute button")[0]
+    _idle(browser)
+    run.click()
+    progress_seen = _wait_for(lambda: (browser.find_element(By.ID, "bif-status").text
+                                       or None), timeout=30, interval=0.05, what="a progress message")
+    assert progress_seen
+    assert browser.find_element(By.ID, "bif-cancel").is_enabled()
+    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#bif-summary tbody tr"), timeout=120,
+              what="the result table")
+    n_traces = browser.execute_script(
+        "return document.getElementById('bif-graph').getElementsByClassName('js-plotly-plot')[0].data.length;")
+    assert n_traces > 4
+    rows = browser.find_elements(By.CSS_SELECTOR, "#bif-summary tbody tr")
+    assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["original", "NES"]
+    assert not browser.find_element(By.ID, "bif-run").get_attribute("disabled")
+    browser.save_screenshot(str(SHOTS / "bifurcation-result.png"))
+    assert _severe(browser) == []
+
+
+def test_time_history_operating_point_button(server, browser):
+    browser.get(server.base + "/time-history")
+    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#th-metrics .metric"), timeout=60,
+              what="the first run")
+    first = browser.find_element(By.ID, "th-metrics").text
+    button = next(b for b in browser.find_elements(By.CSS_SELECTOR, ".op-buttons button") if b.text.startswith("D"))
+    button.click()
+    _wait_for(lambda: browser.find_element(By.ID, "th-metrics").text not in ("", first), timeout=60,
+              what="the run at point D")
+    assert "D" and "350" in browser.find_element(By.CSS_SELECTOR, "#th-series .gtitle").text
+    _wait_for(lambda: "Fz=350" in browser.current_url, timeout=10, what="the URL to carry the point")
+    assert _severe(browser) == []
