@@ -88,6 +88,10 @@ def test_every_page_loads_without_console_errors(server, browser, name):
     assert "Design" in browser.find_element(By.ID, "design-panel").text
 
 
+NES_TRACE = ("return document.getElementById('ov-growth').getElementsByClassName('js-plotly-plot')[0]"
+             ".data.find(t => t.name === 'NES').y;")
+
+
 def _nes_onset(driver) -> str:
     rows = driver.find_elements(By.CSS_SELECTOR, "#ov-hopf-table tbody tr")
     return rows[1].find_elements(By.TAG_NAME, "td")[2].text if len(rows) > 1 else ""
@@ -96,16 +100,14 @@ def _nes_onset(driver) -> str:
 def test_slider_move_updates_the_linear_stability_figure_and_the_url(server, browser):
     browser.get(server.base + "/")
     before = _wait_for(lambda: _nes_onset(browser), what="the Hopf table")
-    traces_before = browser.execute_script(
-        "return document.getElementById('ov-growth').getElementsByClassName('js-plotly-plot')[0].data.find(t => t.name === 'NES').y;")
+    traces_before = browser.execute_script(NES_TRACE)
     handle = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]  # r2
     handle.click()
     for _ in range(20):
         handle.send_keys(Keys.ARROW_RIGHT)
     after = _wait_for(lambda: (v := _nes_onset(browser)) != before and v, timeout=20, what="the table to change")
     assert after != before
-    traces_after = browser.execute_script(
-        "return document.getElementById('ov-growth').getElementsByClassName('js-plotly-plot')[0].data.find(t => t.name === 'NES').y;")
+    traces_after = browser.execute_script(NES_TRACE)
     assert traces_after != traces_before
     _wait_for(lambda: "r2=" in browser.current_url, timeout=10, what="the URL to carry r2")
     # The link reproduces the view.
@@ -146,6 +148,6 @@ def test_time_history_operating_point_button(server, browser):
     button.click()
     _wait_for(lambda: browser.find_element(By.ID, "th-metrics").text not in ("", first), timeout=60,
               what="the run at point D")
-    assert "D" and "350" in browser.find_element(By.CSS_SELECTOR, "#th-series .gtitle").text
+    assert "Fz = 350 kN" in browser.find_element(By.CSS_SELECTOR, "#th-series .gtitle").text
     _wait_for(lambda: "Fz=350" in browser.current_url, timeout=10, what="the URL to carry the point")
     assert _severe(browser) == []
