@@ -70,20 +70,19 @@ def update(design, fz_kn, v_max):
         result, _ = analyses.run("stability", {"Fz": float(fz_kn) * 1e3, "v_max": float(v_max), **design})
     except InvalidParameterError as exc:
         return no_update, no_update, no_update, str(exc), True, True, no_update
-    fig = style.figure(f"Growth rate of straight rolling at Fz = {fz_kn:g} kN", "forward speed V (m/s)",
-                       "largest eigenvalue real part (1/s)")
-    fig.add_hline(y=0, line={"color": "#888", "width": 1})
+    traces = []
     rows = []
     base = result["configs"]["original"]["unstable_intervals"]
     for config in CONFIGS:
         data = result["configs"][config]
-        fig.add_scatter(x=result["V"], y=data["max_real"], mode="lines", name=style.CONFIG_LABELS[config],
-                        line={"color": style.CONFIG_COLOURS[config], "width": 2})
+        traces.append({"type": "scatter", "x": result["V"], "y": data["max_real"], "mode": "lines",
+                       "name": style.CONFIG_LABELS[config],
+                       "line": {"color": style.CONFIG_COLOURS[config], "width": 2}})
         hv = [h["V"] for h in data["hopf_points"]]
         if hv:
-            fig.add_scatter(x=hv, y=[0] * len(hv), mode="markers", showlegend=False,
-                            marker={"color": style.CONFIG_COLOURS[config], "size": 9, "symbol": "diamond"},
-                            hovertext=[f"{style.CONFIG_LABELS[config]} Hopf V = {v:.4g} m/s" for v in hv])
+            traces.append({"type": "scatter", "x": hv, "y": [0] * len(hv), "mode": "markers", "showlegend": False,
+                           "marker": {"color": style.CONFIG_COLOURS[config], "size": 9, "symbol": "diamond"},
+                           "hovertext": [f"{style.CONFIG_LABELS[config]} Hopf V = {v:.4g} m/s" for v in hv]})
         intervals = data["unstable_intervals"]
         onset = intervals[0][0] if intervals else None
         end = intervals[-1][1] if intervals else None
@@ -93,7 +92,11 @@ def update(design, fz_kn, v_max):
                      ", ".join(f"{a:.4g}–{b:.4g}" for a, b in intervals) or "stable",
                      ui.fmt(onset), ui.fmt(end), "–" if d_onset is None else f"{d_onset:+.3g}", ui.fmt(freq),
                      ", ".join(h["criticality"] for h in data["hopf_points"]) or "–"])
-    fig.update_xaxes(type="log")
+    lay = style.layout(f"Growth rate of straight rolling at Fz = {fz_kn:g} kN", "forward speed V (m/s)",
+                       "largest eigenvalue real part (1/s)", x_log=True)
+    lay["shapes"] = [{"type": "line", "xref": "paper", "x0": 0, "x1": 1, "y0": 0, "y1": 0,
+                      "line": {"color": "#888", "width": 1}}]
+    fig = {"data": traces, "layout": lay}
     columns = ["configuration", "unstable for V in (m/s)", "onset (m/s)", "end (m/s)", "onset vs original (m/s)",
                "onset frequency (Hz)", "criticality"]
     table = ui.table(columns, rows, "ov-hopf-table")

@@ -93,8 +93,9 @@ NES_TRACE = ("return document.getElementById('ov-growth').getElementsByClassName
 
 
 def _nes_onset(driver) -> str:
-    rows = driver.find_elements(By.CSS_SELECTOR, "#ov-hopf-table tbody tr")
-    return rows[1].find_elements(By.TAG_NAME, "td")[2].text if len(rows) > 1 else ""
+    """The NES onset speed in the Overview table (read in one script: no stale element references)."""
+    return driver.execute_script("const r = document.querySelectorAll('#ov-hopf-table tbody tr');"
+                                 "return r.length > 1 ? r[1].cells[2].innerText : '';")
 
 
 def test_slider_move_updates_the_linear_stability_figure_and_the_url(server, browser):

@@ -5,10 +5,9 @@ from __future__ import annotations
 import json
 
 import dash
-from dash import ALL, Input, Output, State, ctx, dcc, html, no_update
+from dash import ALL, Input, Output, State, dcc, html
 
-from shimmy.errors import InvalidParameterError
-from shimmy.parameters import MATERIALS, PARAMETER_SPECS, Parameters
+from shimmy.parameters import MATERIALS, PARAMETER_SPECS
 
 from . import state
 
@@ -119,7 +118,48 @@ dash.clientside_callback(
 )
 
 
-@dash.callback(
+# Controls -> the design store, the URL and the error line, in the browser (no server round trip
+# before the page's own callbacks run: a slider move reaches the figure one request sooner).
+# Ranges and presets come from the parameter definitions; the server validates again.
+dash.clientside_callback(
+    """
+    function(values, material, reset, ids) {
+        const C = window.dash_clientside, trig = C.callback_context.triggered_id;
+        const SPEC = %(spec)s, PRESET = %(preset)s, BASE = %(base)s, DEFAULT = %(default)s;
+        const names = ids.map(i => i.name);
+        let cur = {};
+        names.forEach((n, i) => { cur[n] = values[i]; });
+        let outValues = names.map(() => C.no_update), outMaterial = C.no_update;
+        if (trig === "reset-design") {
+            material = DEFAULT; cur = Object.assign({}, BASE[DEFAULT]); outMaterial = DEFAULT;
+            outValues = names.map(n => cur[n]);
+        } else if (trig === "material") {
+            Object.assign(cur, PRESET[material]); outValues = names.map(n => cur[n]);
+        }
+        const base = BASE[material], full = Object.assign({}, base), problems = [];
+        for (const n of names) {
+            const v = cur[n], s = SPEC[n];
+            const ok = typeof v === "number" && isFinite(v) && v >= s.low && v <= s.high
+                       && (!s.integer || Number.isInteger(v));
+            if (ok) { full[n] = v; } else {
+                problems.push(n + "=" + v + " is out of range; allowed: " + s.allowed + " (kept " + base[n] + ")");
+            }
+        }
+        const params = {}, url = {};
+        for (const n in SPEC) { url[n] = null; }
+        for (const n in full) {
+            if (Math.abs(full[n] - base[n]) > 1e-12 * Math.max(1, Math.abs(base[n]))) {
+                params[n] = full[n]; url[n] = String(full[n]);
+            }
+        }
+        url.material = material === DEFAULT ? null : material;
+        return [outValues, outMaterial, url, [{material: material, params: params}], problems.join("; ")];
+    }
+    """ % {"spec": json.dumps({n: {"low": s.low, "high": s.high, "integer": s.integer, "allowed": s.allowed}
+                               for n, s in PARAMETER_SPECS.items()}),
+           "preset": json.dumps(MATERIALS),
+           "base": json.dumps({m: state.material_params(m) for m in MATERIALS}),
+           "default": json.dumps(state.DEFAULT_MATERIAL)},
     Output({"type": "param", "name": ALL}, "value"),
     Output("material", "value"),
     Output("url-update", "data", allow_duplicate=True),
@@ -131,40 +171,3 @@ dash.clientside_callback(
     State({"type": "param", "name": ALL}, "id"),
     prevent_initial_call=True,
 )
-def sync_design(values, material, _reset, ids):
-    """Controls -> the design store and the URL on every change (the page layout set them from the URL)."""
-    names = [i["name"] for i in ids]
-    trigger = ctx.triggered_id
-    if trigger == "reset-design":
-        material = state.DEFAULT_MATERIAL
-        full = state.material_params(material)
-        return ([full[n] for n in names], material, _url_keys(material, full),
-                [state.design_request(material, full)], "")
-    current = dict(zip(names, values, strict=True))
-    if trigger == "material":
-        current.update(MATERIALS[material])
-    problems = []
-    full = state.material_params(material)
-    for name, value in current.items():
-        if value is None:
-            spec = PARAMETER_SPECS[name]
-            problems.append(f"{name}: not a number in range; allowed: {spec.allowed} (kept {full[name]:g})")
-            continue
-        try:
-            Parameters().with_overrides({name: value})
-            full[name] = float(value)
-        except InvalidParameterError as exc:
-            problems.append(f"{exc} (kept {full[name]:g})")
-    try:
-        Parameters().with_overrides(full)
-    except (InvalidParameterError, ValueError) as exc:  # e.g. an NES geometry off its track
-        return no_update, no_update, no_update, no_update, f"design not applied: {exc}"
-    outputs = [full[n] for n in names] if trigger == "material" else [no_update] * len(names)
-    return (outputs, no_update, _url_keys(material, full), [state.design_request(material, full)],
-            "; ".join(problems))
-
-
-def _url_keys(material: str, full: dict[str, float]) -> dict[str, str | None]:
-    keys: dict[str, str | None] = {name: None for name in PARAMETER_SPECS}
-    keys.update(state.design_query(material, full))
-    return keys

@@ -30,3 +30,15 @@ def message_figure(text: str, height: int = 300) -> go.Figure:
     fig.update_layout(height=height, template="plotly_white", xaxis={"visible": False}, yaxis={"visible": False},
                       margin={"l": 10, "r": 10, "t": 10, "b": 10})
     return fig
+
+
+def layout(title: str, x: str, y: str, height: int = 380, x_log: bool = False) -> dict:
+    """The house layout as a plain dict (for figures rebuilt on every slider move: no validation cost)."""
+    axis = {"showline": True, "linecolor": "#888", "mirror": True, "zeroline": False, "gridcolor": "#e5e8ef"}
+    return {"title": {"text": title, "x": 0.01, "font": {"size": 15}}, "height": height,
+            "margin": {"l": 64, "r": 16, "t": 44, "b": 52}, "template": "plotly_white",
+            "legend": {"orientation": "h", "y": -0.22, "x": 0}, "hovermode": "closest",
+            "font": {"family": "system-ui, -apple-system, Segoe UI, Roboto, sans-serif", "size": 12},
+            "plot_bgcolor": "#ffffff", "paper_bgcolor": "#ffffff",
+            "xaxis": {**axis, "title": {"text": x}, "type": "log" if x_log else "linear"},
+            "yaxis": {**axis, "title": {"text": y}}}
