@@ -51,33 +51,59 @@ def layout(Fz: str = "150", v_min: str = "1", v_max: str = "200", configs: str =
                                                           "instant from the cache", 520)),
         html.Div(id="bif-table"),
         ui.downloads("bif"),
-        dcc.Store(id="bif-requests"),
+        dcc.Store(id="bif-requests"), dcc.Store(id="bif-go"),
     )
+
+
+def _requests(fz_kn, v_min, v_max, configs, design):
+    return [{"config": c, "Fz": None if fz_kn is None else float(fz_kn) * 1e3, "v_min": v_min, "v_max": v_max,
+             **design} for c in configs or []]
 
 
 @dash.callback(
     Output("bif-graph", "figure"), Output("bif-table", "children"), Output("bif-error", "children"),
     Output("bif-requests", "data"), Output("bif-csv", "disabled"), Output("bif-json", "disabled"),
+    Output("bif-go", "data"),
     Input("bif-run", "n_clicks"),
     State("bif-fz", "value"), State("bif-vmin", "value"), State("bif-vmax", "value"), State("bif-configs", "value"),
     State(design_id("bif"), "data"),
-    background=True, prevent_initial_call=True,
+    prevent_initial_call=True,
+)
+def dispatch(n, fz_kn, v_min, v_max, configs, design):
+    """Answer at once when every diagram is cached; otherwise hand over to the background job."""
+    if not configs:
+        return no_update, no_update, "choose at least one configuration", no_update, True, True, no_update
+    requests = _requests(fz_kn, v_min, v_max, configs, design)
+    try:
+        results = [analyses.cached("bifurcation", r) for r in requests]
+    except InvalidParameterError as exc:
+        return no_update, no_update, str(exc), no_update, True, True, no_update
+    if all(r is not None for r in results):
+        return figure(results), summary(results), "", requests, False, False, no_update
+    return (no_update,) * 6 + (n,)
+
+
+@dash.callback(
+    Output("bif-graph", "figure", allow_duplicate=True), Output("bif-table", "children", allow_duplicate=True),
+    Output("bif-error", "children", allow_duplicate=True), Output("bif-requests", "data", allow_duplicate=True),
+    Output("bif-csv", "disabled", allow_duplicate=True), Output("bif-json", "disabled", allow_duplicate=True),
+    Input("bif-go", "data"),
+    State("bif-fz", "value"), State("bif-vmin", "value"), State("bif-vmax", "value"), State("bif-configs", "value"),
+    State(design_id("bif"), "data"),
+    background=True, prevent_initial_call=True, interval=250,
     running=[(Output("bif-run", "disabled"), True, False), (Output("bif-cancel", "disabled"), False, True),
              (Output("bif-fz", "disabled"), True, False), (Output("bif-vmin", "disabled"), True, False),
              (Output("bif-vmax", "disabled"), True, False)],
     cancel=[Input("bif-cancel", "n_clicks")],
     progress=[Output("bif-progress", "value"), Output("bif-status", "children")],
 )
-def compute(set_progress, _n, fz_kn, v_min, v_max, configs, design):
-    if not configs:
-        return no_update, no_update, "choose at least one configuration", no_update, True, True
-    requests, results = [], []
-    for k, config in enumerate(configs):
-        request = {"config": config, "Fz": None if fz_kn is None else float(fz_kn) * 1e3, "v_min": v_min,
-                   "v_max": v_max, **design}
+def compute(set_progress, _go, fz_kn, v_min, v_max, configs, design):
+    requests, results = _requests(fz_kn, v_min, v_max, configs, design), []
+    for k, request in enumerate(requests):
+        config = request["config"]
 
         def report(fraction, message, k=k, config=config):
-            set_progress((str(int(100 * (k + fraction) / len(configs))),
+            set_progress((str(int(100 * (k + fraction) / len(requests))),
                           f"{style.CONFIG_LABELS[config]}: {message}"))
 
         report(0.0, "starting")
@@ -87,7 +113,6 @@ def compute(set_progress, _n, fz_kn, v_min, v_max, configs, design):
             return no_update, no_update, str(exc), no_update, True, True
         except ShimmyError as exc:
             return no_update, no_update, f"{config}: {exc}", no_update, True, True
-        requests.append(request)
         results.append(result)
     set_progress(("100", "done"))
     return figure(results), summary(results), "", requests, False, False

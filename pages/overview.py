@@ -117,7 +117,7 @@ def download(_csv, _json, data):
 @dash.callback(
     Output("ov-boundary-graph", "figure"),
     Input("ov-boundary-run", "n_clicks"), State(design_id("ov"), "data"),
-    background=True, prevent_initial_call=True,
+    background=True, prevent_initial_call=True, interval=250,
     running=[(Output("ov-boundary-run", "disabled"), True, False),
              (Output("ov-boundary-cancel", "disabled"), False, True)],
     cancel=[Input("ov-boundary-cancel", "n_clicks")],

@@ -54,7 +54,7 @@ def layout(config: str = "nes_pd", V: str = "30", Fz: str = "150", t_end: str = 
         ui.graph("th-series", figure=style.message_figure("Choose an operating point and press Run")),
         html.Div([ui.graph("th-spectrum"), ui.graph("th-phase")], className="grid-2"),
         ui.downloads("th"),
-        dcc.Store(id="th-request"),
+        dcc.Store(id="th-request"), dcc.Store(id="th-go"),
     )
 
 
@@ -68,27 +68,53 @@ def operating_point(_clicks):
     return v, f
 
 
+def _request(V, fz_kn, config, t_end, design):
+    return {"config": config, "V": V, "Fz": None if fz_kn is None else float(fz_kn) * 1e3, "t_end": t_end,
+            "include_series": True, **design}
+
+
 @dash.callback(
     Output("th-series", "figure"), Output("th-spectrum", "figure"), Output("th-phase", "figure"),
     Output("th-metrics", "children"), Output("th-error", "children"), Output("th-request", "data"),
-    Output("th-csv", "disabled"), Output("th-json", "disabled"),
+    Output("th-csv", "disabled"), Output("th-json", "disabled"), Output("th-go", "data"),
     Input("th-run", "n_clicks"), Input("th-v", "value"), Input("th-fz", "value"),
     State("th-config", "value"), State("th-tend", "value"), State(design_id("th"), "data"),
-    background=True,
+)
+def dispatch(n, V, fz_kn, config, t_end, design):
+    """Answer at once from the cache; otherwise hand over to the background run."""
+    request = _request(V, fz_kn, config, t_end, design)
+    try:
+        result = analyses.cached("simulate", request)
+    except InvalidParameterError as exc:
+        return (no_update,) * 4 + (_field_message(exc), no_update, True, True, no_update)
+    if result is not None:
+        return (*_figures(result), _metrics(result), "" if result["success"] else result["message"], request,
+                False, False, no_update)
+    return (no_update,) * 8 + ([n, V, fz_kn],)
+
+
+@dash.callback(
+    Output("th-series", "figure", allow_duplicate=True), Output("th-spectrum", "figure", allow_duplicate=True),
+    Output("th-phase", "figure", allow_duplicate=True), Output("th-metrics", "children", allow_duplicate=True),
+    Output("th-error", "children", allow_duplicate=True), Output("th-request", "data", allow_duplicate=True),
+    Output("th-csv", "disabled", allow_duplicate=True), Output("th-json", "disabled", allow_duplicate=True),
+    Input("th-go", "data"),
+    State("th-v", "value"), State("th-fz", "value"), State("th-config", "value"), State("th-tend", "value"),
+    State(design_id("th"), "data"),
+    background=True, prevent_initial_call=True, interval=250,
     running=[(Output("th-run", "disabled"), True, False), (Output("th-cancel", "disabled"), False, True)],
     cancel=[Input("th-cancel", "n_clicks")],
     progress=[Output("th-progress", "value"), Output("th-status", "children")],
 )
-def run(set_progress, _n, V, fz_kn, config, t_end, design):
+def run(set_progress, _go, V, fz_kn, config, t_end, design):
     set_progress(("5", "simulating"))
-    request = {"config": config, "V": V, "Fz": None if fz_kn is None else float(fz_kn) * 1e3,
-               "t_end": t_end, "include_series": True, **design}
+    request = _request(V, fz_kn, config, t_end, design)
     try:
-        result, cached = analyses.run("simulate", request)
+        result, _ = analyses.run("simulate", request)
     except InvalidParameterError as exc:
         set_progress(("0", ""))
         return (no_update,) * 4 + (_field_message(exc), no_update, True, True)
-    set_progress(("100", "from the cache" if cached else "done"))
+    set_progress(("100", "done"))
     return (*_figures(result), _metrics(result), "" if result["success"] else result["message"], request,
             False, False)
 

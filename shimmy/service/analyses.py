@@ -133,5 +133,10 @@ def run(analysis: str, body: Any, progress: Progress | None = None) -> tuple[dic
     return run_canonical(analysis, request, progress)
 
 
+def cached(analysis: str, body: Any) -> dict[str, Any] | None:
+    """The cached result for ``body``, or None (validation errors raise as in :func:`run`)."""
+    return cache.get(analysis, schemas.validate(analysis, body))
+
+
 def run_canonical(analysis: str, request: dict[str, Any], progress: Progress | None = None):
     return cache.get_or_compute(analysis, request, lambda: RUNNERS[analysis](request, progress))
