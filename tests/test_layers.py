@@ -46,3 +46,36 @@ def test_analyses_do_not_import_the_ui_or_the_cli():
 def test_every_module_is_assigned_a_layer():
     modules = {p.stem for p in PACKAGE.glob("*.py")} - {"__init__", "__main__", "cli"}
     assert modules == MODEL | ANALYSES
+
+
+SERVICE = PACKAGE / "service"
+ROOT = PACKAGE.parent
+#: What the UI may import from the package: definitions and the service layer, never numerics.
+UI_MAY_IMPORT = {"shimmy.service", "shimmy.parameters", "shimmy.errors", "shimmy.configurations"}
+
+
+def _absolute_imports(path):
+    tree = ast.parse(path.read_text())
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0:
+            found.add(node.module)
+    return found
+
+
+def test_service_layer_does_not_import_the_ui():
+    for path in SERVICE.glob("*.py"):
+        deps = imports(path)
+        assert not deps & {"dash", "plotly", "ui", "pages", "app"}, path.name
+
+
+def test_ui_uses_only_the_service_layer_and_definitions():
+    files = [ROOT / "app.py", *(ROOT / "pages").glob("*.py"), *(ROOT / "ui").glob("*.py")]
+    assert len(files) > 5
+    for path in files:
+        for name in _absolute_imports(path):
+            if name.startswith("shimmy"):
+                assert any(name == allowed or name.startswith(allowed + ".") for allowed in UI_MAY_IMPORT), \
+                    (path.name, name)
