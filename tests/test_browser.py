@@ -84,6 +84,10 @@ def test_every_page_loads_without_console_errors(server, browser, name):
     time.sleep(1.0)
     browser.save_screenshot(str(SHOTS / f"{name}.png"))
     assert _severe(browser) == []
+    # Works offline: every resource the page loaded came from our own server (no CDN).
+    origins = browser.execute_script("return performance.getEntriesByType('resource').map(e => e.name);")
+    assert origins and all(u.startswith(server.base) for u in origins), [u for u in origins
+                                                                         if not u.startswith(server.base)]
     # The design panel is on every page and took the design from the URL.
     assert "Design" in browser.find_element(By.ID, "design-panel").text
 
