@@ -41,6 +41,10 @@ def layout(Fz: str = "150", vmax: str = "200", **query):
                   ui.progress_bar("ov-boundary")], className="controls"),
         ui.graph("ov-boundary-graph", figure=style.message_figure("Press 'Compute boundary' (about 3 s cold, "
                                                                    "instant when cached)")),
+        html.Div([html.Button("Download boundary CSV", id="ovb-csv", className="secondary", disabled=True),
+                  html.Button("Download boundary JSON", id="ovb-json", className="secondary", disabled=True),
+                  dcc.Download(id="ovb-download")], className="downloads"),
+        dcc.Store(id="ovb-requests"),
     ])
 
 
@@ -114,8 +118,13 @@ def download(_csv, _json, data):
     return {"content": ui.json_text(data["result"]), "filename": "overview_stability.json"}
 
 
+def _boundary_requests(design):
+    return [{"config": config, "v_max": 300.0, **design} for config in CONFIGS]
+
+
 @dash.callback(
-    Output("ov-boundary-graph", "figure"),
+    Output("ov-boundary-graph", "figure"), Output("ovb-requests", "data"), Output("ovb-csv", "disabled"),
+    Output("ovb-json", "disabled"),
     Input("ov-boundary-run", "n_clicks"), State(design_id("ov"), "data"),
     background=True, prevent_initial_call=True, interval=250,
     running=[(Output("ov-boundary-run", "disabled"), True, False),
@@ -129,7 +138,7 @@ def boundary(set_progress, _n, design):
         def report(fraction, message, k=k, config=config):
             set_progress((str(int(100 * (k + fraction) / len(CONFIGS))), f"{config}: {message}"))
 
-        result, _ = analyses.run("hopf_curves", {"config": config, "v_max": 300.0, **design}, report)
+        result, _ = analyses.run("hopf_curves", _boundary_requests(design)[k], report)
         for i, curve in enumerate(result["curves"]):
             fig.add_scatter(x=[p["V"] for p in curve["points"]], y=[p["Fz"] / 1e3 for p in curve["points"]],
                             mode="lines", name=style.CONFIG_LABELS[config], legendgroup=config, showlegend=i == 0,
@@ -141,4 +150,18 @@ def boundary(set_progress, _n, design):
                             marker={"color": style.CONFIG_COLOURS[config], "size": 10, "symbol": "star"})
     set_progress(("100", "done"))
     fig.update_xaxes(type="log")
-    return fig
+    return fig, _boundary_requests(design), False, False
+
+
+@dash.callback(Output("ovb-download", "data"), Input("ovb-csv", "n_clicks"), Input("ovb-json", "n_clicks"),
+               State("ovb-requests", "data"), prevent_initial_call=True)
+def download_boundary(_csv, _json, requests):
+    if not requests:
+        return no_update
+    results = [analyses.run("hopf_curves", r)[0] for r in requests]
+    if dash.ctx.triggered_id == "ovb-json":
+        return {"content": ui.json_text(results), "filename": "hopf_curves.json"}
+    rows = [[r["config"], i, p["V"], p["Fz"], p["frequency_hz"], "" if p["lyapunov"] is None else p["lyapunov"]]
+            for r in results for i, c in enumerate(r["curves"]) for p in c["points"]]
+    return {"content": ui.csv_text(["config", "curve", "V_m_s", "Fz_N", "frequency_hz", "lyapunov"], rows),
+            "filename": "hopf_curves.csv"}

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import dash
-from dash import Input, Output, html
+from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.service import analyses
 from ui import components as ui
@@ -24,6 +24,8 @@ def layout(**query):
                   "not a design."),
         html.Div(id="val-content", children=html.P("computing…", className="hint")),
         html.Button("Recompute", id="val-run", className="secondary"),
+        ui.downloads("val"),
+        dcc.Store(id="val-data"),
     )
 
 
@@ -40,7 +42,8 @@ def _amplitude(config, V, params=None, material=None):
     return result["amplitude"]["psi"]
 
 
-@dash.callback(Output("val-content", "children"), Input("val-run", "n_clicks"))
+@dash.callback(Output("val-content", "children"), Output("val-data", "data"), Output("val-csv", "disabled"),
+               Output("val-json", "disabled"), Input("val-run", "n_clicks"))
 def build(_n):
     rows = []
     for config, published in PUBLISHED_HOPF.items():
@@ -77,9 +80,29 @@ def build(_n):
                 f"{original[0]:.4g}" if original else "–", " m/s). The damper's benefit in this model is the "
                 "smaller limit-cycle amplitude, not a shifted onset."], className="note"),
     ])
-    return [html.H2("Hopf points (fix k_lam, I_nes, c_nes, I_pd)"), hopf_table,
+    data = {"hopf": [{"config": r[0], "published": float(r[1]), "computed": float(r[2])} for r in rows],
+            "amplitude": {"published": PUBLISHED_AMPLITUDE, "computed": amp},
+            "sanity": {"a_p_0.8": a08, "a_p_0.9": a09, "steel": amp, "tungsten": tungsten},
+            "pd_alone": {"published": [14.2, 1500.0], "computed": pd_hopf}, "original": original}
+    content = [html.H2("Hopf points (fix k_lam, I_nes, c_nes, I_pd)"), hopf_table,
             html.H2("Limit-cycle amplitude (fixes the PD damping level)"), amp_table,
             html.P("The published 0.017 rad cannot be reached with g_p and f inside their published ranges; the "
                    "defaults take the closest in-range values (g_p = 5, f = 30) and the misfit is reported here, "
                    "not hidden.", className="hint"),
             html.H2("Sanity checks"), sanity, disagreement]
+    return content, data, False, False
+
+
+@dash.callback(Output("val-download", "data"), Input("val-csv", "n_clicks"), Input("val-json", "n_clicks"),
+               State("val-data", "data"), prevent_initial_call=True)
+def download(_csv, _json, data):
+    if not data:
+        return no_update
+    if dash.ctx.triggered_id == "val-json":
+        return {"content": ui.json_text(data), "filename": "validation.json"}
+    rows = [["hopf_V", h["config"], h["published"], h["computed"]] for h in data["hopf"]]
+    rows.append(["amplitude_nes_pd_A", "nes_pd", data["amplitude"]["published"], data["amplitude"]["computed"]])
+    rows += [["pd_alone_hopf_V", "pd", p, c] for p, c in zip(data["pd_alone"]["published"],
+                                                              data["pd_alone"]["computed"], strict=False)]
+    return {"content": ui.csv_text(["quantity", "config", "published", "computed"], rows),
+            "filename": "validation.csv"}

@@ -22,6 +22,7 @@ from selenium.webdriver.common.keys import Keys  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = ROOT / "screenshots"
+DOWNLOADS = ROOT / ".pytest_cache" / "downloads"
 CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 PAGES = {"overview": "/", "devices": "/devices", "time-history": "/time-history", "bifurcation": "/bifurcation",
          "validation": "/validation", "api": "/api"}
@@ -48,6 +49,9 @@ def browser():
         opts.add_argument(arg)
     opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / 'chromium-profile'}")
     opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    DOWNLOADS.mkdir(parents=True, exist_ok=True)
+    opts.add_experimental_option("prefs", {"download.default_directory": str(DOWNLOADS),
+                                           "download.prompt_for_download": False})
     driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
     driver.set_page_load_timeout(60)
     SHOTS.mkdir(exist_ok=True)
@@ -156,3 +160,22 @@ def test_time_history_operating_point_button(server, browser):
     assert "Fz = 350 kN" in browser.find_element(By.CSS_SELECTOR, "#th-series .gtitle").text
     _wait_for(lambda: "Fz=350" in browser.current_url, timeout=10, what="the URL to carry the point")
     assert _severe(browser) == []
+
+
+def test_results_download_as_csv_and_json(server, browser):
+    for f in DOWNLOADS.glob("*"):
+        f.unlink()
+    browser.get(server.base + "/")
+    _wait_for(lambda: _nes_onset(browser), what="the Hopf table")
+    _wait_for(lambda: browser.find_element(By.ID, "ov-csv").is_enabled(), what="the download button")
+    browser.find_element(By.ID, "ov-csv").click()
+    browser.find_element(By.ID, "ov-json").click()
+    files = _wait_for(lambda: sorted(p.name for p in DOWNLOADS.glob("overview_*") if not p.name.endswith(".crdownload"))
+                      if len(list(DOWNLOADS.glob("overview_*"))) >= 2 else None, timeout=20, what="two downloads")
+    assert files == ["overview_hopf.csv", "overview_stability.json"]
+    text = (DOWNLOADS / "overview_hopf.csv").read_text()
+    assert text.startswith("configuration,") and "NES + PD" in text
+    import json
+
+    data = json.loads((DOWNLOADS / "overview_stability.json").read_text())
+    assert set(data["configs"]) == {"original", "nes", "pd", "nes_pd"}
