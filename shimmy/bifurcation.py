@@ -282,16 +282,19 @@ def _limits(model: Model):
 
 
 def _hopf_reached(hopf_speeds: list[float], raw: PeriodicBranch) -> float | None:
-    """The Hopf point a branch ending at zero amplitude runs into: the nearest one ahead of its last
-    point in its direction of travel, within 10 % of the last step's speed change."""
-    if raw.p.size < 2:
+    """The Hopf point a branch ending at zero amplitude runs into: among the Hopf points within
+    5 % (or ten last steps) of its last point, the nearest one ahead in its direction of travel,
+    else the nearest one (near a degenerate Hopf point the amplitude is tiny over a wide speed
+    range, so the branch can stop just past the point it is joining)."""
+    if raw.p.size < 2 or not hopf_speeds:
         return None
     last, before = raw.p[-1], raw.p[-2]
-    ahead = [v for v in hopf_speeds if (v - last) * (last - before) >= -1e-9 * max(abs(last), 1.0)]
-    if not ahead:
-        ahead = list(hopf_speeds)
-    near = min(ahead, key=lambda v: abs(v - last))
-    return near if abs(near - last) <= 0.05 * near + 10 * abs(last - before) else None
+    tolerance = 10.0 * abs(last - before)
+    close = [v for v in hopf_speeds if abs(v - last) <= 0.05 * v + tolerance]
+    if not close:
+        return None
+    ahead = [v for v in close if (v - last) * (last - before) >= -1e-9 * max(abs(last), 1.0)]
+    return min(ahead or close, key=lambda v: abs(v - last))
 
 
 def _equilibrium_output(eq: EquilibriumBranch, hopf: HopfResult) -> Branch:
@@ -435,6 +438,8 @@ def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popt
         except ConvergenceError as exc:
             warnings.append(f"seed at V = {v_seed:.6g} m/s: {exc}")
             return None
+        if halves[0].stop_reason.startswith("closed branch"):  # a loop: one way round covers it
+            return _periodic_output(halves[0], params, f"simulation at V = {v_seed:.6g} m/s", [])
     joined = _join(halves[0], halves[1])
     return _periodic_output(joined, params, f"simulation at V = {v_seed:.6g} m/s", [])
 

@@ -246,6 +246,9 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
             stop = f"amplitude returned to zero near p = {p_end:.6g}: the branch ends at a Hopf point"
             break
         special.extend(found)
+        if _closed(problem, rows):
+            stop = "closed branch: the orbits returned to the first one (a loop of periodic orbits, traversed once)"
+            break
         amp = _amplitude(problem, rows["xmax"][-1], rows["xmin"][-1])
         amp_peak = max(amp_peak, amp)
         amp_stop = options.amplitude_min * amp_first if hopf_start else 1e-3 * amp_peak
@@ -281,6 +284,34 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
     return PeriodicBranch(np.array(rows["p"]), np.array(rows["T"]), np.array(rows["xmax"]),
                           np.array(rows["xmin"]), np.abs(mu[:, 1:]).max(axis=1, initial=0.0) < 1.0, mu, special,
                           stop, steps, problem.mesh.ntst, problem.mesh.ncol, solutions, trivial)
+
+
+def _measures(problem: PeriodicProblem, rows, i: int) -> np.ndarray:
+    """Phase-free description of point i: p, T and every state's max and min, scaled."""
+    return np.concatenate([[rows["p"][i] / problem.p_scale, rows["T"][i] / problem.T_scale],
+                           np.asarray(rows["xmax"][i]) / problem.scale, np.asarray(rows["xmin"][i]) / problem.scale])
+
+
+def _closed(problem: PeriodicProblem, rows) -> bool:
+    """Whether the last step passed the first orbit again (the branch is a closed loop).
+
+    Orbits are compared by phase-free measures (p, T, extremes of every state): the step from
+    the previous to the last point must pass the first point closer than a third of its
+    length, after the branch has gone at least five steps away from it.
+    """
+    k = len(rows["p"])
+    if k < 8:
+        return False
+    first, prev, last = _measures(problem, rows, 0), _measures(problem, rows, k - 2), _measures(problem, rows, k - 1)
+    seg = last - prev
+    length = float(np.linalg.norm(seg))
+    if length == 0.0:
+        return False
+    far = max(float(np.linalg.norm(_measures(problem, rows, i) - first)) for i in range(k))
+    if far < 5.0 * length:
+        return False
+    s = float(np.clip(np.dot(first - prev, seg) / length ** 2, 0.0, 1.0))
+    return float(np.linalg.norm(prev + s * seg - first)) < length / 3.0
 
 
 def _p_direction(problem: PeriodicProblem, u: np.ndarray) -> np.ndarray:

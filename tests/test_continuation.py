@@ -477,3 +477,27 @@ def test_bad_options_raise_invalid_parameter_error_naming_the_field(cls, kwargs,
         cls(**kwargs)
     assert info.value.field == name
     assert name in str(info.value)
+
+
+def test_closed_loop_of_cycles_is_traversed_once():
+    """An isola: G = 1 - p^2 - (r^2 - 2)^2 gives cycles r^2 = 2 +- sqrt(1 - p^2) for |p| <= 1, a
+    closed curve with folds (LPC) at p = +-1; x = 0 is stable for every p (no Hopf point), so
+    only a start on an orbit finds it. The branch must stop after one lap, not run its budget."""
+    from textbook_systems import planar_normal_form
+
+    system = planar_normal_form(g=lambda p: -3.0 - p * p, dg=lambda p: -2.0 * p, a1=4.0, a2=-1.0, name="isola")
+    guess = unit_cycle_guess(40, 2, 0.0, radius=math.sqrt(3.0))
+    br = periodic_branch(system, guess, -5.0, 5.0, np.ones(2), 1.0,
+                         PeriodicOptions(ntst=40, continuation=ContinuationOptions(ds=0.05, ds_max=0.2,
+                                                                                   max_steps=400)))
+    assert br.stop_reason.startswith("closed branch")
+    assert br.steps < 200
+    folds = sorted(s.p for s in br.special_points if s.kind == "LPC")
+    assert len(folds) == 2
+    np.testing.assert_allclose(folds, [-1.0, 1.0], atol=1e-6)
+    r2 = node_radius(br, 0) ** 2
+    assert abs(r2.mean() - 3.0) < 1e-6
+    # Outer half (r^2 > 2) stable, inner half unstable: exponent 2 r^2 (4 - 2 r^2).
+    radius2 = np.array([node_radius(br, i).mean() ** 2 for i in range(br.p.size)])
+    away = np.abs(radius2 - 2.0) > 0.05
+    assert np.all(br.stable[away] == (radius2[away] > 2.0))
