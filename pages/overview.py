@@ -71,7 +71,8 @@ def update(design, fz_kn, v_max):
         return (no_update,) * 3 + ("Fz must be a number in [10, 900] kN and the highest speed in [2, 500] m/s",
                                    True, True, no_update)
     try:
-        result, _ = analyses.run("stability", {"Fz": float(fz_kn) * 1e3, "v_max": float(v_max), **design})
+        result, _ = analyses.run("stability", {"Fz": float(fz_kn) * 1e3, "v_max": float(v_max), "n_points": 120,
+                                              **design})
     except InvalidParameterError as exc:
         return no_update, no_update, no_update, str(exc), True, True, no_update
     traces = []
