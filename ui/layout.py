@@ -24,13 +24,18 @@ def _label(name: str) -> html.Label:
                       title=f"{spec.description}; {spec.allowed}; {spec.provenance}", htmlFor=f"param-{name}")
 
 
+def _short(x: float) -> str:
+    """1.4e+06 -> 1.4e6: slider end labels that fit the panel."""
+    return f"{x:g}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
+
+
 def _slider(name: str, value: float) -> html.Div:
     spec = PARAMETER_SPECS[name]
     return html.Div([
         _label(name),
         dcc.Slider(id={"type": "param", "name": name}, min=spec.low, max=spec.high,
                    step=(spec.high - spec.low) / SLIDER_STEPS, value=value, updatemode="drag",
-                   marks={spec.low: f"{spec.low:g}", spec.high: f"{spec.high:g}"},
+                   marks={spec.low: _short(spec.low), spec.high: _short(spec.high)},
                    tooltip={"placement": "bottom", "always_visible": False}),
     ], className="slider-row")
 
