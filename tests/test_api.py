@@ -77,6 +77,8 @@ BAD = [
     ("/api/v1/simulate", b" " * 70000, 413, "body"),
     ("/api/v1/hopf", {"config": "nes", "Fz": 150000, "v_min": 100, "v_max": 50}, 422, "v_max"),
     ("/api/v1/hopf", {"Fz": 150000}, 422, "config"),
+    # Each value in range, together off the NES track: the constraint names the field it blames.
+    ("/api/v1/hopf", {"config": "nes", "Fz": 150000, "params": {"r1": 0.2, "r2": 0.07}}, 422, "params.r3"),
     ("/api/v1/stability", {"Fz": 150000, "n_points": 1e6}, 422, "n_points"),
     ("/api/v1/stability", {"Fz": 150000, "n_points": 20.5}, 422, "n_points"),
     ("/api/v1/devices", {"v_max": -1}, 422, "v_max"),
