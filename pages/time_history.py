@@ -129,16 +129,26 @@ def _figures(result):
     s = result["series"]
     t = np.asarray(s["t"])
     title = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {result['Fz'] / 1e3:g} kN")
-    series = make_subplots(rows=2, cols=1, shared_xaxes=True, vertical_spacing=0.08)
+    has_nes = "psis" in s
+    rows = 4 if has_nes else 3
+    series = make_subplots(rows=rows, cols=1, shared_xaxes=True, vertical_spacing=0.05)
     colour = style.CONFIG_COLOURS[result["config"]]
     series.add_scatter(x=t, y=s["psi"], name="torsion psi (rad)", line={"color": colour, "width": 1}, row=1, col=1)
     series.add_scatter(x=t, y=s["lateral"], name="lateral l_g delta (m)", line={"color": "#56B4E9", "width": 1},
                        row=2, col=1)
-    series.update_layout(title={"text": title, "x": 0.01}, height=460, template="plotly_white",
-                         margin={"l": 64, "r": 16, "t": 44, "b": 48}, legend={"orientation": "h", "y": -0.15})
-    series.update_xaxes(title_text="time t (s)", row=2, col=1)
+    series.add_scatter(x=t, y=s["lam"], name="tyre deformation lam (m)", line={"color": "#CC79A7", "width": 1},
+                       row=3, col=1)
+    if has_nes:
+        relative = np.asarray(s["psi"]) - np.asarray(s["psis"])
+        series.add_scatter(x=t, y=relative, name="NES relative rotation psi - psis (rad)",
+                           line={"color": "#D55E00", "width": 1}, row=4, col=1)
+        series.update_yaxes(title_text="psi - psis (rad)", row=4, col=1)
+    series.update_layout(title={"text": title, "x": 0.01}, height=180 * rows + 100, template="plotly_white",
+                         margin={"l": 70, "r": 16, "t": 44, "b": 48}, legend={"orientation": "h", "y": -0.08})
+    series.update_xaxes(title_text="time t (s)", row=rows, col=1)
     series.update_yaxes(title_text="psi (rad)", row=1, col=1)
     series.update_yaxes(title_text="l_g delta (m)", row=2, col=1)
+    series.update_yaxes(title_text="lam (m)", row=3, col=1)
     sp = result["spectrum"]
     spectrum = style.figure("Spectrum of the steady window", "frequency (Hz)", "power (normalised)")
     for key, name, c in (("psi", "torsion psi", colour), ("lateral", "lateral l_g delta", "#56B4E9")):
