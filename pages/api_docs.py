@@ -44,7 +44,8 @@ def layout(**query):
                           "jobs."),
                 ui.table(["method", "path", "what"], endpoint_rows, "api-endpoints"),
                 html.P([html.A("openapi.json", href=f"{PREFIX}/openapi.json"), " · limits: body at most "
-                        f"{settings.MAX_BODY_BYTES} bytes, t_end at most 600 s, ntst at most 200, at most "
+                        f"{settings.MAX_BODY_BYTES} bytes, t_end at most {settings.MAX_T_END:g} s, ntst at most "
+                        f"{settings.MAX_NTST}, at most "
                         f"{settings.MAX_RUNNING_JOBS} jobs running at once (others queue)."], className="hint")]
     for name in ("simulate", "hopf", "stability", "devices"):
         sections += [html.H2(f"POST {PREFIX}/{name}"), html.P(schemas.SCHEMAS[name].summary), _fields(name),

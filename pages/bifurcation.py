@@ -18,12 +18,6 @@ CONFIGS = tuple(style.CONFIG_COLOURS)
 SYMBOLS = {"H": "diamond", "LPC": "triangle-up", "NS": "square", "PD": "x", "BPC": "cross", "BP": "circle-open"}
 
 
-def _num(raw, default):
-    try:
-        return float(raw)
-    except (TypeError, ValueError):
-        return default
-
 
 def layout(Fz: str = "150", v_min: str = "1", v_max: str = "200", configs: str = "original,nes,pd,nes_pd", **query):
     chosen = [c for c in configs.split(",") if c in CONFIGS] or list(CONFIGS)
@@ -34,11 +28,11 @@ def layout(Fz: str = "150", v_min: str = "1", v_max: str = "200", configs: str =
                   "(solid stable, dashed unstable); Hopf (H), fold of cycles (LPC), torus (NS) and period-doubling "
                   "(PD) points marked. All four configurations overlaid."),
         html.Div([
-            ui.field("Fz (kN)", dcc.Input(id="bif-fz", type="number", value=_num(Fz, 150), min=10, max=900,
+            ui.field("Fz (kN)", dcc.Input(id="bif-fz", type="number", value=ui.number(Fz, 150), min=10, max=900,
                                           step="any")),
-            ui.field("lowest V (m/s)", dcc.Input(id="bif-vmin", type="number", value=_num(v_min, 1), min=1, max=500,
-                                                 step="any")),
-            ui.field("highest V (m/s)", dcc.Input(id="bif-vmax", type="number", value=_num(v_max, 200), min=1,
+            ui.field("lowest V (m/s)", dcc.Input(id="bif-vmin", type="number", value=ui.number(v_min, 1), min=1,
+                                                 max=500, step="any")),
+            ui.field("highest V (m/s)", dcc.Input(id="bif-vmax", type="number", value=ui.number(v_max, 200), min=1,
                                                   max=500, step="any")),
             ui.field("Configurations", dcc.Checklist(id="bif-configs", value=chosen, inline=True, options=[
                 {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),

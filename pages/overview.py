@@ -22,9 +22,9 @@ def layout(Fz: str = "150", vmax: str = "200", **query):
                   "design: the largest eigenvalue real part against speed (shimmy grows where it is positive), the "
                   "Hopf speed interval of each, and the (V, Fz) stability boundary."),
         html.Div([
-            ui.field("Vertical load Fz (kN)", dcc.Input(id="ov-fz", type="number", value=_number(Fz, 150), min=10,
+            ui.field("Vertical load Fz (kN)", dcc.Input(id="ov-fz", type="number", value=ui.number(Fz, 150), min=10,
                                                        max=900, step="any", debounce=True)),
-            ui.field("Highest speed (m/s)", dcc.Input(id="ov-vmax", type="number", value=_number(vmax, 200), min=2,
+            ui.field("Highest speed (m/s)", dcc.Input(id="ov-vmax", type="number", value=ui.number(vmax, 200), min=2,
                                                      max=500, step="any", debounce=True)),
         ], className="controls"),
         html.Div(id="ov-error", className="error", role="alert"),
@@ -51,12 +51,6 @@ def layout(Fz: str = "150", vmax: str = "200", **query):
 def layout_page(query, children):
     return page(query, "ov", *children)
 
-
-def _number(raw, default):
-    try:
-        return float(raw)
-    except (TypeError, ValueError):
-        return default
 
 
 @dash.callback(

@@ -18,12 +18,6 @@ dash.register_page(__name__, path="/time-history", name="Time history", order=2)
 CONFIG_OPTIONS = [{"label": style.CONFIG_LABELS[c], "value": c} for c in style.CONFIG_COLOURS]
 
 
-def _num(raw, default):
-    try:
-        return float(raw)
-    except (TypeError, ValueError):
-        return default
-
 
 def layout(config: str = "nes_pd", V: str = "30", Fz: str = "150", t_end: str = "60", **query):
     config = config if config in style.CONFIG_COLOURS else "nes_pd"
@@ -36,11 +30,11 @@ def layout(config: str = "nes_pd", V: str = "30", Fz: str = "150", t_end: str = 
         html.Div([
             ui.field("Configuration", dcc.Dropdown(id="th-config", options=CONFIG_OPTIONS, value=config,
                                                    clearable=False, style={"width": "160px"})),
-            ui.field("V (m/s)", dcc.Input(id="th-v", type="number", value=_num(V, 30), min=1, max=500, step="any",
+            ui.field("V (m/s)", dcc.Input(id="th-v", type="number", value=ui.number(V, 30), min=1, max=500, step="any",
                                           debounce=True)),
-            ui.field("Fz (kN)", dcc.Input(id="th-fz", type="number", value=_num(Fz, 150), min=10, max=900,
+            ui.field("Fz (kN)", dcc.Input(id="th-fz", type="number", value=ui.number(Fz, 150), min=10, max=900,
                                           debounce=True, step="any")),
-            ui.field("Simulated time (s)", dcc.Input(id="th-tend", type="number", value=_num(t_end, 60), min=1,
+            ui.field("Simulated time (s)", dcc.Input(id="th-tend", type="number", value=ui.number(t_end, 60), min=1,
                                                      max=600, step="any")),
             html.Button("Run", id="th-run"),
             html.Button("Cancel", id="th-cancel", className="secondary", disabled=True),

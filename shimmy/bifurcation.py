@@ -461,16 +461,19 @@ def _join(down: PeriodicBranch, up: PeriodicBranch) -> PeriodicBranch:
                           max(down.trivial_error, up.trivial_error))
 
 
-def _restore(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray) -> tuple[PeriodicProblem,
-                                                                                             CurvePoint]:
-    """The problem on point i's mesh, with the point and its tangent (oriented towards i + 1)."""
+def _restore(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray,
+             to: int | None = None) -> tuple[PeriodicProblem, CurvePoint, float]:
+    """The problem on point i's mesh, the point with its tangent oriented towards point ``to``
+    (default i + 1), and the arclength to that point."""
     mesh_points, u = raw.solutions[i]
     problem = PeriodicProblem(system, Mesh(mesh_points, raw.ncol), scale, T_SCALE, V_SCALE)
     problem.accept(u)
-    j = min(i + 1, len(raw.solutions) - 1)
+    j = min(i + 1 if to is None else to, len(raw.solutions) - 1)
+    if j == i:
+        return problem, CurvePoint(u, tangent(problem, u, np.eye(u.size)[-1])), 0.0
     other = PeriodicProblem(system, Mesh(raw.solutions[j][0], raw.ncol), scale, T_SCALE, V_SCALE)
-    direction = other.transfer(problem, raw.solutions[j][1]) - u if j != i else np.eye(u.size)[-1]
-    return problem, CurvePoint(u, tangent(problem, u, direction))
+    direction = other.transfer(problem, raw.solutions[j][1]) - u
+    return problem, CurvePoint(u, tangent(problem, u, direction)), weighted_norm(direction, problem.weights)
 
 
 def cycle_at(result: BifurcationResult, branch: int, V: float) -> dict[str, Any]:
@@ -487,12 +490,10 @@ def cycle_at(result: BifurcationResult, branch: int, V: float) -> dict[str, Any]
     for i in range(raw.p.size - 1):
         if (raw.p[i] - V) * (raw.p[i + 1] - V) > 0:
             continue
-        problem, start = _restore(system, raw, i, scale)
+        problem, start, h = _restore(system, raw, i, scale)
         if raw.p[i] == V:
             point = start
         else:
-            far = PeriodicProblem(system, Mesh(raw.solutions[i + 1][0], raw.ncol), scale, T_SCALE, V_SCALE)
-            h = weighted_norm(far.transfer(problem, raw.solutions[i + 1][1]) - start.u, problem.weights)
             hit = locate(problem, start, h, lambda q: q.u[-1] - V, raw.p[i] - V, raw.p[i + 1] - V,
                          ContinuationOptions(locate_tol=1e-10))
             if hit is None:
@@ -528,9 +529,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
     copts = ContinuationOptions(ds=options.ds, ds_max=options.ds_max)
     lo = max(i - 1, 0)
     if 0 < i < raw.p.size - 1 and raw.stable[lo] and raw.stable[i + 1]:
-        problem, start = _restore(system, raw, lo, scale)
-        far = PeriodicProblem(system, Mesh(raw.solutions[i + 1][0], raw.ncol), scale, T_SCALE, V_SCALE)
-        span = weighted_norm(far.transfer(problem, raw.solutions[i + 1][1]) - start.u, problem.weights)
+        problem, start, span = _restore(system, raw, lo, scale, to=i + 1)
         cache: dict[float, tuple[float, CurvePoint | None]] = {}
 
         def minus_amp(h):
@@ -554,7 +553,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
         i_point = None
     mesh_check = None
     if options.mesh_check:
-        problem, start = _restore(system, raw, i, scale)
+        problem, start, _ = _restore(system, raw, i, scale)
         point = i_point or start
         fine = PeriodicProblem(system, problem.adapted_mesh(point.u, 2 * problem.mesh.ntst), scale, T_SCALE,
                                V_SCALE)

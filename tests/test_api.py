@@ -67,6 +67,8 @@ BAD = [
     ("/api/v1/simulate", {"config": "nes", "V": "fast", "Fz": 150000}, 422, "V"),
     ("/api/v1/simulate", {"config": "nes", "V": 1e6, "Fz": 150000}, 422, "V"),
     ("/api/v1/simulate", {"config": "nes", "V": 30, "Fz": 150000, "t_end": 1e5}, 422, "t_end"),
+    ("/api/v1/simulate", {"config": "nes", "V": 30, "Fz": 150000, "t_end": 600, "include_series": True,
+                          "series_dt": 0.001}, 422, "series_dt"),
     ("/api/v1/simulate", {"config": "nesx", "V": 30, "Fz": 150000}, 422, "config"),
     ("/api/v1/simulate", {"config": "nes", "V": True, "Fz": 150000}, 422, "V"),
     ("/api/v1/simulate", b'{"config": "nes", "V": NaN, "Fz": 150000}', 422, "V"),

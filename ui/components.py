@@ -62,5 +62,13 @@ def json_text(payload: Any) -> str:
     return json.dumps(payload, indent=1, allow_nan=False)
 
 
+def number(raw, default: float) -> float:
+    """A URL value as a number for a control's initial value (the default if it is not one)."""
+    try:
+        return float(raw)
+    except (TypeError, ValueError):
+        return default
+
+
 def fmt(x: float | None, digits: int = 4) -> str:
     return "–" if x is None else f"{x:.{digits}g}"

@@ -7,21 +7,11 @@ written); everything else is page state, kept as it is when the design changes.
 from __future__ import annotations
 
 from typing import Any
-from urllib.parse import parse_qsl, urlencode
 
 from shimmy.errors import InvalidParameterError
 from shimmy.parameters import MATERIALS, PARAMETER_SPECS, Parameters
 
 DEFAULT_MATERIAL = "steel"
-
-
-def parse(search: str | None) -> dict[str, str]:
-    return dict(parse_qsl((search or "").lstrip("?"), keep_blank_values=False))
-
-
-def build(query: dict[str, Any]) -> str:
-    clean = {k: v for k, v in query.items() if v is not None and v != ""}
-    return "?" + urlencode(clean) if clean else ""
 
 
 def material_params(material: str) -> dict[str, float]:

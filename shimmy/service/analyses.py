@@ -13,6 +13,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..configurations import Configuration
+from ..errors import InvalidParameterError
 from ..parameters import Parameters
 from . import cache, schemas
 from .settings import MAX_SERIES_POINTS
@@ -29,25 +30,23 @@ def _finite(x) -> float | None:
 
 
 def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..simulation import simulate as run_simulation
+    from ..simulation import SimulationOptions, simulate as run_simulation
 
+    stride = max(1, int(round(request["series_dt"] / SimulationOptions.dt_out)))
+    if request["include_series"]:  # refuse before computing, not after
+        samples = int(round(request["t_end"] / SimulationOptions.dt_out)) // stride + 1
+        if samples > MAX_SERIES_POINTS:
+            raise InvalidParameterError("series_dt", request["series_dt"],
+                                        f"at least {request['t_end'] / MAX_SERIES_POINTS:g} s for t_end = "
+                                        f"{request['t_end']:g} s (at most {MAX_SERIES_POINTS} samples per series)",
+                                        "gives too many samples")
     result = run_simulation(request["config"], request["V"], request["Fz"], _params(request),
                             t_end=request["t_end"], exact_nes=request["exact_nes"])
     out = result.to_dict()
     if request["include_series"]:
-        stride = max(1, int(round(request["series_dt"] / result.options.dt_out)))
-        n = (result.t.size + stride - 1) // stride
-        if n > MAX_SERIES_POINTS:
-            from ..errors import InvalidParameterError
-
-            raise InvalidParameterError("series_dt", request["series_dt"],
-                                        f"at least {result.t[-1] / MAX_SERIES_POINTS:g} s for t_end = "
-                                        f"{request['t_end']:g} s (at most {MAX_SERIES_POINTS} samples per series)",
-                                        "gives too many samples")
         out["series"] = {k: v[::stride] for k, v in result.series().items()}
         out["series_dt"] = stride * result.options.dt_out
-        spectrum = _spectrum(result)
-        out["spectrum"] = spectrum
+        out["spectrum"] = _spectrum(result)
     return out
 
 

@@ -224,5 +224,6 @@ def openapi_document() -> dict[str, Any]:
     return {"openapi": "3.1.0",
             "info": {"title": "shimmy API", "version": __version__,
                      "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Limits: "
-                                    f"body <= {settings.MAX_BODY_BYTES} bytes, t_end <= 600 s, ntst <= 200."},
+                                    f"body <= {settings.MAX_BODY_BYTES} bytes, t_end <= {settings.MAX_T_END:g} s, "
+                                    f"ntst <= {settings.MAX_NTST}."},
             "servers": [{"url": PREFIX}], "paths": paths, "components": {"schemas": comps}}

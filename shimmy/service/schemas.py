@@ -9,12 +9,12 @@ keys. Every refusal is an :class:`~shimmy.errors.InvalidParameterError` naming t
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
 from ..configurations import Configuration
 from ..errors import InvalidParameterError
+from . import settings
 from ..parameters import FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters, check_number, unknown_name_error
 
 CONFIGS = tuple(c.value for c in Configuration)
@@ -155,7 +155,7 @@ def _range(name: str, default: float, bounds: tuple[float, float], unit: str, wh
 SCHEMAS: dict[str, RequestSchema] = {
     "simulate": RequestSchema("simulate", "time history at one operating point", (
         _config(), V, FZ,
-        Field("t_end", "number", "simulated time", default=60.0, low=0.1, high=600.0, unit="s"),
+        Field("t_end", "number", "simulated time", default=60.0, low=0.1, high=settings.MAX_T_END, unit="s"),
         Field("include_series", "boolean", "return the time series (t, states, lateral)", default=False),
         Field("series_dt", "number", "sampling interval of the returned series (a multiple of 1 ms)",
               default=0.002, low=0.001, high=0.1, unit="s"),
@@ -175,7 +175,7 @@ SCHEMAS: dict[str, RequestSchema] = {
     "bifurcation": RequestSchema("bifurcation", "bifurcation diagram in V (equilibrium and periodic branches)", (
         _config(), FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),
         _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
-        Field("ntst", "integer", "collocation mesh intervals", default=40, low=10, high=200),
+        Field("ntst", "integer", "collocation mesh intervals", default=40, low=10, high=settings.MAX_NTST),
         Field("seeds", "boolean", "look for branches not born at a Hopf point by simulation", default=True),
         PARAMS, MATERIAL)),
     "hopf_curves": RequestSchema("hopf_curves", "Hopf curves of x = 0 in (V, Fz) with generalised Hopf points", (
@@ -194,6 +194,3 @@ def validate(analysis: str, body: Any, extra: tuple[str, ...] = ()) -> dict[str,
         raise unknown_name_error(analysis, list(SCHEMAS), "analysis")
     return SCHEMAS[analysis].validate(body, extra)
 
-
-def finite(x: float) -> float | None:
-    return float(x) if x is not None and math.isfinite(x) else None
