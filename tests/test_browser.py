@@ -96,8 +96,16 @@ def test_every_page_loads_without_console_errors(server, browser, name):
     assert "Design" in browser.find_element(By.ID, "design-panel").text
 
 
-NES_TRACE = ("return document.getElementById('ov-growth').getElementsByClassName('js-plotly-plot')[0]"
-             ".data.find(t => t.name === 'NES').y;")
+# Null until Plotly has drawn the figure (the table can render first): tests wait on it, never read it raw.
+NES_TRACE = ("const g = document.querySelector('#ov-growth .js-plotly-plot');"
+             "const t = g && g.data ? g.data.find(t => t.name === 'NES') : null;"
+             "return t ? t.y : null;")
+
+
+def _trace_count(driver, graph_id: str) -> int:
+    """Traces Plotly has drawn in a dcc.Graph (0 until it has drawn: the figure can lag the tables)."""
+    return driver.execute_script(f"const g = document.querySelector('#{graph_id} .js-plotly-plot');"
+                                 "return g && g.data ? g.data.length : 0;")
 
 
 def _nes_onset(driver) -> str:
@@ -109,14 +117,15 @@ def _nes_onset(driver) -> str:
 def test_slider_move_updates_the_linear_stability_figure_and_the_url(server, browser):
     browser.get(server.base + "/")
     before = _wait_for(lambda: _nes_onset(browser), what="the Hopf table")
-    traces_before = browser.execute_script(NES_TRACE)
+    traces_before = _wait_for(lambda: browser.execute_script(NES_TRACE), what="the growth-rate figure")
     handle = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]  # r2
     handle.click()
     for _ in range(20):
         handle.send_keys(Keys.ARROW_RIGHT)
     after = _wait_for(lambda: (v := _nes_onset(browser)) != before and v, timeout=20, what="the table to change")
     assert after != before
-    traces_after = browser.execute_script(NES_TRACE)
+    traces_after = _wait_for(lambda: (t := browser.execute_script(NES_TRACE)) != traces_before and t,
+                             timeout=20, what="the NES growth-rate trace to change")
     assert traces_after != traces_before
     _wait_for(lambda: "r2=" in browser.current_url, timeout=10, what="the URL to carry r2")
     # The link reproduces the view.
@@ -138,8 +147,8 @@ def test_background_job_shows_progress_then_its_figure(server, browser):
     assert browser.find_element(By.ID, "bif-cancel").is_enabled()
     _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#bif-summary tbody tr"), timeout=120,
               what="the result table")
-    n_traces = browser.execute_script(
-        "return document.getElementById('bif-graph').getElementsByClassName('js-plotly-plot')[0].data.length;")
+    n_traces = _wait_for(lambda: _trace_count(browser, "bif-graph") > 4 and _trace_count(browser, "bif-graph"),
+                         what="the diagram's traces")
     assert n_traces > 4
     rows = browser.find_elements(By.CSS_SELECTOR, "#bif-summary tbody tr")
     assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["original", "NES"]
@@ -157,7 +166,8 @@ def test_time_history_operating_point_button(server, browser):
     button.click()
     _wait_for(lambda: browser.find_element(By.ID, "th-metrics").text not in ("", first), timeout=60,
               what="the run at point D")
-    assert "Fz = 350 kN" in browser.find_element(By.CSS_SELECTOR, "#th-series .gtitle").text
+    _wait_for(lambda: any("Fz = 350 kN" in t.text for t in browser.find_elements(By.CSS_SELECTOR, "#th-series .gtitle")),
+              timeout=20, what="the figure title at point D")
     _wait_for(lambda: "Fz=350" in browser.current_url, timeout=10, what="the URL to carry the point")
     assert _severe(browser) == []
 
@@ -170,9 +180,10 @@ def test_results_download_as_csv_and_json(server, browser):
     _wait_for(lambda: browser.find_element(By.ID, "ov-csv").is_enabled(), what="the download button")
     browser.find_element(By.ID, "ov-csv").click()
     browser.find_element(By.ID, "ov-json").click()
-    files = _wait_for(lambda: sorted(p.name for p in DOWNLOADS.glob("overview_*") if not p.name.endswith(".crdownload"))
-                      if len(list(DOWNLOADS.glob("overview_*"))) >= 2 else None, timeout=20, what="two downloads")
-    assert files == ["overview_hopf.csv", "overview_stability.json"]
+    expected = ["overview_hopf.csv", "overview_stability.json"]
+    _wait_for(lambda: all((DOWNLOADS / name).exists() for name in expected), timeout=20, what="two downloads")
+    files = sorted(p.name for p in DOWNLOADS.glob("overview_*") if not p.name.endswith(".crdownload"))
+    assert files == expected
     text = (DOWNLOADS / "overview_hopf.csv").read_text()
     assert text.startswith("configuration,") and "NES + PD" in text
     import json
