@@ -7,7 +7,9 @@ import sys
 import numpy as np
 import pytest
 
-from shimmy.bifurcation import BifurcationOptions, bifurcation, cycle_at
+from shimmy.bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, cycle_at, gear_field
+from shimmy.continuation import ContinuationOptions, equilibrium_branch
+from shimmy.equations import build_model
 from shimmy.errors import InvalidParameterError
 from shimmy.simulation import simulate
 from shimmy.stability import hopf_points
@@ -46,6 +48,21 @@ def test_limit_cycles_agree_with_long_time_histories(diagrams, config):
         assert cycle["period"] == pytest.approx(1.0 / run.frequency_hz, rel=0.01)
         # Observed agreement is ~1e-5; keep a margin well inside the 1 % requirement.
         assert abs(cycle["max_psi"] / run.amplitude["psi"] - 1) < 1e-3
+
+
+@pytest.mark.parametrize("config, Fz", [("original", 300e3), ("original", 450e3), ("nes", 300e3),
+                                        ("pd", 300e3), ("nes_pd", 250e3)])
+def test_equilibrium_continuation_finds_every_hopf_point_of_the_scan(config, Fz):
+    """At 300 kN two pairs of the original gear cross 0.0075 m/s apart (3.8594 and 3.8669 m/s),
+    inside one continuation step: both are located, as at the other loads."""
+    model = build_model(config, None)
+    eq = equilibrium_branch(gear_field(model, Fz), np.zeros(model.n_states), 1.0, 1.0, 200.0,
+                            ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000),
+                            scale=STATE_SCALE[:model.n_states], p_scale=V_SCALE)
+    engine = [s.p for s in eq.special_points if s.kind == "H"]
+    scan = [h.V for h in hopf_points(config, Fz, v_min=1.0, v_max=200.0).hopf_points]
+    assert len(engine) == len(scan) >= 2
+    np.testing.assert_allclose(engine, scan, rtol=1e-6)
 
 
 @pytest.mark.parametrize("config", ["original", "nes", "pd", "nes_pd"])

@@ -23,9 +23,9 @@ from shimmy.collocation import Mesh, PeriodicProblem
 from shimmy.continuation import ContinuationOptions, equilibrium_branch
 from shimmy.errors import ConvergenceError, InvalidParameterError
 from shimmy.periodic_orbits import OrbitGuess, PeriodicOptions, hopf_guess, orbit_from_samples, periodic_branch
-from textbook_systems import (ALL_SYSTEMS, VDP_AMPLITUDE_MU1, VDP_PERIOD_MU1, fold_1d, fold_2d, hopf_shear,
-                              hopf_subcritical_quintic, hopf_supercritical, hopf_twice, neimark_sacker, period_doubling,
-                              pitchfork, transcritical, van_der_pol)
+from textbook_systems import (ALL_SYSTEMS, VDP_AMPLITUDE_MU1, VDP_PERIOD_MU1, fold_1d, fold_2d, hopf_close_pair,
+                              hopf_shear, hopf_subcritical_quintic, hopf_supercritical, hopf_twice, neimark_sacker,
+                              period_doubling, pitchfork, transcritical, two_pairs, van_der_pol)
 
 TWO_PI = 2.0 * math.pi
 
@@ -175,6 +175,30 @@ def test_two_hopf_points_of_a_growth_rate_mu_one_minus_mu():
     np.testing.assert_allclose([s.p for s in br.special_points[:2]], [0.0, 1.0], atol=1e-8)
     np.testing.assert_allclose([s.data["omega"] for s in br.special_points[:2]], 1.0, atol=1e-9)
     assert np.all(br.stable == ((br.p < 0) | (br.p > 1)))
+
+
+@pytest.mark.parametrize("delta", [1e-2, 1e-3, 1e-4])
+def test_two_hopf_points_inside_one_step_are_both_found(delta):
+    """Both crossings within one step: the unstable count agrees at the step's ends, yet the
+    pair is detected (eigenvalue slopes at the ends) and each point located."""
+    options = ContinuationOptions(ds=0.2, ds_max=0.5)
+    br = equilibrium_branch(hopf_close_pair(delta), np.zeros(2), 0.0, 0.0, 1.0, options)
+    assert np.diff(br.p).max() > 10 * delta  # the steps are much longer than the gap
+    assert kinds(br) == ["H", "H", "EP"]
+    # located to the test-function tolerance: |Re lambda| = |(p - 1/2)^2 - delta^2| <= locate_tol
+    p_h = np.array([s.p for s in br.special_points[:2]])
+    assert np.all(np.abs((p_h - 0.5) ** 2 - delta ** 2) <= options.locate_tol)
+    np.testing.assert_allclose(p_h, [0.5 - delta, 0.5 + delta], atol=options.locate_tol / delta)
+    assert all(s.data["located"] for s in br.special_points[:2])
+
+
+def test_two_pairs_crossing_within_one_step_give_two_hopf_points():
+    """The unstable count jumps by four in one step: each pair's crossing is located."""
+    options = ContinuationOptions(ds=0.2, ds_max=0.5)
+    br = equilibrium_branch(two_pairs(1e-3), np.zeros(4), 0.0, 0.0, 1.0, options)
+    assert kinds(br) == ["H", "H", "EP"]
+    np.testing.assert_allclose([s.p for s in br.special_points[:2]], [0.5, 0.501], atol=1e-9)
+    np.testing.assert_allclose([s.data["omega"] for s in br.special_points[:2]], [1.0, 2.0], atol=1e-9)
 
 
 @pytest.mark.parametrize("make, x0", [(pitchfork, np.zeros(2)), (transcritical, np.zeros(1))],

@@ -132,6 +132,38 @@ def hopf_twice(omega: float = 1.0) -> VectorField:
     return planar_normal_form(g=lambda p: p * (1.0 - p), dg=lambda p: 1.0 - 2.0 * p, w0=omega, name="hopf_twice")
 
 
+def hopf_close_pair(delta: float, centre: float = 0.5, omega: float = 1.0) -> VectorField:
+    """Growth rate g = (p - centre)^2 - delta^2: Hopf points at centre -+ delta, unstable outside them.
+
+    With delta much smaller than a continuation step, both crossings fall inside one step and
+    the number of unstable eigenvalues is the same at its two ends.
+    """
+    return planar_normal_form(g=lambda p: (p - centre) ** 2 - delta ** 2, dg=lambda p: 2.0 * (p - centre),
+                              w0=omega, name="hopf_close_pair")
+
+
+def two_pairs(delta: float, centre: float = 0.5) -> VectorField:
+    """Two uncoupled planar normal forms with growth rates p - centre and p - centre - delta
+    (frequencies 1 and 2): two Hopf points delta apart, both pairs turning unstable."""
+    first = planar_normal_form(g=lambda p: p - centre, w0=1.0)
+    second = planar_normal_form(g=lambda p: p - centre - delta, w0=2.0)
+
+    def f(x, p):
+        x = np.asarray(x, float)
+        return np.concatenate([first.f(x[:2], p), second.f(x[2:], p)])
+
+    def dfdx(x, p):
+        x = np.asarray(x, float)
+        J = np.zeros(x.shape[1:] + (4, 4))
+        J[..., :2, :2], J[..., 2:, 2:] = first.dfdx(x[:2], p), second.dfdx(x[2:], p)
+        return J
+
+    def dfdp(x, p):
+        return np.asarray(x, float).copy()
+
+    return VectorField(4, f, dfdx, dfdp, "two_pairs")
+
+
 def hopf_shear(omega: float = 2.0, c: float = -1.0) -> VectorField:
     """Rotation W = w + c r^2: cycles r^2 = mu with period 2 pi / (w + c mu) (grows for c < 0)."""
     return planar_normal_form(w0=omega, c=c, name="hopf_shear")
@@ -235,6 +267,8 @@ ALL_SYSTEMS = {
     "hopf_subcritical_quintic": hopf_subcritical_quintic,
     "hopf_twice": hopf_twice,
     "hopf_shear": hopf_shear,
+    "hopf_close_pair": lambda: hopf_close_pair(1e-3),
+    "two_pairs": lambda: two_pairs(1e-3),
     "van_der_pol": van_der_pol,
     "neimark_sacker": neimark_sacker,
     "period_doubling": period_doubling,
