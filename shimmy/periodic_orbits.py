@@ -228,7 +228,8 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
         if progress is not None:
             progress(min(1.0, abs(p_new - guess.p) / span))
         if T_new > options.period_max:
-            stop = f"period {T_new:.4g} above the limit {options.period_max:.4g} (homoclinic approach?)"
+            stop = (f"period {T_new:.4g} at p = {p_new:.6g} above the limit {options.period_max:.4g} "
+                    "(homoclinic approach?); the branch ends at the last orbit below it")
             break
         if T_new <= 0:
             stop = "period became non-positive: the continuation left the branch"

@@ -454,6 +454,9 @@ def test_periodic_period_limit():
     np.testing.assert_allclose(br.period, TWO_PI / (2.0 - br.p), rtol=1e-9)
     assert "period" in br.stop_reason and "limit 5" in br.stop_reason
     assert np.all(br.period <= 5.0) and br.p[-1] < 2.0 - TWO_PI / 5.0
+    # the message names where the limit was passed: just beyond the last orbit kept
+    p_stop = float(br.stop_reason.split("at p = ")[1].split()[0])
+    assert br.p[-1] < p_stop and TWO_PI / (2.0 - p_stop) > 5.0
     assert br.p[-1] > 0.5  # it did go most of the way
 
 
