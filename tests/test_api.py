@@ -166,8 +166,13 @@ def test_job_runs_to_completion_with_progress_and_is_cached(server):
     assert status == 202 and again["status"] == "done"
 
 
+# Jobs that run for several seconds (a fine mesh at a load with four Hopf points: ~6 s here), so
+# that they are still running when the test acts on them; they never run to the end.
+LONG_JOB = {"analysis": "bifurcation", "config": "original", "v_min": 1, "v_max": 200, "ntst": 200}
+
+
 def test_job_cancelled(server):
-    body = {"analysis": "hopf_curves", "config": "nes", "v_max": 480}
+    body = {**LONG_JOB, "Fz": 300000}
     status, _, job = server.request("POST", "/api/v1/jobs", body)
     assert status == 202
     _wait(server, job["id"], until=("running",), timeout=60)
@@ -184,7 +189,7 @@ def test_job_whose_worker_dies_is_failed_not_running_forever(server):
 
     os.environ["SHIMMY_CACHE_DIR"] = str(server.cache_dir)
     try:
-        body = {"analysis": "hopf_curves", "config": "original", "v_max": 470}
+        body = {**LONG_JOB, "Fz": 310000}
         _, _, job = server.request("POST", "/api/v1/jobs", body)
         _wait(server, job["id"], until=("running",), timeout=60)
         pid = jobs.store().get(("job", job["id"]))["pid"]
