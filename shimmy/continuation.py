@@ -420,9 +420,9 @@ def _hidden_crossing(old: tuple[np.ndarray, np.ndarray], new: tuple[np.ndarray, 
     along the step by a cubic Hermite polynomial from its values and slopes at both ends
     (``old``, ``new``: the Jacobian and its derivative along the step at each end; slopes by
     first-order perturbation, eigenvalues matched end to end by the value predicted from the
-    start); if the interpolant changes sign although the
-    ends agree, the fraction where it is most negative (relative to the ends' sign) is
-    returned for the caller to check with a corrected point. None when nothing suggests it.
+    start); if the interpolant changes sign although the ends agree, the fraction where it
+    is most negative (relative to the ends' sign) is returned for the caller to check with a
+    corrected point. None when nothing suggests it.
     """
     lam0, s0 = _eigen_slopes(*old)
     lam1, s1 = _eigen_slopes(*new)
