@@ -404,12 +404,11 @@ def _eigen_slopes(A: np.ndarray, dA: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return lam, slope
 
 
-def _jacobian_along(system, point: CurvePoint, h: float) -> tuple[np.ndarray, np.ndarray]:
-    """df/dx at the point and its derivative over a step h along the tangent (central differences)."""
+def _jacobian_along(system, point: CurvePoint, h: float) -> np.ndarray:
+    """Derivative of df/dx over a step h along the point's tangent (central differences)."""
     u, d = point.u, 1e-4 * h * point.tangent
-    A = system.dfdx(u[:-1], u[-1])
     A_plus, A_minus = system.dfdx(u[:-1] + d[:-1], u[-1] + d[-1]), system.dfdx(u[:-1] - d[:-1], u[-1] - d[-1])
-    return A, (A_plus - A_minus) / 2e-4
+    return (A_plus - A_minus) / 2e-4
 
 
 def _hidden_crossing(old: tuple[np.ndarray, np.ndarray], new: tuple[np.ndarray, np.ndarray]) -> float | None:
@@ -448,12 +447,14 @@ def _hidden_crossing(old: tuple[np.ndarray, np.ndarray], new: tuple[np.ndarray, 
 
 
 def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: CurvePoint, problem, options):
-    ev_new = _sorted_eigenvalues(system.dfdx(new.u[:-1], new.u[-1]))
+    A_new = system.dfdx(new.u[:-1], new.u[-1])
+    ev_new = _sorted_eigenvalues(A_new)
     ev_old = eigs[-1]
     count_old, count_new = int((ev_old.real > 0).sum()), int((ev_new.real > 0).sum())
     h = weighted_norm(new.u - prev.u, problem.weights)
     if count_old == count_new:
-        tau = _hidden_crossing(_jacobian_along(system, prev, h), _jacobian_along(system, new, h))
+        A_old = system.dfdx(prev.u[:-1], prev.u[-1])
+        tau = _hidden_crossing((A_old, _jacobian_along(system, prev, h)), (A_new, _jacobian_along(system, new, h)))
         mid = step(problem, prev, tau * h, options) if tau is not None else None
         if mid is not None and int((_sorted_eigenvalues(system.dfdx(mid.u[:-1], mid.u[-1])).real > 0).sum()) \
                 != count_old:

@@ -166,7 +166,9 @@ def test_time_history_operating_point_button(server, browser):
     button.click()
     _wait_for(lambda: browser.find_element(By.ID, "th-metrics").text not in ("", first), timeout=60,
               what="the run at point D")
-    titles = lambda: [t.text for t in browser.find_elements(By.CSS_SELECTOR, "#th-series .gtitle")]  # noqa: E731
+    def titles():
+        return [t.text for t in browser.find_elements(By.CSS_SELECTOR, "#th-series .gtitle")]
+
     _wait_for(lambda: any("Fz = 350 kN" in t for t in titles()), timeout=20, what="the figure title at point D")
     _wait_for(lambda: "Fz=350" in browser.current_url, timeout=10, what="the URL to carry the point")
     assert _severe(browser) == []
