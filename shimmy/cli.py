@@ -1,4 +1,5 @@
-"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,bifurcation,hopf-curves,devices,calibrate} ...``.
+"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,bifurcation,hopf-curves,map,classify,metrics,study,
+devices,calibrate} ...``.
 
 Results go to stdout (JSON with ``--json``, a short table otherwise). Bad input exits
 with status 2 and a message on stderr naming the field, its value and what is allowed.
@@ -216,6 +217,132 @@ def _cmd_hopf_curves(args) -> int:
     return 0
 
 
+def _float_list(name: str, text: str) -> list[float]:
+    items = [t.strip() for t in str(text).split(",") if t.strip()]
+    try:
+        return [float(t) for t in items]
+    except ValueError:
+        raise InvalidParameterError(name, text, "comma-separated numbers, e.g. 0.0005,0.001,0.005") from None
+
+
+def _cmd_map(args) -> int:
+    from .design_metrics import metrics
+    from .parameters import check_number
+    from .stability_map import stability_map
+
+    resolution = int(check_number("resolution", args.resolution, 2, 400, integer=True))
+    n_v = int(check_number("n_v", args.n_v, 2, 2000, integer=True))
+    bar = _ProgressBar()
+    try:
+        smap = stability_map(args.config, (args.v_min, args.v_max), (args.fz_min, args.fz_max), resolution,
+                             _params(args), n_v=n_v, progress=bar)
+        figures = metrics(smap, float(check_number("metrics_Fz", args.metrics_Fz, *FZ_RANGE, "N")))
+    finally:
+        bar.close()
+    payload = smap.to_dict()
+    payload["metrics"] = figures
+    if args.csv:
+        smap.write_csv(args.csv)
+    counts = {t: sum(row.count(t) for row in smap.types) for t in ("Stable", "Torsion", "Lateral", "Bistable",
+                                                                    "Both")}
+    lines = [f"{smap.config.value}: {len(smap.Fz)} slices x {len(smap.V)} speeds, V {smap.v_range[0]:g}.."
+             f"{smap.v_range[1]:g} m/s, Fz {smap.fz_range[0]:g}..{smap.fz_range[1]:g} N "
+             f"({smap.elapsed_s:.1f} s, {smap.executor})",
+             "  grid points by type: " + ", ".join(f"{t} {n}" for t, n in counts.items()),
+             f"  Hopf curves {len(smap.hopf.curves)}, GH points {len(smap.hopf.gh_points)}, "
+             f"fold curves {len(smap.fold_curves)}, torus curves {len(smap.torus_curves)}"]
+    if smap.min_shimmy:
+        lines.append(f"  minimum shimmy load {smap.min_shimmy['Fz']:.6g} N at V = {smap.min_shimmy['V']:.5g} m/s "
+                     f"({smap.min_shimmy['source']})")
+    else:
+        lines.append("  no shimmy anywhere in the map")
+    lines.append(f"  pure-torsion area, Fz <= 250 kN: {figures['torsion_area']:.6g} (m/s) kN")
+    lines += [f"  warning: {w}" for w in smap.warnings]
+    _emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_classify(args) -> int:
+    from .stability_map import classify
+
+    result = classify(args.config, args.V, args.Fz, _params(args), (args.v_min, args.v_max))
+    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {result['shimmy_type']}"]
+    for a in result["attractors"]:
+        if a["kind"] == "equilibrium":
+            lines.append("  stable: straight rolling x = 0")
+        else:
+            lines.append(f"  stable: {a['kind']} ({a['mode']}), max |psi| {a['max_psi']:.5g} rad, "
+                         f"max |l_g delta| {a['max_lateral']:.5g} m")
+    _emit(result, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_metrics(args) -> int:
+    from .design_metrics import design_report
+    from .parameters import check_number
+
+    resolution = int(check_number("resolution", args.resolution, 2, 400, integer=True))
+    configs = [c.strip() for c in args.configs.split(",") if c.strip()]
+    bar = _ProgressBar()
+    try:
+        report = design_report(configs, _params(args), float(check_number("Fz", args.Fz, *FZ_RANGE, "N")),
+                               resolution, progress=bar)
+    finally:
+        bar.close()
+    report.pop("maps")
+    lines = [f"{'config':<8}{'min shimmy Fz (kN)':>20}{'change':>9}{'torsion area':>14}{'change':>9}"
+             f"{'max psi (rad)':>15}{'change':>9}  shimmy V (m/s) at {report['Fz'] / 1e3:g} kN"]
+    for c, m in report["metrics"].items():
+        d = m["against_original"]
+
+        def rel(key):
+            r = d[key]["relative"]
+            return "" if r is None else f"{100 * r:+.1f}%"
+
+        fz = "-" if m["min_shimmy_Fz"] is None else f"{m['min_shimmy_Fz'] / 1e3:.2f}"
+        hull = m["at_Fz"]["shimmy_speed_range"]
+        lines.append(f"{c:<8}{fz:>20}{rel('min_shimmy_Fz'):>9}{m['torsion_area']:>14.1f}{rel('torsion_area'):>9}"
+                     f"{m['at_Fz']['max_psi']:>15.5f}{rel('max_psi'):>9}  "
+                     + ("none" if hull is None else f"{hull[0]:.1f}..{hull[1]:.1f}"))
+    _emit(report, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_study(args) -> int:
+    from .studies import study, study_grid
+
+    configs = [c.strip() for c in args.configs.split(",") if c.strip()]
+    bar = _ProgressBar()
+    try:
+        if args.param2:
+            result = study_grid((args.param, args.param2),
+                                (_float_list("values", args.values), _float_list("values2", args.values2 or "")),
+                                configs, args.Fz, _params(args), (args.v_min, args.v_max), progress=bar)
+        else:
+            result = study(args.param, _float_list("values", args.values), configs, args.Fz, _params(args),
+                           (args.v_min, args.v_max), progress=bar)
+    finally:
+        bar.close()
+    if args.csv:
+        result.write_csv(sys.stdout)
+        return 0
+    lines = [f"study at Fz = {result.Fz:g} N, V {result.v_range[0]:g}..{result.v_range[1]:g} m/s "
+             f"({result.elapsed_s:.1f} s, {result.executor})",
+             "".join(f"{p:>12}" for p in result.parameters)
+             + f"  {'config':<8}{'Hopf start':>11}{'Hopf end':>10}{'max psi':>10}{'at V':>8}"]
+
+    def num(x, fmt):
+        return "-" if x is None else format(x, fmt)
+
+    for r in result.rows:
+        lines.append("".join(f"{r[p]:>12.6g}" for p in result.parameters)
+                     + f"  {r['config']:<8}{num(r['hopf_start'], '11.4f')}{num(r['hopf_end'], '10.4f')}"
+                     f"{num(r['max_psi'], '10.5f')}{num(r['max_psi_V'], '8.2f')}")
+    lines += [f"  warning: {w}" for w in result.warnings]
+    _emit(result.to_dict(), args.json, "\n".join(lines))
+    return 0
+
+
 def _cmd_calibrate(args) -> int:
     from .calibration import calibrate, format_report
 
@@ -286,6 +413,48 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
     _add_common(p)
     p.set_defaults(func=_cmd_hopf_curves)
+
+    def plane(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--v-min", default=1.0, help="lowest speed (m/s)")
+        p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
+        p.add_argument("--fz-min", default=FZ_RANGE[0], help="lowest load (N)")
+        p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
+
+    p = sub.add_parser("map", help="(V, Fz) stability map: Hopf, fold and torus curves, shimmy types")
+    p.add_argument("--config", required=True, choices=configs)
+    plane(p)
+    p.add_argument("--resolution", default=40, help="number of Fz slices")
+    p.add_argument("--n-v", default=100, help="number of speeds per slice on the output grid")
+    p.add_argument("--metrics-Fz", default=150e3, help="load (N) of the speed-interval and amplitude metrics")
+    p.add_argument("--csv", metavar="FILE", help="write the classified grid to FILE")
+    _add_common(p)
+    p.set_defaults(func=_cmd_map)
+
+    p = sub.add_parser("classify", help="shimmy type and stable attractors at one operating point")
+    operating_point(p)
+    p.add_argument("--v-min", default=1.0, help="lowest speed of the diagram the answer is read from (m/s)")
+    p.add_argument("--v-max", default=200.0, help="highest speed of that diagram (m/s)")
+    p.set_defaults(func=_cmd_classify)
+
+    p = sub.add_parser("metrics", help="design figures of merit of configurations against original")
+    p.add_argument("--configs", default="original,nes,pd,nes_pd", help="comma-separated configurations")
+    p.add_argument("--Fz", default=150e3, help="load (N) of the speed-interval and amplitude metrics")
+    p.add_argument("--resolution", default=40, help="number of Fz slices of each map")
+    _add_common(p)
+    p.set_defaults(func=_cmd_metrics)
+
+    p = sub.add_parser("study", help="parametric study: Hopf speeds and max amplitude against parameters")
+    p.add_argument("--param", required=True, help="parameter name (see 'params')")
+    p.add_argument("--values", required=True, help="comma-separated values")
+    p.add_argument("--param2", help="second parameter for a two-parameter grid")
+    p.add_argument("--values2", help="comma-separated values of the second parameter")
+    p.add_argument("--configs", default="original,nes,pd,nes_pd", help="comma-separated configurations")
+    p.add_argument("--Fz", default=150e3, help="vertical load (N)")
+    p.add_argument("--v-min", default=1.0, help="lowest speed (m/s)")
+    p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
+    p.add_argument("--csv", action="store_true", help="write the table as CSV to stdout")
+    _add_common(p)
+    p.set_defaults(func=_cmd_study)
 
     p = sub.add_parser("devices", help="NES torque/stiffness and PD damping curves")
     p.add_argument("--v-max", default=2.0, help="largest PD tangential speed (m/s)")

@@ -9,7 +9,8 @@ PACKAGE = pathlib.Path(shimmy.__file__).parent
 MODEL = {"errors", "parameters", "configurations", "nes", "particle_damper", "equations", "integrator",
          "reference_model", "lyapunov", "response"}
 ANALYSES = {"simulation", "stability", "calibration", "device_curves", "continuation", "collocation",
-            "periodic_orbits", "bifurcation", "hopf_continuation", "hopf_curves"}
+            "periodic_orbits", "bifurcation", "hopf_continuation", "hopf_curves", "executors", "stability_map",
+            "studies", "design_metrics"}
 FORBIDDEN = {"dash", "plotly", "flask", "gunicorn", "diskcache"}
 
 

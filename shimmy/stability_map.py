@@ -1,0 +1,479 @@
+"""(V, Fz) stability maps and the shimmy type of an operating point.
+
+How a map is built (what :func:`stability_map` returns says the same in ``methods``):
+
+* **Hopf curves and GH points**: two-parameter continuation of the Hopf points of x = 0
+  (:func:`shimmy.hopf_curves.hopf_curves`; the extended system, l1 along the curve).
+* **Fold-of-cycles (LPC) and torus (NS) curves**: the engine has no two-parameter
+  continuation of cycle bifurcations, so these are joined from the special points of the
+  one-parameter diagrams in V computed on every Fz slice (:func:`_join_curves`). Their
+  accuracy in V is that of the located points (1e-6 relative); in Fz it is the slice
+  spacing. Fold curves are started at the GH point they are born at when one lies within
+  a slice spacing of their end.
+* **Shimmy type** on every slice: the stable attractors at each V read off the slice's
+  bifurcation diagram (:func:`attractors_at`): x = 0 where its eigenvalues say so, and every
+  periodic branch point with all nontrivial Floquet multipliers inside the unit circle, with
+  its mode (torsional / lateral / both, :func:`shimmy.response.mode_of`). The type
+  (:func:`shimmy_type`) is Bistable if a torsional and a lateral cycle are both stable, else
+  Both if a stable cycle has both motions large, else Torsion or Lateral after the stable
+  cycle, else Stable. Where neither x = 0 nor any cycle is stable (past a torus point the
+  attractor is quasi-periodic), the type comes from a time simulation from the standard
+  start (psi = 0.001 rad) at that V; the attractor is then reported with
+  ``"kind": "simulation"``.
+
+:func:`classify` runs exactly the slice computation at one Fz and reads the answer at V,
+so at a map's grid points it gives the map's answer.
+
+Slices are independent units of work and go through :mod:`shimmy.executors` (a local
+process pool, or a Dask cluster).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from . import __version__
+from .bifurcation import BifurcationOptions, BifurcationResult, bifurcation
+from .configurations import Configuration
+from .errors import InvalidParameterError
+from .executors import run_units
+from .hopf_curves import HopfCurvesResult, hopf_curves
+from .parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_operating_point
+from .response import ResponseType
+
+SHIMMY_TYPES = ("Stable", "Torsion", "Lateral", "Bistable", "Both")
+DEFAULT_V_RANGE = (1.0, 200.0)
+DEFAULT_FZ_RANGE = (1.0e4, 9.0e5)
+#: Simulated V per slice at most where no stable equilibrium or cycle exists; the other grid
+#: points of such a stretch take the answer of the nearest simulated one.
+MAX_SIMULATIONS_PER_SLICE = 12
+FALLBACK_T_END = 60.0  # s
+#: Fine grid (per output grid step) on which speed intervals and region lengths are measured.
+FINE = 10
+#: Low-load band of the pure-torsion area metric.
+BAND_FZ_MAX = 250.0e3  # N
+BAND_V = (1.0, 200.0)  # m/s
+#: A "cycle" smaller than this (rad, m) is x = 0: continuation with the particle damper can run a
+#: branch on through its Hopf point along the trivial orbit (amplitudes ~1e-100 observed).
+TRIVIAL_PSI = 1e-6
+TRIVIAL_LATERAL = 1e-7
+#: Curve joining: slice-to-slice match if |ln(V1 / V2)| is below this (a 50 % change).
+JOIN_LOG_V = math.log(1.5)
+
+
+# --------------------------------------------------------------------------- attractors
+
+
+def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
+    """The stable equilibria and limit cycles of a bifurcation diagram at speed V."""
+    found: list[dict[str, Any]] = []
+    if not any(a <= V <= b for a, b in result.hopf.unstable_intervals):
+        found.append({"kind": "equilibrium", "mode": None, "max_psi": 0.0, "max_lateral": 0.0,
+                      "period": None, "branch": 0})
+    tol = 1e-7 * max(1.0, abs(V))  # end points located on a range bound to rounding
+    for k, b in enumerate(result.branches):
+        if b.kind != "periodic" or b.V.size < 2:
+            continue
+        segments = [(i, i + 1) for i in range(b.V.size - 1)]
+        if b.stop_reason.startswith("closed branch"):  # a loop: its last orbit joins its first
+            segments.append((b.V.size - 1, 0))
+        for i, j in segments:
+            v0, v1 = b.V[i], b.V[j]
+            if not min(v0, v1) - tol <= V <= max(v0, v1) + tol or v0 == v1:
+                continue
+            f = min(max((V - v0) / (v1 - v0), 0.0), 1.0)
+            near = i if f <= 0.5 else j
+            stable = bool(b.stable[i]) if b.stable[i] == b.stable[j] else bool(b.stable[near])
+            mode = b.mode[near] or b.mode[i] or b.mode[j]
+            if not stable or mode is None:
+                continue
+            amp = float(b.max_psi[i] + f * (b.max_psi[j] - b.max_psi[i]))
+            lateral = float(b.max_lateral[i] + f * (b.max_lateral[j] - b.max_lateral[i]))
+            if amp <= TRIVIAL_PSI and lateral <= TRIVIAL_LATERAL:
+                continue  # a zero-amplitude end point, or a branch run on along x = 0 itself
+            found.append({"kind": "limit cycle", "mode": mode, "max_psi": amp,
+                          "max_lateral": lateral,
+                          "period": float(b.period[i] + f * (b.period[j] - b.period[i])), "branch": k})
+    return found
+
+
+def shimmy_type(attractors: list[dict[str, Any]]) -> str:
+    """Stable / Torsion / Lateral / Bistable / Both from a list of stable attractors."""
+    modes = {a["mode"] for a in attractors if a["kind"] != "equilibrium"}
+    if "torsional" in modes and "lateral" in modes:
+        return "Bistable"
+    if "both" in modes:
+        return "Both"
+    if "torsional" in modes:
+        return "Torsion"
+    if "lateral" in modes:
+        return "Lateral"
+    return "Stable"
+
+
+_RESPONSE_MODE = {ResponseType.TORSION: "torsional", ResponseType.LATERAL: "lateral", ResponseType.BOTH: "both"}
+
+
+def simulated_attractor(config: Configuration, V: float, Fz: float, params: Parameters) -> dict[str, Any]:
+    """The attractor reached from the standard start, for speeds with no stable equilibrium or cycle."""
+    from .simulation import simulate
+
+    run = simulate(config, V, Fz, params, t_end=FALLBACK_T_END)
+    mode = _RESPONSE_MODE.get(run.response_type)
+    note = "" if run.success else f"simulation stopped: {run.message}"
+    if run.response_type is ResponseType.STABLE:
+        note = note or "the simulation decays (slowly) although x = 0 is unstable"
+    return {"kind": "simulation", "mode": mode, "max_psi": float(run.amplitude["psi"]),
+            "max_lateral": float(run.amplitude["lateral"]), "period": None,
+            "frequency_hz": None if not math.isfinite(run.frequency_hz) else float(run.frequency_hz),
+            "steady": bool(run.steady), "note": note}
+
+
+# --------------------------------------------------------------------------- one slice
+
+
+@dataclass
+class SliceResult:
+    """One Fz slice of a map: types on the V grid, special points, speed measures."""
+
+    Fz: float
+    V: np.ndarray  # output grid (m/s)
+    types: list[str]
+    hopf_points: list[dict[str, Any]]
+    special_points: list[dict[str, Any]]  # LPC / NS / PD / BPC on periodic branches: kind, V, mode
+    intervals: list[dict[str, Any]]  # maximal V intervals of one type other than Stable (fine grid)
+    lengths: dict[str, float]  # measure (m/s) of V with each type (fine grid)
+    max_psi: float
+    max_psi_V: float | None
+    simulated: list[float]  # V where the type came from a simulation
+    warnings: list[str]
+    elapsed_s: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"Fz": self.Fz, "hopf_points": self.hopf_points, "special_points": self.special_points,
+                "intervals": self.intervals, "lengths": self.lengths, "max_psi": self.max_psi,
+                "max_psi_V": self.max_psi_V, "simulated_V": self.simulated, "warnings": self.warnings,
+                "elapsed_s": self.elapsed_s}
+
+
+def _grids(v_min: float, v_max: float, n_v: int) -> tuple[np.ndarray, np.ndarray]:
+    fine = np.linspace(v_min, v_max, (n_v - 1) * FINE + 1)
+    return fine[::FINE].copy(), fine
+
+
+def _slice_types(result: BifurcationResult, fine: np.ndarray, coarse_step: int, config: Configuration,
+                 params: Parameters) -> tuple[list[str], list[list[dict]], list[float]]:
+    """Types on the fine grid; stretches with no stable equilibrium or cycle are simulated at
+    their output-grid points (at most MAX_SIMULATIONS_PER_SLICE, spread evenly)."""
+    attractors = [attractors_at(result, float(v)) for v in fine]
+    empty = [i for i, a in enumerate(attractors) if not a]
+    simulated: list[float] = []
+    if empty:
+        on_grid = [i for i in empty if i % coarse_step == 0] or [empty[len(empty) // 2]]
+        if len(on_grid) > MAX_SIMULATIONS_PER_SLICE:
+            pick = np.linspace(0, len(on_grid) - 1, MAX_SIMULATIONS_PER_SLICE).round().astype(int)
+            on_grid = [on_grid[k] for k in sorted(set(pick.tolist()))]
+        runs = {i: simulated_attractor(config, float(fine[i]), result.Fz, params) for i in on_grid}
+        simulated = [float(fine[i]) for i in on_grid]
+        keys = np.array(on_grid)
+        for i in empty:
+            j = int(keys[np.argmin(np.abs(keys - i))])
+            attractors[i] = [dict(runs[j], simulated_at=float(fine[j]))] if j != i else [runs[j]]
+    return [shimmy_type(a) for a in attractors], attractors, simulated
+
+
+def _intervals(fine: np.ndarray, types: list[str]) -> list[dict[str, Any]]:
+    out = []
+    start = 0
+    for i in range(1, len(types) + 1):
+        if i == len(types) or types[i] != types[start]:
+            if types[start] != "Stable":
+                out.append({"type": types[start], "V_start": float(fine[start]), "V_end": float(fine[i - 1])})
+            start = i
+    return out
+
+
+def _lengths(fine: np.ndarray, types: list[str]) -> dict[str, float]:
+    """Measure of V with each type: each fine point stands for the cell around it."""
+    edges = np.concatenate([[fine[0]], 0.5 * (fine[1:] + fine[:-1]), [fine[-1]]])
+    widths = np.diff(edges)
+    return {t: float(sum(w for w, ty in zip(widths, types, strict=True) if ty == t)) for t in SHIMMY_TYPES}
+
+
+def _special_points(result: BifurcationResult) -> list[dict[str, Any]]:
+    points = []
+    for b in result.branches:
+        if b.kind != "periodic":
+            continue
+        for s in b.special_points:
+            if s["kind"] in ("LPC", "NS", "PD", "BPC"):
+                k = int(np.argmin(np.abs(b.V - s["V"])))
+                points.append({"kind": s["kind"], "V": float(s["V"]), "mode": b.mode[k]})
+    return points
+
+
+def map_slice(config: Configuration | str, Fz: float, v_min: float, v_max: float, n_v: int,
+              params: Parameters, options: BifurcationOptions | None = None) -> SliceResult:
+    """The map's computation on one load: diagram in V, types on the grid, special points."""
+    clock = time.perf_counter()
+    config = Configuration.parse(config)
+    options = options or BifurcationOptions(mesh_check=False)
+    result = bifurcation(config, Fz, v_min, v_max, params, options)
+    coarse, fine = _grids(v_min, v_max, n_v)
+    types_fine, _, simulated = _slice_types(result, fine, FINE, config, params)
+    hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value}
+            for h in result.hopf.hopf_points]
+    return SliceResult(Fz, coarse, types_fine[::FINE], hopf, _special_points(result), _intervals(fine, types_fine),
+                       _lengths(fine, types_fine), result.max_psi, result.max_psi_V, simulated,
+                       list(result.warnings), time.perf_counter() - clock)
+
+
+# --------------------------------------------------------------------------- classify
+
+
+def classify(config: Configuration | str, V: float, Fz: float, params: Parameters | None = None,
+             v_range: tuple[float, float] = DEFAULT_V_RANGE, options: BifurcationOptions | None = None,
+             result: BifurcationResult | None = None) -> dict[str, Any]:
+    """Shimmy type and stable attractors at (V, Fz): the map's computation on the slice at Fz.
+
+    ``result`` may pass an already computed diagram at this Fz over ``v_range``."""
+    config = Configuration.parse(config)
+    params = params if params is not None else Parameters()
+    V, Fz = check_operating_point(V, Fz)
+    v_min, v_max = _check_range("v", v_range, V_RANGE, "m/s")
+    if not v_min <= V <= v_max:
+        raise InvalidParameterError("V", V, f"a number in [{v_min:g}, {v_max:g}] m/s (the diagram's range)")
+    if result is None:
+        result = bifurcation(config, Fz, v_min, v_max, params, options or BifurcationOptions(mesh_check=False))
+    found = attractors_at(result, V)
+    if not found:
+        found = [simulated_attractor(config, V, Fz, params)]
+    return {"config": config.value, "V": V, "Fz": Fz, "shimmy_type": shimmy_type(found), "attractors": found,
+            "hopf_points": [h.V for h in result.hopf.hopf_points], "warnings": list(result.warnings),
+            "version": __version__}
+
+
+# --------------------------------------------------------------------------- curves
+
+
+def _join_curves(slices: list[SliceResult], kind: str) -> list[list[dict[str, float]]]:
+    """Special points of one kind on consecutive slices joined into curves.
+
+    Slice to slice, points are matched by least total |ln(V1 / V2)| (an assignment problem;
+    pairs further apart than JOIN_LOG_V and of different mode are not matched). Two curves
+    ending on the same interior slice at the nearest pair of speeds are joined there: the
+    curve turns in Fz between that slice and the next."""
+    curves: list[list[tuple[int, float, str]]] = []
+    open_ends: list[int] = []  # indices of curves ending on the previous slice
+    for s, sl in enumerate(slices):
+        pts = [(s, p["V"], p["mode"]) for p in sl.special_points if p["kind"] == kind]
+        ends = [curves[c][-1] for c in open_ends]
+        matched: dict[int, int] = {}
+        if ends and pts:
+            cost = np.array([[abs(math.log(p[1] / e[1])) + (0.0 if p[2] == e[2] else 10.0) for p in pts]
+                             for e in ends])
+            rows, cols = linear_sum_assignment(cost)
+            matched = {int(c): int(r) for r, c in zip(rows, cols, strict=True) if cost[r, c] <= JOIN_LOG_V}
+        new_open = []
+        for j, p in enumerate(pts):
+            if j in matched:
+                c = open_ends[matched[j]]
+                curves[c].append(p)
+            else:
+                curves.append([p])
+                c = len(curves) - 1
+            new_open.append(c)
+        open_ends = new_open
+    curves = _join_turns(curves, len(slices), at_end=True)
+    curves = _join_turns(curves, len(slices), at_end=False)
+    return [[{"V": v, "Fz": slices[s].Fz} for s, v, _ in c] for c in curves]
+
+
+def _join_turns(curves, n_slices: int, at_end: bool):
+    """Join pairs of curves that both end (or both start) on the same interior slice."""
+    curves = [list(c) for c in curves]
+    while True:
+        best = None
+        for a in range(len(curves)):
+            for b in range(a + 1, len(curves)):
+                ea = curves[a][-1] if at_end else curves[a][0]
+                eb = curves[b][-1] if at_end else curves[b][0]
+                if ea[0] != eb[0] or ea[0] in (0, n_slices - 1) or ea[2] != eb[2]:
+                    continue
+                d = abs(math.log(ea[1] / eb[1]))
+                if d <= 2 * JOIN_LOG_V and (best is None or d < best[0]):
+                    best = (d, a, b)
+        if best is None:
+            return curves
+        _, a, b = best
+        joined = curves[a] + curves[b][::-1] if at_end else curves[a][::-1] + curves[b]
+        curves = [c for k, c in enumerate(curves) if k not in (a, b)] + [joined]
+
+
+def _attach_gh(curves: list[list[dict[str, float]]], gh: list[dict[str, float]], spacing: float):
+    """Start each fold curve at the GH point it is born at (nearest end within a slice spacing)."""
+    for g in gh:
+        best = None
+        for c in curves:
+            for end in (0, -1):
+                p = c[end]
+                if abs(p["Fz"] - g["Fz"]) <= 1.01 * spacing:
+                    d = abs(math.log(p["V"] / g["V"]))
+                    if d <= JOIN_LOG_V and (best is None or d < best[0]):
+                        best = (d, c, end)
+        if best is not None:
+            _, c, end = best
+            point = {"V": g["V"], "Fz": g["Fz"], "gh": True}
+            if end == 0:
+                c.insert(0, point)
+            else:
+                c.append(point)
+    return curves
+
+
+# --------------------------------------------------------------------------- the map
+
+
+@dataclass
+class StabilityMap:
+    config: Configuration
+    params: Parameters
+    v_range: tuple[float, float]
+    fz_range: tuple[float, float]
+    V: np.ndarray
+    Fz: np.ndarray
+    types: list[list[str]]  # [i_Fz][j_V]
+    slices: list[SliceResult]
+    hopf: HopfCurvesResult
+    fold_curves: list[list[dict[str, float]]]
+    torus_curves: list[list[dict[str, float]]]
+    min_shimmy: dict[str, Any] | None
+    executor: str
+    elapsed_s: float
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def min_shimmy_Fz(self) -> float | None:
+        return None if self.min_shimmy is None else self.min_shimmy["Fz"]
+
+    @property
+    def hopf_curves(self) -> list[list[dict[str, float]]]:
+        return [[{"V": float(p[0]), "Fz": float(p[1])} for p in c.p] for c in self.hopf.curves]
+
+    def type_at(self, V: float, Fz: float) -> str:
+        """The type of the grid point nearest to (V, Fz)."""
+        i = int(np.argmin(np.abs(self.Fz - Fz)))
+        j = int(np.argmin(np.abs(self.V - V)))
+        return self.types[i][j]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"config": self.config.value, "params": self.params.to_dict(),
+                "v_range": list(self.v_range), "fz_range": list(self.fz_range),
+                "hopf_curves": self.hopf_curves, "gh_points": self.hopf.gh_points,
+                "fold_curves": self.fold_curves, "torus_curves": self.torus_curves,
+                "V": self.V.tolist(), "Fz": self.Fz.tolist(), "types": self.types,
+                "min_shimmy_Fz": self.min_shimmy_Fz, "min_shimmy": self.min_shimmy,
+                "slices": [s.to_dict() for s in self.slices],
+                "methods": {
+                    "hopf_curves": "two-parameter continuation of Hopf points (extended system)",
+                    "gh_points": "sign changes of the first Lyapunov coefficient along the Hopf curves "
+                                 "(not defined with the particle damper: not smooth at x = 0)",
+                    "fold_curves": f"LPC points of one-parameter diagrams in V on {len(self.slices)} Fz slices, "
+                                   "joined slice to slice",
+                    "torus_curves": f"NS points of one-parameter diagrams in V on {len(self.slices)} Fz slices, "
+                                    "joined slice to slice",
+                    "types": "stable attractors of each slice's diagram; simulation where none is stable"},
+                "executor": self.executor, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
+                "version": __version__}
+
+    def write_csv(self, path) -> None:
+        import csv
+
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["Fz_N", "V_m_s", "shimmy_type"])
+            for Fz, row in zip(self.Fz, self.types, strict=True):
+                for V, t in zip(self.V, row, strict=True):
+                    w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
+
+
+def _check_range(prefix: str, rng, allowed, unit: str) -> tuple[float, float]:
+    lo = check_number(f"{prefix}_min", rng[0], *allowed, unit)
+    hi = check_number(f"{prefix}_max", rng[1], *allowed, unit)
+    if not hi > lo:
+        raise InvalidParameterError(f"{prefix}_max", hi, f"a number in ({lo:g}, {allowed[1]:g}] {unit}",
+                                    f"must exceed {prefix}_min")
+    return lo, hi
+
+
+def _unit(task: tuple) -> Any:
+    """One independent unit of a map (top level, so that process pools and Dask can ship it)."""
+    if task[0] == "hopf_curves":
+        _, config, params, v_range, fz_range = task
+        return hopf_curves(config, params, v_range=v_range, fz_range=fz_range)
+    _, config, Fz, v_min, v_max, n_v, params, options = task
+    return map_slice(config, Fz, v_min, v_max, n_v, params, options)
+
+
+def _describe(task: tuple) -> str:
+    return "Hopf curves" if task[0] == "hopf_curves" else f"slice Fz = {task[2] / 1e3:.4g} kN"
+
+
+def stability_map(config: Configuration | str, v_range: tuple[float, float] = DEFAULT_V_RANGE,
+                  fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = 40,
+                  params: Parameters | None = None, n_v: int = 100, executor=None,
+                  progress: Callable[[float, str], None] | None = None,
+                  options: BifurcationOptions | None = None) -> StabilityMap:
+    """The (V, Fz) stability map of one configuration: ``resolution`` Fz slices, ``n_v`` speeds.
+
+    ``executor`` is any :class:`concurrent.futures.Executor` (default: see :mod:`shimmy.executors`)."""
+    from .executors import describe
+
+    clock = time.perf_counter()
+    config = Configuration.parse(config)
+    params = params if params is not None else Parameters()
+    v_min, v_max = _check_range("v", v_range, V_RANGE, "m/s")
+    f_min, f_max = _check_range("fz", fz_range, FZ_RANGE, "N")
+    resolution = int(check_number("resolution", resolution, 2, 400, integer=True))
+    n_v = int(check_number("n_v", n_v, 2, 2000, integer=True))
+    options = options or BifurcationOptions(mesh_check=False)
+    loads = np.linspace(f_min, f_max, resolution)
+    # The Hopf curves go first: one unit, longer than a slice.
+    tasks = [("hopf_curves", config, params, (v_min, v_max), (f_min, f_max))]
+    tasks += [("slice", config, float(Fz), v_min, v_max, n_v, params, options) for Fz in loads]
+    results = run_units(_unit, tasks, executor, progress, _describe)
+    hopf: HopfCurvesResult = results[0]
+    slices: list[SliceResult] = results[1:]
+    spacing = float(loads[1] - loads[0])
+    folds = _attach_gh(_join_curves(slices, "LPC"), hopf.gh_points, spacing)
+    tori = _join_curves(slices, "NS")
+    warnings = list(hopf.warnings)
+    for s in slices:
+        warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
+    return StabilityMap(config, params, (v_min, v_max), (f_min, f_max), slices[0].V, loads,
+                        [s.types for s in slices], slices, hopf, folds, tori,
+                        _min_shimmy(hopf, folds, slices), describe() if executor is None else type(executor).__name__,
+                        time.perf_counter() - clock, warnings)
+
+
+def _min_shimmy(hopf: HopfCurvesResult, folds, slices: list[SliceResult]) -> dict[str, Any] | None:
+    """Lowest load with any shimmy: the lowest point of the Hopf and fold curves, or the lowest
+    slice with a type other than Stable, whichever is lower."""
+    candidates = []
+    low = hopf.fz_minimum
+    if low is not None and any(c.p.size for c in hopf.curves):
+        candidates.append({"Fz": low["Fz"], "V": low["V"], "source": "Hopf curve"})
+    for c in folds:
+        p = min(c, key=lambda q: q["Fz"])
+        candidates.append({"Fz": p["Fz"], "V": p["V"], "source": "fold-of-cycles curve"})
+    for s in slices:
+        if s.intervals:
+            candidates.append({"Fz": s.Fz, "V": s.intervals[0]["V_start"], "source": "classified slice"})
+            break
+    return min(candidates, key=lambda c: c["Fz"]) if candidates else None
