@@ -476,10 +476,12 @@ def _restore(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray
     return problem, CurvePoint(u, tangent(problem, u, direction)), weighted_norm(direction, problem.weights)
 
 
-def cycle_at(result: BifurcationResult, branch: int, V: float) -> dict[str, Any]:
+def cycle_at(result: BifurcationResult, branch: int, V: float, max_psi: float | None = None) -> dict[str, Any]:
     """The periodic orbit of ``result.branches[branch]`` at speed V, located exactly on the branch
     (secant on the step from the neighbouring branch point): period, amplitudes, stability and the
-    orbit itself (t, psi, l_g delta). Raises ValueError if the branch does not reach V."""
+    orbit itself (t, psi, l_g delta; ``x0`` the full state at t = 0). Raises ValueError if the
+    branch does not reach V. A branch that passes V more than once (a fold, a loop) gives the
+    orbit whose torsional amplitude is nearest to ``max_psi`` (default: the first one)."""
     b = result.branches[branch]
     if b.kind != "periodic" or b.raw is None:
         raise ValueError(f"branch {branch} is not a periodic branch")
@@ -487,9 +489,16 @@ def cycle_at(result: BifurcationResult, branch: int, V: float) -> dict[str, Any]
     model = build_model(result.config, result.params, exact_nes=result.options.exact_nes)
     system = gear_field(model, result.Fz)
     scale = STATE_SCALE[:model.n_states]
-    for i in range(raw.p.size - 1):
-        if (raw.p[i] - V) * (raw.p[i + 1] - V) > 0:
-            continue
+    crossings = [i for i in range(raw.p.size - 1) if (raw.p[i] - V) * (raw.p[i + 1] - V) <= 0]
+    if max_psi is not None:
+        amp = np.maximum(np.abs(raw.x_max[:, 0]), np.abs(raw.x_min[:, 0]))
+
+        def distance(i):
+            f = 0.0 if raw.p[i + 1] == raw.p[i] else (V - raw.p[i]) / (raw.p[i + 1] - raw.p[i])
+            return abs(amp[i] + f * (amp[i + 1] - amp[i]) - max_psi)
+
+        crossings.sort(key=distance)
+    for i in crossings:
         problem, start, h = _restore(system, raw, i, scale)
         if raw.p[i] == V:
             point = start
@@ -505,7 +514,7 @@ def cycle_at(result: BifurcationResult, branch: int, V: float) -> dict[str, Any]
         l_g = result.params.gear.l_g
         return {"V": float(point.u[-1]), "period": T, "max_psi": float(np.abs(x[:, 0]).max()),
                 "max_lateral": float(l_g * np.abs(x[:, 2]).max()), "stable": bool(np.all(np.abs(mu[1:]) < 1.0)),
-                "multipliers": mu, "t": tau * T, "psi": x[:, 0], "lateral": l_g * x[:, 2]}
+                "multipliers": mu, "t": tau * T, "psi": x[:, 0], "lateral": l_g * x[:, 2], "x0": x[0].copy()}
     raise ValueError(f"branch {branch} does not reach V = {V:g} m/s")
 
 

@@ -1,0 +1,235 @@
+"""Stability maps, the point classifier and the design metrics.
+
+Independent checks: time simulations from several initial conditions (the attractors the map
+claims are the ones the gear settles on), the eigenvalue scan (the pure-torsion region of
+`original` below 250 kN is exactly where x = 0 is unstable, all Hopf points there being
+supercritical), and the Hopf-curve continuation (lowest shimmy load).
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from shimmy.bifurcation import BifurcationOptions, bifurcation, cycle_at
+from shimmy.design_metrics import against_baseline, speed_metrics, torsion_area
+from shimmy.errors import InvalidParameterError
+from shimmy.executors import InlineExecutor
+from shimmy.simulation import simulate
+from shimmy.stability import hopf_points
+from shimmy.stability_map import (SHIMMY_TYPES, SliceResult, _join_curves, attractors_at, classify, shimmy_type,
+                                  stability_map)
+
+RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"}
+
+
+@pytest.fixture(scope="module")
+def original_map():
+    """original over V 1-200 m/s, Fz 10-900 kN on 12 slices (about 10 s on two workers)."""
+    return stability_map("original", (1.0, 200.0), (1.0e4, 9.0e5), resolution=12, n_v=60)
+
+
+def _cycle(mode, amp=0.1):
+    return {"kind": "limit cycle", "mode": mode, "max_psi": amp, "max_lateral": 0.01, "period": 0.1}
+
+
+EQ = {"kind": "equilibrium", "mode": None, "max_psi": 0.0, "max_lateral": 0.0, "period": None}
+
+
+@pytest.mark.parametrize("attractors, expected", [
+    ([EQ], "Stable"),
+    ([], "Stable"),
+    ([_cycle("torsional")], "Torsion"),
+    ([EQ, _cycle("torsional")], "Torsion"),  # subcritical: shimmy after a large enough disturbance
+    ([_cycle("lateral")], "Lateral"),
+    ([_cycle("torsional"), _cycle("lateral")], "Bistable"),
+    ([_cycle("lateral"), _cycle("torsional"), _cycle("both")], "Bistable"),
+    ([_cycle("both")], "Both"),
+    ([_cycle("torsional"), _cycle("both")], "Both"),
+])
+def test_shimmy_type_follows_the_definitions(attractors, expected):
+    assert shimmy_type(attractors) == expected
+
+
+def _settle(config, V, Fz, x0, t_end=100.0, rounds=5):
+    """Simulate until the response is steady (slow transients with the particle damper)."""
+    x = np.asarray(x0, float)
+    for _ in range(rounds):
+        run = simulate(config, V, Fz, x0=x, t_end=t_end)
+        assert run.success, run.message
+        if run.steady:
+            return run
+        x = run.states[:, -1]
+    raise AssertionError(f"{config} at V = {V}, Fz = {Fz}: no steady response after {rounds * t_end} s")
+
+
+def _matches(run, attractor) -> bool:
+    if attractor["kind"] == "equilibrium":
+        return run.response_type.value == "Stable"
+    return (run.response_type.value == RESPONSE_OF_MODE[attractor["mode"]]
+            and math.isclose(run.amplitude["psi"], attractor["max_psi"], rel_tol=0.03, abs_tol=1e-4)
+            and math.isclose(run.amplitude["lateral"], attractor["max_lateral"], rel_tol=0.03, abs_tol=1e-4))
+
+
+# One point inside each region of the maps (types as the classifier gives them; the first
+# five are regions of the original map: low-load stable, A, F, D, low-speed high load).
+SAMPLES = [
+    ("original", 100.0, 100e3, "Stable"),
+    ("original", 30.0, 150e3, "Torsion"),
+    ("original", 180.0, 350e3, "Lateral"),
+    ("original", 50.0, 350e3, "Bistable"),
+    ("original", 10.0, 400e3, "Both"),
+    ("original", 60.0, 650e3, "Bistable"),
+    ("nes_pd", 30.0, 238.2e3, "Both"),
+    ("nes_pd", 45.0, 238.2e3, "Lateral"),
+    ("nes", 30.0, 150e3, "Torsion"),
+    ("pd", 180.0, 850e3, "Lateral"),
+]
+
+
+@pytest.mark.parametrize("config, V, Fz, expected", SAMPLES)
+def test_classification_is_confirmed_by_simulation_from_several_starts(config, V, Fz, expected):
+    """Each start (rest + 0.001 rad, a large torsion, a large lateral bending, and each stable
+    cycle's own orbit) settles on one of the attractors the classifier lists; each listed cycle
+    keeps a run started on it; the type is the expected one."""
+    result = bifurcation(config, Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    answer = classify(config, V, Fz, result=result)
+    assert answer["shimmy_type"] == expected, answer
+    n = result.branches[0].V.size and (7 if "nes" in config else 5)
+    starts = []
+    for index, value in ((0, 0.001), (0, 0.2), (2, 0.05)):
+        x0 = np.zeros(n)
+        x0[index] = value
+        starts.append(x0)
+    attractors = answer["attractors"]
+    for a in attractors:
+        if a["kind"] == "limit cycle":
+            orbit = cycle_at(result, a["branch"], V, max_psi=a["max_psi"])
+            assert orbit["stable"]
+            run = _settle(config, V, Fz, orbit["x0"])
+            assert _matches(run, a), (a, run.response_type, run.amplitude)
+    reached = []
+    for x0 in starts:
+        run = _settle(config, V, Fz, x0)
+        hits = [a for a in attractors if _matches(run, a)]
+        assert hits, (x0, run.response_type, run.amplitude, attractors)
+        reached.append(hits[0]["kind"] + str(hits[0]["mode"]))
+    if expected == "Bistable":  # both attractors are reached from the standard starts
+        assert len(set(reached)) == 2, reached
+
+
+def test_map_grid_and_the_classifier_agree(original_map):
+    m = original_map
+    assert m.Fz.size == 12 and m.V.size == 60
+    assert all(len(row) == 60 and set(row) <= set(SHIMMY_TYPES) for row in m.types)
+    # Every type occurs on this map (see the simulation test for what each is).
+    assert {t for row in m.types for t in row} == set(SHIMMY_TYPES)
+    for i, j in ((3, 10), (4, 40), (6, 5), (6, 45), (9, 30), (11, 59)):
+        answer = classify("original", float(m.V[j]), float(m.Fz[i]))
+        assert answer["shimmy_type"] == m.types[i][j], (m.V[j], m.Fz[i])
+
+
+def test_no_shimmy_below_the_lowest_hopf_point_and_the_minimum_load_is_it(original_map):
+    m = original_map
+    low = m.hopf.fz_minimum
+    assert m.min_shimmy["source"] == "Hopf curve"
+    assert m.min_shimmy_Fz == pytest.approx(low["Fz"])
+    assert 59e3 < m.min_shimmy_Fz < 61e3  # the turning point of the torsional Hopf curve (59.95 kN)
+    for Fz, row in zip(m.Fz, m.types, strict=True):
+        if Fz < m.min_shimmy_Fz:
+            assert set(row) == {"Stable"}
+    # Just above it x = 0 is unstable somewhere and the slice is classified so.
+    assert hopf_points("original", m.min_shimmy_Fz + 500.0).hopf_points
+
+
+def test_fold_curves_start_at_the_generalised_hopf_points(original_map):
+    m = original_map
+    gh = {(round(g["V"], 6), round(g["Fz"], 3)) for g in m.hopf.gh_points}
+    assert len(gh) == 2
+    starts = {(round(c[0]["V"], 6), round(c[0]["Fz"], 3)) for c in m.fold_curves if c[0].get("gh")}
+    assert starts == gh
+    for c in m.fold_curves:  # fold points lie above the GH loads: the subcritical side
+        assert min(p["Fz"] for p in c) >= min(g["Fz"] for g in m.hopf.gh_points) - 1.0
+
+
+def _slice(Fz, points):
+    return SliceResult(Fz, np.array([1.0]), ["Stable"], [], [{"kind": k, "V": v, "mode": "torsional"}
+                                                             for k, v in points],
+                       [], {}, 0.0, None, [], [], 0.0)
+
+
+def test_curve_joining_follows_points_and_closes_a_turn_in_load():
+    slices = [_slice(1e5, [("NS", 10.0), ("LPC", 100.0)]),
+              _slice(2e5, [("NS", 11.0), ("NS", 40.0), ("LPC", 95.0)]),
+              _slice(3e5, [("NS", 12.0), ("NS", 30.0), ("LPC", 90.0)]),
+              _slice(4e5, [("NS", 13.0), ("LPC", 85.0)])]
+    tori = _join_curves(slices, "NS")
+    as_pairs = sorted([[(p["V"], p["Fz"]) for p in c] for c in tori])
+    # 10 -> 11 -> 12 -> 13 is one curve; 40 and 30 are the two sides of a curve turning in Fz above 3e5.
+    assert [(10.0, 1e5), (11.0, 2e5), (12.0, 3e5), (13.0, 4e5)] in as_pairs
+    assert [(40.0, 2e5), (30.0, 3e5)] in as_pairs or [(30.0, 3e5), (40.0, 2e5)] in as_pairs
+    assert len(tori) == 2
+    folds = _join_curves(slices, "LPC")
+    assert len(folds) == 1 and [p["V"] for p in folds[0]] == [100.0, 95.0, 90.0, 85.0]
+
+
+def test_torsion_area_of_original_equals_the_unstable_area_of_straight_rolling():
+    """Below 250 kN every Hopf point of `original` is supercritical and every cycle torsional,
+    so the pure-torsion region is where x = 0 is unstable: its area from 241 eigenvalue scans."""
+    band = stability_map("original", (1.0, 200.0), (1.0e4, 2.5e5), resolution=13, n_v=100,
+                         executor=InlineExecutor())
+    assert {t for row in band.types for t in row} == {"Stable", "Torsion"}
+    loads = np.linspace(1.0e4, 2.5e5, 241)
+    lengths = [sum(b - a for a, b in hopf_points("original", float(Fz), v_min=1.0, v_max=200.0).unstable_intervals)
+               for Fz in loads]
+    reference = float(np.trapezoid(lengths, loads / 1e3))
+    area = torsion_area(band)
+    assert area["torsion_area"] == pytest.approx(reference, rel=0.01)
+    assert area["band"]["Fz"] == [1.0e4, 2.5e5]
+    assert 0.0 < area["torsion_area_fraction"] < 1.0
+
+
+def test_speed_metrics_at_150_kN_match_the_hopf_points_and_the_diagram():
+    m = speed_metrics("original", 150e3, n_v=200)
+    low, high = m["shimmy_speed_range"]
+    assert abs(low - 5.6118) <= m["grid_step"] and abs(high - 93.4290) <= m["grid_step"]
+    assert [iv["type"] for iv in m["shimmy_intervals"]] == ["Torsion"]
+    assert m["max_psi"] == pytest.approx(0.214823, abs=2e-6)
+
+
+def test_changes_against_original_are_differences_and_ratios():
+    base = {"min_shimmy_Fz": 60e3, "torsion_area": 100.0, "at_Fz": {"max_psi": 0.2, "shimmy_speed_range": [5, 90]}}
+    m = {"min_shimmy_Fz": 75e3, "torsion_area": 80.0, "at_Fz": {"max_psi": 0.02, "shimmy_speed_range": None}}
+    d = against_baseline(m, base)
+    assert d["min_shimmy_Fz"]["change"] == pytest.approx(15e3) and d["min_shimmy_Fz"]["relative"] == 0.25
+    assert d["torsion_area"]["relative"] == pytest.approx(-0.2)
+    assert d["max_psi"]["relative"] == pytest.approx(-0.9)
+    assert d["shimmy_onset_V"]["change"] is None
+
+
+def test_attractors_ignore_a_branch_run_on_along_x_equal_0():
+    """With the particle damper a seeded branch can continue through its Hopf points along the
+    trivial orbit; those points are x = 0, not cycles (nes_pd at 78.5 kN, V 1-14 m/s)."""
+    result = bifurcation("nes_pd", 78461.5, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    for V in (5.0, 60.0):
+        found = attractors_at(result, V)
+        assert [a["kind"] for a in found] == ["equilibrium"]
+        assert simulate("nes_pd", V, 78461.5, t_end=60.0).response_type.value == "Stable"
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    ({"resolution": 1}, "resolution"),
+    ({"v_range": (50.0, 20.0)}, "v_max"),
+    ({"fz_range": (1.0e3, 2.0e5)}, "fz_min"),
+    ({"n_v": 5000}, "n_v"),
+])
+def test_bad_map_requests_name_the_field(kwargs, field):
+    with pytest.raises(InvalidParameterError) as err:
+        stability_map("original", **kwargs)
+    assert err.value.field == field
+
+
+def test_classify_refuses_a_speed_outside_its_diagram():
+    with pytest.raises(InvalidParameterError) as err:
+        classify("original", 300.0, 150e3)
+    assert err.value.field == "V"
