@@ -110,3 +110,58 @@ def test_hopf_curves_command(capsys):
     assert all(300000 - 1e-3 <= p["Fz"] <= 500000 + 1e-3 and 1 - 1e-9 <= p["V"] <= 200 + 1e-9
                for c in d["curves"] for p in c["points"])
     assert main(["hopf-curves", "--config", "original", "--fz-min", "5e5", "--fz-max", "1e5"]) == 2
+
+
+def test_map_command_json_carries_the_curves_grid_and_minimum_load(tmp_path):
+    path = tmp_path / "map.csv"
+    out = run("map", "--config", "original", "--v-min", "1", "--v-max", "200", "--fz-min", "100000",
+              "--fz-max", "450000", "--resolution", "4", "--n-v", "25", "--json", "--csv", str(path))
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    for key in ("hopf_curves", "fold_curves", "torus_curves"):
+        assert all(set(p) >= {"V", "Fz"} for c in data[key] for p in c), key
+    assert data["hopf_curves"] and data["gh_points"] and data["torus_curves"]
+    assert len(data["Fz"]) == 4 and len(data["V"]) == 25 and len(data["types"]) == 4
+    assert all(len(row) == 25 for row in data["types"])
+    assert data["min_shimmy_Fz"] == pytest.approx(100000.0)  # shimmy on the lowest slice already
+    assert data["metrics"]["torsion_area"] > 0
+    assert "two-parameter continuation" in data["methods"]["hopf_curves"]
+    assert "joined" in data["methods"]["fold_curves"]
+    rows = list(csv.reader(path.open()))
+    assert rows[0] == ["Fz_N", "V_m_s", "shimmy_type"] and len(rows) == 1 + 4 * 25
+
+
+def test_classify_command():
+    out = run("classify", "--config", "original", "--V", "50", "--Fz", "350000", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["shimmy_type"] == "Bistable"
+    assert sorted(a["mode"] for a in data["attractors"]) == ["lateral", "torsional"]
+
+
+def test_study_command_json_and_csv():
+    out = run("study", "--param", "e_p", "--values", "0.0005,0.001,0.005", "--configs", "nes,nes_pd",
+              "--Fz", "150000", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert len(data["rows"]) == 6 and data["values"] == [[0.0005, 0.001, 0.005]]
+    row = next(r for r in data["rows"] if r["e_p"] == 0.001 and r["config"] == "nes")
+    assert [row["hopf_start"], row["hopf_end"]] == pytest.approx([6.730, 71.255], rel=2e-3)
+    out = run("study", "--param", "e_p", "--values", "0.001", "--configs", "nes", "--csv")
+    rows = list(csv.reader(out.stdout.splitlines()))
+    assert rows[0][:3] == ["e_p", "config", "hopf_start_m_s"] and rows[1][:2] == ["0.001", "nes"]
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["study", "--param", "e_q", "--values", "1"], "parameter"),
+    (["study", "--param", "e_p", "--values", "0.5"], "e_p"),
+    (["study", "--param", "e_p", "--values", "a,b"], "values"),
+    (["study", "--param", "e_p", "--values", "0.001", "--configs", "nes,foo"], "config"),
+    (["map", "--config", "nes", "--resolution", "1"], "resolution"),
+    (["map", "--config", "nes", "--fz-min", "5e5", "--fz-max", "1e5"], "fz_max"),
+    (["classify", "--config", "nes", "--V", "300", "--Fz", "150000"], "V"),
+])
+def test_bad_map_study_classify_input_exits_2_naming_the_field(args, needle):
+    out = run(*args)
+    assert out.returncode == 2, (out.returncode, out.stderr)
+    assert needle in out.stderr

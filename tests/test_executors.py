@@ -1,0 +1,125 @@
+"""The executor interface: inline, local process pool, and a real Dask cluster on loopback.
+
+The Dask fixture starts `dask scheduler` and two `dask worker` processes (one thread each) on
+127.0.0.1 and checks that maps and studies computed there equal the local ones.
+"""
+
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import pytest
+
+from shimmy.errors import InvalidParameterError
+from shimmy.executors import DASK_ENV, WORKERS_ENV, InlineExecutor, describe, open_executor, run_units, worker_count
+from shimmy.stability_map import stability_map
+from shimmy.studies import study
+
+distributed = pytest.importorskip("distributed")
+
+
+def test_run_units_keeps_the_order_and_reports_each_unit():
+    seen = []
+    with open_executor(max_workers=2) as pool:
+        assert isinstance(pool, ProcessPoolExecutor)
+        out = run_units(math.sqrt, [16.0, 1.0, 81.0, 4.0], pool, lambda f, m: seen.append((f, m)))
+    assert out == [4.0, 1.0, 9.0, 2.0]
+    assert [f for f, _ in seen] == [0.25, 0.5, 0.75, 1.0]
+    assert all("done" in m for _, m in seen)
+
+
+def test_a_failing_unit_fails_the_call():
+    with pytest.raises(ValueError, match="math domain error"):
+        run_units(math.sqrt, [1.0, -1.0, 4.0], InlineExecutor())
+
+
+def test_worker_count_comes_from_the_argument_the_environment_or_the_cores(monkeypatch):
+    monkeypatch.delenv(WORKERS_ENV, raising=False)
+    monkeypatch.delenv(DASK_ENV, raising=False)
+    assert worker_count(3) == 3
+    assert worker_count() == (os.cpu_count() or 1)
+    monkeypatch.setenv(WORKERS_ENV, "1")
+    assert describe() == "in process"
+    with open_executor() as ex:
+        assert isinstance(ex, InlineExecutor)
+    monkeypatch.setenv(WORKERS_ENV, "many")
+    with pytest.raises(InvalidParameterError) as err:
+        worker_count()
+    assert err.value.field == WORKERS_ENV
+    with pytest.raises(InvalidParameterError):
+        worker_count(0)
+
+
+def test_an_unreachable_scheduler_is_named():
+    with pytest.raises(InvalidParameterError) as err:
+        with open_executor(scheduler="tcp://127.0.0.1:9"):
+            pass
+    assert err.value.field == DASK_ENV
+
+
+@pytest.fixture(scope="module")
+def dask_cluster(tmp_path_factory):
+    """A real scheduler and two single-threaded workers on loopback; yields the address."""
+    where = tmp_path_factory.mktemp("dask")
+    scheduler_file = where / "scheduler.json"
+    env = dict(os.environ, DASK_DISTRIBUTED__WORKER__DAEMON="False")
+    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+    procs = [subprocess.Popen(dask + ["--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                                      "--scheduler-file", str(scheduler_file)],
+                              stdout=subprocess.DEVNULL, stderr=open(where / "scheduler.log", "w"), env=env)]
+    try:
+        deadline = time.monotonic() + 60
+        while not scheduler_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert scheduler_file.exists(), (where / "scheduler.log").read_text()
+        time.sleep(0.2)
+        address = json.loads(scheduler_file.read_text())["address"]
+        for k in range(2):
+            procs.append(subprocess.Popen(
+                [sys.executable, "-m", "distributed.cli.dask_worker", address, "--host", "127.0.0.1",
+                 "--nworkers", "1", "--nthreads", "1", "--no-dashboard", "--name", f"w{k}"],
+                stdout=subprocess.DEVNULL, stderr=open(where / f"worker{k}.log", "w"), env=env))
+        client = distributed.Client(address, timeout=30)
+        try:
+            client.wait_for_workers(2, timeout=60)
+            assert len(client.scheduler_info()["workers"]) == 2
+        finally:
+            client.close()
+        yield address
+    finally:
+        for p in procs[::-1]:
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+
+def test_a_study_on_the_dask_cluster_equals_the_local_one(dask_cluster, monkeypatch):
+    args = ("e_p", [0.0005, 0.005], ["original", "nes"], 150e3)
+    local = study(*args, executor=InlineExecutor())
+    seen = []
+    monkeypatch.setenv(DASK_ENV, dask_cluster)
+    remote = study(*args, progress=lambda f, m: seen.append(f))
+    assert remote.executor == f"dask cluster at {dask_cluster}"
+    assert remote.rows == local.rows
+    assert seen == [0.25, 0.5, 0.75, 1.0]
+
+
+def test_a_map_on_the_dask_cluster_equals_the_local_one(dask_cluster):
+    kwargs = dict(v_range=(1.0, 200.0), fz_range=(1.0e5, 4.0e5), resolution=4, n_v=30)
+    local = stability_map("original", **kwargs)
+    with open_executor(scheduler=dask_cluster) as ex:
+        workers = ex._client.scheduler_info()["workers"]
+        assert len(workers) == 2 and all(w["host"] == "127.0.0.1" for w in workers.values())
+        remote = stability_map("original", executor=ex, **kwargs)
+    assert remote.types == local.types
+    assert remote.fold_curves == local.fold_curves and remote.torus_curves == local.torus_curves
+    assert remote.hopf_curves == local.hopf_curves
+    assert remote.min_shimmy == local.min_shimmy
+    assert {t for row in remote.types for t in row} >= {"Torsion", "Bistable"}
