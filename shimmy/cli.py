@@ -304,6 +304,10 @@ def _cmd_metrics(args) -> int:
         lines.append(f"{c:<8}{fz:>20}{rel('min_shimmy_Fz'):>9}{m['torsion_area']:>14.1f}{rel('torsion_area'):>9}"
                      f"{m['at_Fz']['max_psi']:>15.5f}{rel('max_psi'):>9}  "
                      + ("none" if hull is None else f"{hull[0]:.1f}..{hull[1]:.1f}"))
+    names = list(next(iter(report["metrics"].values()))["operating_points"])
+    lines.append(f"\nshimmy type at the operating points{'':<2}" + "".join(f"{n:>10}" for n in names))
+    for c, m in report["metrics"].items():
+        lines.append(f"{c:<37}" + "".join(f"{m['operating_points'][n]:>10}" for n in names))
     _emit(report, args.json, "\n".join(lines))
     return 0
 

@@ -21,9 +21,10 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .bifurcation import BifurcationOptions
-from .configurations import Configuration
+from .configurations import OPERATING_POINTS, Configuration
 from .parameters import Parameters
-from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, map_slice, stability_map
+from .executors import run_units
+from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, classify, map_slice, stability_map
 
 BASELINE = "original"
 _trapezoid = getattr(np, "trapezoid", None) or np.trapz  # numpy 2 renamed it
@@ -84,6 +85,32 @@ def against_baseline(m: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
             "shimmy_onset_V": _change(hull[0], hull0[0]), "shimmy_end_V": _change(hull[1], hull0[1])}
 
 
+def _operating_point_unit(task: tuple) -> dict[str, Any]:
+    """Types at the operating points sharing one load (one diagram serves them all)."""
+    config, Fz, names, params = task
+    from .bifurcation import bifurcation
+
+    result = bifurcation(config, Fz, BAND_V[0], BAND_V[1], params, BifurcationOptions(mesh_check=False))
+    return {name: classify(config, OPERATING_POINTS[name][0], Fz, params, BAND_V, result=result) for name in names}
+
+
+def operating_point_types(configs: Sequence[str], params: Parameters | None = None, executor=None,
+                          progress: Callable[[float, str], None] | None = None) -> dict[str, dict[str, Any]]:
+    """{config: {point: classify(...)}} at REFERENCE.md's nine operating points."""
+    params = params if params is not None else Parameters()
+    configs = [Configuration.parse(c).value for c in configs]
+    by_load: dict[float, list[str]] = {}
+    for name, (_, Fz) in OPERATING_POINTS.items():
+        by_load.setdefault(Fz, []).append(name)
+    tasks = [(c, Fz, names, params) for c in configs for Fz, names in by_load.items()]
+    results = run_units(_operating_point_unit, tasks, executor, progress,
+                        lambda t: f"{t[0]} at Fz = {t[1] / 1e3:g} kN")
+    out: dict[str, dict[str, Any]] = {c: {} for c in configs}
+    for task, answers in zip(tasks, results, strict=True):
+        out[task[0]].update(answers)
+    return {c: {name: out[c][name] for name in OPERATING_POINTS} for c in configs}
+
+
 def design_report(configs: Sequence[str] = ("original", "nes", "pd", "nes_pd"), params: Parameters | None = None,
                   Fz: float = 150e3, resolution: int = 40, executor=None,
                   progress: Callable[[float, str], None] | None = None) -> dict[str, Any]:
@@ -101,5 +128,9 @@ def design_report(configs: Sequence[str] = ("original", "nes", "pd", "nes_pd"), 
         results[c] = metrics(maps[c], Fz)
     for c in configs:
         results[c]["against_original"] = against_baseline(results[c], results[BASELINE])
+    points = operating_point_types(configs, params, executor,
+                                   lambda fraction, message: report(0.99, f"operating points: {message}"))
+    for c in configs:
+        results[c]["operating_points"] = {name: a["shimmy_type"] for name, a in points[c].items()}
     return {"Fz": Fz, "resolution": resolution, "configs": configs, "metrics": {c: results[c] for c in configs},
             "maps": maps}

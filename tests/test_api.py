@@ -90,6 +90,24 @@ BAD = [
     ("/api/v1/jobs", {"analysis": "bifurcation", "config": "nes"}, 422, "Fz"),
     ("/api/v1/jobs", {"analysis": "hopf_curves", "config": "nes", "fz_min": 5e5, "fz_max": 1e5}, 422, "fz_max"),
     ("/api/v1/jobs", {"analysis": "simulate", "config": "nes", "V": 30, "Fz": 150000, "t_end": -1}, 422, "t_end"),
+    ("/api/v1/jobs", {"analysis": "map", "config": "nes", "resolution": 500}, 422, "resolution"),
+    ("/api/v1/jobs", {"analysis": "map", "config": "nes", "n_v": 5000}, 422, "n_v"),
+    ("/api/v1/jobs", {"analysis": "map"}, 422, "config"),
+    ("/api/v1/jobs", {"analysis": "map", "config": "nes", "fz_min": 5e5, "fz_max": 1e5}, 422, "fz_max"),
+    ("/api/v1/jobs", {"analysis": "study", "values": [0.001]}, 422, "parameter"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "zeta", "values": [1]}, 422, "parameter"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p"}, 422, "values"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": []}, 422, "values"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": 0.001}, 422, "values"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": [0.001, 0.5]}, 422, "values[1]"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": [0.001, "x"]}, 422, "values[1]"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": [0.001] * 51}, 422, "values"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": [0.001], "configs": ["nes", "x"]}, 422,
+     "configs[1]"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": [0.001], "parameter2": "k_s"}, 422,
+     "values2"),
+    ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": [0.001] * 20, "parameter2": "k_s",
+                      "values2": [1.2e6] * 20}, 422, "values"),
 ]
 
 
@@ -164,6 +182,28 @@ def test_job_runs_to_completion_with_progress_and_is_cached(server):
     # The same request again: done at once from the cache.
     status, _, again = server.request("POST", "/api/v1/jobs", body)
     assert status == 202 and again["status"] == "done"
+
+
+def test_map_and_study_jobs_give_what_the_package_gives(server):
+    from shimmy.stability_map import stability_map
+    from shimmy.studies import study
+
+    body = {"analysis": "map", "config": "original", "fz_min": 100000, "fz_max": 400000, "resolution": 4,
+            "n_v": 20}
+    _, _, job = server.request("POST", "/api/v1/jobs", body)
+    done, seen = _wait(server, job["id"])
+    assert done["status"] == "done", done
+    result = done["result"]
+    local = stability_map("original", (1, 200), (1e5, 4e5), 4, n_v=20)
+    assert result["types"] == local.types and result["min_shimmy_Fz"] == pytest.approx(local.min_shimmy_Fz)
+    assert result["metrics"]["torsion_area"] > 0
+    assert len({p for s, p in seen if s == "running"}) >= 2  # progress per finished slice
+
+    body = {"analysis": "study", "parameter": "e_p", "values": [0.0005, 0.005], "configs": ["nes"]}
+    _, _, job = server.request("POST", "/api/v1/jobs", body)
+    done, _ = _wait(server, job["id"])
+    assert done["status"] == "done", done
+    assert done["result"]["rows"] == study("e_p", [0.0005, 0.005], ["nes"]).rows
 
 
 # Jobs that run for several seconds (a fine mesh at a load with four Hopf points: ~6 s here), so

@@ -4,17 +4,14 @@ The Dask fixture starts `dask scheduler` and two `dask worker` processes (one th
 127.0.0.1 and checks that maps and studies computed there equal the local ones.
 """
 
-import json
 import math
 import os
-import subprocess
-import sys
-import time
 from concurrent.futures import ProcessPoolExecutor
 
 import pytest
 
 from shimmy.errors import InvalidParameterError
+from shimmy.service.dask_cluster import loopback_cluster
 from shimmy.executors import DASK_ENV, WORKERS_ENV, InlineExecutor, describe, open_executor, run_units, worker_count
 from shimmy.stability_map import stability_map
 from shimmy.studies import study
@@ -63,41 +60,9 @@ def test_an_unreachable_scheduler_is_named():
 
 @pytest.fixture(scope="module")
 def dask_cluster(tmp_path_factory):
-    """A real scheduler and two single-threaded workers on loopback; yields the address."""
-    where = tmp_path_factory.mktemp("dask")
-    scheduler_file = where / "scheduler.json"
-    env = dict(os.environ, DASK_DISTRIBUTED__WORKER__DAEMON="False")
-    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
-    procs = [subprocess.Popen(dask + ["--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                                      "--scheduler-file", str(scheduler_file)],
-                              stdout=subprocess.DEVNULL, stderr=open(where / "scheduler.log", "w"), env=env)]
-    try:
-        deadline = time.monotonic() + 60
-        while not scheduler_file.exists() and time.monotonic() < deadline:
-            time.sleep(0.1)
-        assert scheduler_file.exists(), (where / "scheduler.log").read_text()
-        time.sleep(0.2)
-        address = json.loads(scheduler_file.read_text())["address"]
-        for k in range(2):
-            procs.append(subprocess.Popen(
-                [sys.executable, "-m", "distributed.cli.dask_worker", address, "--host", "127.0.0.1",
-                 "--nworkers", "1", "--nthreads", "1", "--no-dashboard", "--name", f"w{k}"],
-                stdout=subprocess.DEVNULL, stderr=open(where / f"worker{k}.log", "w"), env=env))
-        client = distributed.Client(address, timeout=30)
-        try:
-            client.wait_for_workers(2, timeout=60)
-            assert len(client.scheduler_info()["workers"]) == 2
-        finally:
-            client.close()
+    """A real scheduler and two single-threaded worker processes on loopback; yields the address."""
+    with loopback_cluster(n_workers=2, log_dir=tmp_path_factory.mktemp("dask")) as address:
         yield address
-    finally:
-        for p in procs[::-1]:
-            p.terminate()
-        for p in procs:
-            try:
-                p.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                p.kill()
 
 
 def test_a_study_on_the_dask_cluster_equals_the_local_one(dask_cluster, monkeypatch):

@@ -9,9 +9,14 @@ from typing import Any, Iterable
 
 from dash import dcc, html
 
-#: REFERENCE.md's operating points: name -> (V m/s, Fz kN).
-OPERATING_POINTS = {"A": (30, 150), "B": (110, 200), "C": (170, 150), "D": (50, 350), "E": (135, 350),
-                    "F": (180, 350), "G": (50, 550), "H": (110, 550), "I": (170, 550)}
+from shimmy.configurations import OPERATING_POINTS as _OPERATING_POINTS_N
+
+def _whole(x: float) -> float | int:
+    return int(x) if float(x).is_integer() else x
+
+
+#: REFERENCE.md's operating points: name -> (V m/s, Fz kN), from the package's definition in N.
+OPERATING_POINTS = {name: (_whole(v), _whole(fz / 1e3)) for name, (v, fz) in _OPERATING_POINTS_N.items()}
 
 GRAPH_CONFIG = {"displaylogo": False, "toImageButtonOptions": {"format": "png", "scale": 2}}
 

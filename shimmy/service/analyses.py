@@ -120,9 +120,32 @@ def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> di
                            (request["fz_min"], request["fz_max"]), progress=progress).to_dict()
 
 
+def stability_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """The map with its design metrics; slices go through the executor of this environment."""
+    from ..design_metrics import metrics
+    from ..stability_map import stability_map as run_map
+
+    smap = run_map(request["config"], (request["v_min"], request["v_max"]), (request["fz_min"], request["fz_max"]),
+                   request["resolution"], _params(request), n_v=request["n_v"], progress=progress)
+    out = smap.to_dict()
+    out["metrics"] = metrics(smap, request["metrics_Fz"])
+    return out
+
+
+def study(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    from ..studies import study as run_study, study_grid
+
+    common = dict(configs=request["configs"], Fz=request["Fz"], params=_params(request),
+                  v_range=(request["v_min"], request["v_max"]), progress=progress)
+    if request["parameter2"] is None:
+        return run_study(request["parameter"], request["values"], **common).to_dict()
+    return study_grid((request["parameter"], request["parameter2"]), (request["values"], request["values2"]),
+                      **common).to_dict()
+
+
 RUNNERS: dict[str, Callable[[dict[str, Any], Progress | None], dict[str, Any]]] = {
     "simulate": simulate, "hopf": hopf, "stability": stability, "devices": devices,
-    "bifurcation": bifurcation, "hopf_curves": hopf_curves}
+    "bifurcation": bifurcation, "hopf_curves": hopf_curves, "map": stability_map, "study": study}
 assert set(RUNNERS) == set(schemas.SCHEMAS)
 
 

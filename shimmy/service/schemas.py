@@ -23,7 +23,7 @@ CONFIGS = tuple(c.value for c in Configuration)
 @dataclass(frozen=True)
 class Field:
     name: str
-    kind: str  # number | integer | string | boolean | object
+    kind: str  # number | integer | string | boolean | object | numbers | strings (arrays)
     description: str
     required: bool = False
     default: Any = None
@@ -43,6 +43,10 @@ class Field:
             return "true or false"
         if self.kind == "object":
             return "an object {parameter name: number}; names and ranges from GET /api/v1/parameters"
+        if self.kind == "numbers":
+            return f"a list of 1 to {self.high:g} numbers"
+        if self.kind == "strings":
+            return f"a non-empty list of {', '.join(self.choices or ())}"
         return "a string"
 
     def check(self, value: Any) -> Any:
@@ -61,6 +65,22 @@ class Field:
             if self.choices and value not in self.choices:
                 raise unknown_name_error(value, self.choices, self.name)
             return value
+        if self.kind == "numbers":
+            if not isinstance(value, list) or not 1 <= len(value) <= self.high:
+                raise InvalidParameterError(self.name, value, self.allowed)
+            out = []
+            for k, v in enumerate(value):
+                if isinstance(v, (str, bool)) or v is None:
+                    raise InvalidParameterError(f"{self.name}[{k}]", v, "a number", "is not a number")
+                out.append(check_number(f"{self.name}[{k}]", v, -1e300, 1e300))  # ranges: per parameter
+            return out
+        if self.kind == "strings":
+            if not isinstance(value, list) or not value:
+                raise InvalidParameterError(self.name, value, self.allowed)
+            for k, v in enumerate(value):
+                if not isinstance(v, str) or v not in (self.choices or ()):
+                    raise InvalidParameterError(f"{self.name}[{k}]", v, "one of " + ", ".join(self.choices or ()))
+            return list(dict.fromkeys(value))
         if not isinstance(value, Mapping):
             raise InvalidParameterError(self.name, value, self.allowed, "is not an object")
         return dict(value)
@@ -76,6 +96,15 @@ class Field:
             out["default"] = self.default
         if self.kind == "object":
             out["additionalProperties"] = {"type": "number"}
+        if self.kind in ("numbers", "strings"):
+            out["type"] = "array"
+            out.pop("minimum", None)
+            out.pop("maximum", None)
+            out["items"] = {"type": "number"} if self.kind == "numbers" else {"type": "string",
+                                                                              "enum": list(self.choices or ())}
+            out["minItems"] = 1
+            if self.kind == "numbers":
+                out["maxItems"] = int(self.high)
         return out
 
 
@@ -105,6 +134,8 @@ class RequestSchema:
                 out[f.name] = f.default
         if "params" in out:
             out["params"] = design(out.pop("params") or {}, out.pop("material", None))
+        if self.name == "study":
+            _check_study(out)
         for low, high in (("v_min", "v_max"), ("fz_min", "fz_max")):
             if low in out and high in out and not out[high] > out[low]:
                 raise InvalidParameterError(high, out[high], f"a number above {low} = {out[low]:g}",
@@ -115,6 +146,29 @@ class RequestSchema:
         return {"type": "object", "additionalProperties": False,
                 "required": [f.name for f in self.fields if f.required],
                 "properties": {f.name: f.openapi() for f in self.fields}}
+
+
+def _check_study(out: dict[str, Any]) -> None:
+    """Values within their parameter's range; the second parameter complete; the grid within limits."""
+    if (out["parameter2"] is None) != (out["values2"] is None):
+        missing = "values2" if out["values2"] is None else "parameter2"
+        raise InvalidParameterError(missing, None, "given together with "
+                                    + ("parameter2" if missing == "values2" else "values2"),
+                                    message=f"{missing} is required when the other of parameter2/values2 is given")
+    if out["parameter2"] is not None and out["parameter2"] == out["parameter"]:
+        raise InvalidParameterError("parameter2", out["parameter2"], "a parameter other than " + out["parameter"])
+    for name_key, values_key in (("parameter", "values"), ("parameter2", "values2")):
+        name = out[name_key]
+        if name is None:
+            continue
+        spec = PARAMETER_SPECS[name]
+        for k, v in enumerate(out[values_key]):
+            if not spec.low <= v <= spec.high:
+                raise InvalidParameterError(f"{values_key}[{k}]", v, spec.allowed, f"is out of the range of {name}")
+    units = len(out["values"]) * len(out["values2"] or [1]) * len(out["configs"])
+    if units > settings.MAX_STUDY_UNITS:
+        raise InvalidParameterError("values", units, f"at most {settings.MAX_STUDY_UNITS} designs x configurations",
+                                    "asks for too many diagrams")
 
 
 def design(overrides: Mapping[str, Any], material: str | None) -> dict[str, float]:
@@ -183,10 +237,34 @@ SCHEMAS: dict[str, RequestSchema] = {
         _range("v_max", V_RANGE[1], V_RANGE, "m/s", "highest speed"),
         _range("fz_min", FZ_RANGE[0], FZ_RANGE, "N", "lowest load"),
         _range("fz_max", FZ_RANGE[1], FZ_RANGE, "N", "highest load"), PARAMS, MATERIAL)),
+    "map": RequestSchema("map", "(V, Fz) stability map: Hopf, fold and torus curves, shimmy type on a grid, "
+                         "design metrics", (
+        _config(), _range("v_min", 1.0, V_RANGE, "m/s", "lowest speed"),
+        _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
+        _range("fz_min", FZ_RANGE[0], FZ_RANGE, "N", "lowest load"),
+        _range("fz_max", FZ_RANGE[1], FZ_RANGE, "N", "highest load"),
+        Field("resolution", "integer", "number of Fz slices", default=40, low=2, high=settings.MAX_MAP_SLICES),
+        Field("n_v", "integer", "speeds per slice on the output grid", default=100, low=10,
+              high=settings.MAX_MAP_SPEEDS),
+        Field("metrics_Fz", "number", "load of the speed-interval and amplitude metrics", default=150e3,
+              low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
+        PARAMS, MATERIAL)),
+    "study": RequestSchema("study", "parametric study: Hopf speeds and max torsional amplitude per design and "
+                           "configuration (one parameter, or a grid of two)", (
+        Field("parameter", "string", "design parameter to vary", required=True, choices=tuple(PARAMETER_SPECS)),
+        Field("values", "numbers", "its values (each within the parameter's range)", required=True,
+              high=settings.MAX_STUDY_VALUES),
+        Field("parameter2", "string", "second parameter (two-parameter grid)", choices=tuple(PARAMETER_SPECS)),
+        Field("values2", "numbers", "values of the second parameter", high=settings.MAX_STUDY_VALUES),
+        Field("configs", "strings", "configurations", default=list(CONFIGS), choices=CONFIGS),
+        Field("Fz", "number", "vertical load", default=150e3, low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
+        _range("v_min", 1.0, V_RANGE, "m/s", "lowest speed"),
+        _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
+        PARAMS, MATERIAL)),
 }
 
 #: Analyses that run as background jobs (POST /api/v1/jobs).
-JOB_ANALYSES = ("simulate", "bifurcation", "hopf_curves")
+JOB_ANALYSES = ("simulate", "bifurcation", "hopf_curves", "map", "study")
 
 
 def validate(analysis: str, body: Any, extra: tuple[str, ...] = ()) -> dict[str, Any]:

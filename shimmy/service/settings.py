@@ -14,6 +14,10 @@ MAX_BODY_BYTES = 64 * 1024
 MAX_T_END = 600.0  # s of simulated time per request
 MAX_SERIES_POINTS = 200_000  # samples per returned time series (t_end / dt_out)
 MAX_NTST = 200
+MAX_MAP_SLICES = 80  # Fz slices of one map (40 take ~20 s on 2 cores)
+MAX_MAP_SPEEDS = 400  # speeds per slice on a map's output grid
+MAX_STUDY_VALUES = 50  # values per study parameter
+MAX_STUDY_UNITS = 200  # diagrams per study (designs x configurations, ~0.5-2 s each)
 MAX_RUNNING_JOBS = 2  # at most this many analyses run at once on this host; others wait queued
 #: A queued/running job whose heartbeat is older than this has lost its worker (SHIMMY_JOB_STALE_SECONDS).
 JOB_STALE_SECONDS = float(os.environ.get("SHIMMY_JOB_STALE_SECONDS", "30"))
