@@ -163,7 +163,7 @@ class SliceResult:
 
 
 def _grids(v_min: float, v_max: float, n_v: int) -> tuple[np.ndarray, np.ndarray]:
-    fine = np.linspace(v_min, v_max, (n_v - 1) * FINE + 1)
+    fine = np.linspace(v_min, v_max, (n_v - 1) * FINE + 1).round(10)  # no 6.800000000000001 in outputs
     return fine[::FINE].copy(), fine
 
 
@@ -188,13 +188,26 @@ def _slice_types(result: BifurcationResult, fine: np.ndarray, coarse_step: int, 
     return [shimmy_type(a) for a in attractors], attractors, simulated
 
 
-def _intervals(fine: np.ndarray, types: list[str]) -> list[dict[str, Any]]:
+def _intervals(fine: np.ndarray, types: list[str], critical: list[float] = ()) -> list[dict[str, Any]]:
+    """Maximal V intervals of one type other than Stable. An end between two grid points moves to
+    the located Hopf / fold / torus point between them, if there is one (exact), else it is the
+    grid point inside the interval (within one fine step)."""
+    crit = np.sort(np.asarray(list(critical), float))
+
+    def snap(inside: int, outside: int) -> float:
+        lo, hi = sorted((fine[inside], fine[outside]))
+        hits = crit[(crit >= lo) & (crit <= hi)]
+        return float(hits[0]) if hits.size else float(fine[inside])
+
     out = []
     start = 0
-    for i in range(1, len(types) + 1):
-        if i == len(types) or types[i] != types[start]:
+    n = len(types)
+    for i in range(1, n + 1):
+        if i == n or types[i] != types[start]:
             if types[start] != "Stable":
-                out.append({"type": types[start], "V_start": float(fine[start]), "V_end": float(fine[i - 1])})
+                out.append({"type": types[start],
+                            "V_start": snap(start, start - 1) if start > 0 else float(fine[0]),
+                            "V_end": snap(i - 1, i) if i < n else float(fine[-1])})
             start = i
     return out
 
@@ -229,7 +242,9 @@ def map_slice(config: Configuration | str, Fz: float, v_min: float, v_max: float
     types_fine, _, simulated = _slice_types(result, fine, FINE, config, params)
     hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value}
             for h in result.hopf.hopf_points]
-    return SliceResult(Fz, coarse, types_fine[::FINE], hopf, _special_points(result), _intervals(fine, types_fine),
+    special = _special_points(result)
+    critical = [h["V"] for h in hopf] + [p["V"] for p in special]
+    return SliceResult(Fz, coarse, types_fine[::FINE], hopf, special, _intervals(fine, types_fine, critical),
                        _lengths(fine, types_fine), result.max_psi, result.max_psi_V, simulated,
                        list(result.warnings), time.perf_counter() - clock)
 
