@@ -7,6 +7,7 @@ Screenshots of every page go to screenshots/ (not committed) for a person to loo
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import time
@@ -17,6 +18,7 @@ import pytest
 selenium = pytest.importorskip("selenium")
 from selenium import webdriver  # noqa: E402
 from selenium.webdriver.chrome.service import Service  # noqa: E402
+from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
@@ -25,7 +27,7 @@ SHOTS = ROOT / "screenshots"
 DOWNLOADS = ROOT / ".pytest_cache" / "downloads"
 CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 PAGES = {"overview": "/", "devices": "/devices", "time-history": "/time-history", "bifurcation": "/bifurcation",
-         "validation": "/validation", "api": "/api"}
+         "stability-map": "/stability-map", "study": "/study", "validation": "/validation", "api": "/api"}
 
 
 def _ensure_chromium() -> None:
@@ -154,6 +156,48 @@ def test_background_job_shows_progress_then_its_figure(server, browser):
     assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["original", "NES"]
     assert not browser.find_element(By.ID, "bif-run").get_attribute("disabled")
     browser.save_screenshot(str(SHOTS / "bifurcation-result.png"))
+    assert _severe(browser) == []
+
+
+def test_map_click_opens_the_time_history_at_that_point(server, browser):
+    browser.get(server.base + "/stability-map?shade=original&overlay=nes&fz_min=100&fz_max=400&resolution=4")
+    run = _wait_for(lambda: browser.find_elements(By.ID, "map-run"), what="the Compute button")[0]
+    _idle(browser)
+    run.click()
+    _wait_for(lambda: browser.find_element(By.ID, "map-status").text or None, timeout=30, interval=0.05,
+              what="a progress message")
+    rows = _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"), timeout=180,
+                     what="the map's summary table")
+    assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["original", "NES"]
+    _wait_for(lambda: _trace_count(browser, "map-graph") > 8, what="the map's traces")
+    _idle(browser)
+    browser.save_screenshot(str(SHOTS / "stability-map-result.png"))
+    plot = browser.find_element(By.CSS_SELECTOR, "#map-graph .nsewdrag")
+    ActionChains(browser).move_to_element_with_offset(plot, -plot.size["width"] // 4, 0).click().perform()
+    _wait_for(lambda: "/time-history" in browser.current_url, timeout=20, what="navigation to the time history")
+    url = browser.current_url
+    assert "config=original" in url and "V=" in url and "Fz=" in url
+    V = float(re.search(r"[?&]V=([0-9.e+-]+)", url).group(1))
+    fz = float(re.search(r"[?&]Fz=([0-9.e+-]+)", url).group(1))
+    assert 1 <= V <= 200 and 100 <= fz <= 400
+    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#th-metrics .metric"), timeout=60,
+              what="the time history at the clicked point")
+    assert float(browser.find_element(By.ID, "th-v").get_attribute("value")) == pytest.approx(V, rel=1e-5)
+    assert _severe(browser) == []
+
+
+def test_study_page_runs_a_study_and_tabulates_it(server, browser):
+    browser.get(server.base + "/study?parameter=e_p&values=0.0005,0.005&configs=nes,nes_pd")
+    run = _wait_for(lambda: browser.find_elements(By.ID, "study-run"), what="the Compute button")[0]
+    _idle(browser)
+    run.click()
+    rows = _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#study-summary tbody tr"), timeout=120,
+                     what="the study table")
+    assert len(rows) == 4
+    first = rows[0].find_elements(By.TAG_NAME, "td")
+    assert first[0].text == "0.0005" and first[1].text == "NES" and float(first[2].text) > 6
+    assert _wait_for(lambda: _trace_count(browser, "study-graph") == 6, what="three panels x two configurations")
+    browser.save_screenshot(str(SHOTS / "study-result.png"))
     assert _severe(browser) == []
 
 

@@ -1,0 +1,241 @@
+"""(V, Fz) stability maps: the plane shaded by shimmy type, with Hopf, fold and torus curves."""
+
+from __future__ import annotations
+
+from urllib.parse import urlencode
+
+import dash
+from dash import Input, Output, State, dcc, html, no_update
+
+from shimmy.errors import InvalidParameterError, ShimmyError
+from shimmy.service import analyses
+from ui import components as ui
+from ui import style
+from ui.layout import design_id, page
+
+dash.register_page(__name__, path="/stability-map", name="Stability map", order=4)
+
+CONFIGS = tuple(style.CONFIG_COLOURS)
+TYPES = tuple(style.SHIMMY_TYPE_COLOURS)
+CURVE_STYLES = {"hopf_curves": ("Hopf", "solid", 2.6), "fold_curves": ("fold of cycles", "dash", 2.2),
+                "torus_curves": ("torus", "dot", 2.2)}
+
+
+def layout(shade: str = "original", overlay: str = "", fz_min: str = "10", fz_max: str = "900", v_min: str = "1",
+           v_max: str = "200", resolution: str = "40", **query):
+    shade = shade if shade in CONFIGS else "original"
+    others = [c for c in overlay.split(",") if c in CONFIGS and c != shade]
+    return page(
+        query, "map",
+        ui.header("Stability map", "The (V, Fz) plane shaded by shimmy type, from the stable attractors on each load "
+                  "slice (equilibrium, torsional and lateral limit cycles; simulation where none is stable). Hopf "
+                  "curves and GH points by two-parameter continuation; fold-of-cycles and torus curves joined from "
+                  "the special points of the slices' diagrams. Click a point to open its time history."),
+        html.Div([
+            ui.field("Shade by", dcc.Dropdown(id="map-shade", value=shade, clearable=False, style={"width": "150px"},
+                                              options=[{"label": style.CONFIG_LABELS[c], "value": c}
+                                                       for c in CONFIGS])),
+            ui.field("Overlay curves of", dcc.Checklist(id="map-overlay", value=others, inline=True, options=[
+                {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
+            ui.field("Fz from (kN)", dcc.Input(id="map-fzmin", type="number", value=ui.number(fz_min, 10), min=10,
+                                               max=900, step="any")),
+            ui.field("to (kN)", dcc.Input(id="map-fzmax", type="number", value=ui.number(fz_max, 900), min=10,
+                                          max=900, step="any")),
+            ui.field("V from (m/s)", dcc.Input(id="map-vmin", type="number", value=ui.number(v_min, 1), min=1,
+                                               max=500, step="any")),
+            ui.field("to (m/s)", dcc.Input(id="map-vmax", type="number", value=ui.number(v_max, 200), min=1,
+                                           max=500, step="any")),
+            ui.field("Fz slices", dcc.Input(id="map-res", type="number", value=ui.number(resolution, 40), min=2,
+                                            max=80, step=1)),
+            html.Button("Compute", id="map-run"),
+            html.Button("Cancel", id="map-cancel", className="secondary", disabled=True),
+            ui.progress_bar("map"),
+        ], className="controls"),
+        html.Div(id="map-error", className="error", role="alert"),
+        ui.graph("map-graph", figure=style.message_figure("Press Compute: about 20 s per configuration at 40 slices "
+                                                          "cold on 2 cores, instant from the cache", 600)),
+        html.Div(id="map-hint", className="hint"),
+        html.Div(id="map-table"),
+        ui.downloads("map"),
+        dcc.Store(id="map-requests"), dcc.Store(id="map-go"),
+        dcc.Location(id="map-nav", refresh="callback-nav"),
+    )
+
+
+def _requests(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, design):
+    configs = [shade] + [c for c in overlay or [] if c != shade]
+
+    def kn(x):
+        return None if x is None else float(x) * 1e3
+
+    return [{"config": c, "fz_min": kn(fz_min), "fz_max": kn(fz_max), "v_min": v_min, "v_max": v_max,
+             "resolution": resolution, **design} for c in configs]
+
+
+CONTROLS = (State("map-shade", "value"), State("map-overlay", "value"), State("map-fzmin", "value"),
+            State("map-fzmax", "value"), State("map-vmin", "value"), State("map-vmax", "value"),
+            State("map-res", "value"), State(design_id("map"), "data"))
+
+
+@dash.callback(
+    Output("map-graph", "figure"), Output("map-table", "children"), Output("map-error", "children"),
+    Output("map-requests", "data"), Output("map-csv", "disabled"), Output("map-json", "disabled"),
+    Output("map-go", "data"),
+    Input("map-run", "n_clicks"), *CONTROLS, prevent_initial_call=True,
+)
+def dispatch(n, *controls):
+    """Answer at once when every map is cached; otherwise hand over to the background job."""
+    requests = _requests(*controls)
+    try:
+        results = [analyses.cached("map", r) for r in requests]
+    except InvalidParameterError as exc:
+        return no_update, no_update, str(exc), no_update, True, True, no_update
+    if all(r is not None for r in results):
+        return figure(results), summary(results), "", requests, False, False, no_update
+    return (no_update,) * 6 + (n,)
+
+
+@dash.callback(
+    Output("map-graph", "figure", allow_duplicate=True), Output("map-table", "children", allow_duplicate=True),
+    Output("map-error", "children", allow_duplicate=True), Output("map-requests", "data", allow_duplicate=True),
+    Output("map-csv", "disabled", allow_duplicate=True), Output("map-json", "disabled", allow_duplicate=True),
+    Input("map-go", "data"), *CONTROLS,
+    background=True, prevent_initial_call=True, interval=300,
+    running=[(Output("map-run", "disabled"), True, False), (Output("map-cancel", "disabled"), False, True),
+             (Output("map-shade", "disabled"), True, False), (Output("map-res", "disabled"), True, False),
+             (Output("map-fzmin", "disabled"), True, False), (Output("map-fzmax", "disabled"), True, False),
+             (Output("map-vmin", "disabled"), True, False), (Output("map-vmax", "disabled"), True, False)],
+    cancel=[Input("map-cancel", "n_clicks")],
+    progress=[Output("map-progress", "value"), Output("map-status", "children")],
+)
+def compute(set_progress, _go, *controls):
+    requests, results = _requests(*controls), []
+    for k, request in enumerate(requests):
+        config = request["config"]
+
+        def report(fraction, message, k=k, config=config):
+            set_progress((str(int(100 * (k + fraction) / len(requests))),
+                          f"{style.CONFIG_LABELS[config]}: {message}"))
+
+        report(0.0, "starting")
+        try:
+            result, _ = analyses.run("map", request, report)
+        except InvalidParameterError as exc:
+            return no_update, no_update, str(exc), no_update, True, True
+        except ShimmyError as exc:
+            return no_update, no_update, f"{config}: {exc}", no_update, True, True
+        results.append(result)
+    set_progress(("100", "done"))
+    return figure(results), summary(results), "", requests, False, False
+
+
+def figure(results):
+    """The first map shaded by type; the curves of every map in its configuration's colour."""
+    shaded = results[0]
+    V, Fz = shaded["V"], [f / 1e3 for f in shaded["Fz"]]
+    codes = [[TYPES.index(t) for t in row] for row in shaded["types"]]
+    n = len(TYPES)
+    scale = []
+    for k, t in enumerate(TYPES):  # a stepped scale: code k -> its type's colour
+        scale += [[k / n, style.SHIMMY_TYPE_COLOURS[t]], [(k + 1) / n, style.SHIMMY_TYPE_COLOURS[t]]]
+    fig = style.figure(f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)",
+                       "forward speed V (m/s)", "vertical load Fz (kN)", height=640)
+    fig.add_heatmap(x=V, y=Fz, z=codes, zmin=0, zmax=n, colorscale=scale, showscale=False, opacity=0.55,
+                    customdata=shaded["types"], name="shimmy type",
+                    hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history</extra>")
+    for t in TYPES:  # legend entries for the shading
+        fig.add_scatter(x=[None], y=[None], mode="markers", name=t, legendgroup="types",
+                        marker={"symbol": "square", "size": 13, "color": style.SHIMMY_TYPE_COLOURS[t],
+                                "line": {"width": 1, "color": "#888"}})
+    for result in results:
+        config = result["config"]
+        colour, label = style.CONFIG_COLOURS[config], style.CONFIG_LABELS[config]
+        for key, (kind, dash_style, width) in CURVE_STYLES.items():
+            for i, curve in enumerate(result[key]):
+                fig.add_scatter(x=[p["V"] for p in curve], y=[p["Fz"] / 1e3 for p in curve],
+                                mode="lines" if key == "hopf_curves" else "lines+markers",
+                                name=f"{label}: {kind}", legendgroup=f"{config}-{key}", showlegend=i == 0,
+                                line={"color": colour, "dash": dash_style, "width": width},
+                                marker={"size": 4, "color": colour},
+                                hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
+        if result["gh_points"]:
+            fig.add_scatter(x=[g["V"] for g in result["gh_points"]], y=[g["Fz"] / 1e3 for g in result["gh_points"]],
+                            mode="markers", name=f"{label}: GH", legendgroup=f"{config}-gh",
+                            marker={"symbol": "diamond", "size": 12, "color": colour,
+                                    "line": {"width": 1.5, "color": "#fff"}},
+                            hovertemplate=f"{label} GH point<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
+    fig.update_xaxes(range=[min(V), max(V)])
+    fig.update_yaxes(range=[min(Fz), max(Fz)])
+    fig.update_layout(legend={"orientation": "h", "y": -0.13, "x": 0})
+    return fig
+
+
+def _pct(change):
+    r = change["relative"]
+    return "–" if r is None else f"{100 * r:+.1f} %"
+
+
+def summary(results):
+    base = next((r for r in results if r["config"] == "original"), None)
+    rows = []
+    for r in results:
+        m = r["metrics"]
+        at = m["at_Fz"]
+        hull = at["shimmy_speed_range"]
+        low = None if r["min_shimmy_Fz"] is None else r["min_shimmy_Fz"] / 1e3
+        speeds = "–" if hull is None else f"{hull[0]:.4g} – {hull[1]:.4g}"
+        row = [style.CONFIG_LABELS[r["config"]], ui.fmt(low), ui.fmt(m["torsion_area"], 5), speeds, ui.fmt(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]), len(r["torus_curves"])]
+        if base is not None and r is not base:
+            b = base["metrics"]
+            row[1] += f" ({_pct(_change(r['min_shimmy_Fz'], base['min_shimmy_Fz']))})"
+            row[2] += f" ({_pct(_change(m['torsion_area'], b['torsion_area']))})"
+            row[4] += f" ({_pct(_change(at['max_psi'], b['at_Fz']['max_psi']))})"
+        rows.append(row)
+    fz = results[0]["metrics"]["at_Fz"]["Fz"] / 1e3
+    return ui.table(["configuration", "min shimmy Fz (kN)", "pure-torsion area, Fz ≤ 250 kN ((m/s) kN)",
+                     f"shimmy V at {fz:g} kN (m/s)", f"max stable |psi| at {fz:g} kN (rad)", "GH points",
+                     "fold curves", "torus curves"], rows, "map-summary")
+
+
+def _change(value, base):
+    if value is None or base in (None, 0):
+        return {"relative": None}
+    return {"relative": (value - base) / base}
+
+
+@dash.callback(Output("map-nav", "href"), Output("map-hint", "children"),
+               Input("map-graph", "clickData"), State("map-requests", "data"), prevent_initial_call=True)
+def open_time_history(click, requests):
+    """A click on the map opens the time history at that point (same configuration and design)."""
+    if not click or not requests or not click.get("points"):
+        return no_update, no_update
+    point = click["points"][0]
+    V, fz_kn = float(point["x"]), float(point["y"])
+    request = requests[0]
+    query = {"config": request["config"], "V": f"{V:.6g}", "Fz": f"{fz_kn:.6g}"}
+    query.update({k: f"{v:.10g}" for k, v in (request.get("params") or {}).items()})
+    if request.get("material") not in (None, "steel"):
+        query["material"] = request["material"]
+    return "/time-history?" + urlencode(query), f"Opening the time history at V = {V:.4g} m/s, Fz = {fz_kn:.4g} kN"
+
+
+@dash.callback(Output("url-update", "data", allow_duplicate=True),
+               Input("map-shade", "value"), Input("map-overlay", "value"), Input("map-fzmin", "value"),
+               Input("map-fzmax", "value"), Input("map-vmin", "value"), Input("map-vmax", "value"),
+               Input("map-res", "value"), prevent_initial_call=True)
+def remember(shade, overlay, fz_min, fz_max, v_min, v_max, resolution):
+    return {"shade": shade, "overlay": ",".join(overlay or []), "fz_min": fz_min, "fz_max": fz_max, "v_min": v_min,
+            "v_max": v_max, "resolution": resolution}
+
+
+@dash.callback(Output("map-download", "data"), Input("map-csv", "n_clicks"), Input("map-json", "n_clicks"),
+               State("map-requests", "data"), prevent_initial_call=True)
+def download(_csv, _json, requests):
+    if not requests:
+        return no_update
+    results = [analyses.run("map", r)[0] for r in requests]
+    if dash.ctx.triggered_id == "map-json":
+        return {"content": ui.json_text(results), "filename": "stability_map.json"}
+    rows = [[r["config"], Fz, V, t] for r in results for Fz, row in zip(r["Fz"], r["types"], strict=True)
+            for V, t in zip(r["V"], row, strict=True)]
+    return {"content": ui.csv_text(["config", "Fz_N", "V_m_s", "shimmy_type"], rows), "filename": "stability_map.csv"}
