@@ -184,7 +184,8 @@ def summary(results):
         hull = at["shimmy_speed_range"]
         low = None if r["min_shimmy_Fz"] is None else r["min_shimmy_Fz"] / 1e3
         speeds = "–" if hull is None else f"{hull[0]:.4g} – {hull[1]:.4g}"
-        row = [style.CONFIG_LABELS[r["config"]], ui.fmt(low), ui.fmt(m["torsion_area"], 5), speeds, ui.fmt(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]), len(r["torus_curves"])]
+        row = [style.CONFIG_LABELS[r["config"]], ui.fmt(low), ui.fmt(m["torsion_area"], 5), speeds,
+               ui.fmt(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]), len(r["torus_curves"])]
         if base is not None and r is not base:
             b = base["metrics"]
             row[1] += f" ({_pct(_change(r['min_shimmy_Fz'], base['min_shimmy_Fz']))})"
