@@ -59,8 +59,10 @@ FINE = 10
 #: Low-load band of the pure-torsion area metric.
 BAND_FZ_MAX = 250.0e3  # N
 BAND_V = (1.0, 200.0)  # m/s
-#: A "cycle" smaller than this (rad, m) is x = 0: continuation with the particle damper can run a
-#: branch on through its Hopf point along the trivial orbit (amplitudes ~1e-100 observed).
+#: Where x = 0 is stable, a "cycle" smaller than this (rad, m) is x = 0 itself: continuation with the
+#: particle damper can run a branch on through its Hopf point along the trivial orbit (amplitudes
+#: ~1e-100 observed). Where x = 0 is unstable, small cycles are real (with the PD they grow like
+#: (V - V_H)^2 from the Hopf point) and count.
 TRIVIAL_PSI = 1e-6
 TRIVIAL_LATERAL = 1e-7
 #: Curve joining: slice-to-slice match if |ln(V1 / V2)| is below this (a 50 % change).
@@ -73,7 +75,8 @@ JOIN_LOG_V = math.log(1.5)
 def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
     """The stable equilibria and limit cycles of a bifurcation diagram at speed V."""
     found: list[dict[str, Any]] = []
-    if not any(a <= V <= b for a, b in result.hopf.unstable_intervals):
+    equilibrium_stable = not any(a <= V <= b for a, b in result.hopf.unstable_intervals)
+    if equilibrium_stable:
         found.append({"kind": "equilibrium", "mode": None, "max_psi": 0.0, "max_lateral": 0.0,
                       "period": None, "branch": 0})
     tol = 1e-7 * max(1.0, abs(V))  # end points located on a range bound to rounding
@@ -95,8 +98,10 @@ def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
                 continue
             amp = float(b.max_psi[i] + f * (b.max_psi[j] - b.max_psi[i]))
             lateral = float(b.max_lateral[i] + f * (b.max_lateral[j] - b.max_lateral[i]))
-            if amp <= TRIVIAL_PSI and lateral <= TRIVIAL_LATERAL:
-                continue  # a zero-amplitude end point, or a branch run on along x = 0 itself
+            if equilibrium_stable and amp <= TRIVIAL_PSI and lateral <= TRIVIAL_LATERAL:
+                continue  # a zero-amplitude end point, or a branch run on along a stable x = 0
+            if amp <= 0.0 and lateral <= 0.0:
+                continue  # the zero-amplitude end point at a Hopf point
             found.append({"kind": "limit cycle", "mode": mode, "max_psi": amp,
                           "max_lateral": lateral,
                           "period": float(b.period[i] + f * (b.period[j] - b.period[i])), "branch": k})

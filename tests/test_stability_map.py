@@ -190,6 +190,13 @@ def test_torsion_area_of_original_equals_the_unstable_area_of_straight_rolling()
     assert 0.0 < area["torsion_area_fraction"] < 1.0
 
 
+@pytest.mark.parametrize("config", ["pd", "nes_pd"])
+def test_shimmy_speeds_with_the_particle_damper_reach_the_hopf_points(config):
+    """With the PD the cycles grow like (V - V_H)^2: tiny near V_H, and still shimmy there."""
+    m = speed_metrics(config, 150e3, n_v=200)
+    assert m["shimmy_speed_range"] == pytest.approx(m["hopf_points"], abs=1e-12)
+
+
 def test_speed_metrics_at_150_kN_match_the_hopf_points_and_the_diagram():
     m = speed_metrics("original", 150e3, n_v=200)
     low, high = m["shimmy_speed_range"]  # the interval ends are the located Hopf points
