@@ -6,7 +6,7 @@ import dash
 from dash import Input, Output, State, dcc, html, no_update
 from plotly.subplots import make_subplots
 
-from shimmy.errors import InvalidParameterError, ShimmyError
+from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
 from ui import style
@@ -92,23 +92,10 @@ def dispatch(n, fz_kn, v_min, v_max, configs, design):
     progress=[Output("bif-progress", "value"), Output("bif-status", "children")],
 )
 def compute(set_progress, _go, fz_kn, v_min, v_max, configs, design):
-    requests, results = _requests(fz_kn, v_min, v_max, configs, design), []
-    for k, request in enumerate(requests):
-        config = request["config"]
-
-        def report(fraction, message, k=k, config=config):
-            set_progress((str(int(100 * (k + fraction) / len(requests))),
-                          f"{style.CONFIG_LABELS[config]}: {message}"))
-
-        report(0.0, "starting")
-        try:
-            result, _ = analyses.run("bifurcation", request, report)
-        except InvalidParameterError as exc:
-            return no_update, no_update, str(exc), no_update, True, True
-        except ShimmyError as exc:
-            return no_update, no_update, f"{config}: {exc}", no_update, True, True
-        results.append(result)
-    set_progress(("100", "done"))
+    requests = _requests(fz_kn, v_min, v_max, configs, design)
+    results, error = ui.run_each("bifurcation", requests, set_progress)
+    if error:
+        return no_update, no_update, error, no_update, True, True
     return figure(results), summary(results), "", requests, False, False
 
 

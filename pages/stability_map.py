@@ -7,7 +7,7 @@ from urllib.parse import urlencode
 import dash
 from dash import Input, Output, State, dcc, html, no_update
 
-from shimmy.errors import InvalidParameterError, ShimmyError
+from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
 from ui import style
@@ -109,23 +109,10 @@ def dispatch(n, *controls):
     progress=[Output("map-progress", "value"), Output("map-status", "children")],
 )
 def compute(set_progress, _go, *controls):
-    requests, results = _requests(*controls), []
-    for k, request in enumerate(requests):
-        config = request["config"]
-
-        def report(fraction, message, k=k, config=config):
-            set_progress((str(int(100 * (k + fraction) / len(requests))),
-                          f"{style.CONFIG_LABELS[config]}: {message}"))
-
-        report(0.0, "starting")
-        try:
-            result, _ = analyses.run("map", request, report)
-        except InvalidParameterError as exc:
-            return no_update, no_update, str(exc), no_update, True, True
-        except ShimmyError as exc:
-            return no_update, no_update, f"{config}: {exc}", no_update, True, True
-        results.append(result)
-    set_progress(("100", "done"))
+    requests = _requests(*controls)
+    results, error = ui.run_each("map", requests, set_progress)
+    if error:
+        return no_update, no_update, error, no_update, True, True
     return figure(results), summary(results), "", requests, False, False
 
 
@@ -170,9 +157,9 @@ def figure(results):
     return fig
 
 
-def _pct(change):
-    r = change["relative"]
-    return "–" if r is None else f"{100 * r:+.1f} %"
+def _pct(value, base):
+    """Relative change against original, for the table."""
+    return "–" if value is None or not base else f"{100 * (value - base) / base:+.1f} %"
 
 
 def summary(results):
@@ -188,20 +175,14 @@ def summary(results):
                ui.fmt(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]), len(r["torus_curves"])]
         if base is not None and r is not base:
             b = base["metrics"]
-            row[1] += f" ({_pct(_change(r['min_shimmy_Fz'], base['min_shimmy_Fz']))})"
-            row[2] += f" ({_pct(_change(m['torsion_area'], b['torsion_area']))})"
-            row[4] += f" ({_pct(_change(at['max_psi'], b['at_Fz']['max_psi']))})"
+            row[1] += f" ({_pct(r['min_shimmy_Fz'], base['min_shimmy_Fz'])})"
+            row[2] += f" ({_pct(m['torsion_area'], b['torsion_area'])})"
+            row[4] += f" ({_pct(at['max_psi'], b['at_Fz']['max_psi'])})"
         rows.append(row)
     fz = results[0]["metrics"]["at_Fz"]["Fz"] / 1e3
     return ui.table(["configuration", "min shimmy Fz (kN)", "pure-torsion area, Fz ≤ 250 kN ((m/s) kN)",
                      f"shimmy V at {fz:g} kN (m/s)", f"max stable |psi| at {fz:g} kN (rad)", "GH points",
                      "fold curves", "torus curves"], rows, "map-summary")
-
-
-def _change(value, base):
-    if value is None or base in (None, 0):
-        return {"relative": None}
-    return {"relative": (value - base) / base}
 
 
 @dash.callback(Output("map-nav", "href"), Output("map-hint", "children"),

@@ -71,6 +71,11 @@ def describe(scheduler: str | None = None, max_workers: int | None = None) -> st
     return "in process" if n == 1 else f"local process pool ({n} workers)"
 
 
+def name_of(executor: Executor | None) -> str:
+    """What ran a computation: :func:`describe` for the default executor, else the executor's type."""
+    return describe() if executor is None else type(executor).__name__
+
+
 @contextlib.contextmanager
 def open_executor(max_workers: int | None = None, scheduler: str | None = None) -> Iterator[Executor]:
     """The executor for this environment (see the module docstring); closed on exit."""

@@ -22,9 +22,8 @@ from . import __version__
 from .configurations import Configuration
 from .continuation import ContinuationOptions
 from .equations import build_model, jacobian, parameter_jacobian, rhs
-from .errors import InvalidParameterError
 from .hopf_continuation import HopfCurve, TwoParameterField, hopf_curve
-from .parameters import FZ_RANGE, V_RANGE, Parameters, check_number
+from .parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .stability import hopf_points
 
 V_SCALE = 10.0  # m/s
@@ -93,14 +92,8 @@ def hopf_curves(config: Configuration | str, params: Parameters | None = None,
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
-    v_lo = check_number("v_min", v_range[0], *V_RANGE, "m/s")
-    v_hi = check_number("v_max", v_range[1], *V_RANGE, "m/s")
-    f_lo = check_number("fz_min", fz_range[0], *FZ_RANGE, "N")
-    f_hi = check_number("fz_max", fz_range[1], *FZ_RANGE, "N")
-    if not v_hi > v_lo:
-        raise InvalidParameterError("v_max", v_hi, f"a number in ({v_lo:g}, {V_RANGE[1]:g}] m/s", "must exceed v_min")
-    if not f_hi > f_lo:
-        raise InvalidParameterError("fz_max", f_hi, f"a number in ({f_lo:g}, {FZ_RANGE[1]:g}] N", "must exceed fz_min")
+    v_lo, v_hi = check_range("v", v_range, V_RANGE, "m/s")
+    f_lo, f_hi = check_range("fz", fz_range, FZ_RANGE, "N")
     n_slices = int(check_number("n_slices", n_slices, 2, 200, integer=True))
     report = progress or (lambda fraction, message: None)
     system = gear_two_parameter_field(config, params)

@@ -94,6 +94,17 @@ def check_number(name: str, value: Any, low: float, high: float, unit: str = "",
     return number
 
 
+def check_range(prefix: str, bounds: Any, allowed: tuple[float, float], unit: str = "") -> tuple[float, float]:
+    """(low, high) of a range given as ``bounds``, checked as ``{prefix}_min`` and ``{prefix}_max``
+    within ``allowed``, with high above low."""
+    low = check_number(f"{prefix}_min", bounds[0], *allowed, unit)
+    high = check_number(f"{prefix}_max", bounds[1], *allowed, unit)
+    if not high > low:
+        raise InvalidParameterError(f"{prefix}_max", high, f"a number in ({low:g}, {allowed[1]:g}] {unit}".rstrip(),
+                                    f"must exceed {prefix}_min")
+    return low, high
+
+
 @dataclass(frozen=True)
 class GearParameters:
     """Strut and tyre of the single-wheel nose landing gear."""

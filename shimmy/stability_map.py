@@ -42,9 +42,9 @@ from . import __version__
 from .bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from .configurations import Configuration
 from .errors import InvalidParameterError
-from .executors import run_units
+from .executors import name_of, run_units
 from .hopf_curves import HopfCurvesResult, hopf_curves
-from .parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_operating_point
+from .parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_operating_point, check_range
 from .response import ResponseType
 
 SHIMMY_TYPES = ("Stable", "Torsion", "Lateral", "Bistable", "Both")
@@ -266,7 +266,7 @@ def classify(config: Configuration | str, V: float, Fz: float, params: Parameter
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
     V, Fz = check_operating_point(V, Fz)
-    v_min, v_max = _check_range("v", v_range, V_RANGE, "m/s")
+    v_min, v_max = check_range("v", v_range, V_RANGE, "m/s")
     if not v_min <= V <= v_max:
         raise InvalidParameterError("V", V, f"a number in [{v_min:g}, {v_max:g}] m/s (the diagram's range)")
     if result is None:
@@ -423,15 +423,6 @@ class StabilityMap:
                     w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
 
 
-def _check_range(prefix: str, rng, allowed, unit: str) -> tuple[float, float]:
-    lo = check_number(f"{prefix}_min", rng[0], *allowed, unit)
-    hi = check_number(f"{prefix}_max", rng[1], *allowed, unit)
-    if not hi > lo:
-        raise InvalidParameterError(f"{prefix}_max", hi, f"a number in ({lo:g}, {allowed[1]:g}] {unit}",
-                                    f"must exceed {prefix}_min")
-    return lo, hi
-
-
 def _unit(task: tuple) -> Any:
     """One independent unit of a map (top level, so that process pools and Dask can ship it)."""
     if task[0] == "hopf_curves":
@@ -453,13 +444,11 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     """The (V, Fz) stability map of one configuration: ``resolution`` Fz slices, ``n_v`` speeds.
 
     ``executor`` is any :class:`concurrent.futures.Executor` (default: see :mod:`shimmy.executors`)."""
-    from .executors import describe
-
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
-    v_min, v_max = _check_range("v", v_range, V_RANGE, "m/s")
-    f_min, f_max = _check_range("fz", fz_range, FZ_RANGE, "N")
+    v_min, v_max = check_range("v", v_range, V_RANGE, "m/s")
+    f_min, f_max = check_range("fz", fz_range, FZ_RANGE, "N")
     resolution = int(check_number("resolution", resolution, 2, 400, integer=True))
     n_v = int(check_number("n_v", n_v, 2, 2000, integer=True))
     options = options or BifurcationOptions(mesh_check=False)
@@ -478,7 +467,7 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
         warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
     return StabilityMap(config, params, (v_min, v_max), (f_min, f_max), slices[0].V, loads,
                         [s.types for s in slices], slices, hopf, folds, tori,
-                        _min_shimmy(hopf, folds, slices), describe() if executor is None else type(executor).__name__,
+                        _min_shimmy(hopf, folds, slices), name_of(executor),
                         time.perf_counter() - clock, warnings)
 
 

@@ -18,8 +18,8 @@ from . import __version__
 from .bifurcation import BifurcationOptions, bifurcation
 from .configurations import Configuration
 from .errors import InvalidParameterError
-from .executors import run_units
-from .parameters import PARAMETER_SPECS, V_RANGE, Parameters, check_number, check_operating_point
+from .executors import name_of, run_units
+from .parameters import PARAMETER_SPECS, V_RANGE, Parameters, check_operating_point, check_range
 
 MAX_VALUES = 200  # per parameter
 MAX_UNITS = 2000  # designs x configurations
@@ -90,17 +90,11 @@ def _unit(task: tuple) -> dict[str, Any]:
 
 def _run(parameters: list[str], designs: list[dict[str, float]], configs, Fz, v_range, params, executor,
          progress, options) -> StudyResult:
-    from .executors import describe
-
     clock = time.perf_counter()
     params = params if params is not None else Parameters()
     configs = _check_configs(configs)
     _, Fz = check_operating_point(V_RANGE[0], Fz)
-    v_min = check_number("v_min", v_range[0], *V_RANGE, "m/s")
-    v_max = check_number("v_max", v_range[1], *V_RANGE, "m/s")
-    if not v_max > v_min:
-        raise InvalidParameterError("v_max", v_max, f"a number in ({v_min:g}, {V_RANGE[1]:g}] m/s",
-                                    "must exceed v_min")
+    v_min, v_max = check_range("v", v_range, V_RANGE, "m/s")
     if len(designs) * len(configs) > MAX_UNITS:
         raise InvalidParameterError("values", len(designs) * len(configs),
                                     f"at most {MAX_UNITS} designs x configurations")
@@ -112,7 +106,7 @@ def _run(parameters: list[str], designs: list[dict[str, float]], configs, Fz, v_
                 for r in rows for w in r["warnings"]]
     values = [sorted({d[p] for d in designs}, key=[d[p] for d in designs].index) for p in parameters]
     return StudyResult(parameters, values, configs, Fz, (v_min, v_max), rows,
-                       describe() if executor is None else type(executor).__name__, time.perf_counter() - clock,
+                       name_of(executor), time.perf_counter() - clock,
                        warnings)
 
 
