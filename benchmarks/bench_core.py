@@ -7,7 +7,7 @@ psi = 0.001 rad:
   warm-up run (the warm-up loads or compiles the numba code; its time is reported
   separately as "first call");
 * the plain reference: scipy solve_ivp(method="LSODA", rtol=1e-8, atol=1e-10,
-  max_step=0.005) on the per-call Python right-hand side of shimmy.reference_model,
+  max_step=0.005) on the per-call Python right-hand side of shimmy.model.reference_model,
   median of N runs in the same process;
 * their ratio, and the relative difference of the steady amplitudes (max |psi| and
   max |l_g delta| over the last 20 s);
@@ -30,11 +30,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from shimmy import simulate
-from shimmy.configurations import ALL_CONFIGURATIONS
-from shimmy.equations import build_model, jacobian, rhs
-from shimmy.reference_model import make_rhs
-from shimmy.response import peak_amplitude
-from shimmy.stability import hopf_points
+from shimmy.model.configurations import ALL_CONFIGURATIONS
+from shimmy.model.equations import build_model, jacobian, rhs
+from shimmy.model.reference_model import make_rhs
+from shimmy.analyses.response import peak_amplitude
+from shimmy.analyses.stability import hopf_points
 
 V_A, FZ_A, T_END, WINDOW = 30.0, 150_000.0, 60.0, 20.0
 N_COLUMNS = 10_000

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import dash
-from dash import Input, Output, State, dcc, html, no_update
+from dash import Input, Output, State, dcc, html
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
-from shimmy.service import analyses
 from ui import components as ui
+from ui import jobs
 from ui import style
 from ui.layout import design_id, page
 
@@ -36,67 +36,38 @@ def layout(Fz: str = "150", v_min: str = "1", v_max: str = "200", configs: str =
                                                   max=500, step="any")),
             ui.field("Configurations", dcc.Checklist(id="bif-configs", value=chosen, inline=True, options=[
                 {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
-            html.Button("Compute", id="bif-run"),
-            html.Button("Cancel", id="bif-cancel", className="secondary", disabled=True),
-            ui.progress_bar("bif"),
+            *jobs.controls("bif"),
         ], className="controls"),
         html.Div(id="bif-error", className="error", role="alert"),
         ui.graph("bif-graph", figure=style.message_figure("Press Compute: about 1 s per configuration cold, "
                                                           "instant from the cache", 520)),
         html.Div(id="bif-table"),
         ui.downloads("bif"),
-        dcc.Store(id="bif-requests"), dcc.Store(id="bif-go"),
+        *jobs.stores("bif"),
     )
 
 
 def _requests(fz_kn, v_min, v_max, configs, design):
-    return [{"config": c, "Fz": None if fz_kn is None else float(fz_kn) * 1e3, "v_min": v_min, "v_max": v_max,
-             **design} for c in configs or []]
-
-
-@dash.callback(
-    Output("bif-graph", "figure"), Output("bif-table", "children"), Output("bif-error", "children"),
-    Output("bif-requests", "data"), Output("bif-csv", "disabled"), Output("bif-json", "disabled"),
-    Output("bif-go", "data"),
-    Input("bif-run", "n_clicks"),
-    State("bif-fz", "value"), State("bif-vmin", "value"), State("bif-vmax", "value"), State("bif-configs", "value"),
-    State(design_id("bif"), "data"),
-    prevent_initial_call=True,
-)
-def dispatch(n, fz_kn, v_min, v_max, configs, design):
-    """Answer at once when every diagram is cached; otherwise hand over to the background job."""
     if not configs:
-        return no_update, no_update, "choose at least one configuration", no_update, True, True, no_update
-    requests = _requests(fz_kn, v_min, v_max, configs, design)
-    try:
-        results = [analyses.cached("bifurcation", r) for r in requests]
-    except InvalidParameterError as exc:
-        return no_update, no_update, str(exc), no_update, True, True, no_update
-    if all(r is not None for r in results):
-        return figure(results), summary(results), "", requests, False, False, no_update
-    return (no_update,) * 6 + (n,)
+        raise InvalidParameterError("configs", "", ", ".join(CONFIGS), "is empty",
+                                    "choose at least one configuration")
+    return [{"config": c, "Fz": None if fz_kn is None else float(fz_kn) * 1e3, "v_min": v_min, "v_max": v_max,
+             **design} for c in configs]
 
 
-@dash.callback(
-    Output("bif-graph", "figure", allow_duplicate=True), Output("bif-table", "children", allow_duplicate=True),
-    Output("bif-error", "children", allow_duplicate=True), Output("bif-requests", "data", allow_duplicate=True),
-    Output("bif-csv", "disabled", allow_duplicate=True), Output("bif-json", "disabled", allow_duplicate=True),
-    Input("bif-go", "data"),
-    State("bif-fz", "value"), State("bif-vmin", "value"), State("bif-vmax", "value"), State("bif-configs", "value"),
-    State(design_id("bif"), "data"),
-    background=True, prevent_initial_call=True, interval=250,
-    running=[(Output("bif-run", "disabled"), True, False), (Output("bif-cancel", "disabled"), False, True),
-             (Output("bif-fz", "disabled"), True, False), (Output("bif-vmin", "disabled"), True, False),
-             (Output("bif-vmax", "disabled"), True, False)],
-    cancel=[Input("bif-cancel", "n_clicks")],
-    progress=[Output("bif-progress", "value"), Output("bif-status", "children")],
-)
-def compute(set_progress, _go, fz_kn, v_min, v_max, configs, design):
-    requests = _requests(fz_kn, v_min, v_max, configs, design)
-    results, error = ui.run_each("bifurcation", requests, set_progress)
-    if error:
-        return no_update, no_update, error, no_update, True, True
-    return figure(results), summary(results), "", requests, False, False
+def _csv_rows(results):
+    rows = [[r["config"], i, b["kind"], p["V"], "" if p["period"] is None else p["period"], p["max_psi"],
+             p["max_lateral"], int(p["stable"]), p["mode"] or ""]
+            for r in results for i, b in enumerate(r["branches"]) for p in b["points"]]
+    return ["config", "branch", "kind", "V_m_s", "period_s", "max_psi_rad", "max_lateral_m", "stable", "mode"], rows
+
+
+jobs.register(
+    "bif", "bifurcation", requests=_requests, render=lambda results: (figure(results), summary(results)),
+    outputs=[Output("bif-graph", "figure"), Output("bif-table", "children")],
+    states=[State("bif-fz", "value"), State("bif-vmin", "value"), State("bif-vmax", "value"),
+            State("bif-configs", "value"), State(design_id("bif"), "data")],
+    lock=["bif-fz", "bif-vmin", "bif-vmax"], download=jobs.Download("bif", "bifurcation", _csv_rows))
 
 
 def figure(results):
@@ -167,18 +138,3 @@ def summary(results):
                Input("bif-configs", "value"), prevent_initial_call=True)
 def remember(fz, v_min, v_max, configs):
     return {"Fz": fz, "v_min": v_min, "v_max": v_max, "configs": ",".join(configs or [])}
-
-
-@dash.callback(Output("bif-download", "data"), Input("bif-csv", "n_clicks"), Input("bif-json", "n_clicks"),
-               State("bif-requests", "data"), prevent_initial_call=True)
-def download(_csv, _json, requests):
-    if not requests:
-        return no_update
-    results = [analyses.run("bifurcation", r)[0] for r in requests]
-    if dash.ctx.triggered_id == "bif-json":
-        return {"content": ui.json_text(results), "filename": "bifurcation.json"}
-    rows = [[r["config"], i, b["kind"], p["V"], "" if p["period"] is None else p["period"], p["max_psi"],
-             p["max_lateral"], int(p["stable"]), p["mode"] or ""]
-            for r in results for i, b in enumerate(r["branches"]) for p in b["points"]]
-    return {"content": ui.csv_text(["config", "branch", "kind", "V_m_s", "period_s", "max_psi_rad", "max_lateral_m",
-                                    "stable", "mode"], rows), "filename": "bifurcation.csv"}

@@ -8,6 +8,7 @@ from dash import Input, Output, State, dcc, html, no_update
 from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
+from ui import jobs
 from ui.layout import design_id, page
 from ui import style
 
@@ -36,15 +37,14 @@ def layout(Fz: str = "150", vmax: str = "200", **query):
         html.H2("Stability boundary in (V, Fz)"),
         html.P("Hopf curves of straight rolling: inside a closed curve, or above the lateral one, x = 0 is "
                "unstable. Computed by two-parameter continuation; runs in the background.", className="hint"),
-        html.Div([html.Button("Compute boundary", id="ov-boundary-run"),
-                  html.Button("Cancel", id="ov-boundary-cancel", className="secondary", disabled=True),
-                  ui.progress_bar("ov-boundary")], className="controls"),
+        html.Div(jobs.controls("ov-boundary", "Compute boundary"), className="controls"),
+        html.Div(id="ov-boundary-error", className="error", role="alert"),
         ui.graph("ov-boundary-graph", figure=style.message_figure("Press 'Compute boundary' (about 3 s cold, "
                                                                    "instant when cached)")),
         html.Div([html.Button("Download boundary CSV", id="ovb-csv", className="secondary", disabled=True),
                   html.Button("Download boundary JSON", id="ovb-json", className="secondary", disabled=True),
                   dcc.Download(id="ovb-download")], className="downloads"),
-        dcc.Store(id="ovb-requests"),
+        *jobs.stores("ov-boundary", "ovb-requests"),
     ])
 
 
@@ -117,23 +117,10 @@ def _boundary_requests(design):
     return [{"config": config, "v_max": 300.0, **design} for config in CONFIGS]
 
 
-@dash.callback(
-    Output("ov-boundary-graph", "figure"), Output("ovb-requests", "data"), Output("ovb-csv", "disabled"),
-    Output("ovb-json", "disabled"),
-    Input("ov-boundary-run", "n_clicks"), State(design_id("ov"), "data"),
-    background=True, prevent_initial_call=True, interval=250,
-    running=[(Output("ov-boundary-run", "disabled"), True, False),
-             (Output("ov-boundary-cancel", "disabled"), False, True)],
-    cancel=[Input("ov-boundary-cancel", "n_clicks")],
-    progress=[Output("ov-boundary-progress", "value"), Output("ov-boundary-status", "children")],
-)
-def boundary(set_progress, _n, design):
+def boundary_figure(results):
     fig = style.figure("Hopf curves of straight rolling", "forward speed V (m/s)", "vertical load Fz (kN)", 460)
-    for k, config in enumerate(CONFIGS):
-        def report(fraction, message, k=k, config=config):
-            set_progress((str(int(100 * (k + fraction) / len(CONFIGS))), f"{config}: {message}"))
-
-        result, _ = analyses.run("hopf_curves", _boundary_requests(design)[k], report)
+    for result in results:
+        config = result["config"]
         for i, curve in enumerate(result["curves"]):
             fig.add_scatter(x=[p["V"] for p in curve["points"]], y=[p["Fz"] / 1e3 for p in curve["points"]],
                             mode="lines", name=style.CONFIG_LABELS[config], legendgroup=config, showlegend=i == 0,
@@ -143,20 +130,17 @@ def boundary(set_progress, _n, design):
             fig.add_scatter(x=[g["V"] for g in gh], y=[g["Fz"] / 1e3 for g in gh], mode="markers",
                             name=f"{style.CONFIG_LABELS[config]} GH", legendgroup=config,
                             marker={"color": style.CONFIG_COLOURS[config], "size": 10, "symbol": "star"})
-    set_progress(("100", "done"))
     fig.update_xaxes(type="log")
-    return fig, _boundary_requests(design), False, False
+    return fig
 
 
-@dash.callback(Output("ovb-download", "data"), Input("ovb-csv", "n_clicks"), Input("ovb-json", "n_clicks"),
-               State("ovb-requests", "data"), prevent_initial_call=True)
-def download_boundary(_csv, _json, requests):
-    if not requests:
-        return no_update
-    results = [analyses.run("hopf_curves", r)[0] for r in requests]
-    if dash.ctx.triggered_id == "ovb-json":
-        return {"content": ui.json_text(results), "filename": "hopf_curves.json"}
+def _boundary_rows(results):
     rows = [[r["config"], i, p["V"], p["Fz"], p["frequency_hz"], "" if p["lyapunov"] is None else p["lyapunov"]]
             for r in results for i, c in enumerate(r["curves"]) for p in c["points"]]
-    return {"content": ui.csv_text(["config", "curve", "V_m_s", "Fz_N", "frequency_hz", "lyapunov"], rows),
-            "filename": "hopf_curves.csv"}
+    return ["config", "curve", "V_m_s", "Fz_N", "frequency_hz", "lyapunov"], rows
+
+
+jobs.register(
+    "ov-boundary", "hopf_curves", requests=_boundary_requests, render=lambda results: (boundary_figure(results),),
+    outputs=[Output("ov-boundary-graph", "figure")], states=[State(design_id("ov"), "data")],
+    store="ovb-requests", download=jobs.Download("ovb", "hopf_curves", _boundary_rows))

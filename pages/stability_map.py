@@ -7,9 +7,8 @@ from urllib.parse import urlencode
 import dash
 from dash import Input, Output, State, dcc, html, no_update
 
-from shimmy.errors import InvalidParameterError
-from shimmy.service import analyses
 from ui import components as ui
+from ui import jobs
 from ui import style
 from ui.layout import design_id, page
 
@@ -47,9 +46,7 @@ def layout(shade: str = "original", overlay: str = "", fz_min: str = "10", fz_ma
                                            max=500, step="any")),
             ui.field("Fz slices", dcc.Input(id="map-res", type="number", value=ui.number(resolution, 40), min=2,
                                             max=80, step=1)),
-            html.Button("Compute", id="map-run"),
-            html.Button("Cancel", id="map-cancel", className="secondary", disabled=True),
-            ui.progress_bar("map"),
+            *jobs.controls("map"),
         ], className="controls"),
         html.Div(id="map-error", className="error", role="alert"),
         ui.graph("map-graph", figure=style.message_figure("Press Compute: about 20 s per configuration at 40 slices "
@@ -57,7 +54,7 @@ def layout(shade: str = "original", overlay: str = "", fz_min: str = "10", fz_ma
         html.Div(id="map-hint", className="hint"),
         html.Div(id="map-table"),
         ui.downloads("map"),
-        dcc.Store(id="map-requests"), dcc.Store(id="map-go"),
+        *jobs.stores("map"),
         dcc.Location(id="map-nav", refresh="callback-nav"),
     )
 
@@ -77,43 +74,17 @@ CONTROLS = (State("map-shade", "value"), State("map-overlay", "value"), State("m
             State("map-res", "value"), State(design_id("map"), "data"))
 
 
-@dash.callback(
-    Output("map-graph", "figure"), Output("map-table", "children"), Output("map-error", "children"),
-    Output("map-requests", "data"), Output("map-csv", "disabled"), Output("map-json", "disabled"),
-    Output("map-go", "data"),
-    Input("map-run", "n_clicks"), *CONTROLS, prevent_initial_call=True,
-)
-def dispatch(n, *controls):
-    """Answer at once when every map is cached; otherwise hand over to the background job."""
-    requests = _requests(*controls)
-    try:
-        results = [analyses.cached("map", r) for r in requests]
-    except InvalidParameterError as exc:
-        return no_update, no_update, str(exc), no_update, True, True, no_update
-    if all(r is not None for r in results):
-        return figure(results), summary(results), "", requests, False, False, no_update
-    return (no_update,) * 6 + (n,)
+def _csv_rows(results):
+    rows = [[r["config"], Fz, V, t] for r in results for Fz, row in zip(r["Fz"], r["types"], strict=True)
+            for V, t in zip(r["V"], row, strict=True)]
+    return ["config", "Fz_N", "V_m_s", "shimmy_type"], rows
 
 
-@dash.callback(
-    Output("map-graph", "figure", allow_duplicate=True), Output("map-table", "children", allow_duplicate=True),
-    Output("map-error", "children", allow_duplicate=True), Output("map-requests", "data", allow_duplicate=True),
-    Output("map-csv", "disabled", allow_duplicate=True), Output("map-json", "disabled", allow_duplicate=True),
-    Input("map-go", "data"), *CONTROLS,
-    background=True, prevent_initial_call=True, interval=300,
-    running=[(Output("map-run", "disabled"), True, False), (Output("map-cancel", "disabled"), False, True),
-             (Output("map-shade", "disabled"), True, False), (Output("map-res", "disabled"), True, False),
-             (Output("map-fzmin", "disabled"), True, False), (Output("map-fzmax", "disabled"), True, False),
-             (Output("map-vmin", "disabled"), True, False), (Output("map-vmax", "disabled"), True, False)],
-    cancel=[Input("map-cancel", "n_clicks")],
-    progress=[Output("map-progress", "value"), Output("map-status", "children")],
-)
-def compute(set_progress, _go, *controls):
-    requests = _requests(*controls)
-    results, error = ui.run_each("map", requests, set_progress)
-    if error:
-        return no_update, no_update, error, no_update, True, True
-    return figure(results), summary(results), "", requests, False, False
+jobs.register(
+    "map", "map", requests=_requests, render=lambda results: (figure(results), summary(results)),
+    outputs=[Output("map-graph", "figure"), Output("map-table", "children")], states=CONTROLS, interval=300,
+    lock=["map-shade", "map-res", "map-fzmin", "map-fzmax", "map-vmin", "map-vmax"],
+    download=jobs.Download("map", "stability_map", _csv_rows))
 
 
 def figure(results):
@@ -208,16 +179,3 @@ def open_time_history(click, requests):
 def remember(shade, overlay, fz_min, fz_max, v_min, v_max, resolution):
     return {"shade": shade, "overlay": ",".join(overlay or []), "fz_min": fz_min, "fz_max": fz_max, "v_min": v_min,
             "v_max": v_max, "resolution": resolution}
-
-
-@dash.callback(Output("map-download", "data"), Input("map-csv", "n_clicks"), Input("map-json", "n_clicks"),
-               State("map-requests", "data"), prevent_initial_call=True)
-def download(_csv, _json, requests):
-    if not requests:
-        return no_update
-    results = [analyses.run("map", r)[0] for r in requests]
-    if dash.ctx.triggered_id == "map-json":
-        return {"content": ui.json_text(results), "filename": "stability_map.json"}
-    rows = [[r["config"], Fz, V, t] for r in results for Fz, row in zip(r["Fz"], r["types"], strict=True)
-            for V, t in zip(r["V"], row, strict=True)]
-    return {"content": ui.csv_text(["config", "Fz_N", "V_m_s", "shimmy_type"], rows), "filename": "stability_map.csv"}

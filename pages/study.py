@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import dash
-from dash import Input, Output, State, dcc, html, no_update
+from dash import Input, Output, State, dcc, html
 from plotly.subplots import make_subplots
 
-from shimmy.errors import InvalidParameterError, ShimmyError
-from shimmy.parameters import PARAMETER_SPECS
-from shimmy.service import analyses
+from shimmy.errors import InvalidParameterError
+from shimmy.model.parameters import PARAMETER_SPECS
 from ui import components as ui
+from ui import jobs
 from ui import style
 from ui.layout import design_id, page
 
@@ -46,9 +46,7 @@ def layout(parameter: str = "e_p", values: str = DEFAULT_VALUES, configs: str = 
                                           step="any")),
             ui.field("Configurations", dcc.Checklist(id="study-configs", value=chosen, inline=True, options=[
                 {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
-            html.Button("Compute", id="study-run"),
-            html.Button("Cancel", id="study-cancel", className="secondary", disabled=True),
-            ui.progress_bar("study"),
+            *jobs.controls("study"),
         ], className="controls"),
         html.Div(id="study-range", className="hint"),
         html.Div(id="study-error", className="error", role="alert"),
@@ -56,7 +54,7 @@ def layout(parameter: str = "e_p", values: str = DEFAULT_VALUES, configs: str = 
                                                             "configuration cold, instant from the cache", 560)),
         html.Div(id="study-table"),
         ui.downloads("study"),
-        dcc.Store(id="study-request"), dcc.Store(id="study-go"),
+        *jobs.stores("study", "study-request"),
     )
 
 
@@ -84,49 +82,20 @@ CONTROLS = (State("study-param", "value"), State("study-values", "value"), State
             State("study-configs", "value"), State(design_id("study"), "data"))
 
 
-@dash.callback(
-    Output("study-graph", "figure"), Output("study-table", "children"), Output("study-error", "children"),
-    Output("study-request", "data"), Output("study-csv", "disabled"), Output("study-json", "disabled"),
-    Output("study-go", "data"),
-    Input("study-run", "n_clicks"), *CONTROLS, prevent_initial_call=True,
-)
-def dispatch(n, *controls):
-    try:
-        request = _request(*controls)
-        result = analyses.cached("study", request)
-    except InvalidParameterError as exc:
-        return no_update, no_update, str(exc), no_update, True, True, no_update
-    if result is not None:
-        return figure(result), summary(result), "", request, False, False, no_update
-    return (no_update,) * 6 + (n,)
+def _csv_rows(results):
+    result = results[0]
+    name = result["parameters"][0]
+    rows = [[r[name], r["config"], r["hopf_start"], r["hopf_end"], r["max_psi"], r["max_psi_V"]]
+            for r in result["rows"]]
+    return [name, "config", "hopf_start_m_s", "hopf_end_m_s", "max_psi_rad", "max_psi_V_m_s"], rows
 
 
-@dash.callback(
-    Output("study-graph", "figure", allow_duplicate=True), Output("study-table", "children", allow_duplicate=True),
-    Output("study-error", "children", allow_duplicate=True), Output("study-request", "data", allow_duplicate=True),
-    Output("study-csv", "disabled", allow_duplicate=True), Output("study-json", "disabled", allow_duplicate=True),
-    Input("study-go", "data"), *CONTROLS,
-    background=True, prevent_initial_call=True, interval=300,
-    running=[(Output("study-run", "disabled"), True, False), (Output("study-cancel", "disabled"), False, True),
-             (Output("study-param", "disabled"), True, False), (Output("study-values", "disabled"), True, False),
-             (Output("study-fz", "disabled"), True, False)],
-    cancel=[Input("study-cancel", "n_clicks")],
-    progress=[Output("study-progress", "value"), Output("study-status", "children")],
-)
-def compute(set_progress, _go, *controls):
-    def report(fraction, message):
-        set_progress((str(int(100 * fraction)), message))
-
-    report(0.0, "starting")
-    try:
-        request = _request(*controls)
-        result, _ = analyses.run("study", request, report)
-    except InvalidParameterError as exc:
-        return no_update, no_update, str(exc), no_update, True, True
-    except ShimmyError as exc:
-        return no_update, no_update, str(exc), no_update, True, True
-    report(1.0, "done")
-    return figure(result), summary(result), "", request, False, False
+jobs.register(
+    "study", "study", requests=lambda *controls: [_request(*controls)],
+    render=lambda results: (figure(results[0]), summary(results[0])),
+    outputs=[Output("study-graph", "figure"), Output("study-table", "children")], states=CONTROLS, interval=300,
+    lock=["study-param", "study-values", "study-fz"], store="study-request",
+    download=jobs.Download("study", "study", _csv_rows, single=True))
 
 
 def figure(result):
@@ -164,18 +133,3 @@ def summary(result):
                Input("study-configs", "value"), prevent_initial_call=True)
 def remember(parameter, values, fz, configs):
     return {"parameter": parameter, "values": values, "Fz": fz, "configs": ",".join(configs or [])}
-
-
-@dash.callback(Output("study-download", "data"), Input("study-csv", "n_clicks"), Input("study-json", "n_clicks"),
-               State("study-request", "data"), prevent_initial_call=True)
-def download(_csv, _json, request):
-    if not request:
-        return no_update
-    result = analyses.run("study", request)[0]
-    if dash.ctx.triggered_id == "study-json":
-        return {"content": ui.json_text(result), "filename": "study.json"}
-    name = result["parameters"][0]
-    rows = [[r[name], r["config"], r["hopf_start"], r["hopf_end"], r["max_psi"], r["max_psi_V"]]
-            for r in result["rows"]]
-    return {"content": ui.csv_text([name, "config", "hopf_start_m_s", "hopf_end_m_s", "max_psi_rad",
-                                    "max_psi_V_m_s"], rows), "filename": "study.csv"}

@@ -3,17 +3,17 @@
 The model (MODEL.md) and its analyses: parameters, devices, equations with analytic
 Jacobians, time histories, linear stability with Hopf points, calibration, and a
 continuation engine (equilibria, periodic orbits with Floquet multipliers, LPC/NS/PD
-points, Hopf curves) with the gear's bifurcation diagrams (``shimmy.bifurcation``,
-``shimmy.hopf_curves``, imported on demand).
+points, Hopf curves) with the gear's bifurcation diagrams (``shimmy.analyses.bifurcation``,
+``shimmy.analyses.hopf_curves``, imported on demand).
 """
 
 __version__ = "0.1.0"
 
-from .configurations import ALL_CONFIGURATIONS, Configuration  # noqa: E402
+from .model.configurations import ALL_CONFIGURATIONS, Configuration  # noqa: E402
 from .errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError  # noqa: E402
-from .parameters import MATERIALS, PARAMETER_SPECS, Parameters  # noqa: E402
-from .simulation import SimulationOptions, SimulationResult, simulate  # noqa: E402
-from .stability import HopfPoint, HopfResult, eigenvalues, hopf_points  # noqa: E402
+from .model.parameters import MATERIALS, PARAMETER_SPECS, Parameters  # noqa: E402
+from .analyses.simulation import SimulationOptions, SimulationResult, simulate  # noqa: E402
+from .analyses.stability import HopfPoint, HopfResult, eigenvalues, hopf_points  # noqa: E402
 
 __all__ = [
     "ALL_CONFIGURATIONS", "Configuration", "ConvergenceError", "GeometryError",

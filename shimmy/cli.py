@@ -15,9 +15,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .configurations import Configuration
-from .errors import GeometryError, InvalidParameterError, ShimmyError
-from .parameters import FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters
+from .model.configurations import Configuration
+from .continuation.errors import InvalidInputError
+from .errors import EXPECTED_ERRORS, GeometryError, InvalidParameterError
+from .model.parameters import FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 1
@@ -60,7 +61,7 @@ def _cmd_params(args) -> int:
 
 
 def _cmd_hopf(args) -> int:
-    from .stability import hopf_points
+    from .analyses.stability import hopf_points
 
     result = hopf_points(args.config, args.Fz, _params(args), v_min=args.v_min, v_max=args.v_max)
     payload = result.to_dict()
@@ -77,8 +78,8 @@ def _cmd_hopf(args) -> int:
 
 
 def _cmd_eigen(args) -> int:
-    from .parameters import check_operating_point
-    from .stability import eigenvalues
+    from .model.parameters import check_operating_point
+    from .analyses.stability import eigenvalues
 
     V, Fz = check_operating_point(args.V, args.Fz)
     params = _params(args)
@@ -98,7 +99,7 @@ def _cmd_eigen(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from .simulation import simulate
+    from .analyses.simulation import simulate
 
     result = simulate(args.config, args.V, args.Fz, _params(args), t_end=args.t_end,
                       exact_nes=args.exact_nes)
@@ -118,7 +119,7 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_devices(args) -> int:
-    from .device_curves import nes_curve, pd_curves
+    from .analyses.device_curves import nes_curve, pd_curves
 
     params = _params(args)
     nes_c = nes_curve(params)
@@ -157,9 +158,9 @@ class _ProgressBar:
 
 
 def _cmd_bifurcation(args) -> int:
-    from .bifurcation import BifurcationOptions, bifurcation
+    from .analyses.bifurcation import BifurcationOptions, bifurcation
 
-    from .parameters import check_number
+    from .model.parameters import check_number
 
     ntst = int(check_number("ntst", args.ntst, 4, 2000, integer=True))
     options = BifurcationOptions(ntst=ntst, exact_nes=args.exact_nes, seeds=not args.no_seeds)
@@ -194,7 +195,7 @@ def _cmd_bifurcation(args) -> int:
 
 
 def _cmd_hopf_curves(args) -> int:
-    from .hopf_curves import hopf_curves
+    from .analyses.hopf_curves import hopf_curves
 
     bar = _ProgressBar()
     try:
@@ -226,9 +227,9 @@ def _float_list(name: str, text: str) -> list[float]:
 
 
 def _cmd_map(args) -> int:
-    from .design_metrics import metrics
-    from .parameters import check_number
-    from .stability_map import stability_map
+    from .analyses.design_metrics import metrics
+    from .model.parameters import check_number
+    from .analyses.stability_map import stability_map
 
     resolution = int(check_number("resolution", args.resolution, 2, 400, integer=True))
     n_v = int(check_number("n_v", args.n_v, 2, 2000, integer=True))
@@ -263,7 +264,7 @@ def _cmd_map(args) -> int:
 
 
 def _cmd_classify(args) -> int:
-    from .stability_map import classify
+    from .analyses.stability_map import classify
 
     result = classify(args.config, args.V, args.Fz, _params(args), (args.v_min, args.v_max))
     lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {result['shimmy_type']}"]
@@ -278,8 +279,8 @@ def _cmd_classify(args) -> int:
 
 
 def _cmd_metrics(args) -> int:
-    from .design_metrics import design_report
-    from .parameters import check_number
+    from .analyses.design_metrics import design_report
+    from .model.parameters import check_number
 
     resolution = int(check_number("resolution", args.resolution, 2, 400, integer=True))
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
@@ -313,7 +314,7 @@ def _cmd_metrics(args) -> int:
 
 
 def _cmd_study(args) -> int:
-    from .studies import study, study_grid
+    from .analyses.studies import study, study_grid
 
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
     bar = _ProgressBar()
@@ -348,7 +349,7 @@ def _cmd_study(args) -> int:
 
 
 def _cmd_calibrate(args) -> int:
-    from .calibration import calibrate, format_report
+    from .analyses.calibration import calibrate, format_report
 
     result = calibrate(_params(args))
     _emit(result.to_dict(), args.json, format_report(result))
@@ -475,10 +476,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (InvalidParameterError, GeometryError) as exc:
+    except (InvalidInputError, GeometryError) as exc:  # InvalidParameterError derives from the first
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except ShimmyError as exc:
+    except EXPECTED_ERRORS as exc:
         print(f"failed: {exc}", file=sys.stderr)
         return EXIT_FAILED
     except BrokenPipeError:  # stdout closed early (| head): not an error of ours

@@ -185,8 +185,8 @@ def test_job_runs_to_completion_with_progress_and_is_cached(server):
 
 
 def test_map_and_study_jobs_give_what_the_package_gives(server):
-    from shimmy.stability_map import stability_map
-    from shimmy.studies import study
+    from shimmy.analyses.stability_map import stability_map
+    from shimmy.analyses.studies import study
 
     body = {"analysis": "map", "config": "original", "fz_min": 100000, "fz_max": 400000, "resolution": 4,
             "n_v": 20}

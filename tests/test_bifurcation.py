@@ -7,12 +7,12 @@ import sys
 import numpy as np
 import pytest
 
-from shimmy.bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, cycle_at, gear_field
+from shimmy.analyses.bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, cycle_at, gear_field
 from shimmy.continuation import ContinuationOptions, equilibrium_branch
-from shimmy.equations import build_model
+from shimmy.model.equations import build_model
 from shimmy.errors import InvalidParameterError
-from shimmy.simulation import simulate
-from shimmy.stability import hopf_points
+from shimmy.analyses.simulation import simulate
+from shimmy.analyses.stability import hopf_points
 
 FZ = 150e3
 
@@ -206,9 +206,9 @@ def test_fold_of_cycles_bounds_a_bistable_speed_range():
 
 def cycle_at_state(result, V):
     """A full state on the stable cycle at V (first orbit point of the located solution)."""
-    from shimmy.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
-    from shimmy.collocation import Mesh, PeriodicProblem
-    from shimmy.equations import build_model
+    from shimmy.analyses.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
+    from shimmy.continuation.collocation import Mesh, PeriodicProblem
+    from shimmy.model.equations import build_model
 
     raw = result.branches[1].raw
     i = int(np.argmin(np.abs(raw.p[: int(np.argmax(raw.p))] - V)))
@@ -232,9 +232,9 @@ def test_isolated_loop_of_torsional_cycles_at_high_load():
     raw = loop.raw
     i = int(np.argmax(np.where(raw.stable, np.maximum(raw.x_max[:, 0], -raw.x_min[:, 0]), -1)))
     assert raw.stable[i] and loop.mode[i] in ("torsional", "both")
-    from shimmy.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
-    from shimmy.collocation import Mesh, PeriodicProblem
-    from shimmy.equations import build_model
+    from shimmy.analyses.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
+    from shimmy.continuation.collocation import Mesh, PeriodicProblem
+    from shimmy.model.equations import build_model
 
     mesh_points, u = raw.solutions[i]
     problem = PeriodicProblem(gear_field(build_model("original"), 700e3), Mesh(mesh_points, raw.ncol),

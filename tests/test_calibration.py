@@ -1,8 +1,8 @@
 import pytest
 
 from shimmy import Parameters, simulate
-from shimmy.calibration import AMPLITUDE_TARGET, FITTED, HOPF_TARGETS, calibrate, format_report
-from shimmy.parameters import CALIBRATED, PARAMETER_SPECS
+from shimmy.analyses.calibration import AMPLITUDE_TARGET, FITTED, HOPF_TARGETS, calibrate, format_report
+from shimmy.model.parameters import CALIBRATED, PARAMETER_SPECS
 
 
 @pytest.fixture(scope="module")

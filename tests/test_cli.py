@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from shimmy.parameters import PARAMETER_SPECS
+from shimmy.model.parameters import PARAMETER_SPECS
 
 
 def run(*args):
@@ -67,7 +67,7 @@ def test_bad_input_exits_2_naming_the_field(args, needle):
 
 
 def test_eigen_json_matches_the_library():
-    from shimmy.stability import eigenvalues
+    from shimmy.analyses.stability import eigenvalues
 
     out = run("eigen", "--config", "pd", "--V", "30", "--Fz", "150000", "--json")
     assert out.returncode == 0, out.stderr

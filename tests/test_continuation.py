@@ -1,7 +1,7 @@
 """The generic continuation engine on textbook systems with known answers.
 
 Equilibria (:func:`shimmy.continuation.equilibrium_branch`): folds, Hopf and branch points
-at their analytic places. Periodic orbits (:mod:`shimmy.periodic_orbits`): Hopf normal
+at their analytic places. Periodic orbits (:mod:`shimmy.continuation.periodic_orbits`): Hopf normal
 forms (amplitude, period and Floquet multiplier in closed form), a subcritical branch with
 a fold of cycles, Van der Pol against its published period and amplitude and against the
 collocation order, and two constructed 4-D systems whose Neimark-Sacker and
@@ -19,10 +19,11 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
-from shimmy.collocation import Mesh, PeriodicProblem
+from shimmy.continuation.collocation import Mesh, PeriodicProblem
 from shimmy.continuation import ContinuationOptions, equilibrium_branch
-from shimmy.errors import ConvergenceError, InvalidParameterError
-from shimmy.periodic_orbits import OrbitGuess, PeriodicOptions, hopf_guess, orbit_from_samples, periodic_branch
+from shimmy.continuation import ConvergenceError, InvalidInputError
+from shimmy.continuation.periodic_orbits import (OrbitGuess, PeriodicOptions, hopf_guess, orbit_from_samples,
+                                                 periodic_branch)
 from textbook_systems import (ALL_SYSTEMS, VDP_AMPLITUDE_MU1, VDP_PERIOD_MU1, fold_1d, fold_2d, hopf_close_pair,
                               hopf_shear, hopf_subcritical_quintic, hopf_supercritical, hopf_twice, neimark_sacker,
                               period_doubling, pitchfork, transcritical, two_pairs, van_der_pol)
@@ -500,7 +501,7 @@ def test_no_orbit_near_the_guess_raises_convergence_error():
     (PeriodicOptions, {"ncol": 1}, "ncol"),
 ])
 def test_bad_options_raise_invalid_parameter_error_naming_the_field(cls, kwargs, name):
-    with pytest.raises(InvalidParameterError) as info:
+    with pytest.raises(InvalidInputError) as info:
         cls(**kwargs)
     assert info.value.field == name
     assert name in str(info.value)

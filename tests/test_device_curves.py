@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from shimmy import GeometryError, InvalidParameterError, Parameters
-from shimmy.device_curves import nes_curve, pd_curves
-from shimmy.nes import VALID_ANGLE
+from shimmy.analyses.device_curves import nes_curve, pd_curves
+from shimmy.model.nes import VALID_ANGLE
 
 
 def test_nes_curve_spans_the_valid_range_and_is_consistent():

@@ -2,10 +2,10 @@ import numpy as np
 import pytest
 
 from shimmy import Parameters
-from shimmy.configurations import ALL_CONFIGURATIONS
-from shimmy.equations import build_model, effective_caster, jacobian, parameter_jacobian, rhs
-from shimmy.integrator import N_FULL, _f
-from shimmy.reference_model import make_rhs
+from shimmy.model.configurations import ALL_CONFIGURATIONS
+from shimmy.model.equations import build_model, effective_caster, jacobian, parameter_jacobian, rhs
+from shimmy.model.integrator import N_FULL, _f
+from shimmy.model.reference_model import make_rhs
 
 RNG = np.random.default_rng(7)
 SCALES = np.array([0.05, 1.0, 0.01, 0.5, 0.02, 0.05, 1.0])  # typical state magnitudes

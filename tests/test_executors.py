@@ -12,9 +12,10 @@ import pytest
 
 from shimmy.errors import InvalidParameterError
 from shimmy.service.dask_cluster import loopback_cluster
-from shimmy.executors import DASK_ENV, WORKERS_ENV, InlineExecutor, describe, open_executor, run_units, worker_count
-from shimmy.stability_map import stability_map
-from shimmy.studies import study
+from shimmy.analyses.executors import (DASK_ENV, WORKERS_ENV, InlineExecutor, describe, open_executor, run_units,
+                                       worker_count)
+from shimmy.analyses.stability_map import stability_map
+from shimmy.analyses.studies import study
 
 distributed = pytest.importorskip("distributed")
 

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from shimmy.hopf_curves import hopf_curves
-from shimmy.stability import Criticality, Linearisation, hopf_points
-from shimmy.equations import build_model
+from shimmy.analyses.hopf_curves import hopf_curves
+from shimmy.analyses.stability import Criticality, Linearisation, hopf_points
+from shimmy.model.equations import build_model
 
 
 @pytest.fixture(scope="module")

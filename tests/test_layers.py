@@ -1,82 +1,128 @@
-"""The package's layers import only downward, and the numerics never import a UI."""
+"""The package's folders are its layers, and each imports only downward.
+
+continuation (generic engine) <- model (the gear) <- analyses <- service <- UI (app, pages, ui);
+``shimmy.errors`` is the package's exception root, importable from model upwards.
+"""
 
 import ast
 import pathlib
+import sys
 
 import shimmy
 
 PACKAGE = pathlib.Path(shimmy.__file__).parent
-MODEL = {"errors", "parameters", "configurations", "nes", "particle_damper", "equations", "integrator",
-         "reference_model", "lyapunov", "response"}
-ANALYSES = {"simulation", "stability", "calibration", "device_curves", "continuation", "collocation",
-            "periodic_orbits", "bifurcation", "hopf_continuation", "hopf_curves", "executors", "stability_map",
-            "studies", "design_metrics"}
-FORBIDDEN = {"dash", "plotly", "flask", "gunicorn", "diskcache"}
-
-
-def imports(path):
-    tree = ast.parse(path.read_text())
-    found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            found |= {a.name.split(".")[0] for a in node.names}
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:  # relative: from .x import y / from . import x
-                if node.module:
-                    found.add("shimmy." + node.module.split(".")[0])
-                else:
-                    found |= {"shimmy." + a.name for a in node.names}
-            else:
-                found.add(node.module.split(".")[0])
-    return found
-
-
-def test_model_modules_do_not_import_analyses_or_ui():
-    for name in MODEL:
-        deps = imports(PACKAGE / f"{name}.py")
-        assert not deps & FORBIDDEN, name
-        assert not {d for d in deps if d.startswith("shimmy.")} & {f"shimmy.{a}" for a in ANALYSES | {"cli"}}, name
-
-
-def test_analyses_do_not_import_the_ui_or_the_cli():
-    for name in ANALYSES:
-        deps = imports(PACKAGE / f"{name}.py")
-        assert not deps & FORBIDDEN and "shimmy.cli" not in deps, name
-
-
-def test_every_module_is_assigned_a_layer():
-    modules = {p.stem for p in PACKAGE.glob("*.py")} - {"__init__", "__main__", "cli"}
-    assert modules == MODEL | ANALYSES
-
-
-SERVICE = PACKAGE / "service"
 ROOT = PACKAGE.parent
-#: What the UI may import from the package: definitions and the service layer, never numerics.
-UI_MAY_IMPORT = {"shimmy.service", "shimmy.parameters", "shimmy.errors", "shimmy.configurations"}
+LAYERS = ("continuation", "model", "analyses", "service")
+TOP_LEVEL = {"__init__", "__main__", "cli", "errors"}
+UI_LIBRARIES = {"dash", "plotly", "flask", "gunicorn", "diskcache"}
+STDLIB = set(sys.stdlib_module_names)
 
 
-def _absolute_imports(path):
-    tree = ast.parse(path.read_text())
+def module_name(path: pathlib.Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imports(path: pathlib.Path) -> set[str]:
+    """Absolute dotted names of every module (or module attribute) the file imports."""
+    package = module_name(path) if path.name == "__init__.py" else module_name(path).rpartition(".")[0]
     found = set()
-    for node in ast.walk(tree):
+    for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.Import):
             found |= {a.name for a in node.names}
-        elif isinstance(node, ast.ImportFrom) and node.level == 0:
-            found.add(node.module)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                stem = ".".join(base + ([node.module] if node.module else []))
+                found |= {f"{stem}.{a.name}" for a in node.names} if not node.module else {stem}
+            else:
+                found.add(node.module)
     return found
 
 
-def test_service_layer_does_not_import_the_ui():
-    for path in SERVICE.glob("*.py"):
-        deps = imports(path)
-        assert not deps & {"dash", "plotly", "ui", "pages", "app"}, path.name
+def files_of(layer: str) -> list[pathlib.Path]:
+    files = sorted((PACKAGE / layer).glob("*.py"))
+    assert files, layer
+    return files
+
+
+def shimmy_imports(path: pathlib.Path) -> set[str]:
+    return {name for name in imports(path) if name == "shimmy" or name.startswith("shimmy.")}
+
+
+def within(name: str, *prefixes: str) -> bool:
+    return any(name == p or name.startswith(p + ".") for p in prefixes)
+
+
+def test_resolver_reads_relative_imports():
+    assert "shimmy.continuation.core" in imports(PACKAGE / "continuation" / "collocation.py")
+    assert "shimmy.model.parameters" in imports(PACKAGE / "analyses" / "simulation.py")
+    assert "shimmy.errors" in imports(PACKAGE / "model" / "parameters.py")
+
+
+def test_continuation_is_generic_numpy_and_scipy_only():
+    for path in files_of("continuation"):
+        for name in imports(path):
+            if name.startswith("shimmy"):
+                assert within(name, "shimmy.continuation"), (path.name, name)
+            else:
+                assert name.split(".")[0] in STDLIB | {"numpy", "scipy"}, (path.name, name)
+
+
+def test_model_imports_only_the_model_and_the_errors():
+    for path in files_of("model"):
+        for name in shimmy_imports(path):
+            assert within(name, "shimmy.model", "shimmy.errors"), (path.name, name)
+        assert not {n.split(".")[0] for n in imports(path)} & UI_LIBRARIES, path.name
+
+
+def test_analyses_never_import_the_service_the_cli_or_a_ui():
+    for path in files_of("analyses"):
+        for name in shimmy_imports(path):
+            assert not within(name, "shimmy.service", "shimmy.cli"), (path.name, name)
+        assert not {n.split(".")[0] for n in imports(path)} & UI_LIBRARIES, path.name
+
+
+def test_service_never_imports_dash_or_the_ui():
+    for path in files_of("service"):
+        assert not {n.split(".")[0] for n in imports(path)} & {"dash", "plotly", "ui", "pages", "app"}, path.name
+
+
+def test_every_module_sits_in_a_layer():
+    top = {p.stem for p in PACKAGE.glob("*.py")}
+    assert top == TOP_LEVEL
+    folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and p.name != "__pycache__"}
+    assert folders == set(LAYERS)
+    for layer in LAYERS:
+        assert (PACKAGE / layer / "__init__.py").exists(), layer
+
+
+#: What the UI may import from the package: definitions and the service layer, never numerics.
+UI_MAY_IMPORT = ("shimmy.service", "shimmy.errors", "shimmy.model.parameters", "shimmy.model.configurations")
 
 
 def test_ui_uses_only_the_service_layer_and_definitions():
     files = [ROOT / "app.py", *(ROOT / "pages").glob("*.py"), *(ROOT / "ui").glob("*.py")]
     assert len(files) > 5
     for path in files:
-        for name in _absolute_imports(path):
+        for name in imports(path):
             if name.startswith("shimmy"):
-                assert any(name == allowed or name.startswith(allowed + ".") for allowed in UI_MAY_IMPORT), \
-                    (path.name, name)
+                assert within(name, *UI_MAY_IMPORT), (path.name, name)
+
+
+def test_the_engine_exports_what_its_docstring_example_uses():
+    """The example in shimmy.continuation's docstring runs and gives the textbook answer."""
+    import re
+
+    import numpy as np
+
+    import shimmy.continuation as engine
+    code = re.search(r"::\n\n(.*?)\n\n\S", engine.__doc__, re.S).group(1)
+    scope: dict = {}
+    exec("\n".join(line[4:] for line in code.split("\n")), scope)
+    cycles = scope["cycles"]
+    assert scope["H"].p == np.float64(scope["H"].p) and abs(scope["H"].p) < 1e-8
+    np.testing.assert_allclose(cycles.period, 2 * np.pi, rtol=1e-6)
+    big = cycles.p > 0.05
+    np.testing.assert_allclose(cycles.x_max[big, 0], np.sqrt(cycles.p[big]), rtol=1e-4)
+    assert cycles.stable[big].all()

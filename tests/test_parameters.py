@@ -4,7 +4,7 @@ import math
 import pytest
 
 from shimmy import InvalidParameterError, Parameters
-from shimmy.parameters import MATERIALS, PARAMETER_SPECS, check_operating_point
+from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, check_operating_point
 
 ISSUE_NAMES = ("Iz Ix R phi e k_psi c_psi k_delta c_delta k_a alpha_m c_lam l_g h L k_lam "
                "r1 r2 r3 k_s e_p I_nes c_nes r n H d_chamber h_chamber a_p rho_p rho_m_frac g_p e_r "

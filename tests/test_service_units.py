@@ -3,7 +3,7 @@
 import pytest
 
 from shimmy.errors import InvalidParameterError
-from shimmy.parameters import Parameters
+from shimmy.model.parameters import Parameters
 from shimmy.service import cache, schemas
 
 

@@ -3,10 +3,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from shimmy import InvalidParameterError, Parameters, SimulationOptions, simulate
-from shimmy.configurations import ALL_CONFIGURATIONS
-from shimmy.reference_model import make_rhs
-from shimmy.response import ResponseType, dominant_frequency, peak_amplitude
-from shimmy.stability import eigenvalues, hopf_points
+from shimmy.model.configurations import ALL_CONFIGURATIONS
+from shimmy.model.reference_model import make_rhs
+from shimmy.analyses.response import ResponseType, dominant_frequency, peak_amplitude
+from shimmy.analyses.stability import eigenvalues, hopf_points
 
 A = (30.0, 150e3)
 
@@ -151,7 +151,7 @@ def test_options_are_frozen_and_validated():
     ((1.0, 0.5, 0.0, 0.5), ResponseType.TORSION),       # small but not decaying: a small cycle
 ])
 def test_response_type_criteria(energies, expected):
-    from shimmy.response import classify_run
+    from shimmy.analyses.response import classify_run
     assert classify_run(*energies) is expected
 
 

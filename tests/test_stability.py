@@ -2,10 +2,10 @@ import numpy as np
 import pytest
 
 from shimmy import InvalidParameterError, Parameters, simulate
-from shimmy.configurations import ALL_CONFIGURATIONS
-from shimmy.equations import build_model, jacobian
-from shimmy.lyapunov import first_lyapunov_coefficient, hopf_eigenvectors
-from shimmy.stability import Criticality, Linearisation, eigenvalues, hopf_points
+from shimmy.model.configurations import ALL_CONFIGURATIONS
+from shimmy.model.equations import build_model, jacobian
+from shimmy.continuation.lyapunov import first_lyapunov_coefficient, hopf_eigenvectors
+from shimmy.analyses.stability import Criticality, Linearisation, eigenvalues, hopf_points
 
 PUBLISHED = {"original": (5.61, 93.43), "nes": (6.730, 71.255), "nes_pd": (6.410, 71.952)}
 

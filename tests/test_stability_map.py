@@ -11,14 +11,14 @@ import math
 import numpy as np
 import pytest
 
-from shimmy.bifurcation import BifurcationOptions, bifurcation, cycle_at
-from shimmy.design_metrics import against_baseline, speed_metrics, torsion_area
+from shimmy.analyses.bifurcation import BifurcationOptions, bifurcation, cycle_at
+from shimmy.analyses.design_metrics import against_baseline, speed_metrics, torsion_area
 from shimmy.errors import InvalidParameterError
-from shimmy.executors import InlineExecutor
-from shimmy.simulation import simulate
-from shimmy.stability import hopf_points
-from shimmy.stability_map import (SHIMMY_TYPES, SliceResult, _join_curves, attractors_at, classify, shimmy_type,
-                                  stability_map)
+from shimmy.analyses.executors import InlineExecutor
+from shimmy.analyses.simulation import simulate
+from shimmy.analyses.stability import hopf_points
+from shimmy.analyses.stability_map import (SHIMMY_TYPES, SliceResult, _join_curves, attractors_at, classify,
+                                           shimmy_type, stability_map)
 
 RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"}
 

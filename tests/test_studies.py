@@ -5,12 +5,12 @@ import io
 import numpy as np
 import pytest
 
-from shimmy.bifurcation import BifurcationOptions, bifurcation
+from shimmy.analyses.bifurcation import BifurcationOptions, bifurcation
 from shimmy.errors import InvalidParameterError
-from shimmy.executors import InlineExecutor
-from shimmy.parameters import Parameters
-from shimmy.stability import eigenvalues
-from shimmy.studies import study, study_grid
+from shimmy.analyses.executors import InlineExecutor
+from shimmy.model.parameters import Parameters
+from shimmy.analyses.stability import eigenvalues
+from shimmy.analyses.studies import study, study_grid
 
 
 @pytest.fixture(scope="module")

@@ -9,11 +9,8 @@ from typing import Any, Iterable
 
 from dash import dcc, html
 
-from shimmy.configurations import OPERATING_POINTS as _OPERATING_POINTS_N
-from shimmy.errors import InvalidParameterError, ShimmyError
-from shimmy.service import analyses
+from shimmy.model.configurations import OPERATING_POINTS as _OPERATING_POINTS_N
 
-from . import style
 
 def _whole(x: float) -> float | int:
     return int(x) if float(x).is_integer() else x
@@ -77,29 +74,6 @@ def number(raw, default: float) -> float:
         return float(raw)
     except (TypeError, ValueError):
         return default
-
-
-def run_each(analysis: str, requests: list[dict[str, Any]], set_progress) -> tuple[list[dict[str, Any]], str]:
-    """Run ``analysis`` once per request (one per configuration) inside a background callback, with
-    one progress bar over all of them: (results, "") or ([], the error message naming the field)."""
-    results = []
-    for k, request in enumerate(requests):
-        config = request["config"]
-
-        def report(fraction, message, k=k, config=config):
-            set_progress((str(int(100 * (k + fraction) / len(requests))),
-                          f"{style.CONFIG_LABELS[config]}: {message}"))
-
-        report(0.0, "starting")
-        try:
-            result, _ = analyses.run(analysis, request, report)
-        except InvalidParameterError as exc:
-            return [], str(exc)
-        except ShimmyError as exc:
-            return [], f"{config}: {exc}"
-        results.append(result)
-    set_progress(("100", "done"))
-    return results, ""
 
 
 def fmt(x: float | None, digits: int = 4) -> str:

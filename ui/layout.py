@@ -7,7 +7,7 @@ import json
 import dash
 from dash import ALL, Input, Output, State, dcc, html
 
-from shimmy.parameters import MATERIALS, PARAMETER_SPECS
+from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS
 
 from . import state
 

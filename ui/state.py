@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 from shimmy.errors import InvalidParameterError
-from shimmy.parameters import MATERIALS, PARAMETER_SPECS, Parameters
+from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
 
 DEFAULT_MATERIAL = "steel"
 

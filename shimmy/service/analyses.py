@@ -12,9 +12,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..configurations import Configuration
+from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
-from ..parameters import Parameters
+from ..model.parameters import Parameters
 from . import cache, schemas
 from .settings import MAX_SERIES_POINTS
 
@@ -30,7 +30,7 @@ def _finite(x) -> float | None:
 
 
 def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..simulation import SimulationOptions, simulate as run_simulation
+    from ..analyses.simulation import SimulationOptions, simulate as run_simulation
 
     stride = max(1, int(round(request["series_dt"] / SimulationOptions.dt_out)))
     if request["include_series"]:  # refuse before computing, not after
@@ -66,7 +66,7 @@ def _spectrum(result) -> dict[str, Any]:
 
 
 def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..stability import hopf_points
+    from ..analyses.stability import hopf_points
 
     return hopf_points(request["config"], request["Fz"], _params(request), request["v_min"],
                        request["v_max"]).to_dict()
@@ -74,8 +74,8 @@ def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str,
 
 def stability(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """Largest real part of the eigenvalues of x = 0 against V, and the Hopf points, per configuration."""
-    from ..equations import build_model
-    from ..stability import Linearisation, hopf_points
+    from ..model.equations import build_model
+    from ..analyses.stability import Linearisation, hopf_points
 
     params = _params(request)
     V = np.geomspace(request["v_min"], request["v_max"], request["n_points"])
@@ -96,7 +96,7 @@ def stability(request: dict[str, Any], progress: Progress | None = None) -> dict
 
 
 def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..device_curves import nes_curve, pd_curves
+    from ..analyses.device_curves import nes_curve, pd_curves
 
     params = _params(request)
     nes = nes_curve(params)
@@ -106,7 +106,7 @@ def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[s
 
 
 def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..bifurcation import BifurcationOptions, bifurcation as run_bifurcation
+    from ..analyses.bifurcation import BifurcationOptions, bifurcation as run_bifurcation
 
     options = BifurcationOptions(ntst=request["ntst"], seeds=request["seeds"])
     return run_bifurcation(request["config"], request["Fz"], request["v_min"], request["v_max"], _params(request),
@@ -114,7 +114,7 @@ def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> di
 
 
 def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..hopf_curves import hopf_curves as run_hopf_curves
+    from ..analyses.hopf_curves import hopf_curves as run_hopf_curves
 
     return run_hopf_curves(request["config"], _params(request), (request["v_min"], request["v_max"]),
                            (request["fz_min"], request["fz_max"]), progress=progress).to_dict()
@@ -122,8 +122,8 @@ def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> di
 
 def stability_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """The map with its design metrics; slices go through the executor of this environment."""
-    from ..design_metrics import metrics
-    from ..stability_map import stability_map as run_map
+    from ..analyses.design_metrics import metrics
+    from ..analyses.stability_map import stability_map as run_map
 
     smap = run_map(request["config"], (request["v_min"], request["v_max"]), (request["fz_min"], request["fz_max"]),
                    request["resolution"], _params(request), n_v=request["n_v"], progress=progress)
@@ -133,7 +133,7 @@ def stability_map(request: dict[str, Any], progress: Progress | None = None) -> 
 
 
 def study(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..studies import study as run_study, study_grid
+    from ..analyses.studies import study as run_study, study_grid
 
     common = dict(configs=request["configs"], Fz=request["Fz"], params=_params(request),
                   v_range=(request["v_min"], request["v_max"]), progress=progress)

@@ -14,8 +14,9 @@ from typing import Any
 from flask import Blueprint, Response, request
 
 from .. import __version__
+from ..continuation import errors as engine_errors
 from ..errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
-from ..parameters import PARAMETER_SPECS
+from ..model.parameters import PARAMETER_SPECS
 from . import analyses, jobs, schemas, settings
 
 PREFIX = "/api/v1"
@@ -64,8 +65,9 @@ class _TooLarge(Exception):
     pass
 
 
-@api.errorhandler(InvalidParameterError)
-def _invalid(exc: InvalidParameterError):
+@api.errorhandler(InvalidParameterError)  # listed with the engine's class: Flask follows the MRO,
+@api.errorhandler(engine_errors.InvalidInputError)  # where ShimmyError comes before the engine's class
+def _invalid(exc: engine_errors.InvalidInputError):
     return _json(exc.to_dict(), 422 if exc.field != "body" else 400)
 
 
@@ -81,12 +83,14 @@ def _too_large(exc):
 
 
 @api.errorhandler(ConvergenceError)
-def _convergence(exc: ConvergenceError):
+@api.errorhandler(engine_errors.ConvergenceError)
+def _convergence(exc: engine_errors.ConvergenceError):
     return error(f"the solver did not converge: {exc}", None, None, 422)
 
 
 @api.errorhandler(ShimmyError)
-def _shimmy(exc: ShimmyError):
+@api.errorhandler(engine_errors.ContinuationError)
+def _shimmy(exc: Exception):
     return error(str(exc), None, None, 422)
 
 

@@ -14,7 +14,7 @@ from typing import Any, Callable
 import diskcache
 
 from .. import __version__
-from ..parameters import canonical_digest
+from ..model.parameters import canonical_digest
 from . import settings
 
 

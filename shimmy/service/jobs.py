@@ -68,7 +68,7 @@ def update(job_id: str, **changes) -> dict[str, Any] | None:
 def submit(analysis: str, body: dict[str, Any]) -> dict[str, Any]:
     """Validate, create the job and start its worker (or finish it from the cache at once)."""
     if analysis not in schemas.JOB_ANALYSES:
-        from ..parameters import unknown_name_error
+        from ..model.parameters import unknown_name_error
 
         raise unknown_name_error(analysis, list(schemas.JOB_ANALYSES), "analysis")
     request = schemas.validate(analysis, body, extra=("analysis",))

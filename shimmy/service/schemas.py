@@ -12,10 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from ..configurations import Configuration
+from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
 from . import settings
-from ..parameters import FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters, check_number, unknown_name_error
+from ..model.parameters import (FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters, check_number,
+                                unknown_name_error)
 
 CONFIGS = tuple(c.value for c in Configuration)
 

@@ -2,7 +2,7 @@
 
 Why a compiled integrator: a 60 s history needs tens of thousands of steps, and a
 Python-level right-hand side costs more per call than the whole compiled step. The
-equations are not duplicated: :func:`shimmy.equations.vector_field` is plain
+equations are not duplicated: :func:`shimmy.model.equations.vector_field` is plain
 arithmetic that numba inlines here.
 
 Method: explicit embedded Runge-Kutta 5(4) of Dormand and Prince (Hairer, Norsett &
@@ -23,7 +23,7 @@ from .equations import vector_field
 
 N_FULL = 7
 
-# Integration status codes, returned to :mod:`shimmy.simulation`.
+# Integration status codes, returned to :mod:`shimmy.analyses.simulation`.
 SUCCESS = 0
 MAX_STEPS = 1
 NES_OUT_OF_RANGE = 2

@@ -29,7 +29,7 @@ import math
 import numpy as np
 from numba.extending import register_jitable
 
-from .errors import GeometryError
+from ..errors import GeometryError
 
 #: Half-width of the valid relative rotation (rad): the roller leaves its track at pi/6.
 VALID_ANGLE = math.pi / 6.0

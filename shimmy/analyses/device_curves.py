@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from . import nes, particle_damper
-from .parameters import MATERIALS, Parameters, check_number
+from ..model import nes, particle_damper
+from ..model.parameters import MATERIALS, Parameters, check_number
 
 
 @dataclass(frozen=True)

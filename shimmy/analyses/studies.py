@@ -2,7 +2,7 @@
 
 :func:`study` sweeps one parameter, :func:`study_grid` two on a grid. Each (design, config)
 pair is one unit of work (a bifurcation diagram in V at the study's load, through
-:mod:`shimmy.executors`), giving the row a design report carries: the first and last Hopf
+:mod:`shimmy.analyses.executors`), giving the row a design report carries: the first and last Hopf
 speed of x = 0 in the speed range (shimmy onset and end of the linear instability), every
 Hopf point, and the largest torsional amplitude of a stable limit cycle with its speed.
 """
@@ -14,12 +14,12 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
-from . import __version__
+from .. import __version__
 from .bifurcation import BifurcationOptions, bifurcation
-from .configurations import Configuration
-from .errors import InvalidParameterError
+from ..model.configurations import Configuration
+from ..errors import InvalidParameterError
 from .executors import name_of, run_units
-from .parameters import PARAMETER_SPECS, V_RANGE, Parameters, check_operating_point, check_range
+from ..model.parameters import PARAMETER_SPECS, V_RANGE, Parameters, check_operating_point, check_range
 
 MAX_VALUES = 200  # per parameter
 MAX_UNITS = 2000  # designs x configurations

@@ -1,7 +1,7 @@
 """Fit of the constants the published study does not give (REFERENCE.md).
 
-Run ``python -m shimmy.calibration`` (or ``python -m shimmy calibrate``) to refit and
-print the values and residuals. The defaults in :mod:`shimmy.parameters` are this
+Run ``python -m shimmy.analyses.calibration`` (or ``python -m shimmy calibrate``) to refit and
+print the values and residuals. The defaults in :mod:`shimmy.model.parameters` are this
 fit's output rounded to five significant digits; a test reruns the fit and compares.
 
 The fit is sequential, in the order of REFERENCE.md's table, because each step only
@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq, least_squares, minimize_scalar
 
-from .parameters import PARAMETER_SPECS, Parameters
+from ..model.parameters import PARAMETER_SPECS, Parameters
 from .simulation import simulate
 from .stability import hopf_points
 
@@ -162,7 +162,7 @@ def format_report(result: CalibrationResult) -> str:
                   f"({result.amplitude_computed / a['psi'] - 1:+.1%})"]
     if not result.pd_target_met:
         lines.append("  target not reachable with g_p and f inside their published ranges; "
-                     "closest values kept (see shimmy.calibration docstring)")
+                     "closest values kept (see shimmy.analyses.calibration docstring)")
     return "\n".join(lines)
 
 

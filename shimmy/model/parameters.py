@@ -20,11 +20,11 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
-from .errors import InvalidParameterError
+from ..errors import InvalidParameterError
 
 PUBLISHED = "published study"
 ENVELOPE = "published value; range is an engineering envelope around it"
-CALIBRATED = "calibrated by shimmy.calibration against REFERENCE.md"
+CALIBRATED = "calibrated by shimmy.analyses.calibration against REFERENCE.md"
 FIXED = "MODEL.md"
 
 

@@ -3,7 +3,7 @@
 How a map is built (what :func:`stability_map` returns says the same in ``methods``):
 
 * **Hopf curves and GH points**: two-parameter continuation of the Hopf points of x = 0
-  (:func:`shimmy.hopf_curves.hopf_curves`; the extended system, l1 along the curve).
+  (:func:`shimmy.analyses.hopf_curves.hopf_curves`; the extended system, l1 along the curve).
 * **Fold-of-cycles (LPC) and torus (NS) curves**: the engine has no two-parameter
   continuation of cycle bifurcations, so these are joined from the special points of the
   one-parameter diagrams in V computed on every Fz slice (:func:`_join_curves`). Their
@@ -13,7 +13,7 @@ How a map is built (what :func:`stability_map` returns says the same in ``method
 * **Shimmy type** on every slice: the stable attractors at each V read off the slice's
   bifurcation diagram (:func:`attractors_at`): x = 0 where its eigenvalues say so, and every
   periodic branch point with all nontrivial Floquet multipliers inside the unit circle, with
-  its mode (torsional / lateral / both, :func:`shimmy.response.mode_of`). The type
+  its mode (torsional / lateral / both, :func:`shimmy.analyses.response.mode_of`). The type
   (:func:`shimmy_type`) is Bistable if a torsional and a lateral cycle are both stable, else
   Both if a stable cycle has both motions large, else Torsion or Lateral after the stable
   cycle, else Stable. Where neither x = 0 nor any cycle is stable (past a torus point the
@@ -24,7 +24,7 @@ How a map is built (what :func:`stability_map` returns says the same in ``method
 :func:`classify` runs exactly the slice computation at one Fz and reads the answer at V,
 so at a map's grid points it gives the map's answer.
 
-Slices are independent units of work and go through :mod:`shimmy.executors` (a local
+Slices are independent units of work and go through :mod:`shimmy.analyses.executors` (a local
 process pool, or a Dask cluster).
 """
 
@@ -38,13 +38,13 @@ from typing import Any, Callable
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from . import __version__
+from .. import __version__
 from .bifurcation import BifurcationOptions, BifurcationResult, bifurcation
-from .configurations import Configuration
-from .errors import InvalidParameterError
+from ..model.configurations import Configuration
+from ..errors import InvalidParameterError
 from .executors import name_of, run_units
 from .hopf_curves import HopfCurvesResult, hopf_curves
-from .parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_operating_point, check_range
+from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_operating_point, check_range
 from .response import ResponseType
 
 SHIMMY_TYPES = ("Stable", "Torsion", "Lateral", "Bistable", "Both")
@@ -443,7 +443,7 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
                   options: BifurcationOptions | None = None) -> StabilityMap:
     """The (V, Fz) stability map of one configuration: ``resolution`` Fz slices, ``n_v`` speeds.
 
-    ``executor`` is any :class:`concurrent.futures.Executor` (default: see :mod:`shimmy.executors`)."""
+    ``executor`` is any :class:`concurrent.futures.Executor` (default: see :mod:`shimmy.analyses.executors`)."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()

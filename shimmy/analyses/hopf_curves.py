@@ -1,8 +1,8 @@
 """Hopf curves of straight rolling in the (V, Fz) plane, with their generalised Hopf points.
 
-Start points come from the eigenvalue scan (:func:`shimmy.stability.hopf_points`) on
+Start points come from the eigenvalue scan (:func:`shimmy.analyses.stability.hopf_points`) on
 ``n_slices`` loads spread over the Fz range; each Hopf point not already on a computed
-curve is continued both ways in (V, Fz) by :func:`shimmy.hopf_continuation.hopf_curve`
+curve is continued both ways in (V, Fz) by :func:`shimmy.continuation.hopf.hopf_curve`
 until the curve leaves the box, closes, or reaches omega = 0. Generalised Hopf (GH)
 points are where the first Lyapunov coefficient changes sign; configurations with the
 particle damper are not smooth at x = 0 (|dpsi|^(1/2) dpsi), so l1 and GH points are not
@@ -18,12 +18,12 @@ from typing import Any, Callable
 
 import numpy as np
 
-from . import __version__
-from .configurations import Configuration
-from .continuation import ContinuationOptions
-from .equations import build_model, jacobian, parameter_jacobian, rhs
-from .hopf_continuation import HopfCurve, TwoParameterField, hopf_curve
-from .parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
+from .. import __version__
+from ..model.configurations import Configuration
+from ..continuation import ContinuationOptions
+from ..model.equations import build_model, jacobian, parameter_jacobian, rhs
+from ..continuation.hopf import HopfCurve, TwoParameterField, hopf_curve
+from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .stability import hopf_points
 
 V_SCALE = 10.0  # m/s

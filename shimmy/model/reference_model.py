@@ -1,6 +1,6 @@
 """A plain, per-call Python right-hand side written line by line from MODEL.md.
 
-It shares no code with :mod:`shimmy.equations` beyond the parameter set and the
+It shares no code with :mod:`shimmy.model.equations` beyond the parameter set and the
 device coefficient formulas, so it serves two purposes: the tests check the
 vectorised/compiled equations against it, and the benchmark uses it with scipy's
 LSODA as the straightforward baseline the compiled integrator is measured against.

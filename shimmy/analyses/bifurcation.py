@@ -5,9 +5,9 @@
 1. the straight-rolling equilibrium x = 0 continued in V by the generic engine
    (:func:`shimmy.continuation.equilibrium_branch`), with its stability and Hopf points;
    the Hopf points are cross-checked against the independent eigenvalue scan of
-   :func:`shimmy.stability.hopf_points` (which also gives their criticality);
+   :func:`shimmy.analyses.stability.hopf_points` (which also gives their criticality);
 2. every periodic branch born at those Hopf points (orthogonal collocation,
-   :mod:`shimmy.periodic_orbits`), followed until it ends at another Hopf point, leaves
+   :mod:`shimmy.continuation.periodic_orbits`), followed until it ends at another Hopf point, leaves
    [v_min, v_max], or meets a stop rule; a branch that reaches another Hopf point
    accounts for that one too;
 3. branches not born at a Hopf point inside the range (e.g. the lateral limit cycle at
@@ -18,7 +18,7 @@
 Mode of each periodic point: the torsional share of elastic energy, k_psi psi_amp^2
 against k_delta delta_amp^2 (psi_amp, delta_amp = half the peak-to-peak of psi and
 delta over the orbit): torsional >= 0.8, lateral <= 0.2, both in between
-(:func:`shimmy.response.mode_of`, the thresholds of the simulation's response type).
+(:func:`shimmy.analyses.response.mode_of`, the thresholds of the simulation's response type).
 
 The particle damper's |dpsi|^(1/2) dpsi is used exactly: it is C^1 (its slope is zero
 at dpsi = 0), which is all Newton's method and the Floquet multipliers (first
@@ -43,16 +43,18 @@ from typing import Any, Callable
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from . import __version__
-from .collocation import Mesh, PeriodicProblem
-from .configurations import Configuration
-from .continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, SpecialPoint, VectorField,
+from .. import __version__
+from ..continuation.errors import ConvergenceError as EngineConvergenceError
+from ..continuation.errors import InvalidInputError as EngineInvalidInputError
+from ..continuation.collocation import Mesh, PeriodicProblem
+from ..model.configurations import Configuration
+from ..continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, SpecialPoint, VectorField,
                            equilibrium_branch, locate, step, tangent, weighted_norm)
-from .equations import Model, build_model, jacobian, parameter_jacobian, rhs
-from .errors import ConvergenceError, InvalidParameterError
-from .nes import VALID_ANGLE
-from .parameters import V_RANGE, Parameters, check_number, check_operating_point
-from .periodic_orbits import (PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
+from ..model.equations import Model, build_model, jacobian, parameter_jacobian, rhs
+from ..errors import ConvergenceError, InvalidParameterError
+from ..model.nes import VALID_ANGLE
+from ..model.parameters import V_RANGE, Parameters, check_number, check_operating_point
+from ..continuation.periodic_orbits import (PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
                               periodic_branch)
 from .response import mode_of, torsional_share
 from .stability import HopfResult, hopf_points
@@ -79,7 +81,10 @@ class BifurcationOptions:
     exact_nes: bool = False
 
     def __post_init__(self):
-        PeriodicOptions(ntst=self.ntst, ncol=self.ncol)  # validates the mesh
+        try:  # the engine validates the mesh; the gear's callers see the gear's error class
+            PeriodicOptions(ntst=self.ntst, ncol=self.ncol)
+        except EngineInvalidInputError as exc:
+            raise InvalidParameterError(exc.field, exc.value, exc.allowed, message=str(exc)) from None
         check_number("ds", self.ds, 1e-6, 1.0)
         check_number("ds_max", self.ds_max, self.ds, 10.0)
         check_number("max_steps", self.max_steps, 1, 100_000, integer=True)
@@ -221,7 +226,7 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
         try:
             raw = periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts, direction=shape,
                                   limits=limits)
-        except ConvergenceError as exc:
+        except EngineConvergenceError as exc:  # the engine's, or ours derived from it
             warnings.append(f"no periodic branch from the Hopf point at V = {v_h:.6g} m/s: {exc}")
             continue
         done.append(v_h)
@@ -435,7 +440,7 @@ def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popt
         try:
             halves.append(periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts,
                                           p_direction=direction, limits=limits))
-        except ConvergenceError as exc:
+        except EngineConvergenceError as exc:  # the engine's, or ours derived from it
             warnings.append(f"seed at V = {v_seed:.6g} m/s: {exc}")
             return None
         if halves[0].stop_reason.startswith("closed branch"):  # a loop: one way round covers it

@@ -30,9 +30,9 @@ from typing import Any, Callable
 import numpy as np
 
 from .collocation import Mesh, PeriodicProblem
-from .continuation import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step,
+from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step,
                            tangent, weighted_norm)
-from .errors import ConvergenceError, InvalidParameterError
+from .errors import ConvergenceError, InvalidInputError
 
 COMPLEX_TOL = 1e-7  # |Im mu| below this (relative) counts as a real multiplier
 
@@ -48,9 +48,9 @@ class PeriodicOptions:
 
     def __post_init__(self):
         if not (isinstance(self.ntst, int) and 4 <= self.ntst <= 2000):
-            raise InvalidParameterError("ntst", self.ntst, "an integer in [4, 2000]")
+            raise InvalidInputError("ntst", self.ntst, "an integer in [4, 2000]")
         if not (isinstance(self.ncol, int) and 2 <= self.ncol <= 7):
-            raise InvalidParameterError("ncol", self.ncol, "an integer in [2, 7]")
+            raise InvalidInputError("ncol", self.ncol, "an integer in [2, 7]")
 
 
 @dataclass

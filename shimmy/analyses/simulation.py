@@ -14,12 +14,12 @@ from typing import Any
 
 import numpy as np
 
-from . import __version__
-from . import integrator
-from .configurations import STATE_NAMES, Configuration
-from .equations import build_model
-from .errors import InvalidParameterError
-from .parameters import Parameters, check_number, check_operating_point
+from .. import __version__
+from ..model import integrator
+from ..model.configurations import STATE_NAMES, Configuration
+from ..model.equations import build_model
+from ..errors import InvalidParameterError
+from ..model.parameters import Parameters, check_number, check_operating_point
 from .response import DECAYED_FRACTION, ResponseType, classify_run, dominant_frequency, peak_amplitude
 
 #: Largest simulated time and the densest output accepted (service limits build on these).

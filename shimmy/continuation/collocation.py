@@ -34,7 +34,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from .continuation import VectorField
+from .core import VectorField
 
 
 @dataclass(frozen=True)

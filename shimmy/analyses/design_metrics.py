@@ -21,8 +21,8 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .bifurcation import BifurcationOptions
-from .configurations import OPERATING_POINTS, Configuration
-from .parameters import Parameters
+from ..model.configurations import OPERATING_POINTS, Configuration
+from ..model.parameters import Parameters
 from .executors import run_units
 from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, classify, map_slice, stability_map
 

@@ -41,12 +41,12 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from . import __version__
-from . import lyapunov
-from .configurations import Configuration
-from .equations import Model, build_model, jacobian
-from .errors import InvalidParameterError
-from .parameters import V_RANGE, Parameters, check_number, check_operating_point
+from .. import __version__
+from ..continuation import lyapunov
+from ..model.configurations import Configuration
+from ..model.equations import Model, build_model, jacobian
+from ..errors import InvalidParameterError
+from ..model.parameters import V_RANGE, Parameters, check_number, check_operating_point
 
 
 class Criticality(str, Enum):

@@ -27,12 +27,12 @@ import threading
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from typing import Any, Callable, Iterator, Sequence
 
-from .errors import InvalidParameterError
+from ..errors import InvalidParameterError
 
 DASK_ENV = "SHIMMY_DASK_SCHEDULER"
 WORKERS_ENV = "SHIMMY_WORKERS"
 #: Modules the forkserver imports once, so that forked workers start warm.
-PRELOAD = ["shimmy.stability_map", "shimmy.studies"]
+PRELOAD = ["shimmy.analyses.stability_map", "shimmy.analyses.studies"]
 
 
 class InlineExecutor(Executor):

@@ -12,7 +12,7 @@ are central differences of the analytic Jacobian along a, b and the parameters, 
 steps 1e-5 of the respective scales (relative error ~1e-10, far below Newton's needs:
 they only enter the Newton matrix, the residual is exact).
 
-Along the curve: the first Lyapunov coefficient l1 (:mod:`shimmy.lyapunov`) at every
+Along the curve: the first Lyapunov coefficient l1 (:mod:`shimmy.continuation.lyapunov`) at every
 point when the field is smooth; a sign change is a generalised Hopf (Bautin) point,
 located by the secant method on l1. omega falling to zero ends the curve (a
 Bogdanov-Takens point or a double zero eigenvalue). The curve also ends where it
@@ -29,7 +29,7 @@ from typing import Callable
 import numpy as np
 
 from . import lyapunov
-from .continuation import ContinuationOptions, CurvePoint, Tracer, correct, locate, tangent, weighted_norm
+from .core import ContinuationOptions, CurvePoint, Tracer, correct, locate, tangent, weighted_norm
 
 
 @dataclass(frozen=True)

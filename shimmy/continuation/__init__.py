@@ -1,0 +1,70 @@
+"""A continuation engine for any x' = f(x, p): equilibria, periodic orbits, Hopf curves.
+
+Generic: numpy and scipy only, nothing of the landing gear; tested on textbook systems.
+
+* :mod:`.core`: pseudo-arclength continuation of F(u) = 0 (predictor, bordered Newton
+  corrector, step control, location of special points), the :class:`VectorField` every
+  curve type continues and the one :class:`SpecialPoint` type.
+* :mod:`.equilibria`: equilibrium branches with eigenvalues, Hopf (H), fold (LP) and branch
+  (BP) points.
+* :mod:`.collocation` and :mod:`.periodic_orbits`: periodic orbits by orthogonal collocation
+  (boundary-value problem in the period), Floquet multipliers, fold (LPC), torus (NS),
+  period-doubling (PD) and branch (BPC) points of cycles.
+* :mod:`.hopf`: two-parameter Hopf curves with generalised Hopf (GH) points;
+  :mod:`.lyapunov`: the first Lyapunov coefficient.
+
+Continue any ``f(x, p)``: the supercritical Hopf normal form x' = p x - y - x r^2,
+y' = x + p y - y r^2 has x = 0 stable for p < 0, a Hopf point at p = 0 and the stable
+cycle r = sqrt(p) with period 2 pi for p > 0::
+
+    import numpy as np
+    from shimmy.continuation import (Mesh, PeriodicOptions, VectorField, equilibrium_branch,
+                                     hopf_eigenvectors, hopf_guess, periodic_branch)
+
+    def f(x, p):
+        r2 = x[0] ** 2 + x[1] ** 2
+        return np.stack([p * x[0] - x[1] - x[0] * r2, x[0] + p * x[1] - x[1] * r2])
+
+    def dfdx(x, p):  # (n, n) for x (n,), (m, n, n) for x (n, m)
+        x0, x1 = x[0], x[1]
+        J = np.empty(np.shape(x)[1:] + (2, 2))
+        J[..., 0, 0] = p - 3 * x0 ** 2 - x1 ** 2
+        J[..., 0, 1] = -1 - 2 * x0 * x1
+        J[..., 1, 0] = 1 - 2 * x0 * x1
+        J[..., 1, 1] = p - x0 ** 2 - 3 * x1 ** 2
+        return J
+
+    hopf_normal_form = VectorField(2, f, dfdx, lambda x, p: x.copy(), "hopf")
+    eq = equilibrium_branch(hopf_normal_form, np.zeros(2), -0.5, -0.5, 0.5)
+    H = next(s for s in eq.special_points if s.kind == "H")       # H.p ~ 0, H.data["omega"] ~ 1
+    omega, q, _ = hopf_eigenvectors(dfdx(np.array(H.data["x"]), H.p))
+    options = PeriodicOptions(ntst=20, ncol=4)
+    guess, shape = hopf_guess(np.array(H.data["x"]), H.p, omega, q,
+                              Mesh.uniform(options.ntst, options.ncol), 0.0)
+    cycles = periodic_branch(hopf_normal_form, guess, -0.5, 0.5, np.ones(2), 1.0, options,
+                             direction=shape)
+    # cycles.p, cycles.period (~2 pi), cycles.x_max[:, 0] (~ sqrt(p)), cycles.stable (True)
+
+Errors: :class:`InvalidInputError` for bad options or starts, :class:`ConvergenceError` when
+a start does not converge; both derive from :class:`ContinuationError`. A branch that stops
+early says why in its ``stop_reason``.
+"""
+
+from .collocation import Mesh, PeriodicProblem
+from .core import (ContinuationOptions, CurvePoint, CurveProblem, SpecialPoint, Tracer, VectorField, correct,
+                   locate, step, tangent, weighted_norm)
+from .equilibria import EquilibriumBranch, equilibrium_branch
+from .errors import ContinuationError, ConvergenceError, InvalidInputError
+from .hopf import HopfCurve, HopfCurveProblem, TwoParameterField, hopf_curve, hopf_start
+from .lyapunov import first_lyapunov_coefficient, hopf_eigenvectors
+from .periodic_orbits import (OrbitGuess, PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
+                              periodic_branch)
+
+__all__ = [
+    "ContinuationError", "ContinuationOptions", "ConvergenceError", "CurvePoint", "CurveProblem",
+    "EquilibriumBranch", "HopfCurve", "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess",
+    "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "SpecialPoint", "Tracer", "TwoParameterField",
+    "VectorField", "correct", "equilibrium_branch", "first_lyapunov_coefficient", "hopf_curve",
+    "hopf_eigenvectors", "hopf_guess", "hopf_start", "locate", "orbit_from_samples", "periodic_branch",
+    "step", "tangent", "weighted_norm",
+]
