@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from shimmy.continuation import VectorField
+from shimmy.continuation import TwoParameterVectorField, VectorField
 
 
 def _jacobian(entries, x: np.ndarray) -> np.ndarray:
@@ -258,6 +258,57 @@ def period_doubling(beta: float = 0.5, b: float = -1.0) -> VectorField:
     return VectorField(4, f, dfdx, dfdp, "period_doubling")
 
 
+def fold_near_torus(gap: float = 1e-3, w2: float = 0.37, rate: float = 10.0,
+                    second_gap: float | None = None) -> VectorField:
+    """A fold of cycles and a torus point ``gap`` apart in p on the same branch.
+
+    x, y: r' = r (p + rho - rho^2), theta' = 1 (rho = r^2): cycles p = rho^2 - rho, a fold at
+    p = -1/4 (rho = 1/2), period 2 pi; the large cycles (rho > 1/2) are stable in (x, y), the small
+    ones unstable. Each fibre (u, v): growth rate (rho_ns - rho) and rotation w2, so its
+    multipliers are exp(2 pi rate (rho_ns - rho)) exp(+-2 pi i w2): with rho_ns = 1/2 - sqrt(gap)
+    a torus point on the small-cycle side at p = -1/4 + gap. Coming from the large cycles, one step
+    across the fold takes three multipliers out of the unit circle at once, the real one nearest
+    to it. ``second_gap`` adds a second fibre (rotation w2 + 0.1): a second torus point at
+    p = -1/4 + second_gap.
+    """
+    gaps = [gap] + ([second_gap] if second_gap is not None else [])
+    fibres = [(0.5 - math.sqrt(g), w2 + 0.1 * k) for k, g in enumerate(gaps)]
+    n = 2 + 2 * len(fibres)
+
+    def f(z, p):
+        x, y = z[0], z[1]
+        rho = x ** 2 + y ** 2
+        G = p + rho - rho ** 2
+        out = [G * x - y, x + G * y]
+        for k, (rho_ns, w) in enumerate(fibres):
+            u, v = z[2 + 2 * k], z[3 + 2 * k]
+            a, s2 = rate * (rho_ns - rho), u ** 2 + v ** 2
+            out += [a * u - w * v - s2 * u, w * u + a * v - s2 * v]
+        return np.stack(out)
+
+    def dfdx(z, p):
+        x, y = z[0], z[1]
+        rho = x ** 2 + y ** 2
+        G, Gr = p + rho - rho ** 2, 1.0 - 2.0 * rho
+        zero = 0.0 * x
+        rows = [[G + 2 * x * x * Gr, -1.0 + 2 * x * y * Gr] + [zero] * (n - 2),
+                [1.0 + 2 * x * y * Gr, G + 2 * y * y * Gr] + [zero] * (n - 2)]
+        for k, (rho_ns, w) in enumerate(fibres):
+            u, v = z[2 + 2 * k], z[3 + 2 * k]
+            a, s2 = rate * (rho_ns - rho), u ** 2 + v ** 2
+            ru = [-2 * rate * x * u, -2 * rate * y * u] + [zero] * (n - 2)
+            rv = [-2 * rate * x * v, -2 * rate * y * v] + [zero] * (n - 2)
+            ru[2 + 2 * k], ru[3 + 2 * k] = a - s2 - 2 * u * u, -w - 2 * u * v
+            rv[2 + 2 * k], rv[3 + 2 * k] = w - 2 * u * v, a - s2 - 2 * v * v
+            rows += [ru, rv]
+        return _jacobian(rows, z)
+
+    def dfdp(z, p):
+        return np.concatenate([z[:2], 0.0 * z[2:]])
+
+    return VectorField(n, f, dfdx, dfdp, "fold_near_torus")
+
+
 ALL_SYSTEMS = {
     "fold_1d": fold_1d,
     "fold_2d": fold_2d,
@@ -272,4 +323,118 @@ ALL_SYSTEMS = {
     "van_der_pol": van_der_pol,
     "neimark_sacker": neimark_sacker,
     "period_doubling": period_doubling,
+    "fold_near_torus": lambda: fold_near_torus(1e-3, second_gap=2e-3),
+}
+
+
+# --------------------------------------------------------------------------- two-parameter cycles
+
+
+def radial_two_parameter(G, G_rho, G_p, name: str) -> TwoParameterVectorField:
+    """x' = G x - y, y' = x + G y with G = G(rho, p1, p2), rho = x^2 + y^2.
+
+    In polar form r' = r G(r^2, p), theta' = 1: cycles r^2 = rho0 with G(rho0, p) = 0, period
+    2 pi, nontrivial multiplier exp(4 pi rho0 G_rho(rho0, p)): a fold of cycles where
+    G = G_rho = 0. ``G_rho(rho, p)`` and ``G_p(rho, p)`` -> (dG/dp1, dG/dp2).
+    """
+
+    def f(z, p):
+        x, y = z[0], z[1]
+        g = G(x ** 2 + y ** 2, p)
+        return np.stack([g * x - y, x + g * y])
+
+    def dfdx(z, p):
+        x, y = z[0], z[1]
+        rho = x ** 2 + y ** 2
+        g, gr = G(rho, p), G_rho(rho, p)
+        return _jacobian([[g + 2 * x * x * gr, -1.0 + 2 * x * y * gr],
+                          [1.0 + 2 * x * y * gr, g + 2 * y * y * gr]], z)
+
+    def dfdp(z, p):
+        x, y = z[0], z[1]
+        g1, g2 = G_p(x ** 2 + y ** 2, p)
+        return np.stack([np.stack([g1 * x, g1 * y]), np.stack([g2 * x, g2 * y])])
+
+    return TwoParameterVectorField(2, f, dfdx, dfdp, name)
+
+
+def bautin() -> TwoParameterVectorField:
+    """The Bautin normal form G = b1 + b2 rho - rho^2 (l2 = -1).
+
+    Hopf points of x = 0 at b1 = 0, a generalised Hopf point at (0, 0); for b2 > 0 the fold of
+    cycles curve b1 = -b2^2 / 4 with rho0 = b2 / 2 (amplitude sqrt(b2 / 2)), ending at GH with
+    zero amplitude.
+    """
+    return radial_two_parameter(lambda rho, p: p[0] + p[1] * rho - rho ** 2,
+                                lambda rho, p: p[1] - 2.0 * rho,
+                                lambda rho, p: (np.ones_like(rho), rho), "bautin")
+
+
+def cusp_of_cycles() -> TwoParameterVectorField:
+    """G = b1 + b2 (rho - 1) - (rho - 1)^3: the fold curve (b1, b2) = (-2 s^3, 3 s^2) with
+    rho0 = 1 + s, a cusp of cycles at (0, 0) on the unit cycle."""
+    return radial_two_parameter(lambda rho, p: p[0] + p[1] * (rho - 1.0) - (rho - 1.0) ** 3,
+                                lambda rho, p: p[1] - 3.0 * (rho - 1.0) ** 2,
+                                lambda rho, p: (np.ones_like(rho), rho - 1.0), "cusp_of_cycles")
+
+
+def torus_two_parameter(w2_0: float = 0.3, w2_slope: float = 0.1) -> TwoParameterVectorField:
+    """The neimark_sacker system with fibre growth a = p1 - p2^2 and rotation w2 = w2_0 + w2_slope p2.
+
+    Unit cycle, T = 2 pi; fibre multipliers exp(a T) exp(+-i w2 T): the torus curve p1 = p2^2 with
+    kappa = cos(2 pi w2); strong resonances where 2 pi w2 = 2 pi / k: R3 (w2 = 1/3) at
+    p2 = (1/3 - w2_0) / w2_slope.
+    """
+
+    def parts(p):
+        return p[0] - p[1] ** 2, w2_0 + w2_slope * p[1]
+
+    def f(z, p):
+        x, y, u, v = z
+        a, w2 = parts(p)
+        r2, rho2 = x ** 2 + y ** 2, u ** 2 + v ** 2
+        return np.stack([x * (1 - r2) - y, x + y * (1 - r2), a * u - w2 * v - u * rho2, w2 * u + a * v - v * rho2])
+
+    def dfdx(z, p):
+        x, y, u, v = z
+        a, w2 = parts(p)
+        r2, rho2 = x ** 2 + y ** 2, u ** 2 + v ** 2
+        zero = np.zeros_like(x)
+        return _jacobian([[1 - r2 - 2 * x ** 2, -1 - 2 * x * y, zero, zero],
+                          [1 - 2 * x * y, 1 - r2 - 2 * y ** 2, zero, zero],
+                          [zero, zero, a - rho2 - 2 * u ** 2, -w2 - 2 * u * v],
+                          [zero, zero, w2 - 2 * u * v, a - rho2 - 2 * v ** 2]], z)
+
+    def dfdp(z, p):
+        x, y, u, v = z
+        zero = np.zeros_like(x)
+        return np.stack([np.stack([zero, zero, u, v]),
+                         np.stack([zero, zero, -2 * p[1] * u - w2_slope * v, -2 * p[1] * v + w2_slope * u])])
+
+    return TwoParameterVectorField(4, f, dfdx, dfdp, "torus_two_parameter")
+
+
+def flip_two_parameter(b: float = -1.0) -> TwoParameterVectorField:
+    """The period_doubling system with a = p1 - p2^2: fibre multipliers -exp(a T), -exp(b T),
+    T = 2 pi: the period-doubling curve p1 = p2^2."""
+    one = period_doubling(beta=0.0, b=b)
+
+    def f(z, p):
+        return one.f(z, p[0] - p[1] ** 2)
+
+    def dfdx(z, p):
+        return one.dfdx(z, p[0] - p[1] ** 2)
+
+    def dfdp(z, p):
+        d = one.dfdp(z, p[0] - p[1] ** 2)
+        return np.stack([d, -2.0 * p[1] * d])
+
+    return TwoParameterVectorField(4, f, dfdx, dfdp, "flip_two_parameter")
+
+
+TWO_PARAMETER_SYSTEMS = {
+    "bautin": bautin,
+    "cusp_of_cycles": cusp_of_cycles,
+    "torus_two_parameter": torus_two_parameter,
+    "flip_two_parameter": flip_two_parameter,
 }

@@ -456,8 +456,8 @@ def _join(down: PeriodicBranch, up: PeriodicBranch) -> PeriodicBranch:
     def cat(a, b):
         return np.concatenate([a[::-1], b[1:]])
 
-    special = [SpecialPoint(s.kind, s.p, k - 1 - s.index, s.data) for s in down.special_points][::-1]
-    special += [SpecialPoint(s.kind, s.p, k - 1 + s.index, s.data) for s in up.special_points]
+    special = [SpecialPoint(s.kind, s.p, k - 1 - s.index, s.data, s.solution) for s in down.special_points][::-1]
+    special += [SpecialPoint(s.kind, s.p, k - 1 + s.index, s.data, s.solution) for s in up.special_points]
     return PeriodicBranch(cat(down.p, up.p), cat(down.period, up.period), cat(down.x_max, up.x_max),
                           cat(down.x_min, up.x_min), cat(down.stable, up.stable),
                           cat(down.multipliers, up.multipliers), special,

@@ -10,6 +10,8 @@ Generic: numpy and scipy only, nothing of the landing gear; tested on textbook s
 * :mod:`.collocation` and :mod:`.periodic_orbits`: periodic orbits by orthogonal collocation
   (boundary-value problem in the period), Floquet multipliers, fold (LPC), torus (NS),
   period-doubling (PD) and branch (BPC) points of cycles.
+* :mod:`.cycle_curves`: two-parameter curves of folds (LPC), period doublings (PD) and tori (NS)
+  of cycles, with their codimension-2 points;
 * :mod:`.hopf`: two-parameter Hopf curves with generalised Hopf (GH) points;
   :mod:`.lyapunov`: the first Lyapunov coefficient.
 
@@ -51,6 +53,8 @@ early says why in its ``stop_reason``.
 """
 
 from .collocation import Mesh, PeriodicProblem
+from .cycle_curves import (CODIM2_KINDS, CycleBifurcation, CycleCurve, CycleCurveOptions, CycleCurveProblem,
+                           TwoParameterVectorField, cycle_curve)
 from .core import (ContinuationOptions, CurvePoint, CurveProblem, SpecialPoint, Tracer, VectorField, correct,
                    locate, step, tangent, weighted_norm)
 from .equilibria import EquilibriumBranch, equilibrium_branch
@@ -61,6 +65,8 @@ from .periodic_orbits import (OrbitGuess, PeriodicBranch, PeriodicOptions, hopf_
                               periodic_branch)
 
 __all__ = [
+    "CODIM2_KINDS", "CycleBifurcation", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem",
+    "TwoParameterVectorField", "cycle_curve",
     "ContinuationError", "ContinuationOptions", "ConvergenceError", "CurvePoint", "CurveProblem",
     "EquilibriumBranch", "HopfCurve", "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess",
     "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "SpecialPoint", "Tracer", "TwoParameterField",

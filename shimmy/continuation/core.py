@@ -300,6 +300,9 @@ class SpecialPoint:
     p: float
     index: int  # position in the branch's point list
     data: dict[str, Any] = field(default_factory=dict)
+    #: The located point's full solution where a follow-on analysis needs it (cycles:
+    #: (mesh points, u)); not part of :meth:`to_dict`.
+    solution: Any = field(default=None, repr=False, compare=False)
 
     def to_dict(self, parameter: str = "p") -> dict[str, Any]:
         return {"kind": self.kind, parameter: self.p, **self.data}

@@ -121,27 +121,34 @@ def _count_unstable(mu: np.ndarray) -> int:
 
 
 def _kind_of_crossing(mu_a: np.ndarray, mu_b: np.ndarray) -> str:
-    mu = mu_a if _count_unstable(mu_a) > _count_unstable(mu_b) else mu_b
-    rest = mu[1:]
-    outside = rest[np.abs(rest) > 1.0]
-    crit = outside[np.argmin(np.abs(outside))]
-    if abs(crit.imag) > COMPLEX_TOL * abs(crit):
+    """The kind of the multiplier that crossed the unit circle between a and b, from which kind's
+    count outside changed (complex pair -> NS, real negative -> PD, real positive -> BPC)."""
+    ra, na, ca = _outside_by_kind(mu_a)
+    rb, nb, cb = _outside_by_kind(mu_b)
+    if cb != ca:
         return "NS"
-    return "PD" if crit.real < 0 else "BPC"
+    if nb != na:
+        return "PD"
+    return "BPC"
 
 
 def _crossing_test(kind: str) -> Callable[[np.ndarray], float]:
+    """A test function that changes sign when one multiplier of ``kind`` crosses the unit circle:
+    the product of tanh(ln |mu|) over the multipliers of that kind (a complex pair counted
+    once). Continuous across the crossing even when another multiplier of the same kind lies
+    near the circle (the nearest one alone would jump from one to the other)."""
     def g(mu: np.ndarray) -> float:
         rest = mu[1:]
+        real = np.abs(rest.imag) <= COMPLEX_TOL * np.abs(rest)
         if kind == "NS":
-            sel = rest[np.abs(rest.imag) > COMPLEX_TOL * np.abs(rest)]
+            sel = rest[~real & (rest.imag > 0)]
         elif kind == "PD":
-            sel = rest[(np.abs(rest.imag) <= COMPLEX_TOL * np.abs(rest)) & (rest.real < 0)]
+            sel = rest[real & (rest.real < 0)]
         else:
-            sel = rest[(np.abs(rest.imag) <= COMPLEX_TOL * np.abs(rest)) & (rest.real > 0)]
+            sel = rest[real & (rest.real > 0)]
         if sel.size == 0:
             return math.nan
-        return float(np.abs(sel[np.argmin(np.abs(np.abs(sel) - 1.0))]) - 1.0)
+        return float(np.prod(np.tanh(np.log(np.maximum(np.abs(sel), 1e-300)))))
     return g
 
 
@@ -342,29 +349,71 @@ def _special(problem: PeriodicProblem, kind: str, point: CurvePoint, rows, mu=No
         if cand.size:
             crit = cand[np.argmin(np.abs(np.abs(cand) - 1.0))]
             data["torus_angle"] = float(abs(np.angle(crit)))  # rad per period: the second frequency
-    return SpecialPoint(kind, float(point.u[-1]), len(rows["p"]) - 1, data)
+    return SpecialPoint(kind, float(point.u[-1]), len(rows["p"]) - 1, data,
+                        solution=(problem.mesh.points.copy(), point.u.copy()))
+
+
+MAX_SPLITS = 8  # a step holding several crossings is halved at most this many times
+
+
+def _outside_by_kind(mu: np.ndarray) -> tuple[int, int, int]:
+    """Nontrivial multipliers outside the unit circle: (real positive, real negative, complex)."""
+    rest = mu[1:]
+    outside = rest[np.abs(rest) > 1.0]
+    real = np.abs(outside.imag) <= COMPLEX_TOL * np.abs(outside)
+    return int((real & (outside.real > 0)).sum()), int((real & (outside.real < 0)).sum()), int((~real).sum())
+
+
+def _single_event(fold: bool, mu_a: np.ndarray, mu_b: np.ndarray) -> bool:
+    """Whether the step holds at most one event: a fold (its real multiplier through +1), or one
+    real multiplier through +1 or -1, or one complex pair through the circle."""
+    ra, na, ca = _outside_by_kind(mu_a)
+    rb, nb, cb = _outside_by_kind(mu_b)
+    dr, dn, dc = rb - ra, nb - na, cb - ca
+    if fold:
+        return dn == 0 and dc == 0 and abs(dr) <= 1
+    if dr + dn + dc == 0:  # multipliers changing kind outside the circle: no crossing
+        return True
+    changed = [d for d in (dr, dn, dc) if d]
+    return len(changed) == 1 and (abs(dr) == 1 or abs(dn) == 1 or abs(dc) == 2)
 
 
 def _detect(problem: PeriodicProblem, rows, prev: CurvePoint, new: CurvePoint,
             copts: ContinuationOptions) -> list[SpecialPoint]:
-    """Special points between the last two recorded points (prev -> new)."""
-    mu_a, mu_b = rows["mu"][-2], rows["mu"][-1]
-    h = weighted_norm(new.u - prev.u, problem.weights)
+    """Special points between the last two recorded points (prev -> new), in order along the step.
+
+    A step that holds more than one event (a fold and a torus point, two crossings) is halved,
+    each half on the curve, until every event is alone in its piece (at most MAX_SPLITS times).
+    """
+    found = _events(problem, rows, prev, new, rows["mu"][-2], rows["mu"][-1], copts, MAX_SPLITS)
+    return [s for _, s in sorted(found, key=lambda item: item[0])]
+
+
+def _events(problem: PeriodicProblem, rows, a: CurvePoint, b: CurvePoint, mu_a: np.ndarray, mu_b: np.ndarray,
+            copts: ContinuationOptions, splits: int, offset: float = 0.0) -> list[tuple[float, SpecialPoint]]:
+    fold = a.tangent[-1] * b.tangent[-1] < 0
+    h = weighted_norm(b.u - a.u, problem.weights)
+    if splits > 0 and not _single_event(fold, mu_a, mu_b):
+        mid = step(problem, a, 0.5 * h, copts)
+        if mid is not None and mid.tangent @ (problem.weights * a.tangent) > 0:
+            mu_mid = problem.multipliers(mid.u)
+            h_mid = weighted_norm(mid.u - a.u, problem.weights)
+            return (_events(problem, rows, a, mid, mu_a, mu_mid, copts, splits - 1, offset)
+                    + _events(problem, rows, mid, b, mu_mid, mu_b, copts, splits - 1, offset + h_mid))
     found: list[tuple[float, SpecialPoint]] = []
-    fold = prev.tangent[-1] * new.tangent[-1] < 0
     if fold:
-        hit = locate(problem, prev, h, lambda q: q.tangent[-1], prev.tangent[-1], new.tangent[-1], copts)
-        at = hit[0] if hit is not None else new
-        found.append((weighted_norm(at.u - prev.u, problem.weights), _special(problem, "LPC", at, rows)))
+        hit = locate(problem, a, h, lambda q: q.tangent[-1], a.tangent[-1], b.tangent[-1], copts)
+        at = hit[0] if hit is not None else b
+        found.append((offset + weighted_norm(at.u - a.u, problem.weights), _special(problem, "LPC", at, rows)))
     if _count_unstable(mu_a) != _count_unstable(mu_b):
         kind = _kind_of_crossing(mu_a, mu_b)
         if not (kind == "BPC" and fold):
             g_mu = _crossing_test(kind)
             ga, gb = g_mu(mu_a), g_mu(mu_b)
-            at = new
+            at = b
             if np.isfinite(ga) and np.isfinite(gb) and ga * gb < 0:
-                hit = locate(problem, prev, h, lambda q: g_mu(problem.multipliers(q.u)), ga, gb, copts)
+                hit = locate(problem, a, h, lambda q: g_mu(problem.multipliers(q.u)), ga, gb, copts)
                 if hit is not None:
                     at = hit[0]
-            found.append((weighted_norm(at.u - prev.u, problem.weights), _special(problem, kind, at, rows)))
-    return [s for _, s in sorted(found, key=lambda item: item[0])]
+            found.append((offset + weighted_norm(at.u - a.u, problem.weights), _special(problem, kind, at, rows)))
+    return found

@@ -1,0 +1,666 @@
+"""Two-parameter curves of cycle bifurcations: folds (LPC), period doublings (PD) and
+Neimark-Sacker / torus (NS) points of periodic orbits.
+
+Formulation: minimally augmented systems with bordered test functions on the collocation
+discretisation of :mod:`.collocation` (Doedel, Govaerts, Kuznetsov, *Computation of periodic
+solution bifurcations in ODEs using bordered systems*, SIAM J. Numer. Anal. 41, 2003; the
+formulation MATCONT's ``limitpointcycle``, ``perioddoubling`` and ``neimarksacker`` curves
+use). Chosen over the fully extended systems because the unknowns are the cycle's plus one
+parameter (plus kappa for NS) instead of doubling (PD, LPC) or tripling (NS) them; the cost per
+Newton step is one sparse LU more than a cycle's, and the test functions are regular at the
+bifurcation, so Newton converges quadratically up to the finite-difference second
+derivatives.
+
+Unknowns u = (x at the mesh nodes, T, p1, p2[, kappa]); equations: the cycle's collocation,
+periodicity and phase conditions (:class:`~.collocation.PeriodicProblem`) and
+
+* LPC: g = 0 from [[A, b], [c^T, 0]] [v; g] = [0; 1], A the Jacobian of the cycle equations
+  in (x, T) (singular where the cycle folds in p1 at fixed p2);
+* PD: the same with A the linearised collocation in x with the anti-periodic condition
+  v(0) + v(1) = 0 (singular where a multiplier is -1);
+* NS: A the linearised collocation on two periods with v(0) - 2 kappa v(1) + v(2) = 0
+  (singular, with a two-dimensional kernel, where exp(+-i theta), kappa = cos theta, are
+  multipliers); bordered by two vectors, two entries of the 2x2 G = 0, chosen at the start
+  as the best-conditioned pair.
+
+Derivatives: g_u = -w^T A_u v, with w from the transposed bordered system; A_u v is the
+second derivative of the cycle equations along v, a central difference of the analytic
+Jacobian (step 1e-6 of v's size in the weighted norm: relative error ~1e-10, which only
+enters the Newton matrix; the residuals are exact). Borders are moved to the last kernel
+vectors at every accepted point, and the mesh is re-adapted every ``adapt_every`` steps.
+
+Along a curve, codimension-2 points are detected by sign changes between points and located
+by the secant method: on LPC curves the cusp (CPC: the parameter tangent reverses), a fold
+meeting a torus (LPNS: a complex pair crosses the unit circle) or a period doubling (LPPD);
+on PD curves LPPD, PDNS and the 1:2 resonance (R2: a second multiplier at -1); on NS curves
+the strong resonances R1 (kappa = 1), R2 (kappa = -1), R3 (kappa = -1/2), R4 (kappa = 0), and
+LPNS / PDNS (a real multiplier crosses +1 / -1). Stops, each said in ``stop_reason``: the
+parameter box (end point located on it), a closed curve, the amplitude shrinking to zero (the
+curve ends at a codimension-2 point of the equilibrium: GH for a fold curve, a double-Hopf
+or zero-Hopf point for a torus curve), kappa leaving [-1, 1] (past R1/R2 the NS condition
+describes neutral saddle cycles, not tori), the period limit, step underflow, the step budget.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from .collocation import Mesh, PeriodicProblem
+from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step, tangent,
+                   weighted_norm)
+from .errors import ConvergenceError, InvalidInputError
+
+
+class CycleBifurcation(str, enum.Enum):
+    """The curve types: the defining condition held along the curve."""
+
+    LPC = "LPC"
+    PD = "PD"
+    NS = "NS"
+
+
+#: Codimension-2 points reported on each curve type.
+CODIM2_KINDS = {"LPC": ("CPC", "LPNS", "LPPD"), "PD": ("LPPD", "PDNS", "R2"),
+                "NS": ("R1", "R2", "R3", "R4", "LPNS", "PDNS")}
+RESONANCES = {"R1": 1.0, "R4": 0.0, "R3": -0.5, "R2": -1.0}  # kappa = cos(theta) at 1:k
+COMPLEX_TOL = 1e-7
+
+
+@dataclass(frozen=True)
+class TwoParameterVectorField:
+    """x' = f(x, p1, p2) with analytic first derivatives, vectorised over columns.
+
+    ``f(x, p)``: x (n,) or (n, m), p = (p1, p2) -> like x; ``dfdx(x, p)``: (n, n) or (m, n, n);
+    ``dfdp(x, p)``: (2, n) or (2, n, m), the derivatives in p1 and p2 stacked.
+    """
+
+    n: int
+    f: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    dfdx: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    dfdp: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    name: str = "system"
+
+    def at(self, p2: float) -> VectorField:
+        """The one-parameter field in p1 at fixed p2 (for one-parameter branches)."""
+        return _Slice(self, float(p2)).field
+
+
+class _Slice:
+    """The field in p1 at a p2 that can be moved (the curve problems move it every evaluation)."""
+
+    def __init__(self, system: TwoParameterVectorField, p2: float):
+        self.system, self.p2 = system, p2
+        self.field = VectorField(system.n, lambda x, p: system.f(x, np.array([p, self.p2])),
+                                 lambda x, p: system.dfdx(x, np.array([p, self.p2])),
+                                 lambda x, p: system.dfdp(x, np.array([p, self.p2]))[0], system.name)
+
+    def dfdp2(self, x: np.ndarray, p1: float) -> np.ndarray:
+        return self.system.dfdp(x, np.array([p1, self.p2]))[1]
+
+
+@dataclass(frozen=True)
+class CycleCurveOptions:
+    adapt_every: int = 10
+    period_max: float = math.inf
+    amplitude_min: float = 0.02  # end: amplitude below this fraction of the curve's largest
+    kappa_weight: float = 1.0
+    continuation: ContinuationOptions = field(default_factory=lambda: ContinuationOptions(ds=0.05, ds_max=0.5,
+                                                                                         max_steps=300))
+
+    def __post_init__(self):
+        if not (isinstance(self.adapt_every, int) and self.adapt_every >= 0):
+            raise InvalidInputError("adapt_every", self.adapt_every, "an integer >= 0 (0: never)")
+        if not 0.0 < self.amplitude_min < 1.0:
+            raise InvalidInputError("amplitude_min", self.amplitude_min, "a number in (0, 1)")
+
+
+@dataclass
+class CycleCurve:
+    """Points of a curve of cycle bifurcations (one row per point) and its special points."""
+
+    kind: str
+    p: np.ndarray  # (points, 2)
+    period: np.ndarray
+    x_max: np.ndarray  # (points, n)
+    x_min: np.ndarray
+    kappa: np.ndarray  # NS: cos of the torus angle; nan otherwise
+    multipliers: np.ndarray  # (points, n), trivial first, then by decreasing modulus
+    special_points: list[SpecialPoint]
+    stop_reasons: list[str]  # one per direction traced
+    steps: int
+    solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, cycle u = (x, T, p1)) per point
+    closed: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind, "p": self.p.tolist(), "period": self.period.tolist(),
+                "x_max": self.x_max.tolist(), "x_min": self.x_min.tolist(),
+                "kappa": [None if not np.isfinite(k) else float(k) for k in self.kappa],
+                "special_points": [s.to_dict() for s in self.special_points], "stop_reasons": self.stop_reasons,
+                "steps": self.steps, "closed": self.closed}
+
+
+# --------------------------------------------------------------------------- the defining systems
+
+
+class CycleCurveProblem:
+    """The minimally augmented system of one curve type on one mesh, as a curve problem."""
+
+    def __init__(self, system: TwoParameterVectorField, kind: CycleBifurcation | str, mesh: Mesh,
+                 scale: np.ndarray, T_scale: float, p_scale: np.ndarray, kappa_weight: float = 1.0):
+        self.kind = CycleBifurcation(kind)
+        self.system = system
+        self.slice = _Slice(system, 0.0)
+        self.p_scale = np.asarray(p_scale, float)
+        self.cycle = PeriodicProblem(self.slice.field, mesh, scale, T_scale, self.p_scale[0])
+        self.mesh, self.n = mesh, system.n
+        self.n_x = self.cycle.n_x
+        self.n_coll = mesh.ntst * mesh.ncol * self.n
+        extra = [1.0 / self.p_scale[1] ** 2] + ([kappa_weight] if self.kind is CycleBifurcation.NS else [])
+        self.weights = np.concatenate([self.cycle.weights, extra])
+        self.size = self.weights.size
+        self.k = 2 if self.kind is CycleBifurcation.NS else 1  # kernel dimension
+        self.m = {CycleBifurcation.LPC: self.n_x + 1, CycleBifurcation.PD: self.n_x,
+                  CycleBifurcation.NS: 2 * self.n_x}[self.kind]  # size of A
+        rng = np.random.default_rng(12345)
+        self.B = np.linalg.qr(rng.standard_normal((self.m, self.k)))[0]
+        self.C = np.linalg.qr(rng.standard_normal((self.m, self.k)))[0]
+        self.entries: list[tuple[int, int]] = [(0, 0)] if self.k == 1 else [(0, 0), (1, 1)]
+        self._memo: tuple[bytes, dict] | None = None
+
+    # -- unknowns --------------------------------------------------------------------------
+    def cycle_u(self, u: np.ndarray) -> np.ndarray:
+        """(x, T, p1) with the slice moved to p2 = u[n_x + 2]."""
+        self.slice.p2 = float(u[self.n_x + 2])
+        return u[:self.n_x + 2]
+
+    def kappa(self, u: np.ndarray) -> float:
+        return float(u[self.n_x + 3]) if self.kind is CycleBifurcation.NS else math.nan
+
+    # -- the cycle equations in (x, T, p1, p2[, kappa]) ------------------------------------------
+    def cycle_jacobian(self, u: np.ndarray) -> sp.csr_matrix:
+        cu = self.cycle_u(u)
+        J = self.cycle.jacobian(cu)
+        X, T, p1 = self.cycle.unpack(cu)
+        Xc, _ = self.cycle._at_collocation(X)
+        flat = Xc.reshape(-1, self.n).T
+        Fp2 = self.slice.dfdp2(flat, p1).T.reshape(Xc.shape)
+        col = np.zeros(J.shape[0])
+        col[:self.n_coll] = (-(self.mesh.h * T)[:, None, None] * Fp2).ravel()
+        cols = [J, sp.csr_matrix(col[:, None])]
+        if self.kind is CycleBifurcation.NS:
+            cols.append(sp.csr_matrix((J.shape[0], 1)))
+        return sp.hstack(cols, format="csr")
+
+    def _second(self, u: np.ndarray, direction: np.ndarray) -> sp.csr_matrix:
+        """d/de of the cycle Jacobian at u + e * direction (central difference)."""
+        size = weighted_norm(direction, self.weights)
+        if size == 0.0:
+            return sp.csr_matrix((self.n_x + 1, self.size))
+        eps = 1e-6 / size
+        plus = self.cycle_jacobian(u + eps * direction)
+        minus = self.cycle_jacobian(u - eps * direction)
+        self.cycle_u(u)
+        return (plus - minus) / (2.0 * eps)
+
+    # -- the test matrix A ------------------------------------------------------------------------
+    def _test_matrix(self, J: sp.csr_matrix, kappa: float) -> sp.csr_matrix:
+        n, n_x, n_coll = self.n, self.n_x, self.n_coll
+        eye = sp.identity(n, format="csr")
+        if self.kind is CycleBifurcation.LPC:
+            return J[:, :n_x + 1]
+        Jc = J[:n_coll, :n_x]
+        first = sp.hstack([eye, sp.csr_matrix((n, n_x - n))])
+        last = sp.hstack([sp.csr_matrix((n, n_x - n)), eye])
+        if self.kind is CycleBifurcation.PD:
+            return sp.vstack([Jc, first + last], format="csr")
+        zero_c = sp.csr_matrix((n_coll, n_x))
+        return sp.vstack([sp.hstack([Jc, zero_c]), sp.hstack([zero_c, Jc]),
+                          sp.hstack([-last, first]),  # continuity: V1(0) = V0(1)
+                          sp.hstack([first - 2.0 * kappa * last, last])],  # V0(0) - 2 kappa V0(1) + V1(1) = 0
+                         format="csr")
+
+    def _bordered(self, A: sp.csr_matrix):
+        M = sp.bmat([[A, sp.csr_matrix(self.B)], [sp.csr_matrix(self.C.T), None]], format="csc")
+        return splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+
+    def analyse(self, u: np.ndarray) -> dict:
+        """Cycle Jacobian, kernel vectors V, left vectors W and the 2x2 (or 1x1) G at u (memoised)."""
+        key = u.tobytes()
+        if self._memo is not None and self._memo[0] == key:
+            return self._memo[1]
+        J = self.cycle_jacobian(u)
+        A = self._test_matrix(J, self.kappa(u))
+        lu = self._bordered(A)
+        k, m = self.k, self.m
+        rhs = np.zeros((m + k, k))
+        rhs[m:, :] = np.eye(k)
+        right = lu.solve(rhs)
+        left = lu.solve(rhs, trans="T")
+        out = {"J": J, "V": right[:m], "G": right[m:], "W": left[:m], "GT": left[m:]}
+        self._memo = (key, out)
+        return out
+
+    def test_values(self, u: np.ndarray) -> np.ndarray:
+        G = self.analyse(u)["G"]
+        return np.array([G[i, j] for i, j in self.entries])
+
+    def _gradient(self, u: np.ndarray, i: int, j: int, data: dict) -> np.ndarray:
+        """d g_ij / du = -W_i^T A_u V_j."""
+        V, W = data["V"][:, j], data["W"][:, i]
+        n_x, n_coll = self.n_x, self.n_coll
+        grad = np.zeros(self.size)
+        if self.kind is CycleBifurcation.LPC:
+            d = np.zeros(self.size)
+            d[:n_x + 1] = V
+            grad -= W @ self._second(u, d)
+        elif self.kind is CycleBifurcation.PD:
+            d = np.zeros(self.size)
+            d[:n_x] = V
+            grad -= W[:n_coll] @ self._second(u, d)[:n_coll]
+        else:
+            for copy in range(2):
+                d = np.zeros(self.size)
+                d[:n_x] = V[copy * n_x:(copy + 1) * n_x]
+                grad -= W[copy * n_coll:(copy + 1) * n_coll] @ self._second(u, d)[:n_coll]
+            w_bc = W[2 * n_coll + self.n:]  # rows of V0(0) - 2 kappa V0(1) + V1(1)
+            grad[n_x + 3] = 2.0 * w_bc @ V[n_x - self.n:n_x]  # -w^T (dA/dkappa) v, dA/dkappa = -2 at V0(1)
+        return grad
+
+    # -- curve problem ------------------------------------------------------------------------------
+    def residual(self, u: np.ndarray) -> np.ndarray:
+        cycle = self.cycle.residual(self.cycle_u(u))
+        return np.concatenate([cycle, self.test_values(u)])
+
+    def jacobian(self, u: np.ndarray):
+        data = self.analyse(u)
+        rows = [self._gradient(u, i, j, data) for i, j in self.entries]
+        return sp.vstack([data["J"], sp.csr_matrix(np.array(rows))], format="csr")
+
+    def accept(self, u: np.ndarray) -> None:
+        self.cycle.accept(self.cycle_u(u))
+        self.update_borders(u)
+
+    def update_borders(self, u: np.ndarray, sweeps: int = 1) -> None:
+        for _ in range(sweeps):
+            data = self.analyse(u)
+            self.C = np.linalg.qr(data["V"])[0]
+            self.B = np.linalg.qr(data["W"])[0]
+            self._memo = None
+
+    def choose_entries(self, u: np.ndarray) -> None:
+        """NS: the two entries of G whose gradients, restricted to the cycle manifold, are the
+        best conditioned pair (G has four entries, two of them independent near the curve)."""
+        if self.k == 1:
+            return
+        data = self.analyse(u)
+        J = data["J"]
+        n_x = self.n_x
+        square = J[:, :n_x + 1].tocsc()
+        lu = splu(square, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+        null = np.zeros((self.size, 3))
+        for c, col in enumerate((n_x + 1, n_x + 2, n_x + 3)):  # p1, p2, kappa directions on the manifold
+            null[col, c] = 1.0
+            rhs = -J[:, col].toarray().ravel()
+            null[:n_x + 1, c] = lu.solve(rhs)
+        grads = {(i, j): self._gradient(u, i, j, data) @ null for i in range(2) for j in range(2)}
+        best, best_value = self.entries, -1.0
+        keys = list(grads)
+        for a in range(4):
+            for b in range(a + 1, 4):
+                R = np.vstack([grads[keys[a]], grads[keys[b]]])
+                R = R / np.maximum(np.linalg.norm(R, axis=1, keepdims=True), 1e-300)
+                value = np.linalg.svd(R, compute_uv=False)[-1]
+                if value > best_value:
+                    best, best_value = [keys[a], keys[b]], value
+        self.entries = best
+        self._memo = None
+
+    # -- results --------------------------------------------------------------------------------------
+    def multipliers(self, u: np.ndarray) -> np.ndarray:
+        return self.cycle.multipliers(self.cycle_u(u))
+
+    def extremes(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        _, x = self.cycle.sample(self.cycle_u(u))
+        return x.max(axis=0), x.min(axis=0)
+
+    def rebuilt(self, mesh: Mesh) -> "CycleCurveProblem":
+        other = CycleCurveProblem(self.system, self.kind, mesh, self.cycle.scale, self.cycle.T_scale, self.p_scale,
+                                  float(self.weights[-1]) if self.kind is CycleBifurcation.NS else 1.0)
+        other.entries = list(self.entries)
+        return other
+
+    def transfer(self, other: "CycleCurveProblem", u: np.ndarray) -> np.ndarray:
+        """A point (or tangent) of this problem on ``other``'s mesh."""
+        head = self.cycle.transfer(other.cycle, u[:self.n_x + 2])
+        return np.concatenate([head, u[self.n_x + 2:]])
+
+    def transfer_borders(self, other: "CycleCurveProblem") -> None:
+        """Kernel vectors carried over by interpolation; left vectors found again by two sweeps."""
+        def nodes(V):
+            return np.column_stack([self.cycle.evaluate(V[:, c].reshape(self.mesh.n_nodes, self.n),
+                                                        other.mesh.node_times).ravel() for c in range(V.shape[1])])
+        if self.kind is CycleBifurcation.LPC:
+            C = np.vstack([nodes(self.C[:self.n_x]), self.C[self.n_x:]])
+        elif self.kind is CycleBifurcation.PD:
+            C = nodes(self.C)
+        else:
+            C = np.vstack([nodes(self.C[:self.n_x]), nodes(self.C[self.n_x:])])
+        other.C = np.linalg.qr(C)[0]
+
+
+# --------------------------------------------------------------------------- tracing a curve
+
+
+def _crossing_counts(mu: np.ndarray, exclude: list[int]) -> tuple[int, int, int]:
+    """Nontrivial multipliers outside the unit circle, by kind, leaving out the critical ones:
+    (real positive, real negative, complex)."""
+    keep = np.ones(mu.size, bool)
+    keep[exclude] = False
+    rest = mu[keep]
+    outside = rest[np.abs(rest) > 1.0]
+    real = np.abs(outside.imag) <= COMPLEX_TOL * np.abs(outside)
+    return int((real & (outside.real > 0)).sum()), int((real & (outside.real < 0)).sum()), int((~real).sum())
+
+
+def _critical(kind: CycleBifurcation, mu: np.ndarray, kappa: float) -> list[int]:
+    """Indices of the trivial multiplier (0) and of those the curve's condition holds at."""
+    rest = np.arange(1, mu.size)
+    if kind is CycleBifurcation.LPC:
+        return [0, int(rest[np.argmin(np.abs(mu[1:] - 1.0))])]
+    if kind is CycleBifurcation.PD:
+        return [0, int(rest[np.argmin(np.abs(mu[1:] + 1.0))])]
+    target = kappa + 1j * math.sqrt(max(0.0, 1.0 - kappa ** 2))
+    d = np.minimum(np.abs(mu[1:] - target), np.abs(mu[1:] - np.conj(target)))
+    order = rest[np.argsort(d, kind="stable")]
+    return [0, int(order[0]), int(order[1])]
+
+
+def _monitors(problem: CycleCurveProblem, point: CurvePoint, mu: np.ndarray, reference_direction) -> dict:
+    """Test functions of the codimension-2 points of this curve type at a point."""
+    kind = problem.kind
+    kappa = problem.kappa(point.u)
+    out: dict[str, float] = {}
+    rp, rn, cx = _crossing_counts(mu, _critical(kind, mu, kappa))
+    if kind is CycleBifurcation.LPC:
+        t_p = point.tangent[problem.n_x + 1:problem.n_x + 3] * np.sqrt(problem.weights[problem.n_x + 1:problem.n_x + 3])
+        out["CPC"] = float(t_p @ reference_direction) if reference_direction is not None else 1.0
+        out["LPNS"], out["LPPD"] = cx, rn
+    elif kind is CycleBifurcation.PD:
+        out["LPPD"], out["PDNS"], out["R2"] = rp, cx, rn
+    else:
+        for name, value in RESONANCES.items():
+            out[name] = kappa - value
+        out["LPNS"], out["PDNS"] = rp, rn
+    return out
+
+
+_COUNTED = {"LPNS", "LPPD", "PDNS"}
+
+
+def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, start: tuple[np.ndarray, np.ndarray],
+                p2: float, box: tuple[tuple[float, float], tuple[float, float]], scale: np.ndarray,
+                p_scale: tuple[float, float], kappa: float | None = None, options: CycleCurveOptions | None = None,
+                ncol: int = 4, directions: tuple[int, ...] = (1, -1),
+                progress: Callable[[float], None] | None = None) -> CycleCurve:
+    """Continue a fold (LPC), period doubling (PD) or torus (NS) point of a cycle in (p1, p2).
+
+    ``start`` = (mesh points, cycle u = (x at the nodes, T, p1)): a located special point of a
+    one-parameter branch in p1 at ``p2`` (``PeriodicBranch.solutions`` at its index); for NS,
+    ``kappa`` = cos of the torus angle there. ``box`` bounds (p1, p2). Traced in both directions
+    (``directions``: +1 first increases p2); the two halves are joined into one curve.
+    """
+    kind = CycleBifurcation(kind)
+    options = options or CycleCurveOptions()
+    if kind is CycleBifurcation.NS and (kappa is None or not -1.0 < kappa < 1.0):
+        raise InvalidInputError("kappa", kappa, "cos of the torus angle, in (-1, 1)")
+    for name, (low, high) in zip(("p1 range", "p2 range"), box, strict=True):
+        if not (math.isfinite(low) and math.isfinite(high) and low < high):
+            raise InvalidInputError(name, (low, high), "finite bounds, low < high")
+    mesh_points, cu = start
+    mesh = Mesh(np.asarray(mesh_points, float), ncol)
+    problem = CycleCurveProblem(system, kind, mesh, scale, float(cu[-2]), np.asarray(p_scale, float),
+                                options.kappa_weight)
+    u0 = np.concatenate([cu, [p2]] + ([[kappa]] if kind is CycleBifurcation.NS else []))
+    problem.cycle.accept(problem.cycle_u(u0))
+    problem.update_borders(u0, sweeps=3)
+    problem.choose_entries(u0)
+    problem.update_borders(u0, sweeps=1)
+    copts = options.continuation
+    e2 = np.zeros(problem.size)
+    e2[problem.n_x + 2] = 1.0
+    first = step(problem, CurvePoint(u0, e2 / weighted_norm(e2, problem.weights)), 0.0, copts)
+    if first is None:
+        raise ConvergenceError(f"no {kind.value} point converged near the start (p = ({cu[-1]:g}, {p2:g}))")
+    halves, reasons, steps_total = [], [], 0
+    for direction in directions:
+        half_problem = problem if not halves else _fresh(problem, first.u)
+        t = first.tangent if first.tangent[problem.n_x + 2] * direction >= 0 else -first.tangent
+        rows, special, reason, steps, closed = _trace(half_problem, CurvePoint(first.u.copy(), t), box, options,
+                                                      progress)
+        halves.append((rows, special, closed))
+        reasons.append(reason)
+        steps_total += steps
+        if closed:
+            break
+    return _join(kind, halves, reasons, steps_total)
+
+
+def _fresh(problem: CycleCurveProblem, u: np.ndarray) -> CycleCurveProblem:
+    other = problem.rebuilt(problem.mesh)
+    other.B, other.C = problem.B.copy(), problem.C.copy()
+    other.cycle.accept(other.cycle_u(u))
+    other.update_borders(u, sweeps=2)
+    return other
+
+
+def _record(problem: CycleCurveProblem, rows: dict, point: CurvePoint) -> np.ndarray:
+    mu = problem.multipliers(point.u)
+    xmax, xmin = problem.extremes(point.u)
+    n_x = problem.n_x
+    rows["p"].append(point.u[n_x + 1:n_x + 3].copy())
+    rows["T"].append(float(point.u[n_x]))
+    rows["xmax"].append(xmax)
+    rows["xmin"].append(xmin)
+    rows["kappa"].append(problem.kappa(point.u))
+    rows["mu"].append(mu)
+    rows["solutions"].append((problem.mesh.points.copy(), point.u[:n_x + 2].copy()))
+    return mu
+
+
+def _amplitude(problem: CycleCurveProblem, xmax, xmin) -> float:
+    return float(np.max(0.5 * (np.asarray(xmax) - np.asarray(xmin)) / problem.cycle.scale))
+
+
+def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCurveOptions, progress):
+    copts = options.continuation
+    n_x = problem.n_x
+    rows: dict[str, list] = {k: [] for k in ("p", "T", "xmax", "xmin", "kappa", "mu", "solutions")}
+    problem.accept(start.u)
+    mu = _record(problem, rows, start)
+    tracer = Tracer(problem, start, copts)
+    special: list[SpecialPoint] = []
+
+    def p_direction(point):
+        t_p = point.tangent[n_x + 1:n_x + 3] * np.sqrt(problem.weights[n_x + 1:n_x + 3])
+        return t_p / max(np.linalg.norm(t_p), 1e-300)
+
+    reference = p_direction(start)
+    monitors = _monitors(problem, start, mu, reference)
+    amp_peak = _amplitude(problem, rows["xmax"][0], rows["xmin"][0])
+    amp_last = amp_peak
+    reason = f"step budget of {copts.max_steps} steps used"
+    closed = False
+    steps = 0
+    for steps in range(1, copts.max_steps + 1):  # noqa: B007
+        prev = tracer.point
+        adv = tracer.advance()
+        if adv is None:
+            reason = tracer.failed or "Newton failed"
+            break
+        new, h = adv
+        p_new = new.u[n_x + 1:n_x + 3]
+        outside = [(c, bound) for c in range(2) for bound in box[c]
+                   if (bound == box[c][0] and p_new[c] < bound) or (bound == box[c][1] and p_new[c] > bound)]
+        if outside:
+            c, bound = outside[0]
+            index = n_x + 1 + c
+            hit = locate(problem, prev, h, lambda q: q.u[index] - bound, prev.u[index] - bound,
+                         new.u[index] - bound, copts)
+            if hit is not None:
+                problem.accept(hit[0].u)
+                _record(problem, rows, hit[0])
+                special.append(SpecialPoint("EP", float(hit[0].u[n_x + 1]), len(rows["p"]) - 1,
+                                            {"p2": float(hit[0].u[n_x + 2])}))
+            reason = f"left the parameter box at p{c + 1} = {bound:g}"
+            break
+        if new.u[n_x] > options.period_max:
+            reason = f"period {new.u[n_x]:.4g} above the limit {options.period_max:.4g}"
+            break
+        if new.u[n_x] <= 0:
+            reason = "period became non-positive: the continuation left the curve"
+            break
+        kappa = problem.kappa(new.u)
+        if problem.kind is CycleBifurcation.NS and not -1.0 <= kappa <= 1.0:
+            reason = (f"kappa = {kappa:.4g} left [-1, 1] near p = ({p_new[0]:.6g}, {p_new[1]:.6g}): past a strong "
+                      "resonance the condition describes neutral saddle cycles, not tori")
+            break
+        mu = _record(problem, rows, new)
+        new_monitors = _monitors(problem, new, mu, reference)
+        special.extend(_codim2(problem, prev, new, h, monitors, new_monitors, reference, rows, copts))
+        monitors = new_monitors
+        reference = p_direction(new)
+        if problem.kind is CycleBifurcation.LPC:  # the cusp test at `new` against its own direction
+            monitors["CPC"] = _monitors(problem, new, mu, reference)["CPC"]
+        if progress is not None:
+            progress(min(1.0, steps / copts.max_steps))
+        if _closed(rows):
+            reason = "closed curve: returned to its first point"
+            closed = True
+            break
+        amp = _amplitude(problem, rows["xmax"][-1], rows["xmin"][-1])
+        amp_peak = max(amp_peak, amp)
+        if amp < options.amplitude_min * amp_peak and amp < amp_last:
+            reason = (f"amplitude shrank to zero near p = ({p_new[0]:.6g}, {p_new[1]:.6g}): the curve ends at a "
+                      "codimension-2 point of the equilibrium")
+            special.append(SpecialPoint("ZA", float(p_new[0]), len(rows["p"]) - 1,
+                                        {"p2": float(p_new[1]), "amplitude": amp}))
+            break
+        if amp < amp_last:
+            tracer.limit_step(max(0.7 * amp * h / max(amp_last - amp, 1e-300), copts.ds_min))
+        amp_last = amp
+        if options.adapt_every and steps % options.adapt_every == 0:
+            problem = _remesh(problem, tracer, copts)
+    return rows, special, reason, steps, closed
+
+
+def _remesh(problem: CycleCurveProblem, tracer: Tracer, copts: ContinuationOptions) -> CycleCurveProblem:
+    point = tracer.point
+    new_mesh = problem.cycle.adapted_mesh(problem.cycle_u(point.u))
+    other = problem.rebuilt(new_mesh)
+    u_t = problem.transfer(other, point.u)
+    t_t = problem.transfer(other, point.tangent)
+    problem.transfer_borders(other)
+    other.cycle.accept(other.cycle_u(u_t))
+    other.update_borders(u_t, sweeps=2)
+    t_t /= weighted_norm(t_t, other.weights)
+    fixed = step(other, CurvePoint(u_t, t_t), 0.0, copts)
+    if fixed is None:  # keep the old mesh
+        problem.cycle_u(point.u)
+        return problem
+    other.accept(fixed.u)
+    tracer.problem = other
+    tracer.point = CurvePoint(fixed.u, tangent(other, fixed.u, t_t))
+    return other
+
+
+def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: float, before: dict, after: dict,
+            reference, rows, copts) -> list[SpecialPoint]:
+    found = []
+    n_x = problem.n_x
+    for name, a in before.items():
+        b = after[name]
+        if name in _COUNTED:
+            if a == b:
+                continue
+            at = new  # a count: located at the nearer point of the step
+        else:
+            if not (np.isfinite(a) and np.isfinite(b)) or a * b > 0 or a == b:
+                continue
+            if name == "CPC":
+                def g(q):
+                    t_p = q.tangent[n_x + 1:n_x + 3] * np.sqrt(problem.weights[n_x + 1:n_x + 3])
+                    return float(t_p @ reference)
+            else:
+                def g(q, target=RESONANCES[name]):
+                    return problem.kappa(q.u) - target
+            hit = locate(problem, prev, h, g, a, b, copts)
+            at = hit[0] if hit is not None else new
+        mu = problem.multipliers(at.u)
+        data = {"p2": float(at.u[n_x + 2]), "period": float(at.u[n_x]),
+                "multipliers_abs": np.abs(mu[1:]).tolist()}
+        if problem.kind is CycleBifurcation.NS:
+            data["kappa"] = problem.kappa(at.u)
+        found.append(SpecialPoint(name, float(at.u[n_x + 1]), len(rows["p"]) - 1, data))
+    problem.cycle_u(new.u)
+    problem.accept(new.u)
+    return found
+
+
+def _closed(rows: dict) -> bool:
+    k = len(rows["p"])
+    if k < 8:
+        return False
+
+    def measure(i):
+        return np.concatenate([rows["p"][i], [rows["T"][i]], rows["xmax"][i]])
+
+    first, prev, last = measure(0), measure(k - 2), measure(k - 1)
+    span = np.ptp(np.array([measure(i) for i in range(k)]), axis=0)
+    span[span == 0] = 1.0
+    first, prev, last = first / span, prev / span, last / span
+    seg = last - prev
+    length = float(np.linalg.norm(seg))
+    if length == 0.0:
+        return False
+    far = max(float(np.linalg.norm(measure(i) / span - first)) for i in range(k))
+    if far < 5.0 * length:
+        return False
+    s = float(np.clip(np.dot(first - prev, seg) / length ** 2, 0.0, 1.0))
+    return float(np.linalg.norm(prev + s * seg - first)) < length / 3.0
+
+
+def _join(kind: CycleBifurcation, halves, reasons, steps) -> CycleCurve:
+    """One curve: the second half reversed, then the first (they share the start point)."""
+    parts = []
+    special: list[SpecialPoint] = []
+    offset = 0
+    ordered = [halves[1], halves[0]] if len(halves) == 2 else halves
+    for h_index, (rows, pts, _) in enumerate(ordered):
+        count = len(rows["p"])
+        if len(halves) == 2 and h_index == 0:
+            order = list(range(count - 1, 0, -1))  # reversed, without the shared start point
+            position = {i: k for k, i in enumerate(order)}
+            for s in pts:
+                special.append(SpecialPoint(s.kind, s.p, position.get(s.index, 0), s.data))
+        else:
+            order = list(range(count))
+            for s in pts:
+                special.append(SpecialPoint(s.kind, s.p, offset + s.index, s.data))
+        parts.append((rows, order))
+        offset += len(order)
+
+    def gather(key):
+        return [rows[key][i] for rows, order in parts for i in order]
+
+    mu = gather("mu")
+    special.sort(key=lambda s: s.index)
+    return CycleCurve(kind.value, np.array(gather("p")), np.array(gather("T")), np.array(gather("xmax")),
+                      np.array(gather("xmin")), np.array(gather("kappa"), float), np.array(mu), special, reasons,
+                      steps, gather("solutions"), closed=any(c for _, _, c in halves))

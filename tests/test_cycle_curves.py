@@ -1,0 +1,165 @@
+"""Two-parameter curves of cycle bifurcations and one-parameter detection, on textbook systems
+whose curves are known in closed form."""
+
+import math
+
+import numpy as np
+import pytest
+from textbook_systems import (TWO_PARAMETER_SYSTEMS, bautin, cusp_of_cycles, flip_two_parameter, fold_near_torus,
+                              torus_two_parameter)
+
+from shimmy.continuation import (CycleCurveProblem, InvalidInputError, Mesh, OrbitGuess, PeriodicOptions,
+                                 ContinuationOptions, cycle_curve, hopf_guess, periodic_branch)
+
+BOX = ((-2.0, 2.0), (-1.0, 1.0))
+
+
+def circle(mesh: Mesh, radius: float, n: int) -> np.ndarray:
+    tau = mesh.node_times
+    return np.column_stack([radius * np.cos(2 * np.pi * tau), radius * np.sin(2 * np.pi * tau)]
+                           + [0.0 * tau] * (n - 2))
+
+
+def start(mesh: Mesh, radius: float, n: int, p1: float) -> tuple[np.ndarray, np.ndarray]:
+    return mesh.points, np.concatenate([circle(mesh, radius, n).ravel(), [2 * np.pi, p1]])
+
+
+def kinds(curve, kind):
+    return [s for s in curve.special_points if s.kind == kind]
+
+
+@pytest.mark.parametrize("name", sorted(TWO_PARAMETER_SYSTEMS))
+def test_two_parameter_fields_have_exact_jacobians(name):
+    system = TWO_PARAMETER_SYSTEMS[name]()
+    rng = np.random.default_rng(1)
+    x, p = 0.7 * rng.standard_normal(system.n), np.array([0.3, -0.4])
+    eps = 1e-6
+    J = system.dfdx(x, p)
+    for j in range(system.n):
+        e = np.zeros(system.n)
+        e[j] = eps
+        np.testing.assert_allclose(J[:, j], (system.f(x + e, p) - system.f(x - e, p)) / (2 * eps), atol=1e-7)
+    dp = system.dfdp(x, p)
+    for k in range(2):
+        e = np.zeros(2)
+        e[k] = eps
+        np.testing.assert_allclose(dp[k], (system.f(x, p + e) - system.f(x, p - e)) / (2 * eps), atol=1e-7)
+    X = rng.standard_normal((system.n, 5))  # vectorised over columns
+    np.testing.assert_allclose(system.dfdx(X, p)[2], system.dfdx(X[:, 2], p), atol=1e-14)
+    np.testing.assert_allclose(system.dfdp(X, p)[:, :, 2], system.dfdp(X[:, 2], p), atol=1e-14)
+
+
+@pytest.mark.parametrize("kind,system,radius,p,kappa", [
+    ("LPC", bautin, math.sqrt(0.5), (-0.25, 1.0), None),
+    ("PD", flip_two_parameter, 1.0, (0.04, 0.2), None),
+    ("NS", torus_two_parameter, 1.0, (0.04, 0.2), 0.3),
+])
+def test_minimally_augmented_jacobian_matches_finite_differences(kind, system, radius, p, kappa):
+    """The bordered test functions' gradients (second derivatives along the kernel vectors)
+    against central differences of the residual, with the borders held fixed."""
+    system = system()
+    mesh = Mesh.uniform(8, 3)
+    problem = CycleCurveProblem(system, kind, mesh, np.ones(system.n), 2 * np.pi, np.ones(2))
+    u = np.concatenate([circle(mesh, radius, system.n).ravel(), [2 * np.pi, p[0], p[1]]]
+                       + ([[kappa]] if kind == "NS" else []))
+    problem.cycle.accept(problem.cycle_u(u))
+    problem.update_borders(u, sweeps=2)
+    rng = np.random.default_rng(7)
+    u = u + 1e-3 * rng.standard_normal(u.size)  # off the curve: the test functions are not zero
+    J = problem.jacobian(u).toarray()
+    B, C = problem.B.copy(), problem.C.copy()
+    for _ in range(3):
+        d = rng.standard_normal(u.size)
+        eps = 1e-6
+        problem.B, problem.C = B, C
+        fd = (problem.residual(u + eps * d) - problem.residual(u - eps * d)) / (2 * eps)
+        np.testing.assert_allclose(J @ d, fd, rtol=1e-5, atol=1e-6 * np.abs(fd).max())
+
+
+def test_fold_of_cycles_curve_of_the_bautin_normal_form():
+    """From the located LPC of a one-parameter branch to b1 = -b2^2 / 4, ending at GH (0, 0)."""
+    system = bautin()
+    options = PeriodicOptions(ntst=20, ncol=4)
+    guess, shape = hopf_guess(np.zeros(2), 0.0, 1.0, np.array([1.0, -1j]), Mesh.uniform(20, 4), 0.0)
+    branch = periodic_branch(system.at(1.0), guess, -1.0, 1.0, np.ones(2), 1.0, options, direction=shape)
+    lpc = [s for s in branch.special_points if s.kind == "LPC"]
+    assert len(lpc) == 1 and abs(lpc[0].p + 0.25) < 1e-8
+    curve = cycle_curve(system, "LPC", lpc[0].solution, 1.0, BOX, np.ones(2), (1.0, 1.0))
+    b1, b2 = curve.p[:, 0], curve.p[:, 1]
+    assert len(b1) > 10
+    np.testing.assert_allclose(b1, -b2 ** 2 / 4, atol=1e-8)
+    np.testing.assert_allclose(curve.period, 2 * np.pi, rtol=1e-9)
+    np.testing.assert_allclose(curve.x_max[:, 0], np.sqrt(b2 / 2), atol=1e-6)
+    ends = kinds(curve, "ZA")
+    assert len(ends) == 1 and abs(ends[0].p) < 1e-6 and abs(ends[0].data["p2"]) < 1e-3, curve.stop_reasons
+    assert any("amplitude shrank to zero" in r for r in curve.stop_reasons)
+    edge = kinds(curve, "EP")
+    assert len(edge) == 1 and edge[0].data["p2"] == pytest.approx(1.0, abs=1e-9)
+    assert edge[0].p == pytest.approx(-0.25, abs=1e-8)
+    mu = np.abs(curve.multipliers[:, 1])  # the fold's multiplier stays at 1 along the curve
+    np.testing.assert_allclose(mu[b2 > 0.05], 1.0, atol=1e-6)
+
+
+def test_cusp_of_cycles_is_located_on_the_fold_curve():
+    system = cusp_of_cycles()
+    s0 = 0.3
+    curve = cycle_curve(system, "LPC", start(Mesh.uniform(20, 4), math.sqrt(1 + s0), 2, -2 * s0 ** 3), 3 * s0 ** 2,
+                        ((-1.0, 1.0), (-1.0, 1.0)), np.ones(2), (1.0, 1.0))
+    s = curve.x_max[:, 0] ** 2 - 1.0
+    np.testing.assert_allclose(curve.p[:, 0], -2 * s ** 3, atol=1e-8)
+    np.testing.assert_allclose(curve.p[:, 1], 3 * s ** 2, atol=1e-8)
+    cusps = kinds(curve, "CPC")
+    assert len(cusps) == 1
+    assert abs(cusps[0].p) < 1e-8 and abs(cusps[0].data["p2"]) < 1e-6
+    assert len(kinds(curve, "EP")) == 2  # both halves leave the box at b2 = 1
+
+
+def test_torus_curve_with_its_strong_resonances():
+    """p1 = p2^2, kappa = cos(2 pi (0.3 + 0.1 p2)): R4 at p2 = -0.5, R3 at p2 = 1/3."""
+    system = torus_two_parameter()
+    curve = cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, ((-1.0, 2.0), (-1.0, 1.0)),
+                        np.ones(4), (1.0, 1.0), kappa=math.cos(0.6 * math.pi))
+    p1, p2 = curve.p[:, 0], curve.p[:, 1]
+    np.testing.assert_allclose(p1, p2 ** 2, atol=1e-8)
+    np.testing.assert_allclose(curve.kappa, np.cos(2 * np.pi * (0.3 + 0.1 * p2)), atol=1e-8)
+    assert p2.min() == pytest.approx(-1.0) and p2.max() == pytest.approx(1.0)
+    r3, r4 = kinds(curve, "R3"), kinds(curve, "R4")
+    assert len(r3) == 1 and r3[0].data["p2"] == pytest.approx(1 / 3, abs=1e-7)
+    assert len(r4) == 1 and r4[0].data["p2"] == pytest.approx(-0.5, abs=1e-7)
+    assert not kinds(curve, "R1") and not kinds(curve, "R2")
+    assert np.all(np.diff(p2) > 0)  # one curve, ordered along it
+
+
+def test_period_doubling_curve():
+    system = flip_two_parameter()
+    curve = cycle_curve(system, "PD", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, ((-1.0, 2.0), (-1.0, 1.0)),
+                        np.ones(4), (1.0, 1.0))
+    np.testing.assert_allclose(curve.p[:, 0], curve.p[:, 1] ** 2, atol=1e-8)
+    critical = np.min(np.abs(curve.multipliers[:, 1:] + 1.0), axis=1)
+    np.testing.assert_allclose(critical, 0.0, atol=1e-6)
+    assert len(kinds(curve, "EP")) == 2
+
+
+def test_a_torus_start_needs_kappa_in_range_and_the_box_its_order():
+    system = torus_two_parameter()
+    with pytest.raises(InvalidInputError, match="kappa"):
+        cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, BOX, np.ones(4), (1.0, 1.0),
+                    kappa=1.5)
+    with pytest.raises(InvalidInputError, match="p2 range"):
+        cycle_curve(system, "PD", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, ((-1, 1), (1, -1)), np.ones(4),
+                    (1.0, 1.0))
+
+
+@pytest.mark.parametrize("ds_max", [0.5, 2.0])
+def test_a_fold_and_two_torus_points_in_one_step_are_all_found(ds_max):
+    """Torus points 1e-3 and 2e-3 from a fold in p: one default step crosses all three; each is
+    typed and located (three multipliers leave the unit circle across the fold)."""
+    system = fold_near_torus(1e-3, second_gap=2e-3)
+    mesh = Mesh.uniform(20, 4)
+    guess = OrbitGuess(mesh, circle(mesh, math.sqrt(0.7), system.n), 2 * np.pi, -0.21)
+    options = PeriodicOptions(ntst=20, ncol=4, continuation=ContinuationOptions(ds_max=ds_max))
+    branch = periodic_branch(system, guess, -0.3, -0.2, np.ones(system.n), 1.0, options, p_direction=-1)
+    found = [(s.kind, s.p) for s in branch.special_points if s.kind != "EP"]
+    assert [k for k, _ in found] == ["LPC", "NS", "NS"], found
+    np.testing.assert_allclose([p for _, p in found], [-0.25, -0.249, -0.248], atol=1e-6)
+    assert len(branch.p) < 12  # the steps were not made small to find them
