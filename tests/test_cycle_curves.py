@@ -163,3 +163,24 @@ def test_a_fold_and_two_torus_points_in_one_step_are_all_found(ds_max):
     assert [k for k, _ in found] == ["LPC", "NS", "NS"], found
     np.testing.assert_allclose([p for _, p in found], [-0.25, -0.249, -0.248], atol=1e-6)
     assert len(branch.p) < 12  # the steps were not made small to find them
+
+
+def swapped(system):
+    """The same field with p1 and p2 exchanged."""
+    from shimmy.continuation import TwoParameterVectorField
+    return TwoParameterVectorField(system.n, lambda x, p: system.f(x, p[::-1]), lambda x, p: system.dfdx(x, p[::-1]),
+                                   lambda x, p: system.dfdp(x, p[::-1])[::-1], "swapped " + system.name)
+
+
+def test_turning_points_in_p2_and_crossings_of_marked_loads_are_located():
+    """With the torus system's parameters exchanged the curve is p2 = p1^2: a minimum of p2 at
+    p1 = 0 and crossings of p2 = 0.25 at p1 = +-0.5."""
+    system = swapped(torus_two_parameter())
+    curve = cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.3), 0.09, ((-1.0, 1.0), (-1.0, 2.0)),
+                        np.ones(4), (1.0, 1.0), kappa=math.cos(2 * math.pi * 0.33), p2_marks=(0.25,))
+    np.testing.assert_allclose(curve.p[:, 1], curve.p[:, 0] ** 2, atol=1e-8)
+    turns = kinds(curve, "P2_TURN")
+    assert len(turns) == 1 and turns[0].data["turn"] == "min"
+    assert abs(turns[0].p) < 1e-7 and abs(turns[0].data["p2"]) < 1e-7
+    marks = sorted(s.p for s in kinds(curve, "P2_MARK"))
+    np.testing.assert_allclose(marks, [-0.5, 0.5], atol=1e-8)

@@ -198,52 +198,109 @@ class CycleCurveProblem:
             cols.append(sp.csr_matrix((J.shape[0], 1)))
         return sp.hstack(cols, format="csr")
 
-    def _second(self, u: np.ndarray, direction: np.ndarray) -> sp.csr_matrix:
-        """d/de of the cycle Jacobian at u + e * direction (central difference)."""
+    def _row_jacobian(self, u: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """w^T (collocation rows of the cycle Jacobian) at u, straight from the blocks (no assembly)."""
+        cu = self.cycle_u(u)
+        mesh, n = self.mesh, self.n
+        blocks, F, Fp, T = self.cycle.collocation_blocks(cu)
+        W = w.reshape(mesh.ntst, mesh.ncol, n)
+        nodes = np.einsum("jka,jkalb->jlb", W, blocks)
+        row = np.zeros(self.size)
+        np.add.at(row[:self.n_x].reshape(mesh.n_nodes, n), mesh.node_index, nodes)
+        X, _, p1 = self.cycle.unpack(cu)
+        Xc, _ = self.cycle._at_collocation(X)
+        Fp2 = self.slice.dfdp2(Xc.reshape(-1, n).T, p1).T.reshape(Xc.shape)
+        weighted = W * mesh.h[:, None, None]
+        row[self.n_x] = -np.sum(weighted * F)
+        row[self.n_x + 1] = -T * np.sum(weighted * Fp)
+        row[self.n_x + 2] = -T * np.sum(weighted * Fp2)
+        return row
+
+    def _second(self, u: np.ndarray, direction: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """d/de of w^T (collocation rows of the cycle Jacobian) at u + e * direction: the row
+        w^T F_uu[direction, .] (central difference; the other rows of A do not depend on u)."""
         size = weighted_norm(direction, self.weights)
         if size == 0.0:
-            return sp.csr_matrix((self.n_x + 1, self.size))
+            return np.zeros(self.size)
         eps = 1e-6 / size
-        plus = self.cycle_jacobian(u + eps * direction)
-        minus = self.cycle_jacobian(u - eps * direction)
+        plus = self._row_jacobian(u + eps * direction, w)
+        minus = self._row_jacobian(u - eps * direction, w)
         self.cycle_u(u)
         return (plus - minus) / (2.0 * eps)
 
-    # -- the test matrix A ------------------------------------------------------------------------
-    def _test_matrix(self, J: sp.csr_matrix, kappa: float) -> sp.csr_matrix:
-        n, n_x, n_coll = self.n, self.n_x, self.n_coll
-        eye = sp.identity(n, format="csr")
+    # -- the bordered test matrix [[A, B], [C^T, 0]] ------------------------------------------------
+    def _structure(self) -> None:
+        """Row and column of every entry of the bordered matrix, in the order :meth:`_values`
+        produces them, and the slots of the CSC arrays they are summed into (built once per mesh)."""
+        n, n_x, n_coll, m, k = self.n, self.n_x, self.n_coll, self.m, self.k
+        cyc = self.cycle
+        a = np.arange(n)
+        rows, cols = [], []
+        copies = 2 if self.kind is CycleBifurcation.NS else 1
+        for c in range(copies):
+            rows.append(cyc._rows + c * n_coll)
+            cols.append(cyc._cols + c * n_x)
         if self.kind is CycleBifurcation.LPC:
-            return J[:, :n_x + 1]
-        Jc = J[:n_coll, :n_x]
-        first = sp.hstack([eye, sp.csr_matrix((n, n_x - n))])
-        last = sp.hstack([sp.csr_matrix((n, n_x - n)), eye])
-        if self.kind is CycleBifurcation.PD:
-            return sp.vstack([Jc, first + last], format="csr")
-        zero_c = sp.csr_matrix((n_coll, n_x))
-        return sp.vstack([sp.hstack([Jc, zero_c]), sp.hstack([zero_c, Jc]),
-                          sp.hstack([-last, first]),  # continuity: V1(0) = V0(1)
-                          sp.hstack([first - 2.0 * kappa * last, last])],  # V0(0) - 2 kappa V0(1) + V1(1) = 0
-                         format="csr")
+            idx = self.mesh.node_index[:, :, None] * n + a[None, None, :]
+            rows += [np.arange(n_coll), n_coll + a, n_coll + a, np.full(idx.size, n_coll + n)]
+            cols += [np.full(n_coll, n_x), a, n_x - n + a, idx.ravel()]
+        elif self.kind is CycleBifurcation.PD:
+            rows += [n_coll + a, n_coll + a]
+            cols += [a, n_x - n + a]
+        else:
+            cont, bc = 2 * n_coll + a, 2 * n_coll + n + a
+            rows += [cont, cont, bc, bc, bc]
+            cols += [n_x - n + a, n_x + a, a, n_x - n + a, 2 * n_x - n + a]
+        border_r, border_c = np.meshgrid(np.arange(m), np.arange(k), indexing="ij")
+        rows += [border_r.ravel(), m + border_c.ravel()]  # B, then C^T
+        cols += [m + border_c.ravel(), border_r.ravel()]
+        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        size = m + k
+        key = cols.astype(np.int64) * size + rows
+        unique, slot = np.unique(key, return_inverse=True)
+        self._slot, self._nnz = slot, unique.size
+        self._indices = (unique % size).astype(np.int32)
+        counts = np.bincount(unique // size, minlength=size)
+        self._indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
 
-    def _bordered(self, A: sp.csr_matrix):
-        M = sp.bmat([[A, sp.csr_matrix(self.B)], [sp.csr_matrix(self.C.T), None]], format="csc")
+    def _values(self, u: np.ndarray) -> np.ndarray:
+        cu = self.cycle_u(u)
+        n, mesh = self.n, self.mesh
+        blocks, F, _, T = self.cycle.collocation_blocks(cu)
+        parts = [blocks.ravel()] * (2 if self.kind is CycleBifurcation.NS else 1)
+        ones = np.ones(n)
+        if self.kind is CycleBifurcation.LPC:
+            coeff = np.einsum("j,k,kl,jkn->jln", mesh.h, self.cycle.basis.gauss[1], self.cycle.basis.L,
+                              self.cycle.reference_derivative)
+            parts += [(-mesh.h[:, None, None] * F).ravel(), ones, -ones, coeff.ravel()]
+        elif self.kind is CycleBifurcation.PD:
+            parts += [ones, ones]
+        else:
+            parts += [-ones, ones, ones, np.full(n, -2.0 * self.kappa(u)), ones]
+        parts += [self.B.ravel(), self.C.ravel()]
+        return np.concatenate(parts)
+
+    def _bordered(self, u: np.ndarray):
+        if not hasattr(self, "_slot"):
+            self._structure()
+        data = np.bincount(self._slot, weights=self._values(u), minlength=self._nnz)
+        size = self.m + self.k
+        M = sp.csc_matrix((data, self._indices, self._indptr), shape=(size, size))
         return splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
 
     def analyse(self, u: np.ndarray) -> dict:
-        """Cycle Jacobian, kernel vectors V, left vectors W and the 2x2 (or 1x1) G at u (memoised)."""
+        """Kernel vectors V, left vectors W and the 2x2 (or 1x1) G of the bordered test matrix at u
+        (memoised for the last u)."""
         key = u.tobytes()
         if self._memo is not None and self._memo[0] == key:
             return self._memo[1]
-        J = self.cycle_jacobian(u)
-        A = self._test_matrix(J, self.kappa(u))
-        lu = self._bordered(A)
+        lu = self._bordered(u)
         k, m = self.k, self.m
         rhs = np.zeros((m + k, k))
         rhs[m:, :] = np.eye(k)
         right = lu.solve(rhs)
         left = lu.solve(rhs, trans="T")
-        out = {"J": J, "V": right[:m], "G": right[m:], "W": left[:m], "GT": left[m:]}
+        out = {"V": right[:m], "G": right[m:], "W": left[:m], "GT": left[m:]}
         self._memo = (key, out)
         return out
 
@@ -259,16 +316,16 @@ class CycleCurveProblem:
         if self.kind is CycleBifurcation.LPC:
             d = np.zeros(self.size)
             d[:n_x + 1] = V
-            grad -= W @ self._second(u, d)
+            grad -= self._second(u, d, W[:n_coll])
         elif self.kind is CycleBifurcation.PD:
             d = np.zeros(self.size)
             d[:n_x] = V
-            grad -= W[:n_coll] @ self._second(u, d)[:n_coll]
+            grad -= self._second(u, d, W[:n_coll])
         else:
             for copy in range(2):
                 d = np.zeros(self.size)
                 d[:n_x] = V[copy * n_x:(copy + 1) * n_x]
-                grad -= W[copy * n_coll:(copy + 1) * n_coll] @ self._second(u, d)[:n_coll]
+                grad -= self._second(u, d, W[copy * n_coll:(copy + 1) * n_coll])
             w_bc = W[2 * n_coll + self.n:]  # rows of V0(0) - 2 kappa V0(1) + V1(1)
             grad[n_x + 3] = 2.0 * w_bc @ V[n_x - self.n:n_x]  # -w^T (dA/dkappa) v, dA/dkappa = -2 at V0(1)
         return grad
@@ -281,7 +338,7 @@ class CycleCurveProblem:
     def jacobian(self, u: np.ndarray):
         data = self.analyse(u)
         rows = [self._gradient(u, i, j, data) for i, j in self.entries]
-        return sp.vstack([data["J"], sp.csr_matrix(np.array(rows))], format="csr")
+        return sp.vstack([self.cycle_jacobian(u), sp.csr_matrix(np.array(rows))], format="csr")
 
     def accept(self, u: np.ndarray) -> None:
         self.cycle.accept(self.cycle_u(u))
@@ -300,7 +357,7 @@ class CycleCurveProblem:
         if self.k == 1:
             return
         data = self.analyse(u)
-        J = data["J"]
+        J = self.cycle_jacobian(u)
         n_x = self.n_x
         square = J[:, :n_x + 1].tocsc()
         lu = splu(square, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
@@ -407,14 +464,16 @@ _COUNTED = {"LPNS", "LPPD", "PDNS"}
 def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, start: tuple[np.ndarray, np.ndarray],
                 p2: float, box: tuple[tuple[float, float], tuple[float, float]], scale: np.ndarray,
                 p_scale: tuple[float, float], kappa: float | None = None, options: CycleCurveOptions | None = None,
-                ncol: int = 4, directions: tuple[int, ...] = (1, -1),
+                ncol: int = 4, directions: tuple[int, ...] = (1, -1), p2_marks: tuple[float, ...] = (),
                 progress: Callable[[float], None] | None = None) -> CycleCurve:
     """Continue a fold (LPC), period doubling (PD) or torus (NS) point of a cycle in (p1, p2).
 
     ``start`` = (mesh points, cycle u = (x at the nodes, T, p1)): a located special point of a
     one-parameter branch in p1 at ``p2`` (``PeriodicBranch.solutions`` at its index); for NS,
     ``kappa`` = cos of the torus angle there. ``box`` bounds (p1, p2). Traced in both directions
-    (``directions``: +1 first increases p2); the two halves are joined into one curve.
+    (``directions``: +1 first increases p2); the two halves are joined into one curve. Where the
+    curve turns in p2 a ``P2_TURN`` point is located, and where it crosses a value of ``p2_marks``
+    a ``P2_MARK`` point (both with the cycle's period and extremes).
     """
     kind = CycleBifurcation(kind)
     options = options or CycleCurveOptions()
@@ -443,7 +502,7 @@ def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, s
         half_problem = problem if not halves else _fresh(problem, first.u)
         t = first.tangent if first.tangent[problem.n_x + 2] * direction >= 0 else -first.tangent
         rows, special, reason, steps, closed = _trace(half_problem, CurvePoint(first.u.copy(), t), box, options,
-                                                      progress)
+                                                      tuple(p2_marks), progress)
         halves.append((rows, special, closed))
         reasons.append(reason)
         steps_total += steps
@@ -478,7 +537,7 @@ def _amplitude(problem: CycleCurveProblem, xmax, xmin) -> float:
     return float(np.max(0.5 * (np.asarray(xmax) - np.asarray(xmin)) / problem.cycle.scale))
 
 
-def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCurveOptions, progress):
+def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCurveOptions, marks, progress):
     copts = options.continuation
     n_x = problem.n_x
     rows: dict[str, list] = {k: [] for k in ("p", "T", "xmax", "xmin", "kappa", "mu", "solutions")}
@@ -532,6 +591,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
                       "resonance the condition describes neutral saddle cycles, not tori")
             break
         mu = _record(problem, rows, new)
+        special.extend(_p2_points(problem, prev, new, h, marks, rows, copts))
         new_monitors = _monitors(problem, new, mu, reference)
         special.extend(_codim2(problem, prev, new, h, monitors, new_monitors, reference, rows, copts))
         monitors = new_monitors
@@ -580,6 +640,37 @@ def _remesh(problem: CycleCurveProblem, tracer: Tracer, copts: ContinuationOptio
     return other
 
 
+def _located(problem: CycleCurveProblem, kind: str, at: CurvePoint, rows, extra=None) -> SpecialPoint:
+    n_x = problem.n_x
+    mu = problem.multipliers(at.u)
+    xmax, xmin = problem.extremes(at.u)
+    data = {"p2": float(at.u[n_x + 2]), "period": float(at.u[n_x]), "x_max": xmax.tolist(), "x_min": xmin.tolist(),
+            "multipliers_abs": np.abs(mu[1:]).tolist(), **(extra or {})}
+    if problem.kind is CycleBifurcation.NS:
+        data["kappa"] = problem.kappa(at.u)
+    return SpecialPoint(kind, float(at.u[n_x + 1]), len(rows["p"]) - 1, data)
+
+
+def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: float, marks, rows,
+               copts) -> list[SpecialPoint]:
+    """Turning points of the curve in p2 and its crossings of the marked p2 values in this step."""
+    i2 = problem.n_x + 2
+    found = []
+    if prev.tangent[i2] * new.tangent[i2] < 0:
+        hit = locate(problem, prev, h, lambda q: q.tangent[i2], prev.tangent[i2], new.tangent[i2], copts)
+        at = hit[0] if hit is not None else new
+        found.append(_located(problem, "P2_TURN", at, rows,
+                              {"turn": "max" if prev.tangent[i2] > 0 else "min", "located": hit is not None}))
+    for mark in marks:
+        a, b = prev.u[i2] - mark, new.u[i2] - mark
+        if a * b < 0 or b == 0.0:
+            hit = locate(problem, prev, h, lambda q, m=mark: q.u[i2] - m, a, b, copts)
+            if hit is not None:
+                found.append(_located(problem, "P2_MARK", hit[0], rows))
+    problem.cycle_u(new.u)
+    return found
+
+
 def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: float, before: dict, after: dict,
             reference, rows, copts) -> list[SpecialPoint]:
     found = []
@@ -602,14 +693,8 @@ def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: fl
                     return problem.kappa(q.u) - target
             hit = locate(problem, prev, h, g, a, b, copts)
             at = hit[0] if hit is not None else new
-        mu = problem.multipliers(at.u)
-        data = {"p2": float(at.u[n_x + 2]), "period": float(at.u[n_x]),
-                "multipliers_abs": np.abs(mu[1:]).tolist()}
-        if problem.kind is CycleBifurcation.NS:
-            data["kappa"] = problem.kappa(at.u)
-        found.append(SpecialPoint(name, float(at.u[n_x + 1]), len(rows["p"]) - 1, data))
+        found.append(_located(problem, name, at, rows))
     problem.cycle_u(new.u)
-    problem.accept(new.u)
     return found
 
 

@@ -12,8 +12,10 @@ are central differences of the analytic Jacobian along a, b and the parameters, 
 steps 1e-5 of the respective scales (relative error ~1e-10, far below Newton's needs:
 they only enter the Newton matrix, the residual is exact).
 
-Along the curve: the first Lyapunov coefficient l1 (:mod:`shimmy.continuation.lyapunov`) at every
-point when the field is smooth; a sign change is a generalised Hopf (Bautin) point,
+Along the curve: double-Hopf points (a second pair of eigenvalues crosses the imaginary axis)
+and zero-Hopf points (a real eigenvalue crosses zero), from sign changes of products of the
+other eigenvalues' real parts, located by the secant method; the first Lyapunov coefficient
+l1 (:mod:`shimmy.continuation.lyapunov`) at every point when the field is smooth; a sign change is a generalised Hopf (Bautin) point,
 located by the secant method on l1. omega falling to zero ends the curve (a
 Bogdanov-Takens point or a double zero eigenvalue). The curve also ends where it
 leaves the parameter box (end point located on the boundary), returns to its start
@@ -128,6 +130,8 @@ class HopfCurve:
     steps: int
     closed: bool = False
     warnings: list[str] = field(default_factory=list)
+    double_hopf: list[dict] = field(default_factory=list)  # {"p", "omega", "omega2", "located"}
+    zero_hopf: list[dict] = field(default_factory=list)  # {"p", "omega", "located"}
 
 
 def hopf_start(x: np.ndarray, p: np.ndarray, J: np.ndarray) -> tuple[np.ndarray, float]:
@@ -176,6 +180,7 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
         for i in range(len(points) - 1):
             if np.isfinite(l1[i]) and np.isfinite(l1[i + 1]) and l1[i] * l1[i + 1] < 0:
                 gh.append(_locate_gh(problem, points[i], points[i + 1], l1[i], l1[i + 1], options))
+    double_hopf, zero_hopf = _other_crossings(problem, points, options)
     extrema = []
     for i in range(len(points) - 1):
         ta, tb = points[i].tangent[-1], points[i + 1].tangent[-1]
@@ -185,7 +190,60 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
             hit = locate(problem, points[i], h, lambda q: q.tangent[-1], ta, tb, options)
             at = hit[0] if hit is not None else points[i]
             extrema.append({"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n])})
-    return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, gh, extrema, reasons, steps, closed, warnings)
+    return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, gh, extrema, reasons, steps, closed, warnings,
+                     double_hopf, zero_hopf)
+
+
+def _other_eigenvalues(problem: HopfCurveProblem, u: np.ndarray) -> np.ndarray:
+    """Eigenvalues of f_x at a Hopf-curve point without the critical pair +-i omega."""
+    x, _, _, omega, p = problem.split(u)
+    ev = np.linalg.eigvals(problem.system.dfdx(x, p))
+    keep = np.ones(ev.size, bool)
+    for target in (1j * omega, -1j * omega):
+        d = np.where(keep, np.abs(ev - target), np.inf)
+        keep[int(np.argmin(d))] = False
+    return ev[keep]
+
+
+def _crossing_tests(problem: HopfCurveProblem, u: np.ndarray) -> tuple[float, float]:
+    """(double Hopf, zero Hopf) test functions: the products of tanh(Re lambda / |omega|) over the
+    other complex pairs (one of each) and over the real eigenvalues; each changes sign where one
+    of its eigenvalues crosses the imaginary axis."""
+    ev = _other_eigenvalues(problem, u)
+    omega = abs(float(problem.split(u)[3]))
+    scale = max(omega, 1e-12)
+    real = np.abs(ev.imag) <= 1e-9 * np.maximum(np.abs(ev), 1e-300)
+    pairs = ev[~real & (ev.imag > 0)]
+    hh = float(np.prod(np.tanh(pairs.real / scale))) if pairs.size else math.nan
+    zh = float(np.prod(np.tanh(ev[real].real / scale))) if real.any() else math.nan
+    return hh, zh
+
+
+def _other_crossings(problem: HopfCurveProblem, points: list[CurvePoint], options: ContinuationOptions):
+    """Double-Hopf (a second pair on the imaginary axis) and zero-Hopf (a zero eigenvalue) points
+    along the curve, each located by the secant method on its test function."""
+    tests = np.array([_crossing_tests(problem, q.u) for q in points])
+    n = problem.n
+    found: tuple[list[dict], list[dict]] = ([], [])
+    for which in (0, 1):
+        g = tests[:, which]
+        for i in range(len(points) - 1):
+            if not (np.isfinite(g[i]) and np.isfinite(g[i + 1]) and g[i] * g[i + 1] < 0):
+                continue
+            if np.dot(points[i].tangent, problem.weights * points[i + 1].tangent) <= 0:
+                continue  # the halves meet at the start: not a step along the curve
+            problem.accept(points[i].u)
+            h = weighted_norm(points[i + 1].u - points[i].u, problem.weights)
+            hit = locate(problem, points[i], h, lambda q, w=which: _crossing_tests(problem, q.u)[w], g[i], g[i + 1],
+                         options)
+            at = hit[0] if hit is not None else points[i + 1]
+            entry = {"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n]), "located": hit is not None}
+            if which == 0:
+                ev = _other_eigenvalues(problem, at.u)
+                pair = ev[ev.imag > 0]
+                entry["omega2"] = float(pair[np.argmin(np.abs(pair.real))].imag) if pair.size else math.nan
+            found[which].append(entry)
+    return found
 
 
 def _trace(problem: HopfCurveProblem, start: CurvePoint, box, options: ContinuationOptions, u0):

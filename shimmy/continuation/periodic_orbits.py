@@ -45,6 +45,7 @@ class PeriodicOptions:
     period_max: float = math.inf
     amplitude_min: float = 0.05  # end at x*: amplitude below this fraction of the first orbit's (Hopf starts)
     continuation: ContinuationOptions = field(default_factory=ContinuationOptions)
+    stop_at: tuple[str, ...] = ()  # kinds of special point at which to end the branch (e.g. the first LPC)
 
     def __post_init__(self):
         if not (isinstance(self.ntst, int) and 4 <= self.ntst <= 2000):
@@ -254,6 +255,10 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
             stop = f"amplitude returned to zero near p = {p_end:.6g}: the branch ends at a Hopf point"
             break
         special.extend(found)
+        wanted = [s.kind for s in found if s.kind in options.stop_at]
+        if wanted:
+            stop = f"stopped at the first {wanted[0]} point, as asked"
+            break
         if _closed(problem, rows):
             stop = "closed branch: the orbits returned to the first one (a loop of periodic orbits, traversed once)"
             break
