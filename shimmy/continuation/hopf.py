@@ -15,8 +15,8 @@ they only enter the Newton matrix, the residual is exact).
 Along the curve: double-Hopf points (a second pair of eigenvalues crosses the imaginary axis)
 and zero-Hopf points (a real eigenvalue crosses zero), from sign changes of products of the
 other eigenvalues' real parts, located by the secant method; the first Lyapunov coefficient
-l1 (:mod:`shimmy.continuation.lyapunov`) at every point when the field is smooth; a sign change is a generalised Hopf (Bautin) point,
-located by the secant method on l1. omega falling to zero ends the curve (a
+l1 (:mod:`shimmy.continuation.lyapunov`) at every point when the field is smooth; a sign
+change is a generalised Hopf (Bautin) point, located by the secant method on l1. omega falling to zero ends the curve (a
 Bogdanov-Takens point or a double zero eigenvalue). The curve also ends where it
 leaves the parameter box (end point located on the boundary), returns to its start
 (closed curve), or after the step budget.
