@@ -236,10 +236,23 @@ class PeriodicProblem:
         M = np.eye(n)
         for P in transfer:
             M = P @ M
-        mu = np.linalg.eigvals(M)
-        i = int(np.argmin(np.abs(mu - 1.0)))
+        mu, vectors = np.linalg.eig(M)
+        i = self._trivial(u, mu, vectors)
         rest = np.delete(mu, i)
         return np.concatenate([[mu[i]], rest[np.argsort(-np.abs(rest), kind="stable")]])
+
+    def _trivial(self, u: np.ndarray, mu: np.ndarray, vectors: np.ndarray) -> int:
+        """Index of the trivial multiplier: among those within 1e-3 of 1, the one whose eigenvector is
+        the orbit's tangent f(x(0)) (another multiplier passing through 1, at a fold or where a
+        fold curve meets a torus curve, must not be taken for it); else the one nearest to 1."""
+        near = np.abs(mu - 1.0) < 1e-3
+        if near.sum() < 2:
+            return int(np.argmin(np.abs(mu - 1.0)))
+        X, _, p = self.unpack(u)
+        f0 = self.system.f(X[0], p) / self.scale
+        V = vectors / self.scale[:, None]
+        align = np.abs(np.conj(V).T @ f0) / np.maximum(np.linalg.norm(V, axis=0) * np.linalg.norm(f0), 1e-300)
+        return int(np.argmax(np.where(near, align, -1.0)))
 
     def sample(self, u: np.ndarray, per_interval: int = 12) -> tuple[np.ndarray, np.ndarray]:
         """tau (k,) and x (k, n) on a fine grid (``per_interval`` points per mesh interval)."""

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Protocol
 
 import numpy as np
@@ -52,11 +52,14 @@ class ContinuationOptions:
     shrink: float = 0.5
     locate_tol: float = 1e-9
     max_locate: int = 30
+    #: Curvature control: a step whose tangent turns by more than this (rad, in the weighted
+    #: inner product) is refused and retried shorter; the step grows only below half of it.
+    max_angle: float = math.inf
 
     def __post_init__(self):
-        for name in ("ds", "ds_min", "ds_max", "tol", "residual_tol", "locate_tol"):
+        for name in ("ds", "ds_min", "ds_max", "tol", "residual_tol", "locate_tol", "max_angle"):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            if not (isinstance(value, (int, float)) and (math.isfinite(value) or name == "max_angle") and value > 0):
                 raise InvalidInputError(name, value, "a positive finite number")
         if not self.ds_min <= self.ds <= self.ds_max:
             raise InvalidInputError("ds", self.ds, f"[{self.ds_min:g}, {self.ds_max:g}]",
@@ -207,9 +210,10 @@ class Tracer:
         opts = self.options
         while True:
             new = step(self.problem, self.point, self.h, opts)
-            if new is not None:
+            angle = self._turn(new) if new is not None else 0.0
+            if new is not None and (angle <= opts.max_angle or self.h * opts.shrink < opts.ds_min):
                 taken = self.h
-                if new.iterations <= 4:
+                if new.iterations <= 4 and angle <= 0.5 * opts.max_angle:
                     self.h = min(self.h * opts.grow, opts.ds_max)
                 self.problem.accept(new.u)
                 self.point = new
@@ -219,6 +223,15 @@ class Tracer:
                 self.failed = (f"Newton did not converge with step {self.h / opts.shrink:.2g} "
                                f"(minimum {opts.ds_min:g})")
                 return None
+
+    def _turn(self, new: CurvePoint) -> float:
+        """Angle (rad) between the tangents before and after a step, in the weighted inner product."""
+        if not math.isfinite(self.options.max_angle):
+            return 0.0
+        w = self.problem.weights
+        c = float(np.sum(w * self.point.tangent * new.tangent))
+        c /= max(weighted_norm(self.point.tangent, w) * weighted_norm(new.tangent, w), 1e-300)
+        return math.acos(max(-1.0, min(1.0, c)))
 
     def advance_within(self, low: float, high: float, index: int = -1):
         """Like :meth:`advance`, keeping unknown ``index`` in [low, high].
@@ -275,6 +288,33 @@ def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[
             side = 1
         b, gb = h, gh
     return best
+
+
+def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Callable[[CurvePoint], float],
+                   g_a: float, g_b: float, options: ContinuationOptions, tolerance: float,
+                   splits: int = 6) -> tuple[CurvePoint, float] | None:
+    """Zero of g between two points of a curve, to |g| <= ``tolerance``: :func:`locate` from a;
+    where a trial step fails (a long step across a sharp bend), the step is halved on the curve
+    and the half that holds the sign change is searched, at most ``splits`` times."""
+    h = weighted_norm(b.u - a.u, problem.weights)
+    if options.locate_tol != tolerance:
+        options = replace(options, locate_tol=tolerance)
+    hit = locate(problem, a, h, g, g_a, g_b, options)
+    if hit is not None and abs(hit[1]) <= tolerance:
+        return hit
+    if splits == 0:
+        return None
+    mid = step(problem, a, 0.5 * h, options)
+    if mid is None:
+        return None
+    g_mid = g(mid)
+    if not math.isfinite(g_mid):
+        return None
+    if abs(g_mid) <= tolerance:
+        return mid, g_mid
+    if g_a * g_mid < 0:
+        return locate_between(problem, a, mid, g, g_a, g_mid, options, tolerance, splits - 1)
+    return locate_between(problem, mid, b, g, g_mid, g_b, options, tolerance, splits - 1)
 
 
 @dataclass(frozen=True)

@@ -53,9 +53,10 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
 from .collocation import Mesh, PeriodicProblem
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step, tangent,
-                   weighted_norm)
+from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate_between, step,
+                   tangent, weighted_norm)
 from .errors import ConvergenceError, InvalidInputError
+from .periodic_orbits import multiplier_crossing_test
 
 
 class CycleBifurcation(str, enum.Enum):
@@ -71,6 +72,11 @@ CODIM2_KINDS = {"LPC": ("CPC", "LPNS", "LPPD"), "PD": ("LPPD", "PDNS", "R2"),
                 "NS": ("R1", "R2", "R3", "R4", "LPNS", "PDNS")}
 RESONANCES = {"R1": 1.0, "R4": 0.0, "R3": -0.5, "R2": -1.0}  # kappa = cos(theta) at 1:k
 COMPLEX_TOL = 1e-7
+#: |test function| accepted at a located point: tangent slopes and kappa to 1e-8 (the tangent
+#: carries the finite-difference error of the Newton matrix, ~1e-10); ln |mu| to 1e-6 (the
+#: multipliers of a stiff cycle are accurate to ~1e-7)
+LOCATE_TOL = 1e-8
+MULTIPLIER_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -173,6 +179,7 @@ class CycleCurveProblem:
         self.C = np.linalg.qr(rng.standard_normal((self.m, self.k)))[0]
         self.entries: list[tuple[int, int]] = [(0, 0)] if self.k == 1 else [(0, 0), (1, 1)]
         self._memo: tuple[bytes, dict] | None = None
+        self._lu = None  # factors of the last bordered matrix factored
 
     # -- unknowns --------------------------------------------------------------------------
     def cycle_u(self, u: np.ndarray) -> np.ndarray:
@@ -280,26 +287,47 @@ class CycleCurveProblem:
         parts += [self.B.ravel(), self.C.ravel()]
         return np.concatenate(parts)
 
-    def _bordered(self, u: np.ndarray):
+    def _bordered(self, u: np.ndarray) -> sp.csc_matrix:
         if not hasattr(self, "_slot"):
             self._structure()
         data = np.bincount(self._slot, weights=self._values(u), minlength=self._nnz)
         size = self.m + self.k
-        M = sp.csc_matrix((data, self._indices, self._indptr), shape=(size, size))
-        return splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+        return sp.csc_matrix((data, self._indices, self._indptr), shape=(size, size))
+
+    def _solve(self, M: sp.csc_matrix, rhs: np.ndarray, trans: bool) -> np.ndarray | None:
+        """M^-1 rhs (or M^-T rhs) by iterative refinement on the last LU factors (those of a nearby
+        point: a Newton iterate, the previous point); None if it does not reach 1e-13."""
+        if self._lu is None:
+            return None
+        op = M.T if trans else M
+        mode = "T" if trans else "N"
+        z = self._lu.solve(rhs, trans=mode)
+        scale = max(float(np.abs(rhs).max()), 1e-300)
+        for _ in range(6):
+            r = rhs - op @ z
+            if float(np.abs(r).max()) <= 1e-13 * scale * max(1.0, float(np.abs(z).max())):
+                return z
+            z = z + self._lu.solve(r, trans=mode)
+        return None
 
     def analyse(self, u: np.ndarray) -> dict:
         """Kernel vectors V, left vectors W and the 2x2 (or 1x1) G of the bordered test matrix at u
-        (memoised for the last u)."""
+        (memoised for the last u). The bordered matrix is factored afresh only when refinement on
+        the last factors does not converge: most Newton iterates and trial points reuse them."""
         key = u.tobytes()
         if self._memo is not None and self._memo[0] == key:
             return self._memo[1]
-        lu = self._bordered(u)
+        M = self._bordered(u)
         k, m = self.k, self.m
         rhs = np.zeros((m + k, k))
         rhs[m:, :] = np.eye(k)
-        right = lu.solve(rhs)
-        left = lu.solve(rhs, trans="T")
+        right, left = self._solve(M, rhs, False), None
+        if right is not None:
+            left = self._solve(M, rhs, True)
+        if right is None or left is None:
+            self._lu = splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+            right = self._lu.solve(rhs)
+            left = self._lu.solve(rhs, trans="T")
         out = {"V": right[:m], "G": right[m:], "W": left[:m], "GT": left[m:]}
         self._memo = (key, out)
         return out
@@ -349,7 +377,7 @@ class CycleCurveProblem:
             data = self.analyse(u)
             self.C = np.linalg.qr(data["V"])[0]
             self.B = np.linalg.qr(data["W"])[0]
-            self._memo = None
+            self._memo = None  # the factors stay: refinement absorbs the change of borders
 
     def choose_entries(self, u: np.ndarray) -> None:
         """NS: the two entries of G whose gradients, restricted to the cycle manifold, are the
@@ -415,17 +443,6 @@ class CycleCurveProblem:
 # --------------------------------------------------------------------------- tracing a curve
 
 
-def _crossing_counts(mu: np.ndarray, exclude: list[int]) -> tuple[int, int, int]:
-    """Nontrivial multipliers outside the unit circle, by kind, leaving out the critical ones:
-    (real positive, real negative, complex)."""
-    keep = np.ones(mu.size, bool)
-    keep[exclude] = False
-    rest = mu[keep]
-    outside = rest[np.abs(rest) > 1.0]
-    real = np.abs(outside.imag) <= COMPLEX_TOL * np.abs(outside)
-    return int((real & (outside.real > 0)).sum()), int((real & (outside.real < 0)).sum()), int((~real).sum())
-
-
 def _critical(kind: CycleBifurcation, mu: np.ndarray, kappa: float) -> list[int]:
     """Indices of the trivial multiplier (0) and of those the curve's condition holds at."""
     rest = np.arange(1, mu.size)
@@ -444,21 +461,42 @@ def _monitors(problem: CycleCurveProblem, point: CurvePoint, mu: np.ndarray, ref
     kind = problem.kind
     kappa = problem.kappa(point.u)
     out: dict[str, float] = {}
-    rp, rn, cx = _crossing_counts(mu, _critical(kind, mu, kappa))
     if kind is CycleBifurcation.LPC:
         t_p = point.tangent[problem.n_x + 1:problem.n_x + 3] * np.sqrt(problem.weights[problem.n_x + 1:problem.n_x + 3])
         out["CPC"] = float(t_p @ reference_direction) if reference_direction is not None else 1.0
-        out["LPNS"], out["LPPD"] = cx, rn
-    elif kind is CycleBifurcation.PD:
-        out["LPPD"], out["PDNS"], out["R2"] = rp, cx, rn
-    else:
+    elif kind is CycleBifurcation.NS:
         for name, value in RESONANCES.items():
             out[name] = kappa - value
-        out["LPNS"], out["PDNS"] = rp, rn
+    for name, which in _CROSSINGS[kind.value].items():
+        out[name] = _crossing_value(problem, which, mu, kappa)
     return out
 
 
-_COUNTED = {"LPNS", "LPPD", "PDNS"}
+#: Codimension-2 points where a further multiplier crosses the unit circle: which kind of
+#: multiplier (real positive, real negative, complex) crosses, per curve type.
+_CROSSINGS = {"LPC": {"LPNS": "complex", "LPPD": "negative"},
+              "PD": {"LPPD": "positive", "PDNS": "complex", "R2": "negative"},
+              "NS": {"LPNS": "positive", "PDNS": "negative"}}
+
+
+def _crossing_value(problem: "CycleCurveProblem", which: str, mu: np.ndarray, kappa: float,
+                    guard: bool = True) -> float:
+    """(-1)^(noncritical multipliers of one kind outside the unit circle) times the smallest
+    |ln |mu|| among them (a complex pair counted once): continuous, zero exactly where one of
+    them is on the circle, and of the other sign after it crossed; multipliers far from the
+    circle (tiny ones flip between real kinds on rounding) do not change it. NaN where the
+    crossing multiplier is within the multipliers' accuracy (10 |mu_trivial - 1|, at least 1e-6)
+    of the circle: near a zero-amplitude end the cycle's radial multiplier tends to 1 and its
+    side is not resolved."""
+    keep = np.ones(mu.size, bool)
+    keep[_critical(problem.kind, mu, kappa)] = False
+    return multiplier_crossing_test(mu[keep], which, max(10.0 * abs(mu[0] - 1.0), 1e-6) if guard else 0.0)
+
+
+def _crossing_test(problem: "CycleCurveProblem", which: str) -> Callable[[CurvePoint], float]:
+    def g(q: CurvePoint) -> float:
+        return _crossing_value(problem, which, problem.multipliers(q.u), problem.kappa(q.u), guard=False)
+    return g
 
 
 def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, start: tuple[np.ndarray, np.ndarray],
@@ -570,8 +608,8 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         if outside:
             c, bound = outside[0]
             index = n_x + 1 + c
-            hit = locate(problem, prev, h, lambda q: q.u[index] - bound, prev.u[index] - bound,
-                         new.u[index] - bound, copts)
+            hit = locate_between(problem, prev, new, lambda q: q.u[index] - bound, prev.u[index] - bound,
+                                 new.u[index] - bound, copts, 1e-9 * problem.p_scale[c])
             if hit is not None:
                 problem.accept(hit[0].u)
                 _record(problem, rows, hit[0])
@@ -656,15 +694,21 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h:
     """Turning points of the curve in p2 and its crossings of the marked p2 values in this step."""
     i2 = problem.n_x + 2
     found = []
+
+    def slope(q):  # p2's share of the curve's direction in the parameter plane (scaled)
+        t_p = q.tangent[i2 - 1:i2 + 1] * np.sqrt(problem.weights[i2 - 1:i2 + 1])
+        return float(t_p[1] / max(np.linalg.norm(t_p), 1e-300))
+
     if prev.tangent[i2] * new.tangent[i2] < 0:
-        hit = locate(problem, prev, h, lambda q: q.tangent[i2], prev.tangent[i2], new.tangent[i2], copts)
+        hit = locate_between(problem, prev, new, slope, slope(prev), slope(new), copts, LOCATE_TOL)
         at = hit[0] if hit is not None else new
         found.append(_located(problem, "P2_TURN", at, rows,
                               {"turn": "max" if prev.tangent[i2] > 0 else "min", "located": hit is not None}))
     for mark in marks:
         a, b = prev.u[i2] - mark, new.u[i2] - mark
         if a * b < 0 or b == 0.0:
-            hit = locate(problem, prev, h, lambda q, m=mark: q.u[i2] - m, a, b, copts)
+            hit = locate_between(problem, prev, new, lambda q, m=mark: q.u[i2] - m, a, b, copts,
+                                 1e-9 * problem.p_scale[1])
             if hit is not None:
                 found.append(_located(problem, "P2_MARK", hit[0], rows))
     problem.cycle_u(new.u)
@@ -677,22 +721,20 @@ def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: fl
     n_x = problem.n_x
     for name, a in before.items():
         b = after[name]
-        if name in _COUNTED:
-            if a == b:
-                continue
-            at = new  # a count: located at the nearer point of the step
+        if not (np.isfinite(a) and np.isfinite(b)) or a * b > 0 or a == b:
+            continue
+        if name in _CROSSINGS[problem.kind.value]:
+            g = _crossing_test(problem, _CROSSINGS[problem.kind.value][name])
+        elif name == "CPC":
+            def g(q):
+                t_p = q.tangent[n_x + 1:n_x + 3] * np.sqrt(problem.weights[n_x + 1:n_x + 3])
+                return float(t_p @ reference)
         else:
-            if not (np.isfinite(a) and np.isfinite(b)) or a * b > 0 or a == b:
-                continue
-            if name == "CPC":
-                def g(q):
-                    t_p = q.tangent[n_x + 1:n_x + 3] * np.sqrt(problem.weights[n_x + 1:n_x + 3])
-                    return float(t_p @ reference)
-            else:
-                def g(q, target=RESONANCES[name]):
-                    return problem.kappa(q.u) - target
-            hit = locate(problem, prev, h, g, a, b, copts)
-            at = hit[0] if hit is not None else new
+            def g(q, target=RESONANCES[name]):
+                return problem.kappa(q.u) - target
+        hit = locate_between(problem, prev, new, g, a, b, copts,
+                             MULTIPLIER_TOL if name in _CROSSINGS[problem.kind.value] else LOCATE_TOL)
+        at = hit[0] if hit is not None else new
         found.append(_located(problem, name, at, rows))
     problem.cycle_u(new.u)
     return found

@@ -133,23 +133,31 @@ def _kind_of_crossing(mu_a: np.ndarray, mu_b: np.ndarray) -> str:
     return "BPC"
 
 
+def multiplier_crossing_test(mu: np.ndarray, which: str, accuracy: float = 0.0) -> float:
+    """Test function of a crossing of the unit circle by one multiplier of a kind
+    ("positive" / "negative" real, "complex", a pair counted once) among ``mu``:
+    (-1)^(how many of that kind lie outside) times the smallest |ln |mu|| among them.
+    Continuous, zero exactly when one of them is on the circle, of the other sign once it has
+    crossed; multipliers far from the circle (tiny ones flip between real kinds on rounding) do
+    not change it. NaN when there is none of that kind, or when the nearest is closer to the
+    circle than ``accuracy`` (its side is not resolved)."""
+    real = np.abs(mu.imag) <= COMPLEX_TOL * np.abs(mu)
+    sel = {"positive": mu[real & (mu.real > 0)], "negative": mu[real & (mu.real < 0)],
+           "complex": mu[~real & (mu.imag > 0)]}[which]
+    if sel.size == 0:
+        return math.nan
+    log_abs = np.log(np.maximum(np.abs(sel), 1e-300))
+    nearest = float(np.min(np.abs(log_abs)))
+    if nearest < accuracy:
+        return math.nan
+    return (-1.0) ** int((log_abs > 0).sum()) * nearest
+
+
 def _crossing_test(kind: str) -> Callable[[np.ndarray], float]:
-    """A test function that changes sign when one multiplier of ``kind`` crosses the unit circle:
-    the product of tanh(ln |mu|) over the multipliers of that kind (a complex pair counted
-    once). Continuous across the crossing even when another multiplier of the same kind lies
-    near the circle (the nearest one alone would jump from one to the other)."""
+    which = {"NS": "complex", "PD": "negative"}.get(kind, "positive")
+
     def g(mu: np.ndarray) -> float:
-        rest = mu[1:]
-        real = np.abs(rest.imag) <= COMPLEX_TOL * np.abs(rest)
-        if kind == "NS":
-            sel = rest[~real & (rest.imag > 0)]
-        elif kind == "PD":
-            sel = rest[real & (rest.real < 0)]
-        else:
-            sel = rest[real & (rest.real > 0)]
-        if sel.size == 0:
-            return math.nan
-        return float(np.prod(np.tanh(np.log(np.maximum(np.abs(sel), 1e-300)))))
+        return multiplier_crossing_test(mu[1:], which)
     return g
 
 
