@@ -1,5 +1,5 @@
-"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,bifurcation,hopf-curves,map,classify,metrics,study,
-devices,calibrate} ...``.
+"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,bifurcation,hopf-curves,curves,map,classify,metrics,
+study,devices,calibrate} ...``.
 
 Results go to stdout (JSON with ``--json``, a short table otherwise). Bad input exits
 with status 2 and a message on stderr naming the field, its value and what is allowed.
@@ -163,7 +163,9 @@ def _cmd_bifurcation(args) -> int:
     from .model.parameters import check_number
 
     ntst = int(check_number("ntst", args.ntst, 4, 2000, integer=True))
-    options = BifurcationOptions(ntst=ntst, exact_nes=args.exact_nes, seeds=not args.no_seeds)
+    ds_max = check_number("ds_max", args.ds_max, 1e-3, 10.0)
+    options = BifurcationOptions(ntst=ntst, ds=min(BifurcationOptions.ds, ds_max), ds_max=ds_max,
+                                 exact_nes=args.exact_nes, seeds=not args.no_seeds)
     bar = _ProgressBar()
     try:
         result = bifurcation(args.config, args.Fz, args.v_min, args.v_max, _params(args), options, progress=bar)
@@ -211,10 +213,52 @@ def _cmd_hopf_curves(args) -> int:
                      f"Fz {c.p[:, 1].min():.5g}..{c.p[:, 1].max():.5g} N, {'closed' if c.closed else 'open'}")
         for g in c.gh_points:
             lines.append(f"      GH  V = {g['p'][0]:.6g} m/s, Fz = {g['p'][1]:.6g} N")
+        for g in c.double_hopf:
+            lines.append(f"      HH  V = {g['p'][0]:.6g} m/s, Fz = {g['p'][1]:.6g} N "
+                         f"({g['omega'] / (2 * math.pi):.4g} and {g['omega2'] / (2 * math.pi):.4g} Hz)")
     if result.fz_minimum:
         lines.append(f"  lowest load on a Hopf curve: Fz = {result.fz_minimum['Fz']:.6g} N "
                      f"at V = {result.fz_minimum['V']:.6g} m/s")
     _emit(result.to_dict(), args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_curves(args) -> int:
+    from .analyses.cycle_curves import KEY_OF_KIND, KINDS, cycle_curves
+
+    kinds = tuple(k.strip().upper() for k in str(args.kinds).split(",") if k.strip())
+    for k in kinds:
+        if k not in KINDS:
+            raise InvalidParameterError("kinds", args.kinds, "comma-separated kinds among lpc, ns, pd",
+                                        f"names an unknown kind ({k.lower()})")
+    loads = tuple(_float_list("at_fz", args.at_fz)) if args.at_fz else ()
+    bar = _ProgressBar()
+    try:
+        result = cycle_curves(args.config, _params(args), (args.v_min, args.v_max), (args.fz_min, args.fz_max),
+                              kinds, loads, progress=bar)
+    finally:
+        bar.close()
+    data = result.to_dict()
+    lines = [f"{result.config.value}: cycle-bifurcation curves in V {result.v_range[0]:g}..{result.v_range[1]:g} m/s, "
+             f"Fz {result.fz_range[0]:g}..{result.fz_range[1]:g} N ({result.elapsed_s:.2f} s, "
+             f"{result.starts_tried} curve starts)"]
+    names = {"LPC": "fold", "NS": "torus", "PD": "period-doubling"}
+    for kind in kinds:
+        lines.append(f"  {names[kind]} curves: {len(data[KEY_OF_KIND[kind]])}")
+    for i, c in enumerate(data["curves"], start=1):
+        lines.append(f"  {i}. {names[c['kind']]} curve from {c['origin']}: {c['points']} points, Fz "
+                     f"{c['fz_min']['Fz']:.6g} N (V {c['fz_min']['V']:.5g}) .. {c['fz_max']['Fz']:.6g} N "
+                     f"(V {c['fz_max']['V']:.5g})")
+        for x in c["crossings"]:
+            lines.append(f"       at Fz = {x['Fz']:.6g} N: V = {x['V']:.6f} m/s, period {x['period']:.5g} s, "
+                         f"max |psi| {x['max_psi']:.4g} rad")
+        for e in c["stop_reasons"]:
+            lines.append(f"       end: {e}")
+    for p in data["codim2_points"]:
+        lines.append(f"  {p['kind']:<5} V = {p['V']:.6g} m/s, Fz = {p['Fz']:.6g} N")
+    for w in result.warnings:
+        lines.append(f"  warning: {w}")
+    _emit(data, args.json, "\n".join(lines))
     return 0
 
 
@@ -404,6 +448,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
     p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
     p.add_argument("--ntst", default=40, help="collocation mesh intervals")
+    p.add_argument("--ds-max", default=0.5, help="largest continuation step (scaled arclength)")
     p.add_argument("--no-seeds", action="store_true", help="do not look for branches by simulation")
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the branch points to FILE")
@@ -418,6 +463,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
     _add_common(p)
     p.set_defaults(func=_cmd_hopf_curves)
+
+    p = sub.add_parser("curves", help="fold, torus and period-doubling curves of cycles in (V, Fz)")
+    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--kinds", default="lpc,ns,pd", help="comma-separated: lpc, ns, pd")
+    p.add_argument("--v-min", default=1.0, help="lowest speed (m/s)")
+    p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
+    p.add_argument("--fz-min", default=FZ_RANGE[0], help="lowest load (N)")
+    p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
+    p.add_argument("--at-fz", default="", help="loads (N, comma-separated) where each curve's crossings are located")
+    _add_common(p)
+    p.set_defaults(func=_cmd_curves)
 
     def plane(p: argparse.ArgumentParser) -> None:
         p.add_argument("--v-min", default=1.0, help="lowest speed (m/s)")

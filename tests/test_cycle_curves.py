@@ -184,3 +184,37 @@ def test_turning_points_in_p2_and_crossings_of_marked_loads_are_located():
     assert abs(turns[0].p) < 1e-7 and abs(turns[0].data["p2"]) < 1e-7
     marks = sorted(s.p for s in kinds(curve, "P2_MARK"))
     np.testing.assert_allclose(marks, [-0.5, 0.5], atol=1e-8)
+
+
+def test_double_hopf_point_of_two_uncoupled_oscillators_is_located_on_the_hopf_curve():
+    """x' = (p1 + i) x - |x|^2 x, y' = (p2 + 2i) y - |y|^2 y (complex x, y): the Hopf curve p1 = 0 has
+    a double-Hopf point at p2 = 0 with frequencies 1 and 2."""
+    from shimmy.continuation import TwoParameterField, hopf_curve
+
+    def parts(z):
+        return z[0] + 1j * z[1], z[2] + 1j * z[3]
+
+    def f(z, p):
+        x, y = parts(z)
+        fx, fy = (p[0] + 1j) * x - abs(x) ** 2 * x, (p[1] + 2j) * y - abs(y) ** 2 * y
+        return np.array([fx.real, fx.imag, fy.real, fy.imag])
+
+    def block(a, w, u, v):  # Jacobian of (a + i w) z - |z|^2 z in (Re z, Im z)
+        return np.array([[a - 3 * u * u - v * v, -w - 2 * u * v], [w - 2 * u * v, a - u * u - 3 * v * v]])
+
+    def dfdx(z, p):
+        J = np.zeros((4, 4), dtype=np.result_type(z, float))
+        J[:2, :2] = block(p[0], 1.0, z[0], z[1])
+        J[2:, 2:] = block(p[1], 2.0, z[2], z[3])
+        return J
+
+    def dfdp(z, p):
+        return np.array([[z[0], 0.0], [z[1], 0.0], [0.0, z[2]], [0.0, z[3]]])
+
+    curve = hopf_curve(TwoParameterField(4, f, dfdx, dfdp), np.zeros(4), np.array([0.0, 0.5]), ((-1, 1), (-1, 1)),
+                       np.ones(4), np.ones(2))
+    np.testing.assert_allclose(curve.p[:, 0], 0.0, atol=1e-10)
+    assert len(curve.double_hopf) == 1
+    hh = curve.double_hopf[0]
+    assert abs(hh["p"][1]) < 1e-8 and hh["located"]
+    assert hh["omega"] == pytest.approx(1.0) and hh["omega2"] == pytest.approx(2.0)

@@ -79,3 +79,18 @@ def test_to_dict_and_bad_input():
         hopf_curves("nes", fz_range=(5e5, 1e5))
     d = hopf_curves("nes", v_range=(1, 200), fz_range=(1e5, 2e5), n_slices=3).to_dict()
     assert d["curves"] and {"V", "Fz", "frequency_hz", "lyapunov"} == set(d["curves"][0]["points"][0])
+
+
+def test_double_hopf_points_have_two_pairs_on_the_axis(original):
+    """Where the torsional and lateral Hopf curves cross: both pairs' real parts vanish."""
+    hh = original.double_hopf_points
+    assert len(hh) >= 2
+    model = build_model("original")
+    for point in hh:
+        ev = np.linalg.eigvals(model.jacobian(np.zeros(model.n_states), point["V"], point["Fz"]))
+        pairs = ev[ev.imag > 1.0]
+        near = np.sort(np.abs(pairs.real))[:2]
+        assert np.all(near < 1e-6 * np.abs(pairs.imag).max()), (point, ev)
+        freqs = sorted(np.abs(pairs[np.argsort(np.abs(pairs.real))[:2]].imag) / (2 * np.pi))
+        np.testing.assert_allclose(freqs, sorted([point["frequency_hz"], point["frequency2_hz"]]), rtol=1e-6)
+    assert "double_hopf_points" in original.to_dict()

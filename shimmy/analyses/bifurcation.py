@@ -385,11 +385,12 @@ def _on_branch(branches: list[Branch], V: float, period: float, psi_amp: float, 
 
 
 def periodic_orbit_from_simulation(config: Configuration, Fz: float, V: float, params: Parameters,
-                                   mesh: Mesh, t_end: float = SEED_T_END, exact_nes: bool = False):
-    """(guess, None) from a simulated settled periodic motion, or (None, reason)."""
+                                   mesh: Mesh, t_end: float = SEED_T_END, exact_nes: bool = False, x0=None):
+    """(guess, None) from a simulated settled periodic motion, or (None, reason). ``x0``: the
+    start state (default the standard start, psi = 0.001 rad)."""
     from .simulation import simulate  # analyses may use analyses; kept local to keep start-up light
 
-    run = simulate(config, V, Fz, params, t_end=t_end, exact_nes=exact_nes)
+    run = simulate(config, V, Fz, params, t_end=t_end, exact_nes=exact_nes, x0=x0)
     for _ in range(SEED_RETRIES):  # slow growth or decay: go on from where the run ended
         if not run.success or run.steady:
             break

@@ -56,6 +56,20 @@ class HopfCurvesResult:
         return [{"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi)}
                 for c in self.curves for g in c.gh_points]
 
+    @property
+    def double_hopf_points(self) -> list[dict[str, float]]:
+        """Points where a second pair of eigenvalues is on the imaginary axis (two Hopf curves
+        cross there); each listed once although it lies on two curves."""
+        out: list[dict[str, float]] = []
+        for c in self.curves:
+            for g in c.double_hopf:
+                entry = {"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi),
+                         "frequency2_hz": g["omega2"] / (2 * math.pi)}
+                if not any(abs(e["V"] - entry["V"]) <= 1e-5 * V_SCALE and abs(e["Fz"] - entry["Fz"]) <= 1e-5 * FZ_SCALE
+                           for e in out):
+                    out.append(entry)
+        return out
+
     def to_dict(self) -> dict[str, Any]:
         curves = []
         for c in self.curves:
@@ -66,10 +80,13 @@ class HopfCurvesResult:
                 "gh_points": [{"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi)}
                               for g in c.gh_points],
                 "fz_extrema": [{"V": e["p"][0], "Fz": e["p"][1]} for e in c.extrema],
+                "double_hopf_points": [{"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi),
+                                        "frequency2_hz": g["omega2"] / (2 * math.pi)} for g in c.double_hopf],
+                "zero_hopf_points": [{"V": g["p"][0], "Fz": g["p"][1]} for g in c.zero_hopf],
                 "closed": c.closed, "stop_reasons": c.stop_reasons, "steps": c.steps})
         return {"config": self.config.value, "params": self.params.to_dict(),
                 "v_range": list(self.v_range), "fz_range": list(self.fz_range), "curves": curves,
-                "gh_points": self.gh_points,
+                "gh_points": self.gh_points, "double_hopf_points": self.double_hopf_points,
                 "fz_minimum": self.fz_minimum, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
                 "version": __version__}
 

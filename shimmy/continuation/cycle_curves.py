@@ -611,6 +611,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
             hit = locate_between(problem, prev, new, lambda q: q.u[index] - bound, prev.u[index] - bound,
                                  new.u[index] - bound, copts, 1e-9 * problem.p_scale[c])
             if hit is not None:
+                special.extend(_p2_points(problem, prev, hit[0], marks, rows, copts))
                 problem.accept(hit[0].u)
                 _record(problem, rows, hit[0])
                 special.append(SpecialPoint("EP", float(hit[0].u[n_x + 1]), len(rows["p"]) - 1,
@@ -629,7 +630,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
                       "resonance the condition describes neutral saddle cycles, not tori")
             break
         mu = _record(problem, rows, new)
-        special.extend(_p2_points(problem, prev, new, h, marks, rows, copts))
+        special.extend(_p2_points(problem, prev, new, marks, rows, copts))
         new_monitors = _monitors(problem, new, mu, reference)
         special.extend(_codim2(problem, prev, new, h, monitors, new_monitors, reference, rows, copts))
         monitors = new_monitors
@@ -689,8 +690,7 @@ def _located(problem: CycleCurveProblem, kind: str, at: CurvePoint, rows, extra=
     return SpecialPoint(kind, float(at.u[n_x + 1]), len(rows["p"]) - 1, data)
 
 
-def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: float, marks, rows,
-               copts) -> list[SpecialPoint]:
+def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, marks, rows, copts) -> list[SpecialPoint]:
     """Turning points of the curve in p2 and its crossings of the marked p2 values in this step."""
     i2 = problem.n_x + 2
     found = []

@@ -185,9 +185,11 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
     for i in range(len(points) - 1):
         ta, tb = points[i].tangent[-1], points[i + 1].tangent[-1]
         if ta * tb < 0 and np.dot(points[i].tangent, problem.weights * points[i + 1].tangent) > 0:
-            problem.accept(points[i].u)
-            h = weighted_norm(points[i + 1].u - points[i].u, problem.weights)
-            hit = locate(problem, points[i], h, lambda q: q.tangent[-1], ta, tb, options)
+            a = _toward(problem, points[i], points[i + 1])
+            problem.accept(a.u)
+            h = weighted_norm(points[i + 1].u - a.u, problem.weights)
+            sign = 1.0 if a.tangent[-1] == ta else -1.0  # the test along the step's direction
+            hit = locate(problem, a, h, lambda q: q.tangent[-1], sign * ta, sign * tb, options)
             at = hit[0] if hit is not None else points[i]
             extrema.append({"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n])})
     return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, gh, extrema, reasons, steps, closed, warnings,
@@ -230,12 +232,10 @@ def _other_crossings(problem: HopfCurveProblem, points: list[CurvePoint], option
         for i in range(len(points) - 1):
             if not (np.isfinite(g[i]) and np.isfinite(g[i + 1]) and g[i] * g[i + 1] < 0):
                 continue
-            if np.dot(points[i].tangent, problem.weights * points[i + 1].tangent) <= 0:
-                continue  # the halves meet at the start: not a step along the curve
-            problem.accept(points[i].u)
-            h = weighted_norm(points[i + 1].u - points[i].u, problem.weights)
-            hit = locate(problem, points[i], h, lambda q, w=which: _crossing_tests(problem, q.u)[w], g[i], g[i + 1],
-                         options)
+            a = _toward(problem, points[i], points[i + 1])
+            problem.accept(a.u)
+            h = weighted_norm(points[i + 1].u - a.u, problem.weights)
+            hit = locate(problem, a, h, lambda q, w=which: _crossing_tests(problem, q.u)[w], g[i], g[i + 1], options)
             at = hit[0] if hit is not None else points[i + 1]
             entry = {"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n]), "located": hit is not None}
             if which == 0:
@@ -282,8 +282,17 @@ def _trace(problem: HopfCurveProblem, start: CurvePoint, box, options: Continuat
     return points, reason, options.max_steps, False
 
 
+def _toward(problem: HopfCurveProblem, a: CurvePoint, b: CurvePoint) -> CurvePoint:
+    """``a`` with its tangent pointing to ``b`` (the curve's first half is stored reversed, its
+    tangents pointing away from the next point)."""
+    if np.dot(a.tangent, problem.weights * (b.u - a.u)) >= 0:
+        return a
+    return CurvePoint(a.u, -a.tangent, a.iterations)
+
+
 def _locate_gh(problem: HopfCurveProblem, a: CurvePoint, b: CurvePoint, la: float, lb: float,
                options: ContinuationOptions) -> dict:
+    a = _toward(problem, a, b)
     problem.accept(a.u)
     h = weighted_norm(b.u - a.u, problem.weights)
     hit = locate(problem, a, h, lambda q: problem.lyapunov(q.u), la, lb, options)

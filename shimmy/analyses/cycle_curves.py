@@ -1,0 +1,353 @@
+"""The gear's curves of cycle bifurcations in (V, Fz): every fold-of-cycles (LPC), torus (NS) and
+period-doubling (PD) curve of a configuration in a box, each continued to its ends.
+
+Found without being told where to look, from four kinds of start, each a located special point
+of a one-parameter branch in V at some load:
+
+1. generalised Hopf (GH) points of the Hopf curves (a fold curve is born there): the branch from
+   the Hopf point just beside the GH point, on either side, stopped at its first LPC;
+2. double-Hopf points (a torus curve is born there): the branches from both Hopf points just
+   beside it, stopped at their first NS point;
+3. one-parameter diagrams on a few loads (every LPC, NS and PD point of every branch);
+4. cycles from large-amplitude starts (psi = 0.2 rad, l_g delta = 0.1 m) on a few loads and
+   speeds, where no Hopf point feeds them (isolas between two folds): their branches' points.
+
+A start that lies on a curve already continued is skipped, so each curve is continued once
+(:func:`shimmy.continuation.cycle_curve`: minimally augmented systems on the collocation mesh
+of the one-parameter branch, so its points agree with the one-parameter points to the
+location tolerance). Along each curve: its crossings of requested loads, its turning points
+in Fz and its codimension-2 points, located.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from .. import __version__
+from ..continuation import (ContinuationOptions, CycleCurve, CycleCurveOptions, Mesh, SpecialPoint,
+                            TwoParameterVectorField, cycle_curve, hopf_guess, periodic_branch)
+from ..continuation.errors import ContinuationError
+from ..errors import InvalidParameterError
+from ..model.configurations import Configuration
+from ..model.equations import build_model, jacobian, parameter_jacobian, rhs
+from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
+from .bifurcation import (STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation, gear_field,
+                          periodic_orbit_from_simulation)
+from .hopf_curves import hopf_curves
+from .stability import hopf_points
+
+KINDS = ("LPC", "NS", "PD")
+KEY_OF_KIND = {"LPC": "fold_curves", "NS": "torus_curves", "PD": "pd_curves"}
+FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 kN
+CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=1.0, max_steps=400,
+                                                                   max_angle=0.2))
+BESIDE = 0.015  # relative offset in Fz from a GH / double-Hopf point to the Hopf point a start branch leaves
+START_STEPS = 80  # step budget of a start branch
+LARGE_STARTS = (("psi", 0.2), ("lateral", 0.1))  # rad; m of l_g delta
+SEED_SPEEDS = (30.0, 80.0)  # m/s of the large-amplitude starts
+SCAN_FRACTIONS = (0.3, 0.6, 0.9)  # loads of the one-parameter diagrams, as fractions of the box in Fz
+
+
+def gear_cycle_field(config: Configuration, params: Parameters) -> TwoParameterVectorField:
+    """The gear's vector field in (V, Fz), vectorised over columns, analytic derivatives."""
+    model = build_model(config, params)
+    return TwoParameterVectorField(model.n_states, lambda x, p: rhs(model, x, p[0], p[1]),
+                                   lambda x, p: jacobian(model, x, p[0], p[1]),
+                                   lambda x, p: np.stack(parameter_jacobian(model, x, p[0], p[1])),
+                                   f"{config.value} in (V, Fz)")
+
+
+@dataclass
+class Start:
+    kind: str
+    point: SpecialPoint  # located on a branch in V, with its solution
+    Fz: float
+    ncol: int
+    origin: str
+
+
+@dataclass
+class GearCycleCurve:
+    kind: str
+    curve: CycleCurve
+    origin: str
+
+    def points(self, l_g: float) -> list[dict[str, float]]:
+        c = self.curve
+        psi = np.maximum(np.abs(c.x_max[:, 0]), np.abs(c.x_min[:, 0]))
+        lateral = l_g * np.maximum(np.abs(c.x_max[:, 2]), np.abs(c.x_min[:, 2]))
+        return [{"V": float(p[0]), "Fz": float(p[1]), "period": float(T), "max_psi": float(a),
+                 "max_lateral": float(b)} for p, T, a, b in zip(c.p, c.period, psi, lateral, strict=True)]
+
+
+def _located_point(s: SpecialPoint, l_g: float) -> dict[str, Any]:
+    out: dict[str, Any] = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
+    if "x_max" in s.data:
+        xmax, xmin = np.array(s.data["x_max"]), np.array(s.data["x_min"])
+        out.update({"period": s.data["period"], "max_psi": float(max(abs(xmax[0]), abs(xmin[0]))),
+                    "max_lateral": float(l_g * max(abs(xmax[2]), abs(xmin[2])))})
+    return out
+
+
+@dataclass
+class CycleCurvesResult:
+    config: Configuration
+    params: Parameters
+    v_range: tuple[float, float]
+    fz_range: tuple[float, float]
+    kinds: tuple[str, ...]
+    curves: list[GearCycleCurve]
+    gh_points: list[dict[str, float]]
+    double_hopf_points: list[dict[str, float]]
+    loads: tuple[float, ...]
+    elapsed_s: float
+    starts_tried: int
+    warnings: list[str] = field(default_factory=list)
+
+    def of_kind(self, kind: str) -> list[GearCycleCurve]:
+        return [c for c in self.curves if c.kind == kind]
+
+    def codim2_points(self) -> list[dict[str, Any]]:
+        """GH and double-Hopf points of the Hopf curves, and those located on the cycle curves
+        (one entry per point: the same point found on two curves is listed once)."""
+        out = [{"kind": "GH", "V": g["V"], "Fz": g["Fz"]} for g in self.gh_points]
+        out += [{"kind": "HH", "V": g["V"], "Fz": g["Fz"]} for g in self.double_hopf_points]
+        for c in self.curves:
+            for s in c.curve.special_points:
+                if s.kind in ("EP", "ZA", "P2_TURN", "P2_MARK"):
+                    continue
+                entry = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
+                if not any(e["kind"] == entry["kind"] and _close(e, entry, 1e-4) for e in out):
+                    out.append(entry)
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        l_g = self.params.gear.l_g
+        out: dict[str, Any] = {"config": self.config.value, "params": self.params.to_dict(),
+                               "v_range": list(self.v_range), "fz_range": list(self.fz_range),
+                               "kinds": list(self.kinds)}
+        for kind in KINDS:
+            out[KEY_OF_KIND[kind]] = [c.points(l_g) for c in self.of_kind(kind)] if kind in self.kinds else []
+        details = []
+        for c in self.curves:
+            special = c.curve.special_points
+            turns = [_located_point(s, l_g) | {"turn": s.data["turn"]} for s in special if s.kind == "P2_TURN"]
+            fz = c.curve.p[:, 1]
+            lowest = min([{"V": float(c.curve.p[int(np.argmin(fz)), 0]), "Fz": float(fz.min())}]
+                         + [t for t in turns if t["turn"] == "min"], key=lambda e: e["Fz"])
+            highest = max([{"V": float(c.curve.p[int(np.argmax(fz)), 0]), "Fz": float(fz.max())}]
+                          + [t for t in turns if t["turn"] == "max"], key=lambda e: e["Fz"])
+            details.append({
+                "kind": c.kind, "origin": c.origin, "points": len(c.curve.p), "closed": c.curve.closed,
+                "stop_reasons": c.curve.stop_reasons, "steps": c.curve.steps,
+                "fz_min": {"V": lowest["V"], "Fz": lowest["Fz"]}, "fz_max": {"V": highest["V"], "Fz": highest["Fz"]},
+                "turning_points": turns,
+                "crossings": sorted((_located_point(s, l_g) for s in special if s.kind == "P2_MARK"),
+                                    key=lambda e: (e["Fz"], e["V"])),
+                "ends": [_located_point(s, l_g) for s in special if s.kind in ("EP", "ZA")],
+                "codim2_points": [_located_point(s, l_g) for s in special
+                                  if s.kind not in ("EP", "ZA", "P2_TURN", "P2_MARK")],
+            })
+        out.update({"curves": details, "codim2_points": self.codim2_points(), "gh_points": self.gh_points,
+                    "double_hopf_points": self.double_hopf_points, "loads": list(self.loads),
+                    "starts_tried": self.starts_tried, "warnings": list(self.warnings),
+                    "elapsed_s": self.elapsed_s, "version": __version__,
+                    "method": "two-parameter continuation of each curve (minimally augmented systems with bordered "
+                              "test functions on the collocation mesh), started from GH and double-Hopf points, "
+                              "one-parameter diagrams and large-amplitude starts; points exact to the location "
+                              "tolerance (1e-9 in the defining equations)"})
+        return out
+
+
+def _close(a: dict, b: dict, tol: float) -> bool:
+    return abs(a["V"] - b["V"]) <= tol * V_SCALE and abs(a["Fz"] - b["Fz"]) <= tol * FZ_SCALE
+
+
+def cycle_curves(config: Configuration | str, params: Parameters | None = None,
+                 v_range: tuple[float, float] = (V_RANGE[0], 200.0), fz_range: tuple[float, float] = FZ_RANGE,
+                 kinds: tuple[str, ...] = KINDS, loads: tuple[float, ...] = (),
+                 progress: Callable[[float, str], None] | None = None) -> CycleCurvesResult:
+    """Every fold, torus and period-doubling curve of cycles in the box (m/s, N); ``loads``: the
+    loads (N) at which each curve's crossings are located and reported."""
+    clock = time.perf_counter()
+    config = Configuration.parse(config)
+    params = params if params is not None else Parameters()
+    v_lo, v_hi = check_range("v", v_range, V_RANGE, "m/s")
+    f_lo, f_hi = check_range("fz", fz_range, FZ_RANGE, "N")
+    kinds = tuple(kinds)
+    for k in kinds:
+        if k not in KINDS:
+            raise InvalidParameterError("kinds", k, ", ".join(KINDS), "is not a kind of cycle curve")
+    if not kinds:
+        raise InvalidParameterError("kinds", "", ", ".join(KINDS), "is empty")
+    loads = tuple(float(check_number(f"loads[{i}]", f, f_lo, f_hi, "N")) for i, f in enumerate(loads))
+    report = progress or (lambda fraction, message: None)
+    system = gear_cycle_field(config, params)
+    box = ((v_lo, v_hi), (f_lo, f_hi))
+    warnings: list[str] = []
+    model = build_model(config, params)
+
+    report(0.0, "Hopf curves and their GH and double-Hopf points")
+    hopf = hopf_curves(config, params, (v_lo, v_hi), (f_lo, f_hi))
+    gh = [{"V": g["p"][0], "Fz": g["p"][1]} for c in hopf.curves for g in c.gh_points]
+    hh: list[dict[str, float]] = []
+    for c in hopf.curves:
+        for g in c.double_hopf:
+            entry = {"V": g["p"][0], "Fz": g["p"][1], "omega": g["omega"], "omega2": g["omega2"]}
+            if not any(_close(entry, e, 1e-4) for e in hh):
+                hh.append(entry)
+
+    curves: list[GearCycleCurve] = []
+    tried = 0
+
+    def follow(start: Start) -> None:
+        nonlocal tried
+        if start.kind not in kinds or start.point.solution is None:
+            return
+        if any(_on_curve(c, start, params.gear.l_g) for c in curves if c.kind == start.kind):
+            return
+        tried += 1
+        kappa = math.cos(start.point.data["torus_angle"]) if start.kind == "NS" else None
+        if kappa is not None and not -1.0 < kappa < 1.0:
+            return
+        try:
+            curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box, STATE_SCALE[:system.n],
+                                (V_SCALE, FZ_SCALE), kappa=kappa, options=CURVE_OPTIONS, ncol=start.ncol,
+                                p2_marks=loads)
+        except ContinuationError as exc:
+            warnings.append(f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N "
+                            f"({start.origin}) not continued: {exc}")
+            return
+        curves.append(GearCycleCurve(start.kind, curve, start.origin))
+
+    codim2_starts = [(g, "LPC", f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+                     for g in gh] + [(g, "NS", f"beside the double-Hopf point at V = {g['V']:.5g} m/s, "
+                                         f"Fz = {g['Fz']:.6g} N") for g in hh]
+    for k, (point, kind, origin) in enumerate(codim2_starts):
+        report(0.1 + 0.3 * k / max(len(codim2_starts), 1), f"curves from codimension-2 points ({kind})")
+        if kind not in kinds:
+            continue
+        for start in _starts_beside(config, model, params, point, kind, (v_lo, v_hi), (f_lo, f_hi), origin):
+            follow(start)
+
+    scan = [f_lo + fr * (f_hi - f_lo) for fr in SCAN_FRACTIONS]
+    for k, Fz in enumerate(scan):
+        report(0.4 + 0.3 * k / len(scan), f"one-parameter diagram at Fz = {Fz / 1e3:.4g} kN")
+        try:
+            diagram = bifurcation(config, Fz, v_lo, v_hi, params, BifurcationOptions(mesh_check=False))
+        except ContinuationError as exc:
+            warnings.append(f"diagram at Fz = {Fz:.6g} N failed: {exc}")
+            continue
+        for branch in diagram.branches:
+            if branch.kind == "periodic" and branch.raw is not None:
+                for s in branch.raw.special_points:
+                    if s.kind in KINDS:
+                        follow(Start(s.kind, s, Fz, branch.raw.ncol, f"diagram at Fz = {Fz:.6g} N"))
+
+    for k, Fz in enumerate(scan):
+        report(0.7 + 0.3 * k / len(scan), f"large-amplitude starts at Fz = {Fz / 1e3:.4g} kN")
+        for start in _large_amplitude_starts(config, model, params, Fz, (v_lo, v_hi), warnings):
+            follow(start)
+    report(1.0, "done")
+    return CycleCurvesResult(config, params, (v_lo, v_hi), (f_lo, f_hi), kinds, curves, gh,
+                             [{"V": e["V"], "Fz": e["Fz"], "omega": e["omega"], "omega2": e["omega2"]} for e in hh],
+                             loads, time.perf_counter() - clock, tried, warnings)
+
+
+def _branch_options(stop_at: tuple[str, ...]):
+    options = BifurcationOptions(max_steps=START_STEPS).periodic()
+    from dataclasses import replace
+    return replace(options, stop_at=stop_at)
+
+
+def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin) -> list[Start]:
+    """LPC (beside GH) or NS (beside a double-Hopf point) points of the branches that leave the
+    Hopf points just above and below the codimension-2 point's load."""
+    out = []
+    n = model.n_states
+    scale = STATE_SCALE[:n]
+    options = _branch_options((kind,))
+    for side in (-1.0, 1.0):
+        Fz = point["Fz"] * (1.0 + side * BESIDE)
+        if not fz_range[0] <= Fz <= fz_range[1]:
+            continue
+        hopf = hopf_points(config, Fz, params, v_min=v_range[0], v_max=v_range[1]).hopf_points
+        near = sorted(hopf, key=lambda h: abs(math.log(h.V / point["V"])))[:2 if kind == "NS" else 1]
+        system = gear_field(model, Fz)
+        for h in near:
+            if abs(math.log(h.V / point["V"])) > 0.2:
+                continue
+            A = jacobian(model, np.zeros(n), h.V, Fz)
+            ev, vecs = np.linalg.eig(A)
+            i = int(np.argmin(np.abs(ev.real - 0.0) + np.abs(ev.imag - h.omega)))
+            q = vecs[:, i] / vecs[np.argmax(np.abs(vecs[:, i] / scale)), i]
+            guess, shape = hopf_guess(np.zeros(n), h.V, ev[i].imag, q, Mesh.uniform(options.ntst, options.ncol), 0.0)
+            try:
+                raw = periodic_branch(system, guess, v_range[0], v_range[1], scale, V_SCALE, options, direction=shape,
+                                      limits=_limits(model))
+            except ContinuationError:
+                continue
+            out += [Start(s.kind, s, Fz, raw.ncol, origin) for s in raw.special_points if s.kind == kind]
+    return out
+
+
+def _large_amplitude_starts(config, model, params, Fz, v_range, warnings) -> list[Start]:
+    """Special points of the branches through cycles reached from large torsional and lateral starts."""
+    out = []
+    n = model.n_states
+    options = BifurcationOptions().periodic()
+    system = gear_field(model, Fz)
+    for V in SEED_SPEEDS:
+        if not v_range[0] < V < v_range[1]:
+            continue
+        for what, size in LARGE_STARTS:
+            x0 = np.zeros(n)
+            if what == "psi":
+                x0[0] = size
+            else:
+                x0[2] = size / params.gear.l_g
+            guess, reason = periodic_orbit_from_simulation(config, Fz, V, params,
+                                                           Mesh.uniform(options.ntst, options.ncol), x0=x0)
+            if guess is None:
+                continue
+            for direction in (-1, 1):
+                try:
+                    raw = periodic_branch(system, guess, v_range[0], v_range[1], STATE_SCALE[:n], V_SCALE, options,
+                                          p_direction=direction, limits=_limits(model))
+                except ContinuationError as exc:
+                    warnings.append(f"large {what} start at V = {V:g} m/s, Fz = {Fz:.6g} N: {exc}")
+                    break
+                out += [Start(s.kind, s, Fz, raw.ncol, f"large {what} start at V = {V:g} m/s, Fz = {Fz:.6g} N")
+                        for s in raw.special_points if s.kind in KINDS]
+                if raw.stop_reason.startswith("closed branch"):
+                    break
+    return out
+
+
+def _on_curve(curve: GearCycleCurve, start: Start, l_g: float) -> bool:
+    """Whether a start point lies on a continued curve: within a fifth of the local step of its
+    polyline in (V, Fz) (scaled) with a torsional and lateral amplitude within 5 %."""
+    c = curve.curve
+    p = c.p / np.array([V_SCALE, FZ_SCALE])
+    q = np.array([start.point.p / V_SCALE, start.Fz / FZ_SCALE])
+    if len(p) < 2:
+        return False
+    a, b = p[:-1], p[1:]
+    d = b - a
+    length2 = np.maximum(np.sum(d * d, axis=1), 1e-300)
+    s = np.clip(np.sum((q - a) * d, axis=1) / length2, 0.0, 1.0)
+    dist = np.linalg.norm(a + s[:, None] * d - q, axis=1)
+    i = int(np.argmin(dist))
+    if dist[i] > 0.2 * math.sqrt(length2[i]) + 1e-6:
+        return False
+    amp = 0.5 * (c.x_max - c.x_min)
+    here = amp[i] + s[i] * (amp[i + 1] - amp[i])
+    xmax, xmin = np.array(start.point.data["x_max"]), np.array(start.point.data["x_min"])
+    theirs = 0.5 * (xmax - xmin)
+    scale = STATE_SCALE[:len(theirs)]
+    return bool(np.max(np.abs(here - theirs) / scale) <= 0.05 * max(np.max(np.abs(theirs) / scale), 1e-12))
