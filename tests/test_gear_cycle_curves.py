@@ -1,0 +1,99 @@
+"""The gear's fold and torus curves in (V, Fz) against one-parameter diagrams, simulation and the
+Hopf curves' codimension-2 points."""
+
+import json
+
+import numpy as np
+import pytest
+
+from shimmy.analyses.bifurcation import BifurcationOptions, bifurcation
+from shimmy.analyses.cycle_curves import cycle_curves
+from shimmy.analyses.simulation import simulate
+from shimmy.cli import main
+from shimmy.errors import InvalidParameterError
+
+LOADS = (450e3, 650e3, 850e3)
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def original():
+    return cycle_curves("original", loads=LOADS)
+
+
+def crossings(result, kind, Fz):
+    return sorted(x["V"] for c in result.to_dict()["curves"] if c["kind"] == kind for x in c["crossings"]
+                  if abs(x["Fz"] - Fz) < 1e-3)
+
+
+@pytest.mark.parametrize("Fz", LOADS[:2])
+def test_every_fold_and_torus_point_of_a_diagram_lies_on_a_continued_curve(original, Fz):
+    diagram = bifurcation("original", Fz)
+    found = [(s["kind"], s["V"]) for b in diagram.branches if b.kind == "periodic" for s in b.special_points
+             if s["kind"] in ("LPC", "NS")]
+    assert found
+    for kind, V in found:
+        on = crossings(original, kind, Fz)
+        assert on and min(abs(v - V) for v in on) < 1e-6, (kind, V, on)
+
+
+def test_the_torus_point_next_to_the_fold_at_450_kN_is_found_with_default_options():
+    diagram = bifurcation("original", 450e3, options=BifurcationOptions())
+    points = [(s["kind"], s["V"]) for b in diagram.branches for s in b.special_points]
+    ns = [V for k, V in points if k == "NS" and V > 100]
+    lpc = [V for k, V in points if k == "LPC" and V > 100]
+    assert len(ns) == 1 and len(lpc) == 1
+    assert 0.5 < lpc[0] - ns[0] < 5.0  # ~2 m/s below the fold
+
+
+def test_the_isola_above_720_kN_is_bounded_by_two_fold_curves(original):
+    """At 850 kN the torsional cycles live between two folds; a run from psi = 0.2 rad at 50 m/s
+    settles on one of them, whose speed lies between the two fold crossings."""
+    folds = crossings(original, "LPC", 850e3)
+    assert len(folds) == 2, folds
+    low, high = folds
+    assert low < 50.0 < high
+    run = simulate("original", 50.0, 850e3, t_end=60, x0=[0.2, 0, 0, 0, 0])
+    assert run.amplitude["psi"] > 0.1  # a large torsional cycle, not the lateral one
+    run_out = simulate("original", 1.05 * high, 850e3, t_end=60, x0=[0.2, 0, 0, 0, 0])
+    assert run_out.amplitude["psi"] < 0.05  # past the upper fold the torsional cycle is gone
+
+
+def test_fold_and_torus_curves_end_at_the_hopf_curves_codimension_2_points(original):
+    """Each curve that shrinks to zero amplitude ends at a GH point (fold curves) or a double-Hopf
+    point (torus curves) of the Hopf curves."""
+    data = original.to_dict()
+    gh, hh = data["gh_points"], data["double_hopf_points"]
+    assert len(gh) == 2 and len(hh) == 2
+    ended = 0
+    for c in data["curves"]:
+        targets = gh if c["kind"] == "LPC" else hh
+        for end in c["ends"]:
+            if end["kind"] != "ZA":
+                continue
+            ended += 1
+            assert min(abs(end["V"] - t["V"]) / 10 + abs(end["Fz"] - t["Fz"]) / 1e5 for t in targets) < 2e-3, end
+    assert ended >= 4
+    kinds = {p["kind"] for p in data["codim2_points"]}
+    assert {"GH", "HH", "LPNS"} <= kinds
+
+
+def test_curves_in_the_json_shape_the_command_line_promises(original, capsys):
+    data = original.to_dict()
+    assert data["fold_curves"] and data["torus_curves"] and data["pd_curves"] == []
+    for curve in data["fold_curves"] + data["torus_curves"]:
+        assert set(curve[0]) == {"V", "Fz", "period", "max_psi", "max_lateral"}
+        Fz = np.array([p["Fz"] for p in curve])
+        assert np.all((Fz >= 10e3 - 1e-6) & (Fz <= 900e3 + 1e-6))
+    assert all(set(p) == {"kind", "V", "Fz"} for p in data["codim2_points"])
+    json.dumps(data)
+    assert main(["curves", "--config", "original", "--kinds", "lpc,foo"]) == 2
+    assert "unknown kind (foo)" in capsys.readouterr().err
+
+
+def test_bad_requests_name_the_field():
+    with pytest.raises(InvalidParameterError, match="kinds"):
+        cycle_curves("original", kinds=("LPC", "XX"))
+    with pytest.raises(InvalidParameterError, match=r"loads\[0\]"):
+        cycle_curves("original", loads=(5e6,))
