@@ -186,11 +186,15 @@ def test_fold_of_cycles_bounds_a_bistable_speed_range():
     assert len(folds) == 1
     v_fold = folds[0]["V"]
     assert upper.V < v_fold < 200.0
-    # Stable before the fold, unstable after it on the way back to the subcritical Hopf point.
+    # Stable up to the torus point ~2 m/s below the fold, unstable from there over the fold and on
+    # the way back to the subcritical Hopf point.
     raw = b.raw
     k = int(np.argmax(raw.p))
     assert raw.p[k] == pytest.approx(v_fold, abs=0.5)
-    assert raw.stable[k - 3] and not raw.stable[k + 3]
+    torus = [s["V"] for s in b.special_points if s["kind"] == "NS" and s["V"] > upper.V]
+    assert len(torus) == 1 and 0.5 < v_fold - torus[0] < 5.0
+    before = int(np.argmin(np.abs(raw.p[:k] - (torus[0] - 1.0))))
+    assert raw.stable[before] and not raw.stable[k] and not raw.stable[k + 3]
     V = 0.5 * (upper.V + v_fold)
     torsional = cycle_at(result, 1, V)
     lateral = cycle_at(result, 2, V)

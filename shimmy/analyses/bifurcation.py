@@ -37,7 +37,7 @@ from __future__ import annotations
 import csv
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace, field
 from typing import Any, Callable
 
 import numpy as np
@@ -79,6 +79,7 @@ class BifurcationOptions:
     seeds: bool = True
     mesh_check: bool = True
     exact_nes: bool = False
+    max_angle: float = 0.2  # rad: the tangent turns at most this much per step (curvature control)
 
     def __post_init__(self):
         try:  # the engine validates the mesh; the gear's callers see the gear's error class
@@ -88,11 +89,13 @@ class BifurcationOptions:
         check_number("ds", self.ds, 1e-6, 1.0)
         check_number("ds_max", self.ds_max, self.ds, 10.0)
         check_number("max_steps", self.max_steps, 1, 100_000, integer=True)
+        check_number("max_angle", self.max_angle, 0.01, 3.2, "rad")
 
     def periodic(self) -> PeriodicOptions:
         return PeriodicOptions(ntst=self.ntst, ncol=self.ncol, period_max=PERIOD_MAX,
                                continuation=ContinuationOptions(ds=self.ds, ds_max=self.ds_max,
-                                                                max_steps=int(self.max_steps)))
+                                                                max_steps=int(self.max_steps),
+                                                                max_angle=self.max_angle))
 
 
 def gear_field(model: Model, Fz: float) -> VectorField:
@@ -252,7 +255,7 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
                 branches.append(seeded)
 
     report(0.97, "maximum torsional amplitude")
-    max_psi, max_v, max_any, mesh_check = _maximum(system, branches, options, scale, warnings)
+    max_psi, max_v, max_any, mesh_check = _maximum(system, branches, options, scale, warnings, params.gear.l_g)
     report(1.0, "done")
     return BifurcationResult(config, Fz, v_min, v_max, params, hopf, branches, max_psi, max_v, max_any,
                              mesh_check, options, time.perf_counter() - clock, warnings)
@@ -524,7 +527,29 @@ def cycle_at(result: BifurcationResult, branch: int, V: float, max_psi: float | 
     raise ValueError(f"branch {branch} does not reach V = {V:g} m/s")
 
 
-def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale, warnings):
+def _draw_located(branches: list[Branch], raw: PeriodicBranch, problem: PeriodicProblem, point: CurvePoint,
+                  psi_amp: float, l_g: float) -> None:
+    """Put the located maximum among the drawn points of its branch (between the drawn points that
+    bracket it), so that the plotted curve peaks where the reported maximum is."""
+    for k, b in enumerate(branches):
+        if b.raw is not raw:
+            continue
+        V = float(point.u[-1])
+        near = int(np.argmin(np.abs(b.V - V) / V_SCALE + np.abs(b.max_psi - psi_amp) / STATE_SCALE[0]))
+        j = next((m for m in (near - 1, near) if 0 <= m < len(b.V) - 1
+                  and min(b.V[m], b.V[m + 1]) <= V <= max(b.V[m], b.V[m + 1])), None)
+        if j is None:
+            return
+        _, x = problem.sample(point.u)
+        branches[k] = replace(b, V=np.insert(b.V, j + 1, V), period=np.insert(b.period, j + 1, float(point.u[-2])),
+                              max_psi=np.insert(b.max_psi, j + 1, psi_amp),
+                              max_lateral=np.insert(b.max_lateral, j + 1, l_g * float(np.abs(x[:, 2]).max())),
+                              stable=np.insert(b.stable, j + 1, True),
+                              mode=b.mode[:j + 1] + [b.mode[j]] + b.mode[j + 1:])
+        return
+
+
+def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale, warnings, l_g: float):
     """Largest torsional amplitude of stable cycles, refined along the branch, and a mesh check."""
     best = (0.0, None, None, None)  # amplitude, V, branch, index into its raw points
     max_any = 0.0
@@ -562,6 +587,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
         if point is not None and a_opt >= amp:
             amp, V = a_opt, float(point.u[-1])
             i_point = point
+            _draw_located(branches, raw, problem, point, a_opt, l_g)
         else:
             i_point = None
     else:
