@@ -36,16 +36,16 @@ from ..errors import InvalidParameterError
 from ..model.configurations import Configuration
 from ..model.equations import build_model, jacobian, parameter_jacobian, rhs
 from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
-from .bifurcation import (STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation, gear_field,
-                          periodic_orbit_from_simulation)
+from .bifurcation import (STATE_SCALE, V_SCALE, BifurcationOptions, _limits, _on_branch, _periodic_output,
+                          bifurcation, gear_field, periodic_orbit_from_simulation)
 from .hopf_curves import hopf_curves
 from .stability import hopf_points
 
 KINDS = ("LPC", "NS", "PD")
 KEY_OF_KIND = {"LPC": "fold_curves", "NS": "torus_curves", "PD": "pd_curves"}
 FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 kN
-CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=1.0, max_steps=400,
-                                                                   max_angle=0.2))
+CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400,
+                                                                   max_angle=0.3))
 BESIDE = 0.015  # relative offset in Fz from a GH / double-Hopf point to the Hopf point a start branch leaves
 START_STEPS = 80  # step budget of a start branch
 LARGE_STARTS = (("psi", 0.2), ("lateral", 0.1))  # rad; m of l_g delta
@@ -237,7 +237,7 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
 
     scan = [f_lo + fr * (f_hi - f_lo) for fr in SCAN_FRACTIONS]
     for k, Fz in enumerate(scan):
-        report(0.4 + 0.3 * k / len(scan), f"one-parameter diagram at Fz = {Fz / 1e3:.4g} kN")
+        report(0.4 + 0.6 * k / len(scan), f"one-parameter diagram and large-amplitude starts at Fz = {Fz / 1e3:.4g} kN")
         try:
             diagram = bifurcation(config, Fz, v_lo, v_hi, params, BifurcationOptions(mesh_check=False))
         except ContinuationError as exc:
@@ -248,10 +248,7 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
                 for s in branch.raw.special_points:
                     if s.kind in KINDS:
                         follow(Start(s.kind, s, Fz, branch.raw.ncol, f"diagram at Fz = {Fz:.6g} N"))
-
-    for k, Fz in enumerate(scan):
-        report(0.7 + 0.3 * k / len(scan), f"large-amplitude starts at Fz = {Fz / 1e3:.4g} kN")
-        for start in _large_amplitude_starts(config, model, params, Fz, (v_lo, v_hi), warnings):
+        for start in _large_amplitude_starts(config, model, params, Fz, (v_lo, v_hi), diagram.branches, warnings):
             follow(start)
     report(1.0, "done")
     return CycleCurvesResult(config, params, (v_lo, v_hi), (f_lo, f_hi), kinds, curves, gh,
@@ -296,12 +293,16 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
     return out
 
 
-def _large_amplitude_starts(config, model, params, Fz, v_range, warnings) -> list[Start]:
-    """Special points of the branches through cycles reached from large torsional and lateral starts."""
+def _large_amplitude_starts(config, model, params, Fz, v_range, branches, warnings) -> list[Start]:
+    """Special points of the branches through cycles reached from large torsional and lateral
+    starts, where those cycles are on none of ``branches`` (the diagram's at this load, and the
+    branches continued here)."""
     out = []
     n = model.n_states
     options = BifurcationOptions().periodic()
     system = gear_field(model, Fz)
+    known = list(branches)
+    l_g = params.gear.l_g
     for V in SEED_SPEEDS:
         if not v_range[0] < V < v_range[1]:
             continue
@@ -315,6 +316,9 @@ def _large_amplitude_starts(config, model, params, Fz, v_range, warnings) -> lis
                                                            Mesh.uniform(options.ntst, options.ncol), x0=x0)
             if guess is None:
                 continue
+            if _on_branch(known, V, guess.T, float(np.abs(guess.X[:, 0]).max()),
+                          float(l_g * np.abs(guess.X[:, 2]).max())):
+                continue
             for direction in (-1, 1):
                 try:
                     raw = periodic_branch(system, guess, v_range[0], v_range[1], STATE_SCALE[:n], V_SCALE, options,
@@ -324,6 +328,7 @@ def _large_amplitude_starts(config, model, params, Fz, v_range, warnings) -> lis
                     break
                 out += [Start(s.kind, s, Fz, raw.ncol, f"large {what} start at V = {V:g} m/s, Fz = {Fz:.6g} N")
                         for s in raw.special_points if s.kind in KINDS]
+                known.append(_periodic_output(raw, params, "large-amplitude start", []))
                 if raw.stop_reason.startswith("closed branch"):
                     break
     return out

@@ -258,10 +258,13 @@ class Tracer:
 
 
 def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[CurvePoint], float],
-           g_start: float, g_end: float, options: ContinuationOptions) -> tuple[CurvePoint, float] | None:
+           g_start: float, g_end: float, options: ContinuationOptions,
+           with_tangent: bool = True) -> tuple[CurvePoint, float] | None:
     """Zero of g between ``start`` (h = 0) and the point at step h_end (Illinois secant on h).
 
-    Returns (point, g at it), or None if a trial step fails to converge.
+    Returns (point, g at it), or None if a trial step fails to converge. ``with_tangent=False``
+    when g does not read the tangent: the trial points then carry the start's (one
+    factorisation fewer per trial).
     """
     a, b, ga, gb = 0.0, h_end, g_start, g_end
     best = None
@@ -270,10 +273,10 @@ def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[
         h = b - gb * (b - a) / (gb - ga) if gb != ga else 0.5 * (a + b)
         if not (min(a, b) < h < max(a, b)):
             h = 0.5 * (a + b)
-        trial = step(problem, start, h, options)
+        trial = step(problem, start, h, options, with_tangent)
         if trial is None:  # e.g. landed exactly on a singular point (a branch point): nudge off it
-            trial = step(problem, start, h * (1.0 + 1e-7), options) or step(problem, start, h * (1.0 - 1e-7),
-                                                                             options)
+            trial = step(problem, start, h * (1.0 + 1e-7), options, with_tangent) \
+                or step(problem, start, h * (1.0 - 1e-7), options, with_tangent)
         if trial is None:
             return best
         gh = g(trial)
@@ -292,14 +295,14 @@ def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[
 
 def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Callable[[CurvePoint], float],
                    g_a: float, g_b: float, options: ContinuationOptions, tolerance: float,
-                   splits: int = 6) -> tuple[CurvePoint, float] | None:
+                   splits: int = 6, with_tangent: bool = True) -> tuple[CurvePoint, float] | None:
     """Zero of g between two points of a curve, to |g| <= ``tolerance``: :func:`locate` from a;
     where a trial step fails (a long step across a sharp bend), the step is halved on the curve
     and the half that holds the sign change is searched, at most ``splits`` times."""
     h = weighted_norm(b.u - a.u, problem.weights)
     if options.locate_tol != tolerance:
         options = replace(options, locate_tol=tolerance)
-    hit = locate(problem, a, h, g, g_a, g_b, options)
+    hit = locate(problem, a, h, g, g_a, g_b, options, with_tangent)
     if hit is not None and abs(hit[1]) <= tolerance:
         return hit
     if splits == 0:
@@ -313,8 +316,8 @@ def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Calla
     if abs(g_mid) <= tolerance:
         return mid, g_mid
     if g_a * g_mid < 0:
-        return locate_between(problem, a, mid, g, g_a, g_mid, options, tolerance, splits - 1)
-    return locate_between(problem, mid, b, g, g_mid, g_b, options, tolerance, splits - 1)
+        return locate_between(problem, a, mid, g, g_a, g_mid, options, tolerance, splits - 1, with_tangent)
+    return locate_between(problem, mid, b, g, g_mid, g_b, options, tolerance, splits - 1, with_tangent)
 
 
 @dataclass(frozen=True)

@@ -296,7 +296,8 @@ class CycleCurveProblem:
 
     def _solve(self, M: sp.csc_matrix, rhs: np.ndarray, trans: bool) -> np.ndarray | None:
         """M^-1 rhs (or M^-T rhs) by iterative refinement on the last LU factors (those of a nearby
-        point: a Newton iterate, the previous point); None if it does not reach 1e-13."""
+        point: a Newton iterate, the previous point); None if the residual does not reach 1e-13
+        of the solution (a looser 1e-12 leaves the test functions noisy enough to slow Newton)."""
         if self._lu is None:
             return None
         op = M.T if trans else M
@@ -609,7 +610,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
             c, bound = outside[0]
             index = n_x + 1 + c
             hit = locate_between(problem, prev, new, lambda q: q.u[index] - bound, prev.u[index] - bound,
-                                 new.u[index] - bound, copts, 1e-9 * problem.p_scale[c])
+                                 new.u[index] - bound, copts, 1e-9 * problem.p_scale[c], with_tangent=False)
             if hit is not None:
                 special.extend(_p2_points(problem, prev, hit[0], marks, rows, copts))
                 problem.accept(hit[0].u)
@@ -708,7 +709,7 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
         a, b = prev.u[i2] - mark, new.u[i2] - mark
         if a * b < 0 or b == 0.0:
             hit = locate_between(problem, prev, new, lambda q, m=mark: q.u[i2] - m, a, b, copts,
-                                 1e-9 * problem.p_scale[1])
+                                 1e-9 * problem.p_scale[1], with_tangent=False)
             if hit is not None:
                 found.append(_located(problem, "P2_MARK", hit[0], rows))
     problem.cycle_u(new.u)
@@ -733,7 +734,8 @@ def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: fl
             def g(q, target=RESONANCES[name]):
                 return problem.kappa(q.u) - target
         hit = locate_between(problem, prev, new, g, a, b, copts,
-                             MULTIPLIER_TOL if name in _CROSSINGS[problem.kind.value] else LOCATE_TOL)
+                             MULTIPLIER_TOL if name in _CROSSINGS[problem.kind.value] else LOCATE_TOL,
+                             with_tangent=name == "CPC")
         at = hit[0] if hit is not None else new
         found.append(_located(problem, name, at, rows))
     problem.cycle_u(new.u)
