@@ -218,3 +218,77 @@ def test_double_hopf_point_of_two_uncoupled_oscillators_is_located_on_the_hopf_c
     hh = curve.double_hopf[0]
     assert abs(hh["p"][1]) < 1e-8 and hh["located"]
     assert hh["omega"] == pytest.approx(1.0) and hh["omega2"] == pytest.approx(2.0)
+
+
+def test_fold_curve_started_beside_the_generalised_hopf_point():
+    """Bautin: from the Hopf point at (b1, b2) = (0, 0.05), just beside GH (0, 0), the small cycle's
+    first fold starts the fold curve b1 = -b2^2/4, which then runs out to the box."""
+    from shimmy.continuation import start_beside
+
+    system = bautin()
+    point, ncol = start_beside(system, "LPC", np.zeros(2), np.array([0.0, 0.05]), (-1.0, 1.0), np.ones(2), 1.0,
+                               PeriodicOptions(ntst=20, ncol=4))
+    assert point is not None and point.p == pytest.approx(-0.05 ** 2 / 4, abs=1e-9)
+    curve = cycle_curve(system, "LPC", point.solution, 0.05, BOX, np.ones(2), (1.0, 1.0), ncol=ncol)
+    np.testing.assert_allclose(curve.p[:, 0], -curve.p[:, 1] ** 2 / 4, atol=1e-8)
+    assert curve.p[:, 1].max() == pytest.approx(1.0) and curve.p[:, 1].min() < 1e-3
+
+
+def coupled_oscillators(w2: float = 2.3):
+    """The double-Hopf amplitude equations in complex x, y: x' = (p1 + i) x - |x|^2 x,
+    y' = (p2 + i w2) y + (|x|^2 - |y|^2) y. A double-Hopf point at (0, 0); the cycle |x|^2 = p1
+    (T = 2 pi, y = 0) has the fibre multipliers exp(2 pi (p2 + p1)) exp(+-2 pi i w2): the torus curve
+    p2 = -p1, p1 > 0, born at the double-Hopf point, kappa = cos(2 pi w2)."""
+    from shimmy.continuation import TwoParameterVectorField
+
+    def f(z, p):
+        x, y = z[0] + 1j * z[1], z[2] + 1j * z[3]
+        fx = (p[0] + 1j) * x - abs(x) ** 2 * x
+        fy = (p[1] + 1j * w2) * y + (abs(x) ** 2 - abs(y) ** 2) * y
+        return np.stack([fx.real, fx.imag, fy.real, fy.imag])
+
+    def dfdx(z, p):
+        u, v, c, d = z[0], z[1], z[2], z[3]
+        rx = u * u + v * v
+        a = p[1] + rx
+        rows = [[p[0] - 3 * u * u - v * v, -1.0 - 2 * u * v, 0 * u, 0 * u],
+                [1.0 - 2 * u * v, p[0] - u * u - 3 * v * v, 0 * u, 0 * u],
+                [2 * u * c, 2 * v * c, a - 3 * c * c - d * d, -w2 - 2 * c * d],
+                [2 * u * d, 2 * v * d, w2 - 2 * c * d, a - c * c - 3 * d * d]]
+        J = np.empty(np.shape(z)[1:] + (4, 4))
+        for i, row in enumerate(rows):
+            for j, value in enumerate(row):
+                J[..., i, j] = value
+        return J
+
+    def dfdp(z, p):
+        zero = 0.0 * z[0]
+        return np.stack([np.stack([z[0], z[1], zero, zero]), np.stack([zero, zero, z[2], z[3]])])
+
+    return TwoParameterVectorField(4, f, dfdx, dfdp, "coupled_oscillators")
+
+
+def test_coupled_oscillators_have_exact_jacobians():
+    system = coupled_oscillators()
+    rng = np.random.default_rng(3)
+    x, p, eps = rng.standard_normal(4), np.array([0.2, -0.3]), 1e-6
+    for j in range(4):
+        e = np.zeros(4)
+        e[j] = eps
+        np.testing.assert_allclose(system.dfdx(x, p)[:, j], (system.f(x + e, p) - system.f(x - e, p)) / (2 * eps),
+                                   atol=1e-7)
+
+
+def test_torus_curve_started_beside_the_double_hopf_point():
+    from shimmy.continuation import start_beside
+
+    system = coupled_oscillators()
+    point, ncol = start_beside(system, "NS", np.zeros(4), np.array([0.0, -0.02]), (-1.0, 1.0), np.ones(4), 1.0,
+                               PeriodicOptions(ntst=20, ncol=4))
+    assert point is not None and point.p == pytest.approx(0.02, abs=1e-8)
+    curve = cycle_curve(system, "NS", point.solution, -0.02, ((-1.0, 0.5), (-1.0, 1.0)), np.ones(4), (1.0, 1.0),
+                        kappa=math.cos(point.data["torus_angle"]), ncol=ncol)
+    np.testing.assert_allclose(curve.p[:, 1], -curve.p[:, 0], atol=1e-8)
+    np.testing.assert_allclose(curve.kappa, math.cos(2 * math.pi * 2.3), atol=1e-8)
+    assert curve.p[:, 0].max() == pytest.approx(0.5) and curve.p[:, 0].min() < 1e-3
+    assert any("amplitude shrank to zero" in r for r in curve.stop_reasons)  # ends at the double-Hopf point

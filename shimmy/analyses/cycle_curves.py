@@ -30,7 +30,7 @@ import numpy as np
 
 from .. import __version__
 from ..continuation import (ContinuationOptions, CycleCurve, CycleCurveOptions, Mesh, SpecialPoint,
-                            TwoParameterVectorField, cycle_curve, hopf_guess, periodic_branch)
+                            TwoParameterVectorField, cycle_curve, periodic_branch, start_beside)
 from ..continuation.errors import ContinuationError
 from ..errors import InvalidParameterError
 from ..model.configurations import Configuration
@@ -256,40 +256,26 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
                              loads, time.perf_counter() - clock, tried, warnings)
 
 
-def _branch_options(stop_at: tuple[str, ...]):
-    options = BifurcationOptions(max_steps=START_STEPS).periodic()
-    from dataclasses import replace
-    return replace(options, stop_at=stop_at)
-
-
 def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin) -> list[Start]:
     """LPC (beside GH) or NS (beside a double-Hopf point) points of the branches that leave the
     Hopf points just above and below the codimension-2 point's load."""
     out = []
     n = model.n_states
-    scale = STATE_SCALE[:n]
-    options = _branch_options((kind,))
+    system = gear_cycle_field(config, params)
+    options = BifurcationOptions(max_steps=START_STEPS).periodic()
     for side in (-1.0, 1.0):
         Fz = point["Fz"] * (1.0 + side * BESIDE)
         if not fz_range[0] <= Fz <= fz_range[1]:
             continue
         hopf = hopf_points(config, Fz, params, v_min=v_range[0], v_max=v_range[1]).hopf_points
         near = sorted(hopf, key=lambda h: abs(math.log(h.V / point["V"])))[:2 if kind == "NS" else 1]
-        system = gear_field(model, Fz)
         for h in near:
             if abs(math.log(h.V / point["V"])) > 0.2:
                 continue
-            A = jacobian(model, np.zeros(n), h.V, Fz)
-            ev, vecs = np.linalg.eig(A)
-            i = int(np.argmin(np.abs(ev.real - 0.0) + np.abs(ev.imag - h.omega)))
-            q = vecs[:, i] / vecs[np.argmax(np.abs(vecs[:, i] / scale)), i]
-            guess, shape = hopf_guess(np.zeros(n), h.V, ev[i].imag, q, Mesh.uniform(options.ntst, options.ncol), 0.0)
-            try:
-                raw = periodic_branch(system, guess, v_range[0], v_range[1], scale, V_SCALE, options, direction=shape,
-                                      limits=_limits(model))
-            except ContinuationError:
-                continue
-            out += [Start(s.kind, s, Fz, raw.ncol, origin) for s in raw.special_points if s.kind == kind]
+            found, ncol = start_beside(system, kind, np.zeros(n), np.array([h.V, Fz]), v_range, STATE_SCALE[:n],
+                                       V_SCALE, options, limits=_limits(model))
+            if found is not None:
+                out.append(Start(kind, found, Fz, ncol, origin))
     return out
 
 

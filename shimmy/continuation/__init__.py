@@ -54,7 +54,7 @@ early says why in its ``stop_reason``.
 
 from .collocation import Mesh, PeriodicProblem
 from .cycle_curves import (CODIM2_KINDS, CycleBifurcation, CycleCurve, CycleCurveOptions, CycleCurveProblem,
-                           TwoParameterVectorField, cycle_curve)
+                           TwoParameterVectorField, cycle_curve, start_beside)
 from .core import (ContinuationOptions, CurvePoint, CurveProblem, SpecialPoint, Tracer, VectorField, correct,
                    locate, step, tangent, weighted_norm)
 from .equilibria import EquilibriumBranch, equilibrium_branch
@@ -66,7 +66,7 @@ from .periodic_orbits import (OrbitGuess, PeriodicBranch, PeriodicOptions, hopf_
 
 __all__ = [
     "CODIM2_KINDS", "CycleBifurcation", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem",
-    "TwoParameterVectorField", "cycle_curve",
+    "TwoParameterVectorField", "cycle_curve", "start_beside",
     "ContinuationError", "ContinuationOptions", "ConvergenceError", "CurvePoint", "CurveProblem",
     "EquilibriumBranch", "HopfCurve", "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess",
     "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "SpecialPoint", "Tracer", "TwoParameterField",

@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
 import numpy as np
@@ -55,8 +55,9 @@ from scipy.sparse.linalg import splu
 from .collocation import Mesh, PeriodicProblem
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate_between, step,
                    tangent, weighted_norm)
-from .errors import ConvergenceError, InvalidInputError
-from .periodic_orbits import multiplier_crossing_test
+from .errors import ContinuationError, ConvergenceError, InvalidInputError
+from .lyapunov import hopf_eigenvectors
+from .periodic_orbits import PeriodicOptions, hopf_guess, multiplier_crossing_test, periodic_branch
 
 
 class CycleBifurcation(str, enum.Enum):
@@ -548,6 +549,29 @@ def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, s
         if closed:
             break
     return _join(kind, halves, reasons, steps_total)
+
+
+def start_beside(system: TwoParameterVectorField, kind: CycleBifurcation | str, x_star: np.ndarray,
+                 p: np.ndarray, p1_range: tuple[float, float], scale: np.ndarray, p1_scale: float,
+                 options: PeriodicOptions | None = None, limits=None) -> tuple[SpecialPoint | None, int]:
+    """A start for :func:`cycle_curve` near a codimension-2 point of an equilibrium: the first
+    ``kind`` point of the cycle branch born at the Hopf point (x_star, p) (continued in p1 at
+    p2 = p[1]). Beside a generalised Hopf point that is the small-amplitude fold of the fold curve
+    born there; beside a double-Hopf point, the torus point of a torus curve born there. Returns
+    (the located point with its solution, or None; the collocation degree of its mesh)."""
+    kind = CycleBifurcation(kind)
+    options = replace(options or PeriodicOptions(), stop_at=(kind.value,))
+    field_ = system.at(float(p[1]))
+    x_star = np.asarray(x_star, float)
+    omega, q, _ = hopf_eigenvectors(field_.dfdx(x_star, float(p[0])))
+    guess, shape = hopf_guess(x_star, float(p[0]), omega, q, Mesh.uniform(options.ntst, options.ncol), 0.0)
+    try:
+        branch = periodic_branch(field_, guess, p1_range[0], p1_range[1], scale, p1_scale, options,
+                                 direction=shape, limits=limits)
+    except ContinuationError:
+        return None, options.ncol
+    found = [s for s in branch.special_points if s.kind == kind.value]
+    return (found[0] if found else None), branch.ncol
 
 
 def _fresh(problem: CycleCurveProblem, u: np.ndarray) -> CycleCurveProblem:
