@@ -246,3 +246,32 @@ def test_isolated_loop_of_torsional_cycles_at_high_load():
     x0 = problem.unpack(u)[0][0]
     run = simulate("original", float(raw.p[i]), 700e3, t_end=40.0, x0=x0)
     assert run.amplitude["psi"] == pytest.approx(max(raw.x_max[i, 0], -raw.x_min[i, 0]), rel=0.01)
+
+
+def _polyline_distance(V, A, v, a):
+    P = np.column_stack([V, A])
+    q = np.array([v, a])
+    d = P[1:] - P[:-1]
+    length2 = np.maximum(np.sum(d * d, axis=1), 1e-300)
+    s = np.clip(np.sum((q - P[:-1]) * d, axis=1) / length2, 0.0, 1.0)
+    return float(np.min(np.linalg.norm(P[:-1] + s[:, None] * d - q, axis=1)))
+
+
+@pytest.mark.slow
+def test_drawn_branches_follow_the_true_amplitude_and_peak_at_the_located_maximum():
+    """At 150 kN the drawn torsional branch lies within 0.2 % of the amplitude (distance of a
+    dense reference branch's points to the drawn polyline, amplitude scaled by its maximum,
+    speed by 200 m/s), and the located maximum is one of its points."""
+    result = bifurcation("original", 150e3)
+    reference = bifurcation("original", 150e3, options=BifurcationOptions(ds=0.01, ds_max=0.02, max_angle=0.02,
+                                                                          max_steps=8000, mesh_check=False))
+    drawn = max((b for b in result.branches if b.kind == "periodic"), key=lambda b: b.max_psi.max())
+    dense = max((b for b in reference.branches if b.kind == "periodic"), key=lambda b: b.max_psi.max())
+    assert dense.V.size > 4 * drawn.V.size
+    for key in ("max_psi", "max_lateral"):
+        top = getattr(dense, key).max()
+        worst = max(_polyline_distance(drawn.V / 200.0, getattr(drawn, key) / top, v / 200.0, a / top)
+                    for v, a in zip(dense.V, getattr(dense, key), strict=True))
+        assert worst < 2e-3, (key, worst)
+    assert drawn.max_psi.max() == result.max_psi
+    assert result.max_psi == pytest.approx(dense.max_psi.max(), rel=1e-4)
