@@ -74,10 +74,11 @@ CODIM2_KINDS = {"LPC": ("CPC", "LPNS", "LPPD"), "PD": ("LPPD", "PDNS", "R2"),
 RESONANCES = {"R1": 1.0, "R4": 0.0, "R3": -0.5, "R2": -1.0}  # kappa = cos(theta) at 1:k
 COMPLEX_TOL = 1e-7
 #: |test function| accepted at a located point: tangent slopes and kappa to 1e-8 (the tangent
-#: carries the finite-difference error of the Newton matrix, ~1e-10); ln |mu| to 1e-6 (the
-#: multipliers of a stiff cycle are accurate to ~1e-7)
+#: carries the finite-difference error of the Newton matrix, ~1e-10); ln |mu| to 1e-5: where a
+#: multiplier crosses +1 on a torus curve it meets the trivial one, and a double eigenvalue is
+#: only accurate to the square root of the monodromy matrix's error (~1e-6 for the gear)
 LOCATE_TOL = 1e-8
-MULTIPLIER_TOL = 1e-6
+MULTIPLIER_TOL = 1e-5
 
 
 @dataclass(frozen=True)
@@ -731,7 +732,9 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
                               {"turn": "max" if prev.tangent[i2] > 0 else "min", "located": hit is not None}))
     for mark in marks:
         a, b = prev.u[i2] - mark, new.u[i2] - mark
-        if a * b < 0 or b == 0.0:
+        if abs(b) <= 1e-9 * problem.p_scale[1]:  # the step ends on the mark (a box edge)
+            found.append(_located(problem, "P2_MARK", new, rows))
+        elif a * b < 0:
             hit = locate_between(problem, prev, new, lambda q, m=mark: q.u[i2] - m, a, b, copts,
                                  1e-9 * problem.p_scale[1], with_tangent=False)
             if hit is not None:
@@ -761,7 +764,7 @@ def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: fl
                              MULTIPLIER_TOL if name in _CROSSINGS[problem.kind.value] else LOCATE_TOL,
                              with_tangent=name == "CPC")
         at = hit[0] if hit is not None else new
-        found.append(_located(problem, name, at, rows))
+        found.append(_located(problem, name, at, rows, {"located": hit is not None}))
     problem.cycle_u(new.u)
     return found
 
