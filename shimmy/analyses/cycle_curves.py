@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from concurrent.futures import Executor
 from typing import Any, Callable
 
 import numpy as np
@@ -39,6 +40,7 @@ from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, chec
 from .bifurcation import (STATE_SCALE, V_SCALE, BifurcationOptions, _limits, _on_branch, _periodic_output,
                           bifurcation, gear_field, periodic_orbit_from_simulation)
 from .hopf_curves import hopf_curves
+from .executors import open_executor, run_units
 from .stability import hopf_points
 
 KINDS = ("LPC", "NS", "PD")
@@ -175,9 +177,17 @@ def _close(a: dict, b: dict, tol: float) -> bool:
 def cycle_curves(config: Configuration | str, params: Parameters | None = None,
                  v_range: tuple[float, float] = (V_RANGE[0], 200.0), fz_range: tuple[float, float] = FZ_RANGE,
                  kinds: tuple[str, ...] = KINDS, loads: tuple[float, ...] = (),
-                 progress: Callable[[float, str], None] | None = None) -> CycleCurvesResult:
+                 progress: Callable[[float, str], None] | None = None,
+                 executor: Executor | None = None) -> CycleCurvesResult:
     """Every fold, torus and period-doubling curve of cycles in the box (m/s, N); ``loads``: the
-    loads (N) at which each curve's crossings are located and reported."""
+    loads (N) at which each curve's crossings are located and reported.
+
+    The starts (branches beside each codimension-2 point, a diagram and large-amplitude starts
+    per scan load) are independent units, and so are the continuations of starts that lie on no
+    curve yet: both go through ``executor`` (default :func:`~.executors.open_executor`: one
+    process per core, or a Dask cluster); a start that lies on a curve continued in an earlier
+    round is skipped.
+    """
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
@@ -190,11 +200,11 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
     if not kinds:
         raise InvalidParameterError("kinds", "", ", ".join(KINDS), "is empty")
     loads = tuple(float(check_number(f"loads[{i}]", f, f_lo, f_hi, "N")) for i, f in enumerate(loads))
+    if executor is None:
+        with open_executor() as own:
+            return cycle_curves(config, params, v_range, fz_range, kinds, loads, progress, own)
     report = progress or (lambda fraction, message: None)
-    system = gear_cycle_field(config, params)
     box = ((v_lo, v_hi), (f_lo, f_hi))
-    warnings: list[str] = []
-    model = build_model(config, params)
 
     report(0.0, "Hopf curves and their GH and double-Hopf points")
     hopf = hopf_curves(config, params, (v_lo, v_hi), (f_lo, f_hi))
@@ -206,58 +216,98 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
             if not any(_close(entry, e, 1e-4) for e in hh):
                 hh.append(entry)
 
+    tasks = [("beside", config, params, g, "LPC", box, f"beside the GH point at V = {g['V']:.5g} m/s, "
+              f"Fz = {g['Fz']:.6g} N") for g in gh if "LPC" in kinds]
+    tasks += [("beside", config, params, g, "NS", box, f"beside the double-Hopf point at V = {g['V']:.5g} m/s, "
+               f"Fz = {g['Fz']:.6g} N") for g in hh if "NS" in kinds]
+    tasks += [("scan", config, params, f_lo + fr * (f_hi - f_lo), box) for fr in SCAN_FRACTIONS]
+    found = run_units(_find_starts, tasks, executor, lambda f, m: report(0.05 + 0.45 * f, m), _describe_task)
+    starts = [s for part, _ in found for s in part if s.kind in kinds and s.point.solution is not None]
+    warnings = [w for _, part in found for w in part]
+
     curves: list[GearCycleCurve] = []
     tried = 0
-
-    def follow(start: Start) -> None:
-        nonlocal tried
-        if start.kind not in kinds or start.point.solution is None:
-            return
-        if any(_on_curve(c, start, params.gear.l_g) for c in curves if c.kind == start.kind):
-            return
-        tried += 1
-        kappa = math.cos(start.point.data["torus_angle"]) if start.kind == "NS" else None
-        if kappa is not None and not -1.0 < kappa < 1.0:
-            return
-        try:
-            curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box, STATE_SCALE[:system.n],
-                                (V_SCALE, FZ_SCALE), kappa=kappa, options=CURVE_OPTIONS, ncol=start.ncol,
-                                p2_marks=loads)
-        except ContinuationError as exc:
-            warnings.append(f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N "
-                            f"({start.origin}) not continued: {exc}")
-            return
-        curves.append(GearCycleCurve(start.kind, curve, start.origin))
-
-    codim2_starts = [(g, "LPC", f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
-                     for g in gh] + [(g, "NS", f"beside the double-Hopf point at V = {g['V']:.5g} m/s, "
-                                         f"Fz = {g['Fz']:.6g} N") for g in hh]
-    for k, (point, kind, origin) in enumerate(codim2_starts):
-        report(0.1 + 0.3 * k / max(len(codim2_starts), 1), f"curves from codimension-2 points ({kind})")
-        if kind not in kinds:
-            continue
-        for start in _starts_beside(config, model, params, point, kind, (v_lo, v_hi), (f_lo, f_hi), origin):
-            follow(start)
-
-    scan = [f_lo + fr * (f_hi - f_lo) for fr in SCAN_FRACTIONS]
-    for k, Fz in enumerate(scan):
-        report(0.4 + 0.6 * k / len(scan), f"one-parameter diagram and large-amplitude starts at Fz = {Fz / 1e3:.4g} kN")
-        try:
-            diagram = bifurcation(config, Fz, v_lo, v_hi, params, BifurcationOptions(mesh_check=False))
-        except ContinuationError as exc:
-            warnings.append(f"diagram at Fz = {Fz:.6g} N failed: {exc}")
-            continue
-        for branch in diagram.branches:
-            if branch.kind == "periodic" and branch.raw is not None:
-                for s in branch.raw.special_points:
-                    if s.kind in KINDS:
-                        follow(Start(s.kind, s, Fz, branch.raw.ncol, f"diagram at Fz = {Fz:.6g} N"))
-        for start in _large_amplitude_starts(config, model, params, Fz, (v_lo, v_hi), diagram.branches, warnings):
-            follow(start)
+    width = max(1, getattr(executor, "_max_workers", 2) or 2)
+    while True:
+        pending = [s for s in starts if not any(_on_curve(c, s, params.gear.l_g) for c in curves if c.kind == s.kind)]
+        if not pending:
+            break
+        batch = [pending[0]]
+        for s in pending[1:]:  # one start per curve as far as can be told before continuing
+            if len(batch) < width and all(s.kind != b.kind or _far(s, b) for b in batch):
+                batch.append(s)
+        report(0.5 + 0.5 * len(curves) / (len(curves) + len(pending)), f"continuing {len(batch)} curve(s)")
+        results = run_units(_continue, [(config, params, s, box, loads) for s in batch], executor)
+        tried += len(batch)
+        for s, (curve, warning) in zip(batch, results, strict=True):
+            starts.remove(s)
+            if warning:
+                warnings.append(warning)
+            elif curve is not None and not any(_same_curve(curve, c, params.gear.l_g) for c in curves):
+                curves.append(curve)
     report(1.0, "done")
     return CycleCurvesResult(config, params, (v_lo, v_hi), (f_lo, f_hi), kinds, curves, gh,
                              [{"V": e["V"], "Fz": e["Fz"], "omega": e["omega"], "omega2": e["omega2"]} for e in hh],
                              loads, time.perf_counter() - clock, tried, warnings)
+
+
+def _describe_task(task: tuple) -> str:
+    if task[0] == "scan":
+        return f"diagram and large-amplitude starts at Fz = {task[3] / 1e3:.4g} kN"
+    return f"branches {task[6]}"
+
+
+def _find_starts(task: tuple) -> tuple[list[Start], list[str]]:
+    """Starts of one unit: the branches beside one codimension-2 point, or the diagram and the
+    large-amplitude starts at one load (a unit of :func:`cycle_curves`, run in any process)."""
+    if task[0] == "beside":
+        _, config, params, point, kind, box, origin = task
+        model = build_model(config, params)
+        return _starts_beside(config, model, params, point, kind, box[0], box[1], origin), []
+    _, config, params, Fz, box = task
+    warnings: list[str] = []
+    try:
+        diagram = bifurcation(config, Fz, box[0][0], box[0][1], params, BifurcationOptions(mesh_check=False))
+    except ContinuationError as exc:
+        return [], [f"diagram at Fz = {Fz:.6g} N failed: {exc}"]
+    starts = [Start(s.kind, s, Fz, b.raw.ncol, f"diagram at Fz = {Fz:.6g} N") for b in diagram.branches
+              if b.kind == "periodic" and b.raw is not None for s in b.raw.special_points if s.kind in KINDS]
+    model = build_model(config, params)
+    starts += _large_amplitude_starts(config, model, params, Fz, box[0], diagram.branches, warnings)
+    return starts, warnings
+
+
+def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
+    """One curve continued from one start (a unit of :func:`cycle_curves`)."""
+    config, params, start, box, loads = task
+    system = gear_cycle_field(config, params)
+    kappa = math.cos(start.point.data["torus_angle"]) if start.kind == "NS" else None
+    if kappa is not None and not -1.0 < kappa < 1.0:
+        return None, None
+    try:
+        curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box, STATE_SCALE[:system.n],
+                            (V_SCALE, FZ_SCALE), kappa=kappa, options=CURVE_OPTIONS, ncol=start.ncol, p2_marks=loads)
+    except ContinuationError as exc:
+        return None, (f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin}) "
+                      f"not continued: {exc}")
+    return GearCycleCurve(start.kind, curve, start.origin), None
+
+
+def _far(a: Start, b: Start) -> bool:
+    """Whether two starts of a kind are unlikely to lie on one curve (they are continued together)."""
+    return abs(a.point.p - b.point.p) > 0.5 * V_SCALE or abs(a.Fz - b.Fz) > 0.5 * FZ_SCALE \
+        or abs(a.point.data["x_max"][0] - b.point.data["x_max"][0]) > 0.2 * max(abs(a.point.data["x_max"][0]), 1e-6)
+
+
+def _same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:
+    """Whether a curve continued in the same round as another is that curve again (its start, the
+    first point of its half traced first, lies on the other)."""
+    if new.kind != old.kind:
+        return False
+    c = new.curve
+    i = len(c.p) // 2
+    probe = SpecialPoint(new.kind, float(c.p[i, 0]), 0, {"x_max": c.x_max[i].tolist(), "x_min": c.x_min[i].tolist()})
+    return _on_curve(old, Start(new.kind, probe, float(c.p[i, 1]), 0, ""), l_g)
 
 
 def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin) -> list[Start]:
