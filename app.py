@@ -1,31 +1,32 @@
 """The workbench: a Dash multi-page app with the HTTP API on the same Flask server.
 
-``gunicorn app:server`` serves both. Pages live in ``pages/``; styling in ``assets/``
-(no CDN). Numerics never run here: pages call :mod:`shimmy.service.analyses`, which
-validates, caches and computes.
+``gunicorn app:server`` serves both (gunicorn.conf.py beside this file is read by default).
+Pages live in ``pages/``; styling in ``assets/`` (no CDN). Numerics never run here: pages
+call :mod:`shimmy.service.analyses` for quick answers and submit long ones as jobs through
+:mod:`shimmy.service.jobs` (the API's admission control); Dash starts no process of its own.
 """
 
 from __future__ import annotations
 
 import os
 
-import diskcache
-from dash import Dash, DiskcacheManager
+from dash import Dash
 
 from shimmy.service import settings
 from shimmy.service.api import api
 
-background = DiskcacheManager(diskcache.Cache(str(settings.cache_dir() / "dash-background")), expire=3600)
+settings.cache_dir()  # refuse to start on a cache directory that is not private to this user
 
-app = Dash(__name__, use_pages=True, title="shimmy workbench", background_callback_manager=background,
-           suppress_callback_exceptions=True, update_title=None)
+app = Dash(__name__, use_pages=True, title="shimmy workbench", suppress_callback_exceptions=True,
+           update_title=None)
 server = app.server
 server.config["MAX_CONTENT_LENGTH"] = settings.MAX_BODY_BYTES
 server.register_blueprint(api)
 
-from ui import layout  # noqa: E402  (needs the registered pages)
+from ui import guard, layout  # noqa: E402  (needs the registered pages)
 
 app.layout = layout.shell()
+guard.install(app)
 
 if __name__ == "__main__":
     app.run(host="127.0.0.1", port=int(os.environ.get("PORT", "8050")), debug=False)

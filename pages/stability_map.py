@@ -82,7 +82,7 @@ def _csv_rows(results):
 
 jobs.register(
     "map", "map", requests=_requests, render=lambda results: (figure(results), summary(results)),
-    outputs=[Output("map-graph", "figure"), Output("map-table", "children")], states=CONTROLS, interval=300,
+    outputs=[Output("map-graph", "figure"), Output("map-table", "children")], states=CONTROLS,
     lock=["map-shade", "map-res", "map-fzmin", "map-fzmax", "map-vmin", "map-vmax"],
     download=jobs.Download("map", "stability_map", _csv_rows))
 

@@ -93,7 +93,7 @@ def _csv_rows(results):
 jobs.register(
     "study", "study", requests=lambda *controls: [_request(*controls)],
     render=lambda results: (figure(results[0]), summary(results[0])),
-    outputs=[Output("study-graph", "figure"), Output("study-table", "children")], states=CONTROLS, interval=300,
+    outputs=[Output("study-graph", "figure"), Output("study-table", "children")], states=CONTROLS,
     lock=["study-param", "study-values", "study-fz"], store="study-request",
     download=jobs.Download("study", "study", _csv_rows, single=True))
 

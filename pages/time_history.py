@@ -8,8 +8,9 @@ from dash import Input, Output, State, dcc, html, no_update
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
-from shimmy.service import analyses
+from shimmy.service import schemas
 from ui import components as ui
+from ui import jobs
 from ui import style
 from ui.layout import design_id, page
 
@@ -36,9 +37,7 @@ def layout(config: str = "nes_pd", V: str = "30", Fz: str = "150", t_end: str = 
                                           debounce=True, step="any")),
             ui.field("Simulated time (s)", dcc.Input(id="th-tend", type="number", value=ui.number(t_end, 60), min=1,
                                                      max=600, step="any")),
-            html.Button("Run", id="th-run"),
-            html.Button("Cancel", id="th-cancel", className="secondary", disabled=True),
-            ui.progress_bar("th"),
+            *jobs.controls("th", "Run"),
         ], className="controls"),
         html.Div([html.Span("Operating points: ", className="hint"),
                   *[html.Button(f"{name} ({v} m/s, {f} kN)", id={"type": "th-op", "name": name}, className="secondary")
@@ -48,7 +47,7 @@ def layout(config: str = "nes_pd", V: str = "30", Fz: str = "150", t_end: str = 
         ui.graph("th-series", figure=style.message_figure("Choose an operating point and press Run")),
         html.Div([ui.graph("th-spectrum"), ui.graph("th-phase")], className="grid-2"),
         ui.downloads("th"),
-        dcc.Store(id="th-request"), dcc.Store(id="th-go"),
+        *jobs.stores("th", "th-request"),
     )
 
 
@@ -67,56 +66,38 @@ def _request(V, fz_kn, config, t_end, design):
             "include_series": True, **design}
 
 
-@dash.callback(
-    Output("th-series", "figure"), Output("th-spectrum", "figure"), Output("th-phase", "figure"),
-    Output("th-metrics", "children"), Output("th-error", "children"), Output("th-request", "data"),
-    Output("th-csv", "disabled"), Output("th-json", "disabled"), Output("th-go", "data"),
-    Input("th-run", "n_clicks"), Input("th-v", "value"), Input("th-fz", "value"),
-    State("th-config", "value"), State("th-tend", "value"), State(design_id("th"), "data"),
-)
-def dispatch(n, V, fz_kn, config, t_end, design):
-    """Answer at once from the cache; otherwise hand over to the background run."""
+def _requests(V, fz_kn, config, t_end, design):
     request = _request(V, fz_kn, config, t_end, design)
     try:
-        result = analyses.cached("simulate", request)
+        schemas.validate("simulate", request)
     except InvalidParameterError as exc:
-        return (no_update,) * 4 + (_field_message(exc), no_update, True, True, no_update)
-    if result is not None:
-        return (*_figures(result), _metrics(result), "" if result["success"] else result["message"], request,
-                False, False, no_update)
-    return (no_update,) * 8 + ([n, V, fz_kn],)
+        if exc.field == "Fz":
+            raise InvalidParameterError("Fz", fz_kn, "a number in [10, 900] kN",
+                                        message=f"Fz={fz_kn!r} kN is outside [10, 900] kN") from None
+        raise
+    return [request]
 
 
-@dash.callback(
-    Output("th-series", "figure", allow_duplicate=True), Output("th-spectrum", "figure", allow_duplicate=True),
-    Output("th-phase", "figure", allow_duplicate=True), Output("th-metrics", "children", allow_duplicate=True),
-    Output("th-error", "children", allow_duplicate=True), Output("th-request", "data", allow_duplicate=True),
-    Output("th-csv", "disabled", allow_duplicate=True), Output("th-json", "disabled", allow_duplicate=True),
-    Input("th-go", "data"),
-    State("th-v", "value"), State("th-fz", "value"), State("th-config", "value"), State("th-tend", "value"),
-    State(design_id("th"), "data"),
-    background=True, prevent_initial_call=True, interval=250,
-    running=[(Output("th-run", "disabled"), True, False), (Output("th-cancel", "disabled"), False, True)],
-    cancel=[Input("th-cancel", "n_clicks")],
-    progress=[Output("th-progress", "value"), Output("th-status", "children")],
-)
-def run(set_progress, _go, V, fz_kn, config, t_end, design):
-    set_progress(("5", "simulating"))
-    request = _request(V, fz_kn, config, t_end, design)
-    try:
-        result, _ = analyses.run("simulate", request)
-    except InvalidParameterError as exc:
-        set_progress(("0", ""))
-        return (no_update,) * 4 + (_field_message(exc), no_update, True, True)
-    set_progress(("100", "done"))
-    return (*_figures(result), _metrics(result), "" if result["success"] else result["message"], request,
-            False, False)
+def _csv_rows(results):
+    s = results[0]["series"]
+    keys = list(s)
+    return keys, zip(*(s[k] for k in keys), strict=True)
 
 
-def _field_message(exc: InvalidParameterError) -> str:
-    if exc.field == "Fz":
-        return f"Fz={exc.value!r} N is outside [10, 900] kN"
-    return str(exc)
+def _file_stem(results):
+    r = results[0]
+    return f"time_history_{r['config']}_V{r['V']:g}_Fz{r['Fz'] / 1e3:g}kN"
+
+
+jobs.register(
+    "th", "simulate", requests=_requests, initial=True,
+    render=lambda results: (*_figures(results[0]), _metrics(results[0])),
+    notice=lambda results: "" if results[0]["success"] else results[0]["message"],
+    outputs=[Output("th-series", "figure"), Output("th-spectrum", "figure"), Output("th-phase", "figure"),
+             Output("th-metrics", "children")],
+    triggers=[Input("th-v", "value"), Input("th-fz", "value")],
+    states=[State("th-config", "value"), State("th-tend", "value"), State(design_id("th"), "data")],
+    store="th-request", download=jobs.Download("th", "time_history", _csv_rows, single=True, filename=_file_stem))
 
 
 def _figures(result):
@@ -177,17 +158,3 @@ def _metrics(result):
                prevent_initial_call=True)
 def remember(config, V, fz, t_end):
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end}
-
-
-@dash.callback(Output("th-download", "data"), Input("th-csv", "n_clicks"), Input("th-json", "n_clicks"),
-               State("th-request", "data"), prevent_initial_call=True)
-def download(_csv, _json, request):
-    if not request:
-        return no_update
-    result, _ = analyses.run("simulate", request)
-    name = f"time_history_{result['config']}_V{result['V']:g}_Fz{result['Fz'] / 1e3:g}kN"
-    if dash.ctx.triggered_id == "th-json":
-        return {"content": ui.json_text(result), "filename": name + ".json"}
-    s = result["series"]
-    keys = list(s)
-    return {"content": ui.csv_text(keys, zip(*(s[k] for k in keys), strict=True)), "filename": name + ".csv"}

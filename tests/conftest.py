@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import socket
@@ -27,6 +28,19 @@ class Server:
     def __init__(self, base: str, cache_dir: Path, proc: subprocess.Popen):
         self.base, self.cache_dir, self.proc = base, cache_dir, proc
 
+    @contextlib.contextmanager
+    def cache_env(self):
+        """SHIMMY_CACHE_DIR set to this server's cache while the block runs (to read its job store)."""
+        before = os.environ.get("SHIMMY_CACHE_DIR")
+        os.environ["SHIMMY_CACHE_DIR"] = str(self.cache_dir)
+        try:
+            yield
+        finally:
+            if before is None:
+                os.environ.pop("SHIMMY_CACHE_DIR", None)
+            else:
+                os.environ["SHIMMY_CACHE_DIR"] = before
+
     def request(self, method: str, path: str, body=None, raw: bytes | None = None, timeout: float = 60.0):
         """(status, headers, parsed JSON or text) of one request."""
         data = raw if raw is not None else (None if body is None else json.dumps(body).encode())
@@ -48,7 +62,7 @@ def server(tmp_path_factory):
     """gunicorn app:server with 2 workers and a fresh shared cache directory."""
     cache_dir = tmp_path_factory.mktemp("shimmy-cache")
     port = free_port()
-    env = {**os.environ, "SHIMMY_CACHE_DIR": str(cache_dir), "SHIMMY_JOB_STALE_SECONDS": "4"}
+    env = {**os.environ, "SHIMMY_CACHE_DIR": str(cache_dir)}
     log = open(cache_dir / "gunicorn.log", "w")
     proc = subprocess.Popen([sys.executable, "-m", "gunicorn", "app:server", "--bind", f"127.0.0.1:{port}",
                              "--workers", "2", "--timeout", "120", "--no-control-socket"],

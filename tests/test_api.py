@@ -211,30 +211,60 @@ def test_map_and_study_jobs_give_what_the_package_gives(server):
 LONG_JOB = {"analysis": "bifurcation", "config": "original", "v_min": 1, "v_max": 200, "ntst": 200}
 
 
-def test_job_cancelled(server):
+def _holder(server, job_id, timeout=30):
+    """The process that holds the job's slot, as the jobs store records it: {pid, started, host}."""
+    from shimmy.service import jobs
+
+    deadline = time.time() + timeout
+    with server.cache_env():
+        while time.time() < deadline:
+            holder = jobs.store().get("running", {}).get(job_id)
+            if holder and holder["pid"]:
+                return holder
+            time.sleep(0.1)
+    raise AssertionError(f"job {job_id} holds no process after {timeout} s")
+
+
+def _group_gone(pgid, timeout=30):
+    """True once no process of group ``pgid`` is left (zombies included)."""
+    import psutil
+
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        left = [p for p in psutil.process_iter(["pid"]) if _pgid(p.pid) == pgid]
+        if not left:
+            return True
+        time.sleep(0.2)
+    return False
+
+
+def _pgid(pid):
+    try:
+        return os.getpgid(pid)
+    except OSError:
+        return None
+
+
+def test_job_cancelled_and_deleted_leaves_no_process(server):
     body = {**LONG_JOB, "Fz": 300000}
     status, _, job = server.request("POST", "/api/v1/jobs", body)
     assert status == 202
     _wait(server, job["id"], until=("running",), timeout=60)
+    holder = _holder(server, job["id"])
     status, _, cancelled = server.request("DELETE", f"/api/v1/jobs/{job['id']}")
     assert status == 200 and cancelled["status"] == "cancelled"
-    time.sleep(1.5)
-    _, _, later = server.request("GET", f"/api/v1/jobs/{job['id']}")
-    assert later["status"] == "cancelled" and "result" not in later
+    status, _, later = server.request("GET", f"/api/v1/jobs/{job['id']}")
+    assert status == 404 and later["field"] == "id"
+    assert _group_gone(holder["pid"])
 
 
-def test_job_whose_worker_dies_is_failed_not_running_forever(server):
-    """A worker killed mid-job (as by a server restart) stops its heartbeat: the job turns failed."""
-    from shimmy.service import jobs
-
-    os.environ["SHIMMY_CACHE_DIR"] = str(server.cache_dir)
-    try:
-        body = {**LONG_JOB, "Fz": 310000}
-        _, _, job = server.request("POST", "/api/v1/jobs", body)
-        _wait(server, job["id"], until=("running",), timeout=60)
-        pid = jobs.store().get(("job", job["id"]))["pid"]
-        os.killpg(pid, signal.SIGKILL)
-        failed, _ = _wait(server, job["id"], until=("failed", "done"), timeout=30)
-        assert failed["status"] == "failed" and "heartbeat" in failed["error"]
-    finally:
-        os.environ.pop("SHIMMY_CACHE_DIR", None)
+def test_job_whose_worker_is_killed_is_failed_and_its_group_ends(server):
+    """kill -9 of the worker alone (not its group): the job turns failed, nothing of its group survives."""
+    body = {**LONG_JOB, "Fz": 310000}
+    _, _, job = server.request("POST", "/api/v1/jobs", body)
+    _wait(server, job["id"], until=("running",), timeout=60)
+    holder = _holder(server, job["id"])
+    os.kill(holder["pid"], signal.SIGKILL)
+    failed, _ = _wait(server, job["id"], until=("failed", "done"), timeout=60)
+    assert failed["status"] == "failed" and "ended without a result" in failed["error"]
+    assert _group_gone(holder["pid"])

@@ -1,11 +1,18 @@
 """One component for a page's long computation: Compute and Cancel buttons, a progress bar,
-an answer at once from the cache, a background job otherwise, and CSV/JSON downloads.
+an answer at once from the cache, jobs of the service otherwise, and CSV/JSON downloads.
 
-A page lays out :func:`controls` (ids PREFIX-run, PREFIX-cancel, PREFIX-progress, PREFIX-status)
-and :func:`ui.components.downloads`, then calls :func:`register` with what is particular to it:
-how its controls become requests, how results become its outputs, and how results become
-CSV rows. The requests of the last answer are kept in a store so that the downloads serialise
-exactly what is drawn, from the cache (a download never computes).
+A page lays out :func:`controls` (ids PREFIX-run, PREFIX-cancel, PREFIX-progress, PREFIX-status,
+PREFIX-poll) and :func:`ui.components.downloads`, then calls :func:`register` with what is
+particular to it: how its controls become requests, how results become its outputs, and how
+results become CSV rows.
+
+Nothing is computed in the web worker and no process is started by Dash: a Compute submits
+one job per uncached request through :mod:`shimmy.service.jobs`, the admission control the
+API uses (bounded queue, identical requests shared, a full queue refused with a message), and
+an interval reads the jobs' progress until every result is in the cache. At most
+``MAX_PAGE_REQUESTS`` requests per action. The requests of the last answer are kept in a
+store so that the downloads serialise exactly what is drawn, from the cache (a download never
+computes).
 """
 
 from __future__ import annotations
@@ -16,21 +23,22 @@ from typing import Any, Callable, Sequence
 import dash
 from dash import Input, Output, State, dcc, html, no_update
 
-from shimmy.errors import EXPECTED_ERRORS, InvalidParameterError
-from shimmy.service import analyses
+from shimmy.errors import InvalidParameterError
+from shimmy.service import cache, jobs, schemas, settings
 
 from . import components
 
 
-def controls(prefix: str, label: str = "Compute") -> list:
-    """The run and cancel buttons and the progress bar of a job."""
+def controls(prefix: str, label: str = "Compute", interval: int = 400) -> list:
+    """The run and cancel buttons, the progress bar of a job and the interval that reads it."""
     return [html.Button(label, id=f"{prefix}-run"),
             html.Button("Cancel", id=f"{prefix}-cancel", className="secondary", disabled=True),
-            components.progress_bar(prefix)]
+            components.progress_bar(prefix),
+            dcc.Interval(id=f"{prefix}-poll", interval=interval, disabled=True)]
 
 
 def stores(prefix: str, store: str | None = None) -> list:
-    """The store of the shown results' requests and the hand-over to the background job."""
+    """The store of the shown results' requests and the ids of the jobs being waited for."""
     return [dcc.Store(id=store or f"{prefix}-requests"), dcc.Store(id=f"{prefix}-go")]
 
 
@@ -42,98 +50,142 @@ class Download:
     name: str  # file stem
     rows: Callable[[list[dict[str, Any]]], tuple[list[str], list[list[Any]]]]
     single: bool = False  # the page shows one result: its JSON is that result, not a list of one
+    filename: Callable[[list[dict[str, Any]]], str] | None = None  # file stem from the results
+
+
+def canonical(analysis: str, wanted: Any) -> list[dict[str, Any]]:
+    """The page's requests validated (each refusal names its field), duplicates dropped, at most
+    MAX_PAGE_REQUESTS."""
+    if not isinstance(wanted, list) or not wanted:
+        raise InvalidParameterError("requests", type(wanted).__name__, "a non-empty list of requests")
+    out, keys = [], set()
+    for body in wanted:
+        request = schemas.validate(analysis, body)
+        k = cache.key(analysis, request)
+        if k not in keys:
+            keys.add(k)
+            out.append(request)
+    if len(out) > settings.MAX_PAGE_REQUESTS:
+        raise InvalidParameterError("configs", len(out), f"at most {settings.MAX_PAGE_REQUESTS} analyses at once",
+                                    "asks for too many analyses")
+    return out
 
 
 def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[str, Any]]],
              render: Callable[[list[dict[str, Any]]], tuple], outputs: Sequence[Output], states: Sequence[State],
-             download: Download, lock: Sequence[str] = (), store: str | None = None, interval: int = 250,
-             error: str | None = None) -> None:
+             download: Download, lock: Sequence[str] = (), store: str | None = None,
+             error: str | None = None, triggers: Sequence[Input] = (), initial: bool = False,
+             notice: Callable[[list[dict[str, Any]]], str] | None = None) -> None:
     """Wire the job of one page.
 
-    ``requests(*state values)`` -> the analysis requests (may raise InvalidParameterError);
-    ``render(results)`` -> one value per entry of ``outputs``; ``lock`` are ids of controls
-    disabled while the job runs; ``error`` the id of the element that shows a refusal
-    (PREFIX-error by default).
+    ``requests(*trigger values, *state values)`` -> the analysis requests (may raise
+    InvalidParameterError); ``render(results)`` -> one value per entry of ``outputs``;
+    ``lock`` are ids of controls disabled while the jobs run; ``error`` the id of the element
+    that shows a refusal (PREFIX-error by default), ``notice(results)`` what it shows with a
+    result; ``triggers`` inputs that start a computation besides the run button; ``initial`` runs
+    it when the page loads.
     """
     store = store or f"{prefix}-requests"
     error = error or f"{prefix}-error"
     n_out = len(outputs)
     tail = [Output(error, "children"), Output(store, "data"), Output(f"{download.prefix}-csv", "disabled"),
             Output(f"{download.prefix}-json", "disabled")]
+    state = [Output(f"{prefix}-go", "data"), Output(f"{prefix}-poll", "disabled"), Output(f"{prefix}-run", "disabled"),
+             Output(f"{prefix}-cancel", "disabled"), *(Output(name, "disabled") for name in lock),
+             Output(f"{prefix}-progress", "value"), Output(f"{prefix}-status", "children")]
+    idle = (None, True, False, True, *(False for _ in lock))
 
-    def refused(message: str) -> tuple:
-        return (no_update,) * n_out + (message, no_update, True, True)
+    def refused(message: str, status: str = "") -> tuple:
+        return (no_update,) * n_out + (message, no_update, no_update, no_update) + idle + ("0", status)
 
-    @dash.callback(*outputs, *tail, Output(f"{prefix}-go", "data"), Input(f"{prefix}-run", "n_clicks"), *states,
-                   prevent_initial_call=True)
-    def dispatch(n, *values):
-        """Answer at once when every result is cached; otherwise hand over to the background job."""
+    def shown(results: list[dict[str, Any]], wanted: list[dict[str, Any]]) -> tuple:
+        return (*render(results), notice(results) if notice else "", wanted, False, False) + idle + ("100", "")
+
+    @dash.callback(*outputs, *tail, *state, Input(f"{prefix}-run", "n_clicks"), *triggers, *states,
+                   prevent_initial_call=not initial)
+    def dispatch(_n, *values):
+        """Answer at once when every result is cached; otherwise submit jobs and start reading them."""
         try:
-            wanted = requests(*values)
-            results = [analyses.cached(analysis, r) for r in wanted]
-        except InvalidParameterError as exc:
-            return refused(str(exc)) + (no_update,)
-        if all(r is not None for r in results):
-            return (*render(results), "", wanted, False, False, no_update)
-        return (no_update,) * (n_out + len(tail)) + (n,)
-
-    running = [(Output(f"{prefix}-run", "disabled"), True, False),
-               (Output(f"{prefix}-cancel", "disabled"), False, True),
-               *((Output(name, "disabled"), True, False) for name in lock)]
-
-    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail]), Input(f"{prefix}-go", "data"), *states,
-                   background=True, prevent_initial_call=True, interval=interval, running=running,
-                   cancel=[Input(f"{prefix}-cancel", "n_clicks")],
-                   progress=[Output(f"{prefix}-progress", "value"), Output(f"{prefix}-status", "children")])
-    def compute(set_progress, _go, *values):
-        try:
-            wanted = requests(*values)
+            wanted = canonical(analysis, requests(*values))
         except InvalidParameterError as exc:
             return refused(str(exc))
-        results, message = run_each(analysis, wanted, set_progress)
-        if message:
-            return refused(message)
-        return (*render(results), "", wanted, False, False)
+        results = [cache.get(analysis, r) for r in wanted]
+        if all(r is not None for r in results):
+            return shown(results, wanted)
+        try:
+            ids = [jobs.submit_canonical(analysis, r)["id"] for r, done in zip(wanted, results, strict=True)
+                   if done is None]
+        except jobs.QueueFull as exc:
+            return refused(f"The service is busy: {exc}.")
+        return ((no_update,) * (n_out + len(tail)) + ({"jobs": ids, "requests": wanted}, False, True, False)
+                + tuple(True for _ in lock) + ("0", "queued"))
+
+    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-poll", "n_intervals"),
+                   State(f"{prefix}-go", "data"), prevent_initial_call=True)
+    def poll(_n, go):
+        """Progress of the page's jobs; the figure once every result is in the cache."""
+        ids, wanted = _waiting(go)
+        if not ids:
+            return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update)
+        current = [jobs.get(i) for i in ids]
+        for job in current:
+            if job is None or job["status"] == "cancelled":
+                return refused("", "cancelled")
+            if job["status"] == "failed":
+                return refused(f"{job['request'].get('config') or analysis}: {job['error']}")
+        if all(job["status"] == "done" for job in current):
+            try:  # the requests came back through the browser's JSON (150000.0 as 150000): canonical again
+                wanted = canonical(analysis, wanted)
+            except InvalidParameterError as exc:
+                return refused(str(exc))
+            results = [cache.get(analysis, r) for r in wanted]
+            if any(r is None for r in results):
+                return refused("A result left the cache before it could be shown; press Compute again.")
+            return shown(results, wanted)
+        fraction = sum(job["progress"] if job["status"] == "running" else 0.0 for job in current) / len(current)
+        first = next(job for job in current if job["status"] != "done")
+        label = first["request"].get("config") or analysis
+        status = (f"{label}: {first['message']}" if first["status"] == "running"
+                  else f"{label}: queued ({jobs.counts()['running']} analyses running)")
+        return (no_update,) * (n_out + len(tail) + len(state) - 2) + (str(int(100 * fraction)), status)
+
+    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-cancel", "n_clicks"),
+                   State(f"{prefix}-go", "data"), prevent_initial_call=True)
+    def cancel(_n, go):
+        ids, _ = _waiting(go)
+        for job_id in ids:
+            jobs.cancel(job_id, remove=False)
+        return refused("", "cancelled")
 
     @dash.callback(Output(f"{download.prefix}-download", "data"), Input(f"{download.prefix}-csv", "n_clicks"),
                    Input(f"{download.prefix}-json", "n_clicks"), State(store, "data"), prevent_initial_call=True)
-    def save(_csv, _json, shown):
-        if not shown:
+    def save(_csv, _json, wanted):
+        if not wanted:
             return no_update
-        results = [analyses.cached(analysis, r) for r in shown]
+        try:
+            results = [cache.get(analysis, r) for r in canonical(analysis, wanted)]
+        except InvalidParameterError:
+            return no_update
         if any(r is None for r in results):  # evicted from the cache since it was drawn: compute again first
             return no_update
+        name = download.filename(results) if download.filename else download.name
         if dash.ctx.triggered_id == f"{download.prefix}-json":
             return {"content": components.json_text(results[0] if download.single else results),
-                    "filename": f"{download.name}.json"}
+                    "filename": f"{name}.json"}
         columns, rows = download.rows(results)
-        return {"content": components.csv_text(columns, rows), "filename": f"{download.name}.csv"}
+        return {"content": components.csv_text(columns, rows), "filename": f"{name}.csv"}
+
+
+def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
+    """The job ids and requests of the store (as the client sent it back: bounded, strings only)."""
+    if not isinstance(go, dict):
+        return [], []
+    ids, wanted = go.get("jobs"), go.get("requests")
+    if (not isinstance(ids, list) or not isinstance(wanted, list) or len(ids) > settings.MAX_PAGE_REQUESTS
+            or len(wanted) > settings.MAX_PAGE_REQUESTS or not all(isinstance(i, str) and len(i) < 64 for i in ids)):
+        return [], []
+    return ids, wanted
 
 
 def _duplicate(output: Output) -> Output:
     return Output(output.component_id, output.component_property, allow_duplicate=True)
-
-
-def run_each(analysis: str, requests: list[dict[str, Any]], set_progress) -> tuple[list[dict[str, Any]], str]:
-    """Run ``analysis`` once per request inside a background callback, with one progress bar over
-    all of them: (results, "") or ([], the error message naming the field)."""
-    from . import style
-
-    results = []
-    for k, request in enumerate(requests):
-        config = request.get("config")
-        label = style.CONFIG_LABELS.get(config, analysis) if config else analysis
-
-        def report(fraction, message, k=k, label=label):
-            set_progress((str(int(100 * (k + fraction) / len(requests))), f"{label}: {message}"))
-
-        report(0.0, "starting")
-        try:
-            result, _ = analyses.run(analysis, request, report)
-        except InvalidParameterError as exc:
-            return [], str(exc)
-        except EXPECTED_ERRORS as exc:
-            return [], f"{config or analysis}: {exc}"
-        results.append(result)
-    set_progress(("100", "done"))
-    return results, ""

@@ -8,16 +8,18 @@ from __future__ import annotations
 
 import json
 import math
+import reprlib
 import time
 from typing import Any
 
 from flask import Blueprint, Response, request
+from werkzeug.exceptions import HTTPException
 
 from .. import __version__
 from ..continuation import errors as engine_errors
 from ..errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
 from ..model.parameters import PARAMETER_SPECS
-from . import analyses, jobs, schemas, settings
+from . import analyses, cache, jobs, schemas, settings
 
 PREFIX = "/api/v1"
 api = Blueprint("api", __name__, url_prefix=PREFIX)
@@ -41,45 +43,101 @@ def _clean(x):
     return x
 
 
-def error(message: str, field: str | None, allowed: str | None, status: int = 400) -> Response:
-    return _json({"error": message, "field": field, "allowed": allowed}, status)
+def error(message: str, field: str | None, allowed: str | None, status: int = 400,
+          headers: dict[str, str] | None = None) -> Response:
+    return _json({"error": message, "field": field, "allowed": allowed}, status, headers)
+
+
+class RequestRefused(Exception):
+    """A request refused before any analysis sees it (transport, size, media type, JSON syntax)."""
+
+    status = 400
+
+    def __init__(self, message: str, field: str | None, allowed: str | None, status: int | None = None,
+                 headers: dict[str, str] | None = None):
+        super().__init__(message)
+        self.field, self.allowed, self.headers = field, allowed, headers or {}
+        if status is not None:
+            self.status = status
+
+    def response(self) -> Response:
+        return error(str(self), self.field, self.allowed, self.status, self.headers)
+
+
+def _parse_int(text: str):
+    # A JSON integer too long for a float becomes inf, which every number field refuses by name
+    # (float() of the int would raise OverflowError; int() of > 4300 digits raises ValueError).
+    return int(text) if len(text) <= 18 else float(text)
+
+
+def parse_json(req) -> Any:
+    """The JSON body of ``req``: application/json only, at most MAX_BODY_BYTES, read within
+    BODY_READ_SECONDS, nested at most as deep as the parser allows; RequestRefused otherwise."""
+    mimetype = (req.mimetype or "").lower()
+    if mimetype != "application/json":
+        raise RequestRefused(f"Content-Type {req.content_type or '(none)'!r} is not accepted", "Content-Type",
+                             "application/json", 415)
+    length = req.content_length
+    if length is not None and length > settings.MAX_BODY_BYTES:
+        raise _too_large()
+    sock = req.environ.get("gunicorn.socket")
+    try:
+        if sock is not None:  # a body announced longer than sent ends in a bounded time, not at the worker timeout
+            sock.settimeout(settings.BODY_READ_SECONDS)
+        raw = req.get_data(cache=True)
+    except (OSError, HTTPException) as exc:
+        if isinstance(exc, HTTPException) and exc.code == 413:
+            raise _too_large() from None
+        raise RequestRefused(f"the request body did not arrive complete within {settings.BODY_READ_SECONDS:g} s "
+                             f"({type(exc).__name__})", "body", f"Content-Length bytes within "
+                             f"{settings.BODY_READ_SECONDS:g} s", 408, {"Connection": "close"}) from None
+    finally:
+        if sock is not None:
+            try:
+                sock.settimeout(None)
+            except OSError:
+                pass
+    if len(raw) > settings.MAX_BODY_BYTES:
+        raise _too_large()
+    if not raw.strip():
+        raise RequestRefused("body is empty; allowed: a JSON object", "body", "a JSON object")
+    try:
+        # NaN/Infinity parse to floats and are refused by the field they are in
+        return json.loads(raw, parse_int=_parse_int)
+    except RecursionError:
+        raise RequestRefused("body is nested too deeply", "body", "a JSON object nested at most a few hundred "
+                             "levels") from None
+    except ValueError as exc:
+        raise RequestRefused(f"body={reprlib.repr(raw[:80].decode('utf-8', 'replace'))} is not valid JSON ({exc})",
+                             "body", "a JSON object") from None
+
+
+def _too_large() -> RequestRefused:
+    return RequestRefused(f"request body above the limit of {settings.MAX_BODY_BYTES} bytes", "body",
+                          f"at most {settings.MAX_BODY_BYTES} bytes", 413)
 
 
 def _body() -> Any:
-    length = request.content_length
-    if length is not None and length > settings.MAX_BODY_BYTES:
-        raise _TooLarge()
-    raw = request.get_data(cache=False)
-    if len(raw) > settings.MAX_BODY_BYTES:
-        raise _TooLarge()
-    if not raw.strip():
-        raise InvalidParameterError("body", "", "a JSON object", "is empty")
-    try:
-        return json.loads(raw)  # NaN/Infinity parse to floats and are refused by the field they are in
-    except ValueError as exc:
-        raise InvalidParameterError("body", raw[:80].decode("utf-8", "replace"), "a JSON object",
-                                    f"is not valid JSON ({exc})") from None
+    return parse_json(request)
 
 
-class _TooLarge(Exception):
-    pass
+@api.errorhandler(RequestRefused)
+def _refused(exc: RequestRefused):
+    return exc.response()
 
 
 @api.errorhandler(InvalidParameterError)  # listed with the engine's class: Flask follows the MRO,
 @api.errorhandler(engine_errors.InvalidInputError)  # where ShimmyError comes before the engine's class
 def _invalid(exc: engine_errors.InvalidInputError):
-    return _json(exc.to_dict(), 422 if exc.field != "body" else 400)
+    message = str(exc)
+    if len(message) > 600:  # a huge value is named, not echoed back whole
+        message = f"{exc.field}={reprlib.repr(exc.value)} is refused; allowed: {exc.allowed}"
+    return error(message, exc.field, exc.allowed, 400 if exc.field == "body" else 422)
 
 
 @api.errorhandler(GeometryError)
 def _geometry(exc: GeometryError):
     return error(str(exc), "params", "a design whose NES roller stays on its track", 422)
-
-
-@api.errorhandler(_TooLarge)
-def _too_large(exc):
-    return error(f"request body above the limit of {settings.MAX_BODY_BYTES} bytes", "body",
-                 f"at most {settings.MAX_BODY_BYTES} bytes", 413)
 
 
 @api.errorhandler(ConvergenceError)
@@ -97,15 +155,22 @@ def _shimmy(exc: Exception):
 @api.route("/<path:anything>", methods=["GET", "POST", "PUT", "PATCH", "DELETE"])
 def _unmatched(anything: str):
     """Everything under /api/v1 that no endpoint takes: 405 for a known path, else 404 (JSON)."""
-    methods = sorted(m for m in _METHODS.get("/" + anything, ()) if m not in ("HEAD", "OPTIONS"))
+    route = "/jobs/{id}" if anything.startswith("jobs/") and anything.count("/") == 1 else "/" + anything
+    methods = sorted(m for m in _METHODS.get(route, ()) if m not in ("HEAD", "OPTIONS"))
     if methods:
-        return error(f"method {request.method} not allowed on {request.path}", "method", ", ".join(methods), 405)
+        return error(f"method {request.method} not allowed on {request.path}", "method", ", ".join(methods), 405,
+                     {"Allow": ", ".join(methods)})
     return error(f"no such endpoint: {request.method} {request.path}", "path", f"see {PREFIX}/openapi.json", 404)
 
 
 @api.get("/health")
 def health():
-    return _json({"status": "ok", "version": __version__, "time": time.time()})
+    """ok (200), or degraded (503) when the cache cannot store and return a value."""
+    state = cache.health()
+    body = {"status": "ok" if state["ok"] else "degraded", "version": __version__, "time": time.time()}
+    if not state["ok"]:
+        body["cache"] = state["detail"]
+    return _json(body, 200 if state["ok"] else 503)
 
 
 @api.get("/parameters")
@@ -149,7 +214,11 @@ def submit_job():
     if not isinstance(analysis, str):
         raise InvalidParameterError("analysis", analysis, "one of " + ", ".join(schemas.JOB_ANALYSES),
                                     "is not a string")
-    job = jobs.submit(analysis, body)
+    try:
+        job = jobs.submit(analysis, body)
+    except jobs.QueueFull as exc:
+        return error(str(exc), "analysis", f"a job once fewer than {settings.MAX_QUEUED_JOBS} are queued", 503,
+                     {"Retry-After": str(exc.retry_after)})
     return _json(jobs.public(job, with_result=False), 202, headers={"Location": f"{PREFIX}/jobs/{job['id']}"})
 
 
@@ -175,7 +244,8 @@ def cancel_job(job_id: str):
 
 
 _METHODS = {"/health": ("GET",), "/parameters": ("GET",), "/simulate": ("POST",), "/hopf": ("POST",),
-            "/stability": ("POST",), "/devices": ("POST",), "/jobs": ("POST",), "/openapi.json": ("GET",)}
+            "/stability": ("POST",), "/devices": ("POST",), "/jobs": ("POST",), "/jobs/{id}": ("GET", "DELETE"),
+            "/openapi.json": ("GET",)}
 
 
 @api.get("/openapi.json")
@@ -194,7 +264,8 @@ def openapi_document() -> dict[str, Any]:
             "progress": {"type": "number", "minimum": 0, "maximum": 1}, "message": {"type": "string"},
             "error": {"type": ["string", "null"]}, "request": {"type": "object"}, "result": {"type": "object"}}}}
     paths: dict[str, Any] = {
-        "/health": {"get": {"summary": "liveness", "responses": {"200": {"description": "ok"}}}},
+        "/health": {"get": {"summary": "liveness and a working cache", "responses": {
+            "200": {"description": "ok"}, "503": {"description": "degraded: the cache cannot store results"}}}},
         "/parameters": {"get": {"summary": "every parameter with unit, default, range and provenance",
                                 "responses": {"200": {"description": "the parameter table"}}}},
     }
@@ -204,8 +275,8 @@ def openapi_document() -> dict[str, Any]:
         paths[f"/{name}"] = {"post": {
             "summary": s.summary, "requestBody": {"required": True, "content": {"application/json": {
                 "schema": {"$ref": f"#/components/schemas/{name}_request"}}}},
-            "responses": {"200": {"description": "the result (X-Shimmy-Cache: hit|miss)"}, "400": err, "413": err,
-                          "422": err}}}
+            "responses": {"200": {"description": "the result (X-Shimmy-Cache: hit|miss)"}, "400": err, "408": err,
+                          "413": err, "415": err, "422": err}}}
     job_bodies = []
     for name in schemas.JOB_ANALYSES:
         s = schemas.SCHEMAS[name]
@@ -218,16 +289,22 @@ def openapi_document() -> dict[str, Any]:
         "summary": "start a long analysis (" + ", ".join(schemas.JOB_ANALYSES) + ")",
         "requestBody": {"required": True, "content": {"application/json": {"schema": {"oneOf": job_bodies}}}},
         "responses": {"202": {"description": "accepted", "content": {"application/json": {
-            "schema": {"$ref": "#/components/schemas/Job"}}}}, "400": err, "413": err, "422": err}}}
+            "schema": {"$ref": "#/components/schemas/Job"}}}}, "400": err, "408": err, "413": err, "415": err,
+            "422": err, "503": {**err, "description": "the job queue is full",
+                                "headers": {"Retry-After": {"schema": {"type": "integer"}}}}}}}
     paths["/jobs/{id}"] = {
         "parameters": [{"name": "id", "in": "path", "required": True, "schema": {"type": "string"}}],
         "get": {"summary": "status, progress and (when done) the result", "responses": {
             "200": {"description": "the job", "content": {"application/json": {
                 "schema": {"$ref": "#/components/schemas/Job"}}}}, "404": err}},
-        "delete": {"summary": "cancel", "responses": {"200": {"description": "the cancelled job"}, "404": err}}}
+        "delete": {"summary": "cancel the job and delete it (later reads answer 404)", "responses": {
+            "200": {"description": "the job as cancelled", "content": {"application/json": {
+                "schema": {"$ref": "#/components/schemas/Job"}}}}, "404": err}}}
     return {"openapi": "3.1.0",
             "info": {"title": "shimmy API", "version": __version__,
                      "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Limits: "
                                     f"body <= {settings.MAX_BODY_BYTES} bytes, t_end <= {settings.MAX_T_END:g} s, "
-                                    f"ntst <= {settings.MAX_NTST}."},
+                                    f"ntst <= {settings.MAX_NTST}; at most {settings.MAX_RUNNING_JOBS} jobs run and "
+                                    f"{settings.MAX_QUEUED_JOBS} wait queued (then 503 with Retry-After); an identical "
+                                    "request already queued or running is that job. POST bodies: application/json."},
             "servers": [{"url": PREFIX}], "paths": paths, "components": {"schemas": comps}}

@@ -3,12 +3,24 @@
 Key: SHA-256 of the canonical JSON of {analysis, canonical request (every parameter and
 numerical option, defaults filled in), schema version, package version}. Values are the
 JSON-ready result dicts. diskcache is process- and thread-safe on one directory, so all
-gunicorn workers, the job workers and the Dash background manager share it.
+gunicorn workers, the job workers and the Dash pages share it.
+
+A damaged cache never stops an analysis: an entry that cannot be read is a miss (logged,
+removed, recomputed); a database that cannot be opened or queried is moved aside and rebuilt
+empty; a directory deleted under a running server is recreated (every handle follows the
+inode of its ``cache.db``, so all processes meet again in the new one). Where even that fails
+the analyses answer uncached and :func:`health` says why (the API's health answers 503).
 """
 
 from __future__ import annotations
 
 import functools
+import logging
+import os
+import pathlib
+import shutil
+import sqlite3
+import time
 from typing import Any, Callable
 
 import diskcache
@@ -17,14 +29,59 @@ from .. import __version__
 from ..model.parameters import canonical_digest
 from . import settings
 
+log = logging.getLogger(__name__)
+#: What a damaged store raises: sqlite errors, a truncated or garbled pickle, a vanished file.
+DAMAGE = (sqlite3.Error, OSError, EOFError, ValueError, TypeError, AttributeError, ImportError, IndexError,
+          KeyError, UnicodeDecodeError, __import__("pickle").UnpicklingError)
 
-@functools.lru_cache(maxsize=None)
-def _open(path: str, size_limit: int) -> diskcache.Cache:
-    return diskcache.Cache(path, size_limit=size_limit, eviction_policy="least-recently-stored")
+
+def identity(path: pathlib.Path) -> tuple[int, int]:
+    """(device, inode) of ``path``/cache.db; (0, 0) if it is missing."""
+    try:
+        st = os.stat(path / "cache.db")
+    except OSError:
+        return (0, 0)
+    return (st.st_dev, st.st_ino)
+
+
+@functools.lru_cache(maxsize=64)
+def _open(path: str, ident: tuple[int, int], size_limit: int | None) -> diskcache.Cache:
+    kwargs = {} if size_limit is None else {"size_limit": size_limit, "eviction_policy": "least-recently-stored"}
+    return diskcache.Cache(path, **kwargs)
+
+
+def open_store(path: pathlib.Path, size_limit: int | None = None) -> diskcache.Cache:
+    """The diskcache at ``path``, (re)built when it is missing, replaced or unreadable."""
+    for attempt in range(2):
+        ident = identity(path)
+        try:
+            if ident == (0, 0):  # missing (or deleted under us): create it, then key the handle by its inode
+                path.mkdir(mode=0o700, parents=True, exist_ok=True)
+                diskcache.Cache(str(path)).close()
+                ident = identity(path)
+            handle = _open(str(path), ident, size_limit)
+            handle.get("__probe__")  # a damaged database fails here, not in the caller's query
+            return handle
+        except DAMAGE as exc:
+            if attempt:
+                raise
+            quarantine(path, exc)
+    raise AssertionError("unreachable")
+
+
+def quarantine(path: pathlib.Path, exc: BaseException) -> None:
+    """Move a damaged store aside (kept for inspection, named .broken-TIME) so it is rebuilt empty."""
+    aside = path.with_name(f"{path.name}.broken-{time.time():.0f}-{os.getpid()}")
+    log.error("cache %s is damaged (%s: %s); moved to %s and rebuilt empty", path, type(exc).__name__, exc, aside)
+    _open.cache_clear()
+    try:
+        path.rename(aside)
+    except OSError:
+        shutil.rmtree(path, ignore_errors=True)
 
 
 def results() -> diskcache.Cache:
-    return _open(str(settings.cache_dir() / "results"), settings.cache_size_limit())
+    return open_store(settings.cache_dir() / "results", settings.cache_size_limit())
 
 
 def key(analysis: str, request: dict[str, Any]) -> str:
@@ -33,16 +90,57 @@ def key(analysis: str, request: dict[str, Any]) -> str:
 
 
 def get(analysis: str, request: dict[str, Any]) -> dict[str, Any] | None:
-    return results().get(key(analysis, request))
+    return get_key(key(analysis, request))
+
+
+def get_key(k: str) -> dict[str, Any] | None:
+    """The cached value of ``k``, or None: a missing, unreadable or damaged entry is a miss."""
+    try:
+        store = results()
+    except DAMAGE as exc:
+        log.error("result cache unusable, answering uncached: %s", exc)
+        return None
+    try:
+        return store.get(k)
+    except DAMAGE as exc:
+        log.warning("cache entry %s unreadable (%s: %s): removed, will be recomputed", k[:12], type(exc).__name__,
+                    exc)
+        try:
+            store.delete(k)
+        except DAMAGE:
+            quarantine(settings.cache_dir() / "results", exc)
+        return None
+
+
+def put(k: str, value: dict[str, Any]) -> None:
+    try:
+        results().set(k, value)
+    except DAMAGE as exc:
+        log.error("result not cached (%s: %s)", type(exc).__name__, exc)
 
 
 def get_or_compute(analysis: str, request: dict[str, Any],
                    compute: Callable[[], dict[str, Any]]) -> tuple[dict[str, Any], bool]:
     """(result, True if it came from the cache)."""
     k = key(analysis, request)
-    found = results().get(k)
+    found = get_key(k)
     if found is not None:
         return found, True
     value = compute()
-    results().set(k, value)
+    put(k, value)
     return value, False
+
+
+def health() -> dict[str, Any]:
+    """{"ok": bool, "detail": str}: a value written to each store can be read back."""
+    try:
+        root = settings.cache_dir()
+        for name in ("results", "jobs"):
+            store = open_store(root / name)
+            probe = f"__health__{os.getpid()}"
+            store.set(probe, name, expire=60)
+            if store.get(probe) != name:
+                return {"ok": False, "detail": f"the {name} store does not return what was written"}
+    except Exception as exc:  # noqa: BLE001 - whatever is wrong is what health reports
+        return {"ok": False, "detail": f"{type(exc).__name__}: {exc}"}
+    return {"ok": True, "detail": str(root)}

@@ -1,118 +1,154 @@
 """Background jobs for long analyses, shared by every process through the cache directory.
 
-A job record lives in a diskcache store next to the results: id, analysis, canonical
-request, status (queued | running | done | failed | cancelled), progress 0-1, message,
-error, timestamps, the worker's pid and host, and a heartbeat. :func:`submit` answers at
-once from the result cache when it can; otherwise it starts a worker process
-(``python -m shimmy.service.worker ID``, its own session so it outlives the request and
-can be killed as a group) which waits for one of ``MAX_RUNNING_JOBS`` slots, runs the
-analysis with a progress callback, and stores the result in the shared cache.
+One admission control for the API and the workbench pages. A job record lives in a
+diskcache store next to the results: id, analysis, canonical request, status (queued |
+running | done | failed | cancelled), progress 0-1, message, error, timestamps. Besides the
+records the store holds the queue (ids waiting, in order, at most ``MAX_QUEUED_JOBS``), the
+running map (id -> the process that holds one of ``MAX_RUNNING_JOBS`` slots) and an index
+result key -> active job, so that an identical request already queued or running is that job.
 
-Nothing stays running forever: the worker beats every second; a queued or running job
-whose heartbeat is older than ``JOB_STALE_SECONDS`` (its worker died, the server was
-restarted) is marked failed with that reason when it is next read. Cancelling sets the
-status, which the worker's progress callback notices (it then stops), and terminates the
-worker's process group if it runs on this host.
+A queued job holds no process. :func:`pump` (called on every submit, read and cancel, and by a
+worker when it finishes) starts a worker for the first queued jobs while slots are free:
+``python -m shimmy.service.worker ID`` in its own session, so that it outlives the request and
+its whole process group (process pool, forkserver, resource tracker) can be ended at once. A
+worker that finishes takes the next queued job itself, in the same slot.
+
+A job is failed only when its process is gone: the process is identified by pid and start
+time (psutil), so a late heartbeat under load fails nothing, and a dead one never stays
+running. Whoever finds the process gone (the thread in the web worker that started it, or
+any later read) ends what is left of its process group with SIGKILL. A heartbeat is kept
+only for workers on another host sharing the directory.
 """
 
 from __future__ import annotations
 
-import functools
+import logging
 import os
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 import uuid
 from typing import Any
 
 import diskcache
+import psutil
 
 from . import cache, schemas, settings
 
 ACTIVE = ("queued", "running")
+HOST = socket.gethostname()
+log = logging.getLogger(__name__)
 
 
-@functools.lru_cache(maxsize=None)
-def _open(path: str) -> diskcache.Cache:
-    return diskcache.Cache(path)
+class QueueFull(Exception):
+    """The queue holds MAX_QUEUED_JOBS jobs already: try again after ``retry_after`` seconds."""
+
+    def __init__(self, queued: int, running: int):
+        self.queued, self.running = queued, running
+        self.retry_after = settings.JOB_RETRY_AFTER_SECONDS
+        super().__init__(f"the job queue is full ({queued} queued, {running} running); "
+                         f"try again in {self.retry_after} s")
 
 
 def store() -> diskcache.Cache:
-    return _open(str(settings.cache_dir() / "jobs"))
+    return cache.open_store(settings.cache_dir() / "jobs")
 
 
 def _now() -> float:
     return time.time()
 
 
-def _put(job: dict[str, Any]) -> dict[str, Any]:
+def _put(s: diskcache.Cache, job: dict[str, Any]) -> dict[str, Any]:
     job["updated"] = _now()
-    store().set(("job", job["id"]), job)
+    s.set(("job", job["id"]), job)
     return job
 
 
 def update(job_id: str, **changes) -> dict[str, Any] | None:
     """Apply ``changes`` to a job atomically; a finished job is never reopened."""
-    with store().transact():
-        job = store().get(("job", job_id))
+    s = store()
+    with s.transact():
+        job = s.get(("job", job_id))
         if job is None:
             return None
         if job["status"] not in ACTIVE and "status" in changes:
             return job  # done/failed/cancelled are final
         job.update(changes)
-        return _put(job)
+        if job["status"] not in ACTIVE and s.get(("active", job["result_key"])) == job_id:
+            s.delete(("active", job["result_key"]))
+        return _put(s, job)
 
 
 def submit(analysis: str, body: dict[str, Any]) -> dict[str, Any]:
-    """Validate, create the job and start its worker (or finish it from the cache at once)."""
+    """The job for ``body``: done at once from the cache, the same job when an identical one is
+    queued or running, else a new queued job (QueueFull when the queue is full)."""
     if analysis not in schemas.JOB_ANALYSES:
         from ..model.parameters import unknown_name_error
 
         raise unknown_name_error(analysis, list(schemas.JOB_ANALYSES), "analysis")
     request = schemas.validate(analysis, body, extra=("analysis",))
+    return submit_canonical(analysis, request)
+
+
+def submit_canonical(analysis: str, request: dict[str, Any]) -> dict[str, Any]:
+    key = cache.key(analysis, request)
     job = {"id": uuid.uuid4().hex, "analysis": analysis, "request": request, "status": "queued",
            "progress": 0.0, "message": "queued", "error": None, "created": _now(), "heartbeat": _now(),
-           "pid": None, "host": socket.gethostname(), "result_key": cache.key(analysis, request)}
-    if cache.results().get(job["result_key"]) is not None:
+           "result_key": key}
+    s = store()
+    if cache.get_key(key) is not None:
         job.update(status="done", progress=1.0, message="from the cache")
-        return _put(job)
-    _put(job)
-    proc = subprocess.Popen([sys.executable, "-m", "shimmy.service.worker", job["id"]], start_new_session=True,
-                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            env={**os.environ, "SHIMMY_CACHE_DIR": str(settings.cache_dir())})
-    return update(job["id"], pid=proc.pid) or job
+        return _put(s, job)
+    _reap(s)
+    with s.transact():
+        same = s.get(("active", key))
+        existing = s.get(("job", same)) if same else None
+        if existing is not None and existing["status"] in ACTIVE:
+            return existing
+        queue = s.get("queue", [])
+        if len(queue) >= settings.MAX_QUEUED_JOBS:
+            raise QueueFull(len(queue), len(s.get("running", {})))
+        _put(s, job)
+        s.set("queue", [*queue, job["id"]])
+        s.set(("active", key), job["id"])
+    pump()
+    return store().get(("job", job["id"])) or job
 
 
 def get(job_id: str) -> dict[str, Any] | None:
-    """The job, with a stale queued/running one marked failed first."""
-    job = store().get(("job", job_id))
-    if job is None:
-        return None
-    if job["status"] in ACTIVE and _now() - job["heartbeat"] > settings.JOB_STALE_SECONDS:
-        job = update(job_id, status="failed", error=(
-            f"the worker running this job stopped (no heartbeat for more than {settings.JOB_STALE_SECONDS:g} s, "
-            "e.g. a server restart); submit it again")) or job
-    return job
+    """The job, after failing jobs whose process is gone and starting queued ones on free slots."""
+    pump()
+    return store().get(("job", job_id))
 
 
-def cancel(job_id: str) -> dict[str, Any] | None:
-    job = get(job_id)
-    if job is None or job["status"] not in ACTIVE:
-        return job
-    job = update(job_id, status="cancelled", message="cancelled by request", progress=job["progress"])
-    pid = job.get("pid")
-    if pid and job.get("host") == socket.gethostname():
-        try:
-            os.killpg(pid, signal.SIGTERM)
-        except (ProcessLookupError, PermissionError):
-            pass
+def cancel(job_id: str, remove: bool = True) -> dict[str, Any] | None:
+    """Cancel a job (a queued one leaves the queue; a running one's process group is ended) and,
+    with ``remove``, delete its record: (the job as it was cancelled) or None if unknown."""
+    s = store()
+    with s.transact():
+        job = s.get(("job", job_id))
+        if job is None:
+            return None
+        if job["status"] in ACTIVE:
+            job.update(status="cancelled", message="cancelled by request")
+            s.set("queue", [j for j in s.get("queue", []) if j != job_id])
+            if s.get(("active", job["result_key"])) == job_id:
+                s.delete(("active", job["result_key"]))
+            _put(s, job)
+        holder = s.get("running", {}).get(job_id)
+        if remove:
+            s.delete(("job", job_id))
+    if holder is not None:
+        _signal_group(holder, signal.SIGTERM)
+    pump()
     return job
 
 
 def result(job: dict[str, Any]) -> dict[str, Any] | None:
-    return cache.results().get(job["result_key"]) if job["status"] == "done" else None
+    return cache.get_key(job["result_key"]) if job["status"] == "done" else None
 
 
 def public(job: dict[str, Any], with_result: bool = True) -> dict[str, Any]:
@@ -124,6 +160,121 @@ def public(job: dict[str, Any], with_result: bool = True) -> dict[str, Any]:
     return out
 
 
+def counts() -> dict[str, int]:
+    s = store()
+    return {"queued": len(s.get("queue", [])), "running": len(s.get("running", {}))}
+
+
+# -- processes -------------------------------------------------------------------------------
+
+
+def pump() -> None:
+    """Fail jobs whose process is gone, then start workers for queued jobs on free slots."""
+    s = store()
+    _reap(s)
+    starting = []
+    with s.transact():
+        running = dict(s.get("running", {}))
+        queue = list(s.get("queue", []))
+        while queue and len(running) < settings.MAX_RUNNING_JOBS:
+            job_id = queue.pop(0)
+            job = s.get(("job", job_id))
+            if job is None or job["status"] != "queued":
+                continue
+            running[job_id] = {"pid": None, "started": None, "host": HOST, "claimed": _now()}
+            starting.append(job_id)
+        s.set("queue", queue)
+        s.set("running", running)
+    for job_id in starting:
+        _start(s, job_id)
+
+
+def _start(s: diskcache.Cache, job_id: str) -> None:
+    try:
+        proc = subprocess.Popen([sys.executable, "-m", "shimmy.service.worker", job_id], start_new_session=True,
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                env={**os.environ, "SHIMMY_CACHE_DIR": str(settings.cache_dir())})
+    except OSError as exc:
+        _release(s, job_id)
+        update(job_id, status="failed", error=f"could not start a worker: {exc}")
+        return
+    holder = {"pid": proc.pid, "started": _create_time(proc.pid), "host": HOST, "claimed": _now()}
+    with s.transact():
+        running = dict(s.get("running", {}))
+        if job_id in running and running[job_id]["pid"] is None:
+            running[job_id] = holder
+            s.set("running", running)
+    threading.Thread(target=_wait, args=(proc, job_id), daemon=True, name=f"job-{job_id[:8]}").start()
+
+
+def _wait(proc: subprocess.Popen, job_id: str) -> None:
+    """In the process that started a worker: reap it, end what is left of its group, fail the job
+    it held (if it ended without finishing it) and start the next queued ones."""
+    code = proc.wait()
+    _signal_group({"pid": proc.pid, "host": HOST}, signal.SIGKILL)
+    try:
+        s = store()
+        for held, holder in list(s.get("running", {}).items()):
+            if holder.get("pid") == proc.pid and holder.get("host") == HOST:
+                _release(s, held, holder)
+                update(held, status="failed", error=_death(code))
+        pump()
+    except Exception:  # noqa: BLE001 - a broken store is reported by health; this thread must not die loudly
+        log.exception("after the worker of job %s", job_id)
+
+
+def _death(code: int | None = None) -> str:
+    how = "" if code is None else (f" (killed by signal {-code})" if code < 0 else f" (exit status {code})")
+    return f"the process running this job ended without a result{how}; submit it again"
+
+
+def _reap(s: diskcache.Cache) -> None:
+    """Fail every job whose slot holder is gone, and end what is left of its process group."""
+    gone = [(job_id, holder) for job_id, holder in list(s.get("running", {}).items())
+            if not _alive(s, job_id, holder)]
+    for job_id, holder in gone:
+        _signal_group(holder, signal.SIGKILL)
+        _release(s, job_id, holder)
+        update(job_id, status="failed", error=_death())
+
+
+def _alive(s: diskcache.Cache, job_id: str, holder: dict[str, Any]) -> bool:
+    if holder.get("host") != HOST:  # another machine's worker: only its heartbeat can tell
+        job = s.get(("job", job_id))
+        return job is not None and _now() - job["heartbeat"] <= settings.JOB_STALE_SECONDS
+    if holder.get("pid") is None:  # being started: Popen returns within milliseconds
+        return _now() - holder.get("claimed", 0) < settings.JOB_START_SECONDS
+    try:
+        p = psutil.Process(holder["pid"])
+        return p.status() != psutil.STATUS_ZOMBIE and abs(p.create_time() - holder["started"]) < 0.05
+    except (psutil.NoSuchProcess, psutil.AccessDenied, TypeError):
+        return False
+
+
+def _create_time(pid: int) -> float | None:
+    try:
+        return psutil.Process(pid).create_time()
+    except psutil.Error:
+        return None
+
+
+def _signal_group(holder: dict[str, Any], sig: int) -> None:
+    pid = holder.get("pid")
+    if pid and holder.get("host") == HOST:
+        try:
+            os.killpg(pid, sig)  # the worker leads its own session: the group id is its pid
+        except (ProcessLookupError, PermissionError):
+            pass
+
+
+def _release(s: diskcache.Cache, job_id: str, holder: dict[str, Any] | None = None) -> None:
+    with s.transact():
+        running = dict(s.get("running", {}))
+        if job_id in running and (holder is None or running[job_id] == holder):
+            del running[job_id]
+            s.set("running", running)
+
+
 # -- the worker side -------------------------------------------------------------------------
 
 
@@ -132,67 +283,70 @@ class Cancelled(Exception):
 
 
 def run(job_id: str) -> None:
-    """Run job ``job_id`` in this process (called by ``python -m shimmy.service.worker``)."""
-    import threading
-
-    from . import analyses
-
-    job = store().get(("job", job_id))
-    if job is None:
-        return
+    """Run job ``job_id`` in this process (``python -m shimmy.service.worker``), then the next
+    queued jobs in the same slot until the queue is empty."""
+    me = {"pid": os.getpid(), "started": _create_time(os.getpid()), "host": HOST}
     stop = threading.Event()
+    current = [job_id]
 
     def beat():
         while not stop.wait(1.0):
-            update(job_id, heartbeat=_now())
+            update(current[0], heartbeat=_now())
 
     threading.Thread(target=beat, daemon=True).start()
     try:
-        _wait_for_slot(job_id)
-        if store().get(("job", job_id))["status"] != "queued":
-            return
-        update(job_id, status="running", message="running", pid=os.getpid())
-
-        def progress(fraction: float, message: str) -> None:
-            current = update(job_id, progress=float(min(max(fraction, 0.0), 1.0)), message=message)
-            if current is None or current["status"] == "cancelled":
-                raise Cancelled()
-
-        try:
-            analyses.run_canonical(job["analysis"], job["request"], progress)
-        except Cancelled:
-            return
-        except Exception as exc:  # noqa: BLE001 - every failure is reported on the job
-            update(job_id, status="failed", error=f"{type(exc).__name__}: {exc}")
-            return
-        update(job_id, status="done", progress=1.0, message="done")
+        while job_id is not None:
+            current[0] = job_id
+            if not _run_one(job_id):  # cancelled: the canceller's SIGTERM for this group is on its way
+                return
+            job_id = _next(job_id, me)
     finally:
-        _release_slot(job_id)
         stop.set()
 
 
-def _wait_for_slot(job_id: str) -> None:
-    s = store()
-    while True:
-        with s.transact():
-            running = {k for k in s.get("slots", set()) if _alive(k)}
-            if len(running) < settings.MAX_RUNNING_JOBS:
-                s.set("slots", running | {job_id})
-                return
-            s.set("slots", running)
-        job = s.get(("job", job_id))
-        if job is None or job["status"] != "queued":
-            return
-        update(job_id, message=f"queued: {len(running)} analyses running")
-        time.sleep(0.5)
+def _run_one(job_id: str) -> bool:
+    """Run one job; False if it was cancelled."""
+    from . import analyses
+
+    job = update(job_id, status="running", message="running", heartbeat=_now())
+    if job is None or job["status"] != "running":
+        return job is not None and job["status"] != "cancelled"
+
+    def progress(fraction: float, message: str) -> None:
+        now = update(job_id, progress=float(min(max(fraction, 0.0), 1.0)), message=message)
+        if now is None or now["status"] == "cancelled":
+            raise Cancelled()
+
+    try:
+        analyses.run_canonical(job["analysis"], job["request"], progress)
+    except Cancelled:
+        return False
+    except Exception as exc:  # noqa: BLE001 - every failure is reported on the job
+        update(job_id, status="failed", error=f"{type(exc).__name__}: {exc}")
+        return True
+    update(job_id, status="done", progress=1.0, message="done")
+    return True
 
 
-def _release_slot(job_id: str) -> None:
+def _next(finished: str, me: dict[str, Any]) -> str | None:
+    """Hand this process's slot from ``finished`` to the first queued job, or give it up."""
     s = store()
     with s.transact():
-        s.set("slots", set(s.get("slots", set())) - {job_id})
-
-
-def _alive(job_id: str) -> bool:
-    job = store().get(("job", job_id))
-    return job is not None and job["status"] in ACTIVE and _now() - job["heartbeat"] <= settings.JOB_STALE_SECONDS
+        running = dict(s.get("running", {}))
+        running.pop(finished, None)
+        queue = list(s.get("queue", []))
+        nxt = None
+        while queue:
+            candidate = queue.pop(0)
+            job = s.get(("job", candidate))
+            if job is not None and job["status"] == "queued":
+                nxt = candidate
+                break
+        if nxt is not None and len(running) < settings.MAX_RUNNING_JOBS:
+            running[nxt] = {**me, "claimed": _now()}
+        elif nxt is not None:
+            queue.insert(0, nxt)
+            nxt = None
+        s.set("queue", queue)
+        s.set("running", running)
+    return nxt

@@ -21,6 +21,13 @@ from ..model.parameters import (FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, P
 CONFIGS = tuple(c.value for c in Configuration)
 
 
+def _huge(value: Any) -> Any:
+    """An integer beyond float range as inf (refused as not finite, by name) instead of an OverflowError."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 1e308:
+        return float("inf") if value > 0 else float("-inf")
+    return value
+
+
 @dataclass(frozen=True)
 class Field:
     name: str
@@ -54,7 +61,7 @@ class Field:
         if self.kind in ("number", "integer"):
             if isinstance(value, str):  # JSON numbers only: "30" is a type error in a body
                 raise InvalidParameterError(self.name, value, self.allowed, "is not a number")
-            number = check_number(self.name, value, self.low, self.high, self.unit, self.kind == "integer")
+            number = check_number(self.name, _huge(value), self.low, self.high, self.unit, self.kind == "integer")
             return int(number) if self.kind == "integer" else number
         if self.kind == "boolean":
             if not isinstance(value, bool):
@@ -73,7 +80,7 @@ class Field:
             for k, v in enumerate(value):
                 if isinstance(v, (str, bool)) or v is None:
                     raise InvalidParameterError(f"{self.name}[{k}]", v, "a number", "is not a number")
-                out.append(check_number(f"{self.name}[{k}]", v, -1e300, 1e300))  # ranges: per parameter
+                out.append(check_number(f"{self.name}[{k}]", _huge(v), -1e300, 1e300))  # ranges: per parameter
             return out
         if self.kind == "strings":
             if not isinstance(value, list) or not value:
@@ -95,8 +102,12 @@ class Field:
             out["enum"] = list(self.choices)
         if self.default is not None:
             out["default"] = self.default
-        if self.kind == "object":
-            out["additionalProperties"] = {"type": "number"}
+        if self.kind == "object":  # exactly the parameter names the server takes, each with its range
+            out["additionalProperties"] = False
+            out["properties"] = {
+                name: {"type": "integer" if spec.integer else "number", "minimum": spec.low, "maximum": spec.high,
+                       "description": spec.description + (f" ({spec.unit})" if spec.unit else "")}
+                for name, spec in PARAMETER_SPECS.items()}
         if self.kind in ("numbers", "strings"):
             out["type"] = "array"
             out.pop("minimum", None)
@@ -185,7 +196,7 @@ def design(overrides: Mapping[str, Any], material: str | None) -> dict[str, floa
             spec = PARAMETER_SPECS[name]
             raise InvalidParameterError(f"params.{name}", value, spec.allowed, "is not a number")
     try:
-        params = params.with_overrides(overrides)
+        params = params.with_overrides({name: _huge(value) for name, value in overrides.items()})
     except InvalidParameterError as exc:
         name = exc.field if exc.field in PARAMETER_SPECS else next(iter(overrides), exc.field)
         raise InvalidParameterError(f"params.{name}", exc.value, exc.allowed, message=str(exc)) from None

@@ -11,6 +11,8 @@ SCHEMA_VERSION = 1
 
 #: Limits on what one request may ask for (refused with 4xx naming the limit).
 MAX_BODY_BYTES = 64 * 1024
+#: A request body must arrive within this many seconds of the app asking for it (else 408).
+BODY_READ_SECONDS = float(os.environ.get("SHIMMY_BODY_READ_SECONDS", "10"))
 MAX_T_END = 600.0  # s of simulated time per request
 MAX_SERIES_POINTS = 200_000  # samples per returned time series (t_end / dt_out)
 MAX_NTST = 200
@@ -18,16 +20,39 @@ MAX_MAP_SLICES = 80  # Fz slices of one map (40 take ~20 s on 2 cores)
 MAX_MAP_SPEEDS = 400  # speeds per slice on a map's output grid
 MAX_STUDY_VALUES = 50  # values per study parameter
 MAX_STUDY_UNITS = 200  # diagrams per study (designs x configurations, ~0.5-2 s each)
-MAX_RUNNING_JOBS = 2  # at most this many analyses run at once on this host; others wait queued
-#: A queued/running job whose heartbeat is older than this has lost its worker (SHIMMY_JOB_STALE_SECONDS).
+#: Admission control of jobs, shared by the API and the workbench pages (SHIMMY_MAX_RUNNING_JOBS,
+#: SHIMMY_MAX_QUEUED_JOBS): at most this many run at once on this host, each in its own process;
+#: at most this many more wait queued, holding no process; beyond that a submission is refused
+#: (503 with Retry-After: JOB_RETRY_AFTER_SECONDS).
+MAX_RUNNING_JOBS = int(os.environ.get("SHIMMY_MAX_RUNNING_JOBS", "2"))
+MAX_QUEUED_JOBS = int(os.environ.get("SHIMMY_MAX_QUEUED_JOBS", "8"))
+JOB_RETRY_AFTER_SECONDS = int(os.environ.get("SHIMMY_JOB_RETRY_AFTER_SECONDS", "30"))
+#: A worker being started that has not been recorded after this long is taken for dead.
+JOB_START_SECONDS = 60.0
+#: Only for a worker on another host sharing the directory: no heartbeat for this long means it is gone
+#: (SHIMMY_JOB_STALE_SECONDS). Workers on this host are judged by their process, never by a late beat.
 JOB_STALE_SECONDS = float(os.environ.get("SHIMMY_JOB_STALE_SECONDS", "30"))
+#: Requests one page action may send (configurations x designs); more are refused by name.
+MAX_PAGE_REQUESTS = 8
+
+
+class CacheDirectoryError(RuntimeError):
+    """The cache directory is not private to this user (its values are unpickled)."""
 
 
 def cache_dir() -> pathlib.Path:
-    """SHIMMY_CACHE_DIR, or a per-user folder in the temporary directory."""
+    """SHIMMY_CACHE_DIR, or a per-user folder in the temporary directory; created 0700 and
+    refused if another user owns it or anyone else may write to it."""
     path = os.environ.get("SHIMMY_CACHE_DIR") or os.path.join(tempfile.gettempdir(), f"shimmy-cache-{os.getuid()}")
     p = pathlib.Path(path)
-    p.mkdir(parents=True, exist_ok=True)
+    p.mkdir(mode=0o700, parents=True, exist_ok=True)
+    st = p.stat()
+    if st.st_uid != os.getuid():
+        raise CacheDirectoryError(f"cache directory {p} belongs to uid {st.st_uid}, not to this user "
+                                  f"(uid {os.getuid()}); set SHIMMY_CACHE_DIR to a directory of your own")
+    if st.st_mode & 0o022:
+        raise CacheDirectoryError(f"cache directory {p} is writable by group or others (mode "
+                                  f"{st.st_mode & 0o777:o}); chmod go-w it or set SHIMMY_CACHE_DIR elsewhere")
     return p
 
 

@@ -1,0 +1,20 @@
+"""gunicorn settings read by every ``gunicorn app:server`` started from this folder (README,
+Dockerfile, tests, benchmarks): gunicorn loads ./gunicorn.conf.py by default.
+
+The arbiter becomes the child subreaper of everything started below it: a job worker whose
+web worker died (killed, timed out, restarted) is adopted by the arbiter instead of PID 1,
+and the arbiter's SIGCHLD handler reaps every child it has (gunicorn reaps unknown children),
+so no job process is left a zombie where PID 1 does not reap (a bare container or sandbox).
+"""
+
+import ctypes
+import sys
+
+PR_SET_CHILD_SUBREAPER = 36
+
+
+def on_starting(server):
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) != 0:
+            server.log.warning("could not become the child subreaper (errno %d)", ctypes.get_errno())
