@@ -117,7 +117,12 @@ def test_high_load_lateral_branch_found_by_simulation_seed(high_load):
     assert not result.hopf.hopf_points  # x = 0 unstable over the whole range, no Hopf point in it
     assert not result.branches[0].stable.any()
     periodic = [b for b in result.branches if b.kind == "periodic"]
-    assert len(periodic) == 1
+    assert len(periodic) == 2  # the lateral cycle, and the torsional isola reached from psi = 0.2 rad
+    isola = periodic[1]
+    assert isola.origin.startswith("large psi start") and isola.stop_reason.startswith("closed branch")
+    folds = sorted(s["V"] for s in isola.special_points if s["kind"] == "LPC")
+    assert len(folds) == 2 and folds[0] < 50.0 < folds[1]
+    assert set(isola.mode) == {"torsional"} and isola.max_psi.max() > 0.2
     b = periodic[0]
     assert b.origin.startswith("simulation")
     assert b.V.min() == pytest.approx(1.0) and b.V.max() == pytest.approx(200.0)

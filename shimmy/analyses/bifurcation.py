@@ -67,6 +67,10 @@ MAX_PSI = 1.0  # rad: beyond this a branch is stopped (far outside any physical 
 PERIOD_MAX = 2.0  # s: a period blow-up (homoclinic approach) stops a branch
 SEED_T_END = 30.0  # s of simulation per seed
 SEED_RETRIES = 2  # further runs of 2 * SEED_T_END from the last state while the motion has not settled
+#: Large-amplitude seeds: cycles no Hopf point in range feeds and the standard start does not reach
+#: (the torsional isola between two folds above ~720 kN). (state, size): psi in rad, l_g delta in m.
+LARGE_STARTS = (("psi", 0.2), ("lateral", 0.1))
+LARGE_SEED_SPEEDS = (30.0, 80.0)  # m/s
 
 
 @dataclass(frozen=True)
@@ -214,7 +218,8 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
     popts = options.periodic()
     limits = _limits(model)
     done: list[float] = []
-    units = max(1, len(starts)) + (len(_seed_speeds(hopf)) if options.seeds else 0)
+    large = [(V, what, size) for V in LARGE_SEED_SPEEDS if v_min < V < v_max for what, size in LARGE_STARTS]
+    units = max(1, len(starts)) + (len(_seed_speeds(hopf)) + len(large) if options.seeds else 0)
     unit = 0
     for v_h in starts:
         unit += 1
@@ -251,6 +256,15 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
             report(unit / (units + 1), f"simulation seed at V = {v_seed:.4g} m/s")
             seeded = _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popts,
                                     limits, branches, warnings)
+            if seeded is not None:
+                branches.append(seeded)
+        for v_seed, what, size in large:
+            unit += 1
+            report(unit / (units + 1), f"large {what} seed at V = {v_seed:.4g} m/s")
+            x0 = np.zeros(n)
+            x0[0 if what == "psi" else 2] = size if what == "psi" else size / params.gear.l_g
+            seeded = _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popts,
+                                    limits, branches, warnings, x0=x0, label=f"large {what} start")
             if seeded is not None:
                 branches.append(seeded)
 
@@ -427,12 +441,13 @@ def periodic_orbit_from_simulation(config: Configuration, Fz: float, V: float, p
 
 
 def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popts, limits, branches,
-                   warnings) -> Branch | None:
+                   warnings, x0=None, label: str = "simulation") -> Branch | None:
     mesh = Mesh.uniform(popts.ntst, popts.ncol)
-    guess, reason = periodic_orbit_from_simulation(config, Fz, v_seed, params, mesh, exact_nes=model.exact_nes)
+    guess, reason = periodic_orbit_from_simulation(config, Fz, v_seed, params, mesh, exact_nes=model.exact_nes,
+                                                   x0=x0)
     if guess is None:
         if "not periodic" in reason or "failed" in reason:
-            warnings.append(f"seed at V = {v_seed:.6g} m/s: {reason}")
+            warnings.append(f"{label} at V = {v_seed:.6g} m/s: {reason}")
         return None
     psi_amp = float(np.abs(guess.X[:, 0]).max())
     lat_amp = float(params.gear.l_g * np.abs(guess.X[:, 2]).max())
@@ -445,12 +460,12 @@ def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popt
             halves.append(periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts,
                                           p_direction=direction, limits=limits))
         except EngineConvergenceError as exc:  # the engine's, or ours derived from it
-            warnings.append(f"seed at V = {v_seed:.6g} m/s: {exc}")
+            warnings.append(f"{label} at V = {v_seed:.6g} m/s: {exc}")
             return None
         if halves[0].stop_reason.startswith("closed branch"):  # a loop: one way round covers it
-            return _periodic_output(halves[0], params, f"simulation at V = {v_seed:.6g} m/s", [])
+            return _periodic_output(halves[0], params, f"{label} at V = {v_seed:.6g} m/s", [])
     joined = _join(halves[0], halves[1])
-    return _periodic_output(joined, params, f"simulation at V = {v_seed:.6g} m/s", [])
+    return _periodic_output(joined, params, f"{label} at V = {v_seed:.6g} m/s", [])
 
 
 def _join(down: PeriodicBranch, up: PeriodicBranch) -> PeriodicBranch:

@@ -8,9 +8,9 @@ of a one-parameter branch in V at some load:
    the Hopf point just beside the GH point, on either side, stopped at its first LPC;
 2. double-Hopf points (a torus curve is born there): the branches from both Hopf points just
    beside it, stopped at their first NS point;
-3. one-parameter diagrams on a few loads (every LPC, NS and PD point of every branch);
-4. cycles from large-amplitude starts (psi = 0.2 rad, l_g delta = 0.1 m) on a few loads and
-   speeds, where no Hopf point feeds them (isolas between two folds): their branches' points.
+3. one-parameter diagrams on a few loads (every LPC, NS and PD point of every branch), whose
+   seeds include large-amplitude starts (psi = 0.2 rad, l_g delta = 0.1 m) that reach cycles no
+   Hopf point feeds (the isola between two folds above ~720 kN).
 
 A start that lies on a curve already continued is skipped, so each curve is continued once
 (:func:`shimmy.continuation.cycle_curve`: minimally augmented systems on the collocation mesh
@@ -30,15 +30,14 @@ from typing import Any, Callable
 import numpy as np
 
 from .. import __version__
-from ..continuation import (ContinuationOptions, CycleCurve, CycleCurveOptions, Mesh, SpecialPoint,
-                            TwoParameterVectorField, cycle_curve, periodic_branch, start_beside)
+from ..continuation import (ContinuationOptions, CycleCurve, CycleCurveOptions, SpecialPoint,
+                            TwoParameterVectorField, cycle_curve, start_beside)
 from ..continuation.errors import ContinuationError
 from ..errors import InvalidParameterError
 from ..model.configurations import Configuration
 from ..model.equations import build_model, jacobian, parameter_jacobian, rhs
 from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
-from .bifurcation import (STATE_SCALE, V_SCALE, BifurcationOptions, _limits, _on_branch, _periodic_output,
-                          bifurcation, gear_field, periodic_orbit_from_simulation)
+from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation
 from .hopf_curves import hopf_curves
 from .executors import open_executor, run_units
 from .stability import hopf_points
@@ -50,8 +49,6 @@ CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_m
                                                                    max_angle=0.3))
 BESIDE = 0.015  # relative offset in Fz from a GH / double-Hopf point to the Hopf point a start branch leaves
 START_STEPS = 80  # step budget of a start branch
-LARGE_STARTS = (("psi", 0.2), ("lateral", 0.1))  # rad; m of l_g delta
-SEED_SPEEDS = (30.0, 80.0)  # m/s of the large-amplitude starts
 SCAN_FRACTIONS = (0.3, 0.6, 0.9)  # loads of the one-parameter diagrams, as fractions of the box in Fz
 
 
@@ -270,10 +267,9 @@ def _find_starts(task: tuple) -> tuple[list[Start], list[str]]:
         diagram = bifurcation(config, Fz, box[0][0], box[0][1], params, BifurcationOptions(mesh_check=False))
     except ContinuationError as exc:
         return [], [f"diagram at Fz = {Fz:.6g} N failed: {exc}"]
-    starts = [Start(s.kind, s, Fz, b.raw.ncol, f"diagram at Fz = {Fz:.6g} N") for b in diagram.branches
-              if b.kind == "periodic" and b.raw is not None for s in b.raw.special_points if s.kind in KINDS]
-    model = build_model(config, params)
-    starts += _large_amplitude_starts(config, model, params, Fz, box[0], diagram.branches, warnings)
+    starts = [Start(s.kind, s, Fz, b.raw.ncol, f"{b.origin}, diagram at Fz = {Fz:.6g} N")
+              for b in diagram.branches if b.kind == "periodic" and b.raw is not None
+              for s in b.raw.special_points if s.kind in KINDS]
     return starts, warnings
 
 
@@ -330,47 +326,6 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
                                        V_SCALE, options, limits=_limits(model))
             if found is not None:
                 out.append(Start(kind, found, Fz, ncol, origin))
-    return out
-
-
-def _large_amplitude_starts(config, model, params, Fz, v_range, branches, warnings) -> list[Start]:
-    """Special points of the branches through cycles reached from large torsional and lateral
-    starts, where those cycles are on none of ``branches`` (the diagram's at this load, and the
-    branches continued here)."""
-    out = []
-    n = model.n_states
-    options = BifurcationOptions().periodic()
-    system = gear_field(model, Fz)
-    known = list(branches)
-    l_g = params.gear.l_g
-    for V in SEED_SPEEDS:
-        if not v_range[0] < V < v_range[1]:
-            continue
-        for what, size in LARGE_STARTS:
-            x0 = np.zeros(n)
-            if what == "psi":
-                x0[0] = size
-            else:
-                x0[2] = size / params.gear.l_g
-            guess, reason = periodic_orbit_from_simulation(config, Fz, V, params,
-                                                           Mesh.uniform(options.ntst, options.ncol), x0=x0)
-            if guess is None:
-                continue
-            if _on_branch(known, V, guess.T, float(np.abs(guess.X[:, 0]).max()),
-                          float(l_g * np.abs(guess.X[:, 2]).max())):
-                continue
-            for direction in (-1, 1):
-                try:
-                    raw = periodic_branch(system, guess, v_range[0], v_range[1], STATE_SCALE[:n], V_SCALE, options,
-                                          p_direction=direction, limits=_limits(model))
-                except ContinuationError as exc:
-                    warnings.append(f"large {what} start at V = {V:g} m/s, Fz = {Fz:.6g} N: {exc}")
-                    break
-                out += [Start(s.kind, s, Fz, raw.ncol, f"large {what} start at V = {V:g} m/s, Fz = {Fz:.6g} N")
-                        for s in raw.special_points if s.kind in KINDS]
-                known.append(_periodic_output(raw, params, "large-amplitude start", []))
-                if raw.stop_reason.startswith("closed branch"):
-                    break
     return out
 
 
