@@ -27,9 +27,10 @@ def layout(shade: str = "original", overlay: str = "", fz_min: str = "10", fz_ma
     return page(
         query, "map",
         ui.header("Stability map", "The (V, Fz) plane shaded by shimmy type, from the stable attractors on each load "
-                  "slice (equilibrium, torsional and lateral limit cycles; simulation where none is stable). Hopf "
-                  "curves and GH points by two-parameter continuation; fold-of-cycles and torus curves joined from "
-                  "the special points of the slices' diagrams. Click a point to open its time history."),
+                  "slice (equilibrium, torsional and lateral limit cycles, including those reached from large "
+                  "torsional and lateral starts; simulation where none is stable). Hopf, fold-of-cycles and torus "
+                  "curves, GH and double-Hopf points by two-parameter continuation. Click a point to open its "
+                  "time history."),
         html.Div([
             ui.field("Shade by", dcc.Dropdown(id="map-shade", value=shade, clearable=False, style={"width": "150px"},
                                               options=[{"label": style.CONFIG_LABELS[c], "value": c}
@@ -110,8 +111,7 @@ def figure(results):
         colour, label = style.CONFIG_COLOURS[config], style.CONFIG_LABELS[config]
         for key, (kind, dash_style, width) in CURVE_STYLES.items():
             for i, curve in enumerate(result[key]):
-                fig.add_scatter(x=[p["V"] for p in curve], y=[p["Fz"] / 1e3 for p in curve],
-                                mode="lines" if key == "hopf_curves" else "lines+markers",
+                fig.add_scatter(x=[p["V"] for p in curve], y=[p["Fz"] / 1e3 for p in curve], mode="lines",
                                 name=f"{label}: {kind}", legendgroup=f"{config}-{key}", showlegend=i == 0,
                                 line={"color": colour, "dash": dash_style, "width": width},
                                 marker={"size": 4, "color": colour},
@@ -122,6 +122,14 @@ def figure(results):
                             marker={"symbol": "diamond", "size": 12, "color": colour,
                                     "line": {"width": 1.5, "color": "#fff"}},
                             hovertemplate=f"{label} GH point<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
+        hh = result.get("double_hopf_points") or []
+        if hh:  # where two Hopf curves cross and torus curves are born
+            fig.add_scatter(x=[g["V"] for g in hh], y=[g["Fz"] / 1e3 for g in hh], mode="markers",
+                            name=f"{label}: double Hopf", legendgroup=f"{config}-hh",
+                            marker={"symbol": "star", "size": 13, "color": colour,
+                                    "line": {"width": 1.5, "color": "#fff"}},
+                            hovertemplate=f"{label} double-Hopf point<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN"
+                                          "<extra></extra>")
     fig.update_xaxes(range=[min(V), max(V)])
     fig.update_yaxes(range=[min(Fz), max(Fz)])
     fig.update_layout(legend={"orientation": "h", "y": -0.13, "x": 0})

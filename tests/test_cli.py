@@ -126,7 +126,8 @@ def test_map_command_json_carries_the_curves_grid_and_minimum_load(tmp_path):
     assert data["min_shimmy_Fz"] == pytest.approx(100000.0)  # shimmy on the lowest slice already
     assert data["metrics"]["torsion_area"] > 0
     assert "two-parameter continuation" in data["methods"]["hopf_curves"]
-    assert "joined" in data["methods"]["fold_curves"]
+    assert "two-parameter continuation" in data["methods"]["fold_curves"]
+    assert "double_hopf_points" in data
     rows = list(csv.reader(path.open()))
     assert rows[0] == ["Fz_N", "V_m_s", "shimmy_type"] and len(rows) == 1 + 4 * 25
 

@@ -4,12 +4,11 @@ How a map is built (what :func:`stability_map` returns says the same in ``method
 
 * **Hopf curves and GH points**: two-parameter continuation of the Hopf points of x = 0
   (:func:`shimmy.analyses.hopf_curves.hopf_curves`; the extended system, l1 along the curve).
-* **Fold-of-cycles (LPC) and torus (NS) curves**: the engine has no two-parameter
-  continuation of cycle bifurcations, so these are joined from the special points of the
-  one-parameter diagrams in V computed on every Fz slice (:func:`_join_curves`). Their
-  accuracy in V is that of the located points (1e-6 relative); in Fz it is the slice
-  spacing. Fold curves are started at the GH point they are born at when one lies within
-  a slice spacing of their end.
+* **Fold-of-cycles (LPC) and torus (NS) curves**: two-parameter continuation of each curve
+  (:func:`shimmy.analyses.cycle_curves.cycle_curves`: minimally augmented systems, started from
+  the GH and double-Hopf points, one-parameter diagrams and large-amplitude starts), exact in V
+  and Fz; each curve's crossings of the slice loads are located, so the slices' LPC and NS
+  points lie on the drawn curves. Double-Hopf points are reported beside the GH points.
 * **Shimmy type** on every slice: the stable attractors at each V read off the slice's
   bifurcation diagram (:func:`attractors_at`): x = 0 where its eigenvalues say so, and every
   periodic branch point with all nontrivial Floquet multipliers inside the unit circle, with
@@ -36,13 +35,13 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from .. import __version__
 from .bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
-from .executors import name_of, run_units
+from .cycle_curves import cycle_curves
+from .executors import InlineExecutor, name_of, run_units
 from .hopf_curves import HopfCurvesResult, hopf_curves
 from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_operating_point, check_range
 from .response import ResponseType
@@ -66,7 +65,6 @@ BAND_V = (1.0, 200.0)  # m/s
 TRIVIAL_PSI = 1e-6
 TRIVIAL_LATERAL = 1e-7
 #: Curve joining: slice-to-slice match if |ln(V1 / V2)| is below this (a 50 % change).
-JOIN_LOG_V = math.log(1.5)
 
 
 # --------------------------------------------------------------------------- attractors
@@ -279,87 +277,6 @@ def classify(config: Configuration | str, V: float, Fz: float, params: Parameter
             "version": __version__}
 
 
-# --------------------------------------------------------------------------- curves
-
-
-def _join_curves(slices: list[SliceResult], kind: str) -> list[list[dict[str, float]]]:
-    """Special points of one kind on consecutive slices joined into curves.
-
-    Slice to slice, points are matched by least total |ln(V1 / V2)| (an assignment problem;
-    pairs further apart than JOIN_LOG_V and of different mode are not matched). Two curves
-    ending on the same interior slice at the nearest pair of speeds are joined there: the
-    curve turns in Fz between that slice and the next."""
-    curves: list[list[tuple[int, float, str]]] = []
-    open_ends: list[int] = []  # indices of curves ending on the previous slice
-    for s, sl in enumerate(slices):
-        pts = [(s, p["V"], p["mode"]) for p in sl.special_points if p["kind"] == kind]
-        ends = [curves[c][-1] for c in open_ends]
-        matched: dict[int, int] = {}
-        if ends and pts:
-            cost = np.array([[abs(math.log(p[1] / e[1])) + (0.0 if p[2] == e[2] else 10.0) for p in pts]
-                             for e in ends])
-            rows, cols = linear_sum_assignment(cost)
-            matched = {int(c): int(r) for r, c in zip(rows, cols, strict=True) if cost[r, c] <= JOIN_LOG_V}
-        new_open = []
-        for j, p in enumerate(pts):
-            if j in matched:
-                c = open_ends[matched[j]]
-                curves[c].append(p)
-            else:
-                curves.append([p])
-                c = len(curves) - 1
-            new_open.append(c)
-        open_ends = new_open
-    curves = _join_turns(curves, len(slices), at_end=True)
-    curves = _join_turns(curves, len(slices), at_end=False)
-    return [[{"V": v, "Fz": slices[s].Fz} for s, v, _ in c] for c in curves]
-
-
-def _join_turns(curves, n_slices: int, at_end: bool):
-    """Join pairs of curves that both end (or both start) on the same interior slice."""
-    curves = [list(c) for c in curves]
-    while True:
-        best = None
-        for a in range(len(curves)):
-            for b in range(a + 1, len(curves)):
-                ea = curves[a][-1] if at_end else curves[a][0]
-                eb = curves[b][-1] if at_end else curves[b][0]
-                if ea[0] != eb[0] or ea[0] in (0, n_slices - 1) or ea[2] != eb[2]:
-                    continue
-                d = abs(math.log(ea[1] / eb[1]))
-                if d <= 2 * JOIN_LOG_V and (best is None or d < best[0]):
-                    best = (d, a, b)
-        if best is None:
-            return curves
-        _, a, b = best
-        joined = curves[a] + curves[b][::-1] if at_end else curves[a][::-1] + curves[b]
-        curves = [c for k, c in enumerate(curves) if k not in (a, b)] + [joined]
-
-
-def _attach_gh(curves: list[list[dict[str, float]]], gh: list[dict[str, float]], spacing: float):
-    """Start each fold curve at the GH point it is born at (nearest end within a slice spacing)."""
-    for g in gh:
-        best = None
-        for c in curves:
-            for end in (0, -1):
-                p = c[end]
-                if abs(p["Fz"] - g["Fz"]) <= 1.01 * spacing:
-                    d = abs(math.log(p["V"] / g["V"]))
-                    if d <= JOIN_LOG_V and (best is None or d < best[0]):
-                        best = (d, c, end)
-        if best is not None:
-            _, c, end = best
-            point = {"V": g["V"], "Fz": g["Fz"], "gh": True}
-            if end == 0:
-                c.insert(0, point)
-            else:
-                c.append(point)
-    return curves
-
-
-# --------------------------------------------------------------------------- the map
-
-
 @dataclass
 class StabilityMap:
     config: Configuration
@@ -371,8 +288,7 @@ class StabilityMap:
     types: list[list[str]]  # [i_Fz][j_V]
     slices: list[SliceResult]
     hopf: HopfCurvesResult
-    fold_curves: list[list[dict[str, float]]]
-    torus_curves: list[list[dict[str, float]]]
+    cycles: dict[str, Any]  # fold and torus curves with their details (:func:`_cycle_curves_unit`)
     min_shimmy: dict[str, Any] | None
     executor: str
     elapsed_s: float
@@ -381,6 +297,14 @@ class StabilityMap:
     @property
     def min_shimmy_Fz(self) -> float | None:
         return None if self.min_shimmy is None else self.min_shimmy["Fz"]
+
+    @property
+    def fold_curves(self) -> list[list[dict[str, float]]]:
+        return self.cycles["fold_curves"]
+
+    @property
+    def torus_curves(self) -> list[list[dict[str, float]]]:
+        return self.cycles["torus_curves"]
 
     @property
     def hopf_curves(self) -> list[list[dict[str, float]]]:
@@ -396,7 +320,9 @@ class StabilityMap:
         return {"config": self.config.value, "params": self.params.to_dict(),
                 "v_range": list(self.v_range), "fz_range": list(self.fz_range),
                 "hopf_curves": self.hopf_curves, "gh_points": self.hopf.gh_points,
+                "double_hopf_points": self.hopf.double_hopf_points,
                 "fold_curves": self.fold_curves, "torus_curves": self.torus_curves,
+                "cycle_curves": self.cycles["curves"], "codim2_points": self.cycles["codim2_points"],
                 "V": self.V.tolist(), "Fz": self.Fz.tolist(), "types": self.types,
                 "min_shimmy_Fz": self.min_shimmy_Fz, "min_shimmy": self.min_shimmy,
                 "slices": [s.to_dict() for s in self.slices],
@@ -404,10 +330,11 @@ class StabilityMap:
                     "hopf_curves": "two-parameter continuation of Hopf points (extended system)",
                     "gh_points": "sign changes of the first Lyapunov coefficient along the Hopf curves "
                                  "(not defined with the particle damper: not smooth at x = 0)",
-                    "fold_curves": f"LPC points of one-parameter diagrams in V on {len(self.slices)} Fz slices, "
-                                   "joined slice to slice",
-                    "torus_curves": f"NS points of one-parameter diagrams in V on {len(self.slices)} Fz slices, "
-                                    "joined slice to slice",
+                    "double_hopf_points": "sign changes of the other eigenvalues' real parts along the Hopf curves",
+                    "fold_curves": "two-parameter continuation of folds of cycles (minimally augmented system on the "
+                                   "collocation mesh), exact in V and Fz",
+                    "torus_curves": "two-parameter continuation of Neimark-Sacker points of cycles (minimally "
+                                    "augmented system), exact in V and Fz",
                     "types": "stable attractors of each slice's diagram; simulation where none is stable"},
                 "executor": self.executor, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
                 "version": __version__}
@@ -423,17 +350,30 @@ class StabilityMap:
                     w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
 
 
+def _cycle_curves_unit(config, params, v_range, fz_range, loads) -> dict[str, Any]:
+    """The fold and torus curves of a map, with their crossings of the slice loads (one unit: run in
+    one process, its own units inline)."""
+    result = cycle_curves(config, params, v_range, fz_range, kinds=("LPC", "NS"), loads=tuple(loads),
+                          executor=InlineExecutor())
+    data = result.to_dict()
+    return {key: data[key] for key in ("fold_curves", "torus_curves", "curves", "codim2_points", "warnings")}
+
+
 def _unit(task: tuple) -> Any:
     """One independent unit of a map (top level, so that process pools and Dask can ship it)."""
     if task[0] == "hopf_curves":
         _, config, params, v_range, fz_range = task
         return hopf_curves(config, params, v_range=v_range, fz_range=fz_range)
+    if task[0] == "cycle_curves":
+        return _cycle_curves_unit(*task[1:])
     _, config, Fz, v_min, v_max, n_v, params, options = task
     return map_slice(config, Fz, v_min, v_max, n_v, params, options)
 
 
 def _describe(task: tuple) -> str:
-    return "Hopf curves" if task[0] == "hopf_curves" else f"slice Fz = {task[2] / 1e3:.4g} kN"
+    if task[0] in ("hopf_curves", "cycle_curves"):
+        return {"hopf_curves": "Hopf curves", "cycle_curves": "fold and torus curves"}[task[0]]
+    return f"slice Fz = {task[2] / 1e3:.4g} kN"
 
 
 def stability_map(config: Configuration | str, v_range: tuple[float, float] = DEFAULT_V_RANGE,
@@ -453,34 +393,33 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     n_v = int(check_number("n_v", n_v, 2, 2000, integer=True))
     options = options or BifurcationOptions(mesh_check=False)
     loads = np.linspace(f_min, f_max, resolution)
-    # The Hopf curves go first: one unit, longer than a slice.
-    tasks = [("hopf_curves", config, params, (v_min, v_max), (f_min, f_max))]
+    # The curves go first: each one unit, longer than a slice.
+    tasks = [("cycle_curves", config, params, (v_min, v_max), (f_min, f_max), [float(f) for f in loads]),
+             ("hopf_curves", config, params, (v_min, v_max), (f_min, f_max))]
     tasks += [("slice", config, float(Fz), v_min, v_max, n_v, params, options) for Fz in loads]
     results = run_units(_unit, tasks, executor, progress, _describe)
-    hopf: HopfCurvesResult = results[0]
-    slices: list[SliceResult] = results[1:]
-    spacing = float(loads[1] - loads[0])
-    folds = _attach_gh(_join_curves(slices, "LPC"), hopf.gh_points, spacing)
-    tori = _join_curves(slices, "NS")
-    warnings = list(hopf.warnings)
+    cycles: dict[str, Any] = results[0]
+    hopf: HopfCurvesResult = results[1]
+    slices: list[SliceResult] = results[2:]
+    warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
     for s in slices:
         warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
     return StabilityMap(config, params, (v_min, v_max), (f_min, f_max), slices[0].V, loads,
-                        [s.types for s in slices], slices, hopf, folds, tori,
-                        _min_shimmy(hopf, folds, slices), name_of(executor),
+                        [s.types for s in slices], slices, hopf, cycles,
+                        _min_shimmy(hopf, cycles, slices), name_of(executor),
                         time.perf_counter() - clock, warnings)
 
 
-def _min_shimmy(hopf: HopfCurvesResult, folds, slices: list[SliceResult]) -> dict[str, Any] | None:
-    """Lowest load with any shimmy: the lowest point of the Hopf and fold curves, or the lowest
-    slice with a type other than Stable, whichever is lower."""
+def _min_shimmy(hopf: HopfCurvesResult, cycles: dict[str, Any], slices: list[SliceResult]) -> dict[str, Any] | None:
+    """Lowest load with any shimmy: the located lowest point of the Hopf and fold curves, or the
+    lowest slice with a type other than Stable, whichever is lower."""
     candidates = []
     low = hopf.fz_minimum
     if low is not None and any(c.p.size for c in hopf.curves):
         candidates.append({"Fz": low["Fz"], "V": low["V"], "source": "Hopf curve"})
-    for c in folds:
-        p = min(c, key=lambda q: q["Fz"])
-        candidates.append({"Fz": p["Fz"], "V": p["V"], "source": "fold-of-cycles curve"})
+    for c in cycles["curves"]:
+        if c["kind"] == "LPC":
+            candidates.append({"Fz": c["fz_min"]["Fz"], "V": c["fz_min"]["V"], "source": "fold-of-cycles curve"})
     for s in slices:
         if s.intervals:
             candidates.append({"Fz": s.Fz, "V": s.intervals[0]["V_start"], "source": "classified slice"})
