@@ -17,8 +17,17 @@ from shimmy.service.api import api
 
 settings.cache_dir()  # refuse to start on a cache directory that is not private to this user
 
-app = Dash(__name__, use_pages=True, title="shimmy workbench", suppress_callback_exceptions=True,
-           update_title=None)
+
+class Workbench(Dash):
+    def _config(self):
+        """The page's config without the Python version Dash puts there (it tells an attacker too much)."""
+        config = super()._config()
+        config.pop("python_version", None)
+        return config
+
+
+app = Workbench(__name__, use_pages=True, title="shimmy workbench", suppress_callback_exceptions=True,
+                update_title=None)
 server = app.server
 server.config["MAX_CONTENT_LENGTH"] = settings.MAX_BODY_BYTES
 server.register_blueprint(api)

@@ -41,11 +41,12 @@ class Server:
             else:
                 os.environ["SHIMMY_CACHE_DIR"] = before
 
-    def request(self, method: str, path: str, body=None, raw: bytes | None = None, timeout: float = 60.0):
-        """(status, headers, parsed JSON or text) of one request."""
+    def request(self, method: str, path: str, body=None, raw: bytes | None = None, timeout: float = 60.0,
+                headers: dict[str, str] | None = None):
+        """(status, headers, parsed JSON or text) of one request (Content-Type JSON unless ``headers`` say)."""
         data = raw if raw is not None else (None if body is None else json.dumps(body).encode())
-        req = urllib.request.Request(self.base + path, data=data, method=method,
-                                     headers={"Content-Type": "application/json"} if data is not None else {})
+        sent = {"Content-Type": "application/json"} if data is not None else {}
+        req = urllib.request.Request(self.base + path, data=data, method=method, headers={**sent, **(headers or {})})
         try:
             with urllib.request.urlopen(req, timeout=timeout) as resp:
                 status, headers, text = resp.status, dict(resp.headers), resp.read().decode()
@@ -57,16 +58,14 @@ class Server:
             return status, headers, text
 
 
-@pytest.fixture(scope="session")
-def server(tmp_path_factory):
-    """gunicorn app:server with 2 workers and a fresh shared cache directory."""
-    cache_dir = tmp_path_factory.mktemp("shimmy-cache")
+def start_server(cache_dir: Path, env: dict[str, str] | None = None, workers: int = 2) -> Server:
+    """gunicorn app:server on a free loopback port with ``cache_dir`` (and ``env``), once it answers."""
     port = free_port()
-    env = {**os.environ, "SHIMMY_CACHE_DIR": str(cache_dir)}
+    full_env = {**os.environ, "SHIMMY_CACHE_DIR": str(cache_dir), **(env or {})}
     log = open(cache_dir / "gunicorn.log", "w")
     proc = subprocess.Popen([sys.executable, "-m", "gunicorn", "app:server", "--bind", f"127.0.0.1:{port}",
-                             "--workers", "2", "--timeout", "120", "--no-control-socket"],
-                            cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
+                             "--workers", str(workers), "--timeout", "120", "--no-control-socket"],
+                            cwd=ROOT, env=full_env, stdout=log, stderr=subprocess.STDOUT)
     base = f"http://127.0.0.1:{port}"
     deadline = time.time() + 60
     while True:
@@ -80,10 +79,24 @@ def server(tmp_path_factory):
             proc.kill()
             raise RuntimeError("gunicorn did not start: " + (cache_dir / "gunicorn.log").read_text()[-2000:])
         time.sleep(0.3)
-    yield Server(base, cache_dir, proc)
-    proc.terminate()
+    server = Server(base, cache_dir, proc)
+    server.log = log
+    return server
+
+
+def stop_server(server: Server) -> None:
+    server.proc.terminate()
     try:
-        proc.wait(timeout=15)
+        server.proc.wait(timeout=15)
     except subprocess.TimeoutExpired:
-        proc.kill()
-    log.close()
+        server.proc.kill()
+        server.proc.wait(timeout=15)
+    server.log.close()
+
+
+@pytest.fixture(scope="session")
+def server(tmp_path_factory):
+    """gunicorn app:server with 2 workers and a fresh shared cache directory."""
+    srv = start_server(tmp_path_factory.mktemp("shimmy-cache"))
+    yield srv
+    stop_server(srv)

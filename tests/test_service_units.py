@@ -58,3 +58,65 @@ def test_url_design_state_round_trip_and_bad_keys():
     assert state.design_request(material, values) == {"material": "tungsten", "params": {"r2": 0.085}}
     material, values, problems = state.design_from_query({"r2": "9", "e_p": "x", "material": "gold"})
     assert material == "steel" and values["r2"] == 0.08 and len(problems) == 3
+
+
+def test_cache_directory_is_private_and_refused_when_shared(tmp_path, monkeypatch):
+    import os
+
+    from shimmy.service import settings
+
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path / "new"))
+    assert settings.cache_dir().stat().st_mode & 0o777 == 0o700
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(shared))
+    with pytest.raises(settings.CacheDirectoryError, match="writable by group or others"):
+        settings.cache_dir()
+    if os.getuid() == 0:  # root can give a directory away: another user's folder is refused
+        theirs = tmp_path / "theirs"
+        theirs.mkdir(mode=0o700)
+        os.chown(theirs, 65534, 65534)
+        monkeypatch.setenv("SHIMMY_CACHE_DIR", str(theirs))
+        with pytest.raises(settings.CacheDirectoryError, match="belongs to uid 65534"):
+            settings.cache_dir()
+
+
+def test_unusable_cache_is_reported_degraded_while_analyses_answer_uncached(tmp_path, monkeypatch):
+    import sqlite3
+
+    from shimmy.service import cache
+
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+
+    def broken(*args, **kwargs):
+        raise sqlite3.OperationalError("disk I/O error")
+
+    monkeypatch.setattr(cache, "open_store", broken)
+    import app
+
+    client = app.server.test_client()
+    health = client.get("/api/v1/health")
+    assert health.status_code == 503 and health.json["status"] == "degraded" and "disk I/O" in health.json["cache"]
+    answer = client.post("/api/v1/hopf", json={"config": "nes", "Fz": 150000})
+    assert answer.status_code == 200 and answer.headers["X-Shimmy-Cache"] == "miss"
+
+
+def test_non_json_posts_are_refused_and_responses_carry_security_headers(tmp_path, monkeypatch):
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+    import app
+
+    client = app.server.test_client()
+    body = '{"config": "nes", "analysis": "simulate", "V": 30, "Fz": 150000}'
+    for mimetype in ("text/plain", "application/x-www-form-urlencoded", "multipart/form-data"):
+        answer = client.post("/api/v1/jobs", data=body, content_type=mimetype)
+        assert answer.status_code == 415 and answer.json["field"] == "Content-Type", mimetype
+    answer = client.post("/_dash-update-component", data="{}", content_type="text/plain")
+    assert answer.status_code == 415
+    for path in ("/", "/api/v1/health", "/api/v1/nothing", "/_dash-layout"):
+        headers = client.get(path).headers
+        assert headers["X-Content-Type-Options"] == "nosniff", path
+        assert "frame-ancestors 'none'" in headers["Content-Security-Policy"], path
+        assert headers["X-Frame-Options"] == "DENY" and headers["Referrer-Policy"] == "no-referrer", path
+    page = client.get("/").get_data(as_text=True)
+    assert "Python/" not in page and "Werkzeug/" not in page

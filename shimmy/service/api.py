@@ -217,7 +217,8 @@ def submit_job():
     try:
         job = jobs.submit(analysis, body)
     except jobs.QueueFull as exc:
-        return error(str(exc), "analysis", f"a job once fewer than {settings.MAX_QUEUED_JOBS} are queued", 503,
+        return error(f"analysis {analysis!r} not queued: {exc}", "analysis",
+                     f"a job once fewer than {settings.MAX_QUEUED_JOBS} are queued", 503,
                      {"Retry-After": str(exc.retry_after)})
     return _json(jobs.public(job, with_result=False), 202, headers={"Location": f"{PREFIX}/jobs/{job['id']}"})
 

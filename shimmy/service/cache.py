@@ -18,7 +18,6 @@ import functools
 import logging
 import os
 import pathlib
-import shutil
 import sqlite3
 import time
 from typing import Any, Callable
@@ -76,8 +75,8 @@ def quarantine(path: pathlib.Path, exc: BaseException) -> None:
     _open.cache_clear()
     try:
         path.rename(aside)
-    except OSError:
-        shutil.rmtree(path, ignore_errors=True)
+    except OSError as exc2:  # another process moved it first; its rebuilt store is used
+        log.warning("could not move %s aside: %s", path, exc2)
 
 
 def results() -> diskcache.Cache:

@@ -21,6 +21,12 @@ from ..model.parameters import (FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, P
 CONFIGS = tuple(c.value for c in Configuration)
 
 
+def _key(name: Any) -> str:
+    """A body key as a field name: quoted where it is empty or has surrounding blanks."""
+    name = str(name)
+    return name if name and name == name.strip() else repr(name)
+
+
 def _huge(value: Any) -> Any:
     """An integer beyond float range as inf (refused as not finite, by name) instead of an OverflowError."""
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 1e308:
@@ -134,7 +140,7 @@ class RequestSchema:
         for name in body:
             if name not in known and name not in extra:
                 hint = unknown_name_error(name, sorted(known), "field")
-                raise InvalidParameterError(str(name), body[name], hint.allowed, message=str(hint))
+                raise InvalidParameterError(_key(name), body[name], hint.allowed, message=str(hint))
         out: dict[str, Any] = {}
         for f in self.fields:
             if f.name in body and body[f.name] is not None:
@@ -191,7 +197,7 @@ def design(overrides: Mapping[str, Any], material: str | None) -> dict[str, floa
     for name, value in overrides.items():
         if name not in PARAMETER_SPECS:
             err = unknown_name_error(name, PARAMETER_SPECS)
-            raise InvalidParameterError(f"params.{name}", name, err.allowed, message=str(err))
+            raise InvalidParameterError(f"params.{_key(name)}", name, err.allowed, message=str(err))
         if isinstance(value, str) or isinstance(value, bool) or value is None:
             spec = PARAMETER_SPECS[name]
             raise InvalidParameterError(f"params.{name}", value, spec.allowed, "is not a number")
