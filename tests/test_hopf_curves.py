@@ -94,3 +94,21 @@ def test_double_hopf_points_have_two_pairs_on_the_axis(original):
         freqs = sorted(np.abs(pairs[np.argsort(np.abs(pairs.real))[:2]].imag) / (2 * np.pi))
         np.testing.assert_allclose(freqs, sorted([point["frequency_hz"], point["frequency2_hz"]]), rtol=1e-6)
     assert "double_hopf_points" in original.to_dict()
+
+
+def test_the_lateral_hopf_curve_and_its_located_lowest_load(original):
+    """The lateral curve (critical eigenvector mostly lateral bending) has its lowest load at a
+    located turning point: 200 N above it x = 0 has two lateral Hopf points near that speed, 200 N
+    below none."""
+    modes = [original.mode_of_curve(c) for c in original.curves]
+    assert sorted(modes) == ["lateral", "torsional"]
+    low = original.lateral_minimum
+    lateral = original.curves[modes.index("lateral")]
+    assert low["Fz"] <= lateral.p[:, 1].min() + 1e-6
+    assert 15.5 < low["frequency_hz"] < 16.5
+
+    def near(Fz):
+        return [h for h in hopf_points("original", Fz).hopf_points if abs(h.V - low["V"]) < 15.0]
+
+    assert len(near(low["Fz"] + 200.0)) == 2 and not near(low["Fz"] - 200.0)
+    assert original.to_dict()["lateral_minimum"] == low

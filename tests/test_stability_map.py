@@ -203,10 +203,13 @@ def test_speed_metrics_at_150_kN_match_the_hopf_points_and_the_diagram():
 
 
 def test_changes_against_original_are_differences_and_ratios():
-    base = {"min_shimmy_Fz": 60e3, "torsion_area": 100.0, "at_Fz": {"max_psi": 0.2, "shimmy_speed_range": [5, 90]}}
-    m = {"min_shimmy_Fz": 75e3, "torsion_area": 80.0, "at_Fz": {"max_psi": 0.02, "shimmy_speed_range": None}}
+    base = {"min_shimmy_Fz": 60e3, "lateral_min_Fz": 220e3, "torsion_area": 100.0,
+            "at_Fz": {"max_psi": 0.2, "shimmy_speed_range": [5, 90]}}
+    m = {"min_shimmy_Fz": 75e3, "lateral_min_Fz": 231e3, "torsion_area": 80.0,
+         "at_Fz": {"max_psi": 0.02, "shimmy_speed_range": None}}
     d = against_baseline(m, base)
     assert d["min_shimmy_Fz"]["change"] == pytest.approx(15e3) and d["min_shimmy_Fz"]["relative"] == 0.25
+    assert d["lateral_min_Fz"]["change"] == pytest.approx(11e3) and d["lateral_min_Fz"]["relative"] == 0.05
     assert d["torsion_area"]["relative"] == pytest.approx(-0.2)
     assert d["max_psi"]["relative"] == pytest.approx(-0.9)
     assert d["shimmy_onset_V"]["change"] is None

@@ -4,6 +4,9 @@
   the map's range: the lowest point of the Hopf curves (x = 0 loses stability), of the
   fold-of-cycles curves (subcritical regions reach below the Hopf curves), or of a slice
   classified other than Stable, whichever is lowest (:attr:`StabilityMap.min_shimmy`).
+* ``lateral_min_Fz`` (N): the lowest load of the lateral Hopf curve (its critical eigenvector's
+  elastic energy mostly in lateral bending), the located turning point: the lateral bending
+  boundary, below which the lateral mode of straight rolling is stable at every speed;
 * at a chosen load: the shimmy speed intervals (every maximal V interval of one type other than
   Stable, on the slice's fine grid of (v_max - v_min) / (10 (n_v - 1)) m/s), their hull, and the
   largest torsional amplitude of a stable limit cycle with its speed;
@@ -62,7 +65,9 @@ def speed_metrics(config: Configuration | str, Fz: float, params: Parameters | N
 
 def metrics(smap: StabilityMap, Fz: float = 150e3, options: BifurcationOptions | None = None) -> dict[str, Any]:
     """All figures of merit of one configuration from its map (plus one slice at ``Fz``)."""
-    out = {"config": smap.config.value, "min_shimmy_Fz": smap.min_shimmy_Fz, "min_shimmy": smap.min_shimmy}
+    lateral = smap.hopf.lateral_minimum
+    out = {"config": smap.config.value, "min_shimmy_Fz": smap.min_shimmy_Fz, "min_shimmy": smap.min_shimmy,
+           "lateral_min_Fz": None if lateral is None else lateral["Fz"], "lateral_min": lateral}
     out.update(torsion_area(smap))
     out["at_Fz"] = speed_metrics(smap.config, Fz, smap.params, smap.v_range, options=options)
     return out
@@ -80,6 +85,7 @@ def against_baseline(m: dict[str, Any], base: dict[str, Any]) -> dict[str, Any]:
     at, at0 = m["at_Fz"], base["at_Fz"]
     hull, hull0 = at["shimmy_speed_range"] or [None, None], at0["shimmy_speed_range"] or [None, None]
     return {"min_shimmy_Fz": _change(m["min_shimmy_Fz"], base["min_shimmy_Fz"]),
+            "lateral_min_Fz": _change(m["lateral_min_Fz"], base["lateral_min_Fz"]),
             "torsion_area": _change(m["torsion_area"], base["torsion_area"]),
             "max_psi": _change(at["max_psi"], at0["max_psi"]),
             "shimmy_onset_V": _change(hull[0], hull0[0]), "shimmy_end_V": _change(hull[1], hull0[1])}

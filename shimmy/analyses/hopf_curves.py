@@ -24,6 +24,7 @@ from ..continuation import ContinuationOptions
 from ..model.equations import build_model, jacobian, parameter_jacobian, rhs
 from ..continuation.hopf import HopfCurve, TwoParameterField, hopf_curve
 from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
+from .response import torsional_share
 from .stability import hopf_points
 
 V_SCALE = 10.0  # m/s
@@ -56,6 +57,30 @@ class HopfCurvesResult:
         return [{"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi)}
                 for c in self.curves for g in c.gh_points]
 
+    def mode_of_curve(self, curve: HopfCurve) -> str:
+        """"torsional" or "lateral": the larger share of elastic energy in the critical eigenvector
+        (psi against delta, weighted by k_psi and k_delta) at the curve's middle point."""
+        model = build_model(self.config, self.params)
+        i = len(curve.p) // 2
+        V, Fz = curve.p[i]
+        ev, vectors = np.linalg.eig(jacobian(model, np.zeros(model.n_states), V, Fz))
+        q = vectors[:, int(np.argmin(np.abs(ev - 1j * curve.omega[i])))]
+        share = torsional_share(abs(q[0]), abs(q[2]), self.params.gear.k_psi, self.params.gear.k_delta)
+        return "torsional" if share >= 0.5 else "lateral"
+
+    @property
+    def lateral_minimum(self) -> dict[str, float] | None:
+        """The lowest load on a lateral Hopf curve (its located turning point, or a box edge): the
+        lateral bending boundary's lowest point."""
+        best = None
+        for c in self.curves:
+            if c.p.size == 0 or self.mode_of_curve(c) != "lateral":
+                continue
+            for e in c.extrema + [{"p": c.p[i].tolist(), "omega": float(c.omega[i])} for i in (0, -1)]:
+                if best is None or e["p"][1] < best["Fz"]:
+                    best = {"V": e["p"][0], "Fz": e["p"][1], "frequency_hz": e["omega"] / (2 * math.pi)}
+        return best
+
     @property
     def double_hopf_points(self) -> list[dict[str, float]]:
         """Points where a second pair of eigenvalues is on the imaginary axis (two Hopf curves
@@ -87,6 +112,7 @@ class HopfCurvesResult:
         return {"config": self.config.value, "params": self.params.to_dict(),
                 "v_range": list(self.v_range), "fz_range": list(self.fz_range), "curves": curves,
                 "gh_points": self.gh_points, "double_hopf_points": self.double_hopf_points,
+                "lateral_minimum": self.lateral_minimum,
                 "fz_minimum": self.fz_minimum, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
                 "version": __version__}
 
