@@ -91,8 +91,9 @@ jobs.register(
 def figure(results):
     """The first map shaded by type; the curves of every map in its configuration's colour."""
     shaded = results[0]
-    V, Fz = shaded["V"], [f / 1e3 for f in shaded["Fz"]]
-    codes = [[TYPES.index(t) for t in row] for row in shaded["types"]]
+    grid = shaded.get("shading") or shaded  # read off the curves; a map without it: its slices
+    V, Fz = grid["V"], [f / 1e3 for f in grid["Fz"]]
+    codes = [[TYPES.index(t) for t in row] for row in grid["types"]]
     n = len(TYPES)
     scale = []
     for k, t in enumerate(TYPES):  # a stepped scale: code k -> its type's colour
@@ -100,7 +101,7 @@ def figure(results):
     fig = style.figure(f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)",
                        "forward speed V (m/s)", "vertical load Fz (kN)", height=640)
     fig.add_heatmap(x=V, y=Fz, z=codes, zmin=0, zmax=n, colorscale=scale, showscale=False, opacity=0.55,
-                    customdata=shaded["types"], name="shimmy type",
+                    customdata=grid["types"], name="shimmy type",
                     hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history</extra>")
     for t in TYPES:  # legend entries for the shading
         fig.add_scatter(x=[None], y=[None], mode="markers", name=t, legendgroup="types",

@@ -241,3 +241,44 @@ def test_classify_refuses_a_speed_outside_its_diagram():
     with pytest.raises(InvalidParameterError) as err:
         classify("original", 300.0, 150e3)
     assert err.value.field == "V"
+
+
+@pytest.mark.slow
+def test_shading_read_off_the_curves_agrees_with_the_classifier_away_from_boundaries(original_map):
+    """The shading's rows lie between the slices; at points of uniform shading (5 x 5 cells) the
+    classifier, which computes a diagram at that very load, gives the shaded type."""
+    m = original_map
+    grid = np.array(m.shading)
+    assert grid.shape == (len(m.shading_Fz), len(m.V))
+    picked = []
+    for i in range(2, grid.shape[0] - 2, 17):
+        for j in range(2, grid.shape[1] - 2, 7):
+            block = grid[i - 2:i + 3, j - 2:j + 3]
+            if (block == grid[i, j]).all():
+                picked.append((i, j))
+    picked = picked[::max(1, len(picked) // 8)][:8]
+    assert len({grid[i, j] for i, j in picked}) >= 3
+    for i, j in picked:
+        V, Fz = float(m.V[j]), float(m.shading_Fz[i])
+        assert classify("original", V, Fz)["shimmy_type"] == grid[i, j], (V, Fz)
+
+
+def test_shading_changes_only_at_the_curves_or_where_the_slices_change():
+    """Read-off by construction: within one row, between two consecutive boundary crossings, the
+    shading repeats the slice interval it is mapped from."""
+    from shimmy.analyses import map_shading
+
+    class S:
+        def __init__(self, Fz, intervals):
+            self.Fz, self.intervals = Fz, intervals
+
+    # one vertical boundary at V = 50 + Fz / 1e4 (moves with the load); Torsion left of it on both slices
+    curve = ("b", np.array([[50.0, 0.0], [150.0, 1.0e6]]))
+    slices = [S(1e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 60.0}]),
+              S(3e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 80.0}])]
+    V = np.linspace(1.0, 200.0, 400)
+    rows, fallbacks = map_shading.shade(slices, [curve], V, np.array([2e5]), (1.0, 200.0))
+    edge = 50.0 + 2e5 / 1e4  # the boundary at the row's load: 70 m/s, between the slices' 60 and 80
+    row = np.array(rows[0])
+    assert fallbacks == 0
+    assert (row[V < edge - 0.5] == "Torsion").all() and (row[V > edge + 0.5] == "Stable").all()

@@ -40,6 +40,7 @@ from .. import __version__
 from .bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
+from . import map_shading
 from .cycle_curves import cycle_curves
 from .executors import InlineExecutor, name_of, run_units
 from .hopf_curves import HopfCurvesResult, hopf_curves
@@ -47,6 +48,7 @@ from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, chec
 from .response import ResponseType
 
 SHIMMY_TYPES = ("Stable", "Torsion", "Lateral", "Bistable", "Both")
+SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
 DEFAULT_V_RANGE = (1.0, 200.0)
 DEFAULT_FZ_RANGE = (1.0e4, 9.0e5)
 #: Simulated V per slice at most where no stable equilibrium or cycle exists; the other grid
@@ -289,6 +291,9 @@ class StabilityMap:
     slices: list[SliceResult]
     hopf: HopfCurvesResult
     cycles: dict[str, Any]  # fold and torus curves with their details (:func:`_cycle_curves_unit`)
+    shading_Fz: np.ndarray  # rows of the shading (N), on the grid V
+    shading: list[list[str]]  # [i_row][j_V]: types read off the slices along the curves
+    shading_fallbacks: int  # row intervals read off the nearest slice at the same speed instead
     min_shimmy: dict[str, Any] | None
     executor: str
     elapsed_s: float
@@ -326,6 +331,8 @@ class StabilityMap:
                 "V": self.V.tolist(), "Fz": self.Fz.tolist(), "types": self.types,
                 "min_shimmy_Fz": self.min_shimmy_Fz, "min_shimmy": self.min_shimmy,
                 "slices": [s.to_dict() for s in self.slices],
+                "shading": {"V": self.V.tolist(), "Fz": self.shading_Fz.tolist(), "types": self.shading,
+                            "fallback_intervals": self.shading_fallbacks},
                 "methods": {
                     "hopf_curves": "two-parameter continuation of Hopf points (extended system)",
                     "gh_points": "sign changes of the first Lyapunov coefficient along the Hopf curves "
@@ -335,7 +342,9 @@ class StabilityMap:
                                    "collocation mesh), exact in V and Fz",
                     "torus_curves": "two-parameter continuation of Neimark-Sacker points of cycles (minimally "
                                     "augmented system), exact in V and Fz",
-                    "types": "stable attractors of each slice's diagram; simulation where none is stable"},
+                    "types": "stable attractors of each slice's diagram; simulation where none is stable",
+                    "shading": "each row's intervals between the Hopf, fold and torus curves take the type of the "
+                               "same interval on the nearest slice, mapped linearly (read off the curves)"},
                 "executor": self.executor, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
                 "version": __version__}
 
@@ -404,8 +413,13 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
     for s in slices:
         warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
+    boundaries = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
+    for key in ("fold_curves", "torus_curves"):
+        boundaries += [(f"{key}{i}", np.array([[p["V"], p["Fz"]] for p in c])) for i, c in enumerate(cycles[key])]
+    rows = np.linspace(f_min, f_max, max(SHADING_ROWS, 4 * resolution))
+    shading, fallbacks = map_shading.shade(slices, boundaries, slices[0].V, rows, (v_min, v_max))
     return StabilityMap(config, params, (v_min, v_max), (f_min, f_max), slices[0].V, loads,
-                        [s.types for s in slices], slices, hopf, cycles,
+                        [s.types for s in slices], slices, hopf, cycles, rows, shading, fallbacks,
                         _min_shimmy(hopf, cycles, slices), name_of(executor),
                         time.perf_counter() - clock, warnings)
 
