@@ -10,6 +10,10 @@ so no job process is left a zombie where PID 1 does not reap (a bare container o
 import ctypes
 import sys
 
+# Slow clients: gunicorn's asyncio worker reads every connection in its event loop and the WSGI
+# app runs on complete requests only (shimmy/service/buffered.py).
+worker_class = "shimmy.service.buffered.BufferingWorker"
+
 PR_SET_CHILD_SUBREAPER = 36
 
 

@@ -49,9 +49,9 @@ class Server:
         req = urllib.request.Request(self.base + path, data=data, method=method, headers={**sent, **(headers or {})})
         try:
             with urllib.request.urlopen(req, timeout=timeout) as resp:
-                status, headers, text = resp.status, dict(resp.headers), resp.read().decode()
+                status, headers, text = resp.status, resp.headers, resp.read().decode()
         except urllib.error.HTTPError as exc:
-            status, headers, text = exc.code, dict(exc.headers), exc.read().decode()
+            status, headers, text = exc.code, exc.headers, exc.read().decode()
         try:
             return status, headers, json.loads(text)
         except ValueError:

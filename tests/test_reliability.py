@@ -14,6 +14,7 @@ import os
 import random
 import shutil
 import signal
+import socket
 import statistics
 import time
 
@@ -25,7 +26,7 @@ from conftest import start_server, stop_server
 pytestmark = pytest.mark.slow
 
 LIMITS = {"SHIMMY_MAX_RUNNING_JOBS": "1", "SHIMMY_MAX_QUEUED_JOBS": "3", "SHIMMY_JOB_RETRY_AFTER_SECONDS": "7",
-          "SHIMMY_BODY_READ_SECONDS": "2"}
+          "SHIMMY_BODY_READ_SECONDS": "3", "SHIMMY_HEADER_READ_SECONDS": "3"}
 OK = {
     "/api/v1/simulate": {"config": "nes_pd", "V": 30, "Fz": 150000, "t_end": 5},
     "/api/v1/hopf": {"config": "nes", "Fz": 150000, "v_max": 200},
@@ -366,3 +367,55 @@ def test_deleted_cache_directory_is_recreated_and_jobs_still_run(srv):
     done = _until(lambda: (j := srv.request("GET", f"/api/v1/jobs/{job['id']}")[2]).get("status") in
                   ("done", "failed") and j, what="the job to finish")
     assert done["status"] == "done" and done["result"]["amplitude"]["psi"] > 0
+
+
+def open_slow_clients(base: str, n: int) -> list[socket.socket]:
+    """``n`` connections that never finish their request: half stop inside the headers, half send
+    complete headers announcing 1000 body bytes and then one."""
+    host, port = base.removeprefix("http://").split(":")
+    socks = []
+    for k in range(n):
+        s = socket.create_connection((host, int(port)), timeout=10)
+        s.sendall(b"POST /api/v1/simulate HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                  b"Content-Length: 1000\r\n\r\n{" if k % 2 else b"GET /api/v1/health HTTP/1.1\r\nHost: x\r\nX-Slow")
+        socks.append(s)
+    return socks
+
+
+def closed_by_server(s: socket.socket) -> bool:
+    s.settimeout(0.01)
+    try:
+        data = s.recv(4096)
+    except TimeoutError:
+        return False
+    except OSError:
+        return True
+    return data == b"" or data.startswith(b"HTTP/1.1 408")
+
+
+def test_fifty_slow_clients_do_not_stall_the_service_and_are_closed(srv):
+    socks = open_slow_clients(srv.base, 50)
+    try:
+        health, hopf = [], []
+        for k in range(10):
+            t0 = time.perf_counter()
+            status, _, _ = srv.request("GET", "/api/v1/health", timeout=30)
+            health.append(time.perf_counter() - t0)
+            assert status == 200
+            t0 = time.perf_counter()
+            status, _, _ = srv.request("POST", "/api/v1/hopf", {"config": "nes", "Fz": 150000 + k})
+            hopf.append(time.perf_counter() - t0)
+            assert status == 200
+        print(f"\n50 slow clients: health median {1e3 * statistics.median(health):.1f} ms, max "
+              f"{1e3 * max(health):.1f} ms; uncached POST /hopf median {1e3 * statistics.median(hopf):.1f} ms")
+        assert statistics.median(health) < 1.0 and max(health) < 5.0
+        t0 = time.time()
+        open_ = set(range(len(socks)))
+        while open_ and time.time() - t0 < 60:
+            open_ -= {i for i in open_ if closed_by_server(socks[i])}
+            time.sleep(0.2)
+        print(f"slow connections closed by the server: {50 - len(open_)} of 50 within {time.time() - t0:.1f} s")
+        assert not open_
+    finally:
+        for s in socks:
+            s.close()

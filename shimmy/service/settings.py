@@ -11,6 +11,11 @@ SCHEMA_VERSION = 1
 
 #: Limits on what one request may ask for (refused with 4xx naming the limit).
 MAX_BODY_BYTES = 64 * 1024
+#: Threads per web worker that run the WSGI app on complete requests (SHIMMY_WEB_THREADS).
+WEB_THREADS = int(os.environ.get("SHIMMY_WEB_THREADS", "8"))
+#: The headers of a connection's first request must be complete within this many seconds, else it is
+#: closed (SHIMMY_HEADER_READ_SECONDS).
+HEADER_READ_SECONDS = float(os.environ.get("SHIMMY_HEADER_READ_SECONDS", "10"))
 #: A request body must arrive within this many seconds of the app asking for it (else 408).
 BODY_READ_SECONDS = float(os.environ.get("SHIMMY_BODY_READ_SECONDS", "10"))
 MAX_T_END = 600.0  # s of simulated time per request
