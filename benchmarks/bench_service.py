@@ -1,4 +1,5 @@
-"""Service benchmarks: cached API latency, sustained cached throughput, slider-to-figure latency.
+"""Service benchmarks: cached API latency, sustained cached throughput, slider-to-figure latency,
+health under slow clients, time to refuse a job when the queue is full.
 
     python benchmarks/bench_service.py [--seconds 5] [--repeats 5]
 
@@ -12,7 +13,12 @@ Starts gunicorn (app:server, 2 workers, a fresh cache directory) on loopback, th
   slider until the Overview figure is redrawn with the new data, timed inside the page
   (keydown event to the figure's last DOM change; the driver-polled time is printed too),
   median of --repeats moves
-  (target <= 300 ms).
+  (target <= 300 ms);
+* health with 50 slow clients open (25 stopped inside their headers, 25 with a body never
+  finished): median and max of 20 GET /api/v1/health (target <= 1 s), and how many of the 50 the
+  server has closed after its header/body limits;
+* a full job queue: 2 running + 8 queued map jobs (the default limits), then the median time of
+  20 further submissions to be refused (503 with Retry-After); every job is cancelled after.
 """
 
 from __future__ import annotations
@@ -121,6 +127,51 @@ def slider_latency(base: str, repeats: int) -> list[float]:
         driver.quit()
 
 
+def slow_clients(base: str, n: int = 50) -> tuple[list[float], int]:
+    """Health latencies with ``n`` slow clients open, and how many the server closed (limits 10 s)."""
+    from test_reliability import closed_by_server, open_slow_clients
+
+    socks = open_slow_clients(base, n)
+    try:
+        lat = []
+        for _ in range(20):
+            t0 = time.perf_counter()
+            with urllib.request.urlopen(base + "/api/v1/health", timeout=60) as resp:
+                resp.read()
+            lat.append(time.perf_counter() - t0)
+            time.sleep(0.05)
+        deadline = time.time() + 30
+        open_ = set(range(n))
+        while open_ and time.time() < deadline:
+            open_ -= {i for i in open_ if closed_by_server(socks[i])}
+            time.sleep(0.2)
+        return lat, n - len(open_)
+    finally:
+        for s in socks:
+            s.close()
+
+
+def queue_refusal(port: int) -> tuple[int, list[float]]:
+    """(jobs accepted, times of 20 refusals) once the queue is full; every accepted job is cancelled."""
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=60)
+    accepted, refusals = [], []
+    for k in range(30):
+        body = {"analysis": "map", "config": "original", "resolution": 40, "fz_max": 900000.0 - 1000 * k}
+        t0 = time.perf_counter()
+        status, raw = post(conn, "/api/v1/jobs", body)
+        elapsed = time.perf_counter() - t0
+        if status == 202:
+            accepted.append(json.loads(raw)["id"])
+        elif status == 503:
+            refusals.append(elapsed)
+        if len(refusals) == 20:
+            break
+    for job_id in accepted:
+        conn.request("DELETE", f"/api/v1/jobs/{job_id}")
+        conn.getresponse().read()
+    return len(accepted), refusals
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=5.0)
@@ -148,6 +199,8 @@ def main() -> None:
                      for k in range(10_000)]
             fresh_rate = throughput(port, fresh, min(args.seconds, 3.0))
             moves, polled = slider_latency(f"http://127.0.0.1:{port}", args.repeats)
+            slow, closed = slow_clients(f"http://127.0.0.1:{port}")
+            n_accepted, refusals = queue_refusal(port)
         finally:
             proc.terminate()
             proc.wait(timeout=20)
@@ -161,6 +214,14 @@ def main() -> None:
           f"{1e3 * statistics.median(moves):>12.0f}{'<= 300':>12}")
     print(f"{'slider key -> figure redrawn, in page, max (ms)':<52}{1e3 * max(moves):>12.0f}{'':>12}")
     print(f"{'same, seen by the test driver (adds its overhead) (ms)':<52}{1e3 * statistics.median(polled):>12.0f}"
+          f"{'':>12}")
+
+    print(f"{'health with 50 slow clients, median of 20 (ms)':<52}{1e3 * statistics.median(slow):>12.1f}"
+          f"{'<= 1000':>12}")
+    print(f"{'health with 50 slow clients, max (ms)':<52}{1e3 * max(slow):>12.1f}{'<= 1000':>12}")
+    print(f"{'slow connections closed by the server (of 50)':<52}{closed:>12d}{'50':>12}")
+    print(f"{'jobs accepted before the queue was full':<52}{n_accepted:>12d}{'10':>12}")
+    print(f"{'time to refuse a job, queue full, median of 20 (ms)':<52}{1e3 * statistics.median(refusals):>12.1f}"
           f"{'':>12}")
 
 
