@@ -277,8 +277,9 @@ def test_shading_changes_only_at_the_curves_or_where_the_slices_change():
     slices = [S(1e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 60.0}]),
               S(3e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 80.0}])]
     V = np.linspace(1.0, 200.0, 400)
-    rows, fallbacks = map_shading.shade(slices, [curve], V, np.array([2e5]), (1.0, 200.0))
+    rows, lengths, fallbacks = map_shading.shade(slices, [curve], V, np.array([2e5]), (1.0, 200.0))
     edge = 50.0 + 2e5 / 1e4  # the boundary at the row's load: 70 m/s, between the slices' 60 and 80
     row = np.array(rows[0])
     assert fallbacks == 0
     assert (row[V < edge - 0.5] == "Torsion").all() and (row[V > edge + 0.5] == "Stable").all()
+    assert lengths[0]["Torsion"] == pytest.approx(edge - 1.0) and lengths[0]["Stable"] == pytest.approx(200.0 - edge)

@@ -11,10 +11,9 @@
   Stable, on the slice's fine grid of (v_max - v_min) / (10 (n_v - 1)) m/s), their hull, and the
   largest torsional amplitude of a stable limit cycle with its speed;
 * ``torsion_area`` ((m/s) kN): the area of the pure-torsion (type Torsion) region in the
-  low-load band Fz <= 250 kN, V 1-200 m/s: on each map slice the measure of V classified
-  Torsion, integrated over Fz by the trapezoidal rule between the slices (so its accuracy is
-  that of the slice spacing; a map of the band alone, ``stability_map(config,
-  fz_range=(10e3, 250e3), resolution=...)``, gives finer slices there).
+  low-load band Fz <= 250 kN, V 1-200 m/s: on each row of the map's shading (read off the
+  continued curves, :mod:`shimmy.analyses.map_shading`) the measure of V classified Torsion,
+  exact for the read-off, integrated over Fz by the trapezoidal rule between the rows.
 """
 
 from __future__ import annotations
@@ -34,9 +33,10 @@ _trapezoid = getattr(np, "trapezoid", None) or np.trapz  # numpy 2 renamed it
 
 
 def torsion_area(smap: StabilityMap, fz_max: float = BAND_FZ_MAX) -> dict[str, Any]:
-    """Area ((m/s) kN) of the Torsion region of a map below ``fz_max``, and its share of the band."""
-    Fz = np.array([s.Fz for s in smap.slices])
-    length = np.array([s.lengths["Torsion"] for s in smap.slices])
+    """Area ((m/s) kN) of the Torsion region of a map below ``fz_max``, and its share of the band:
+    the Torsion measure of each row of the shading read off the curves, trapezoidal in Fz."""
+    Fz = np.asarray(smap.shading_Fz, float)
+    length = np.array([row.get("Torsion", 0.0) for row in smap.shading_lengths])
     top = min(fz_max, smap.fz_range[1])
     inside = Fz <= top
     f = Fz[inside]
@@ -48,7 +48,7 @@ def torsion_area(smap: StabilityMap, fz_max: float = BAND_FZ_MAX) -> dict[str, A
     area = float(_trapezoid(L, f / 1e3)) if f.size > 1 else 0.0
     band = (smap.v_range[1] - smap.v_range[0]) * (top - smap.fz_range[0]) / 1e3
     return {"torsion_area": area, "torsion_area_fraction": area / band if band > 0 else None,
-            "band": {"V": list(smap.v_range), "Fz": [smap.fz_range[0], top], "slices": int(f.size)}}
+            "band": {"V": list(smap.v_range), "Fz": [smap.fz_range[0], top], "rows": int(f.size)}}
 
 
 def speed_metrics(config: Configuration | str, Fz: float, params: Parameters | None = None,

@@ -58,9 +58,21 @@ def type_at(intervals: Sequence[dict[str, Any]], V: float) -> str:
     return "Stable"
 
 
+def measures(intervals: Sequence[dict[str, Any]], lo: float, hi: float) -> dict[str, float]:
+    """Measure (m/s) of each type of a slice inside [lo, hi] (Stable: what no interval covers)."""
+    out: dict[str, float] = {}
+    for iv in intervals:
+        overlap = min(hi, iv["V_end"]) - max(lo, iv["V_start"])
+        if overlap > 0:
+            out[iv["type"]] = out.get(iv["type"], 0.0) + overlap
+    out["Stable"] = out.get("Stable", 0.0) + max(0.0, (hi - lo) - sum(out.values()))
+    return out
+
+
 def shade(slices: Sequence[Any], curves: Sequence[Curve], v_grid: np.ndarray, fz_rows: np.ndarray,
-          v_range: tuple[float, float]) -> tuple[list[list[str]], int]:
-    """Types on the grid v_grid x fz_rows, and how many row intervals fell back to the nearest
+          v_range: tuple[float, float]) -> tuple[list[list[str]], list[dict[str, float]], int]:
+    """Types on the grid v_grid x fz_rows, the exact measure (m/s) of each type on every row (the
+    mapped slice intervals, not the cells), and how many row intervals fell back to the nearest
     slice at the same speed. ``slices`` carry ``Fz`` and ``intervals`` (see
     :class:`~shimmy.analyses.stability_map.SliceResult`)."""
     loads = np.array([s.Fz for s in slices])
@@ -69,10 +81,12 @@ def shade(slices: Sequence[Any], curves: Sequence[Curve], v_grid: np.ndarray, fz
         ivs = _intervals(crossings(curves, s.Fz), *v_range)
         named.append({name: (lo, hi) for lo, hi, name in ivs})
     rows: list[list[str]] = []
+    lengths: list[dict[str, float]] = []
     fallbacks = 0
     for Fz in fz_rows:
         order = np.argsort(np.abs(loads - Fz), kind="stable")
         row = ["Stable"] * len(v_grid)
+        length: dict[str, float] = {}
         for lo, hi, name in _intervals(crossings(curves, float(Fz)), *v_range):
             k = next((int(j) for j in order[:2] if name in named[int(j)]), None)
             cells = np.nonzero((v_grid >= lo) & (v_grid <= hi))[0]
@@ -81,10 +95,16 @@ def shade(slices: Sequence[Any], curves: Sequence[Curve], v_grid: np.ndarray, fz
                 for c in cells:
                     f = 0.5 if hi == lo else (v_grid[c] - lo) / (hi - lo)
                     row[c] = type_at(slices[k].intervals, float(a + f * (b - a)))
+                scale = (hi - lo) / (b - a) if b > a else 0.0
+                part = {t: m * scale for t, m in measures(slices[k].intervals, a, b).items()}
             else:
                 fallbacks += 1
                 near = slices[int(order[0])]
                 for c in cells:
                     row[c] = type_at(near.intervals, float(v_grid[c]))
+                part = measures(near.intervals, lo, hi)
+            for t, m in part.items():
+                length[t] = length.get(t, 0.0) + m
         rows.append(row)
-    return rows, fallbacks
+        lengths.append(length)
+    return rows, lengths, fallbacks

@@ -293,6 +293,7 @@ class StabilityMap:
     cycles: dict[str, Any]  # fold and torus curves with their details (:func:`_cycle_curves_unit`)
     shading_Fz: np.ndarray  # rows of the shading (N), on the grid V
     shading: list[list[str]]  # [i_row][j_V]: types read off the slices along the curves
+    shading_lengths: list[dict[str, float]]  # per row: measure (m/s) of each type, exact for the read-off
     shading_fallbacks: int  # row intervals read off the nearest slice at the same speed instead
     min_shimmy: dict[str, Any] | None
     executor: str
@@ -417,9 +418,9 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     for key in ("fold_curves", "torus_curves"):
         boundaries += [(f"{key}{i}", np.array([[p["V"], p["Fz"]] for p in c])) for i, c in enumerate(cycles[key])]
     rows = np.linspace(f_min, f_max, max(SHADING_ROWS, 4 * resolution))
-    shading, fallbacks = map_shading.shade(slices, boundaries, slices[0].V, rows, (v_min, v_max))
+    shading, lengths, fallbacks = map_shading.shade(slices, boundaries, slices[0].V, rows, (v_min, v_max))
     return StabilityMap(config, params, (v_min, v_max), (f_min, f_max), slices[0].V, loads,
-                        [s.types for s in slices], slices, hopf, cycles, rows, shading, fallbacks,
+                        [s.types for s in slices], slices, hopf, cycles, rows, shading, lengths, fallbacks,
                         _min_shimmy(hopf, cycles, slices), name_of(executor),
                         time.perf_counter() - clock, warnings)
 
