@@ -50,7 +50,7 @@ def layout(shade: str = "original", overlay: str = "", fz_min: str = "10", fz_ma
             *jobs.controls("map"),
         ], className="controls"),
         html.Div(id="map-error", className="error", role="alert"),
-        ui.graph("map-graph", figure=style.message_figure("Press Compute: about 20 s per configuration at 40 slices "
+        ui.graph("map-graph", figure=style.message_figure("Press Compute: about 35 s per configuration at 40 slices "
                                                           "cold on 2 cores, instant from the cache", 600)),
         html.Div(id="map-hint", className="hint"),
         html.Div(id="map-table"),
