@@ -124,8 +124,10 @@ def test_bad_input_gets_4xx_naming_the_field(server, path, body, status, field):
 def test_unknown_paths_methods_and_jobs(server):
     status, _, body = server.request("GET", "/api/v1/nothing")
     assert status == 404 and body["field"] == "path"
-    status, _, body = server.request("GET", "/api/v1/simulate")
-    assert status == 405 and body["allowed"] == "POST"
+    status, headers, body = server.request("GET", "/api/v1/simulate")
+    assert status == 405 and body["allowed"] == "POST" and headers["Allow"] == "POST"
+    status, headers, body = server.request("PUT", "/api/v1/jobs/abc", {})
+    assert status == 405 and headers["Allow"] == "DELETE, GET"
     status, _, body = server.request("GET", "/api/v1/jobs/doesnotexist")
     assert status == 404 and body["field"] == "id"
     status, _, body = server.request("DELETE", "/api/v1/jobs/doesnotexist")

@@ -193,6 +193,7 @@ def test_callback_fuzz_campaign_gives_no_5xx(srv):
     assert all(s < 500 for s in statuses), [a for a in answers if a[0] >= 500][:3]
     assert not unnamed, unnamed[:3]
     cancel_all(srv)
+    _until(lambda: not _zombies_below(srv.proc.pid), what="no zombie left by the campaign")
 
 
 def _workers(srv):
@@ -419,3 +420,22 @@ def test_fifty_slow_clients_do_not_stall_the_service_and_are_closed(srv):
     finally:
         for s in socks:
             s.close()
+
+
+def test_body_shorter_than_its_content_length_is_answered_408_in_bounded_time(srv):
+    host, port = srv.base.removeprefix("http://").split(":")
+    with socket.create_connection((host, int(port)), timeout=30) as s:
+        t0 = time.perf_counter()
+        s.sendall(b"POST /api/v1/simulate HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                  b"Content-Length: 1000\r\n\r\n{\"config\": \"nes\"")
+        answer = b""
+        while b"}" not in answer:
+            chunk = s.recv(4096)
+            if not chunk:
+                break
+            answer += chunk
+        elapsed = time.perf_counter() - t0
+    head, _, body = answer.partition(b"\r\n\r\n")
+    assert head.startswith(b"HTTP/1.1 408"), answer[:200]
+    assert json.loads(body)["field"] == "body"
+    assert elapsed < 3 + 20  # the limit (3 s here) plus a generous margin, far from gunicorn's 120 s timeout

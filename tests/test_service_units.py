@@ -46,6 +46,13 @@ def test_openapi_fields_match_the_schemas():
         assert set(props) == {f.name for f in schemas.SCHEMAS[name].fields}
     for name in schemas.JOB_ANALYSES:
         assert doc["components"]["schemas"][f"job_{name}"]["properties"]["analysis"]["enum"] == [name]
+    # The document says exactly which design parameters the server takes, with their ranges.
+    from shimmy.model.parameters import PARAMETER_SPECS
+
+    params = doc["components"]["schemas"]["hopf_request"]["properties"]["params"]
+    assert params["additionalProperties"] is False and set(params["properties"]) == set(PARAMETER_SPECS)
+    assert (params["properties"]["r2"]["minimum"], params["properties"]["r2"]["maximum"]) == (0.07, 0.09)
+    assert "Retry-After" in doc["paths"]["/jobs"]["post"]["responses"]["503"]["headers"]
 
 
 def test_url_design_state_round_trip_and_bad_keys():
