@@ -18,7 +18,7 @@ Starts gunicorn (app:server, 2 workers, a fresh cache directory) on loopback, th
   finished): median and max of 20 GET /api/v1/health (target <= 1 s), and how many of the 50 the
   server has closed after its header/body limits;
 * a full job queue: 2 running + 8 queued map jobs (the default limits), then the median time of
-  20 further submissions to be refused (503 with Retry-After); every job is cancelled after.
+  20 further submissions to be refused (429 with Retry-After); every job is cancelled after.
 """
 
 from __future__ import annotations
@@ -162,7 +162,7 @@ def queue_refusal(port: int) -> tuple[int, list[float]]:
         elapsed = time.perf_counter() - t0
         if status == 202:
             accepted.append(json.loads(raw)["id"])
-        elif status == 503:
+        elif status == 429:
             refusals.append(elapsed)
         if len(refusals) == 20:
             break

@@ -52,7 +52,7 @@ def test_openapi_fields_match_the_schemas():
     params = doc["components"]["schemas"]["hopf_request"]["properties"]["params"]
     assert params["additionalProperties"] is False and set(params["properties"]) == set(PARAMETER_SPECS)
     assert (params["properties"]["r2"]["minimum"], params["properties"]["r2"]["maximum"]) == (0.07, 0.09)
-    assert "Retry-After" in doc["paths"]["/jobs"]["post"]["responses"]["503"]["headers"]
+    assert "Retry-After" in doc["paths"]["/jobs"]["post"]["responses"]["429"]["headers"]
 
 
 def test_url_design_state_round_trip_and_bad_keys():

@@ -155,12 +155,28 @@ def _shimmy(exc: Exception):
 @api.route("/<path:anything>", methods=["GET", "POST", "PUT", "PATCH", "DELETE"])
 def _unmatched(anything: str):
     """Everything under /api/v1 that no endpoint takes: 405 for a known path, else 404 (JSON)."""
-    route = "/jobs/{id}" if anything.startswith("jobs/") and anything.count("/") == 1 else "/" + anything
-    methods = sorted(m for m in _METHODS.get(route, ()) if m not in ("HEAD", "OPTIONS"))
+    methods = _methods_of(anything)
     if methods:
         return error(f"method {request.method} not allowed on {request.path}", "method", ", ".join(methods), 405,
                      {"Allow": ", ".join(methods)})
     return error(f"no such endpoint: {request.method} {request.path}", "path", f"see {PREFIX}/openapi.json", 404)
+
+
+def _methods_of(subpath: str) -> list[str]:
+    """The documented methods of PREFIX/``subpath`` (empty for an unknown path)."""
+    route = "/jobs/{id}" if subpath.startswith("jobs/") and subpath.count("/") == 1 else "/" + subpath
+    return sorted(_METHODS.get(route, ()))
+
+
+@api.before_request
+def _options():
+    """OPTIONS lists exactly the documented methods (Flask's own answer would add the catch-all's)."""
+    if request.method != "OPTIONS":
+        return None
+    methods = _methods_of(request.path.removeprefix(PREFIX + "/"))
+    if not methods:
+        return error(f"no such endpoint: {request.path}", "path", f"see {PREFIX}/openapi.json", 404)
+    return Response(status=204, headers={"Allow": ", ".join([*methods, "OPTIONS"])})
 
 
 @api.get("/health")
@@ -218,7 +234,7 @@ def submit_job():
         job = jobs.submit(analysis, body)
     except jobs.QueueFull as exc:
         return error(f"analysis {analysis!r} not queued: {exc}", "analysis",
-                     f"a job once fewer than {settings.MAX_QUEUED_JOBS} are queued", 503,
+                     f"a job once fewer than {settings.MAX_QUEUED_JOBS} are queued", 429,
                      {"Retry-After": str(exc.retry_after)})
     return _json(jobs.public(job, with_result=False), 202, headers={"Location": f"{PREFIX}/jobs/{job['id']}"})
 
@@ -291,7 +307,7 @@ def openapi_document() -> dict[str, Any]:
         "requestBody": {"required": True, "content": {"application/json": {"schema": {"oneOf": job_bodies}}}},
         "responses": {"202": {"description": "accepted", "content": {"application/json": {
             "schema": {"$ref": "#/components/schemas/Job"}}}}, "400": err, "408": err, "413": err, "415": err,
-            "422": err, "503": {**err, "description": "the job queue is full",
+            "422": err, "429": {**err, "description": "the job queue is full",
                                 "headers": {"Retry-After": {"schema": {"type": "integer"}}}}}}}
     paths["/jobs/{id}"] = {
         "parameters": [{"name": "id", "in": "path", "required": True, "schema": {"type": "string"}}],
@@ -306,6 +322,6 @@ def openapi_document() -> dict[str, Any]:
                      "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Limits: "
                                     f"body <= {settings.MAX_BODY_BYTES} bytes, t_end <= {settings.MAX_T_END:g} s, "
                                     f"ntst <= {settings.MAX_NTST}; at most {settings.MAX_RUNNING_JOBS} jobs run and "
-                                    f"{settings.MAX_QUEUED_JOBS} wait queued (then 503 with Retry-After); an identical "
+                                    f"{settings.MAX_QUEUED_JOBS} wait queued (then 429 with Retry-After); an identical "
                                     "request already queued or running is that job. POST bodies: application/json."},
             "servers": [{"url": PREFIX}], "paths": paths, "components": {"schemas": comps}}

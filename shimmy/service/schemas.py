@@ -100,6 +100,15 @@ class Field:
         return dict(value)
 
     def openapi(self) -> dict[str, Any]:
+        """The field's JSON Schema; an optional field may also be null (the server takes it as absent)."""
+        out = self._openapi()
+        if not self.required:
+            out["type"] = [out["type"], "null"]
+            if "enum" in out:
+                out["enum"] = [*out["enum"], None]
+        return out
+
+    def _openapi(self) -> dict[str, Any]:
         out: dict[str, Any] = {"type": self.kind, "description": self.description + (f" ({self.unit})" if self.unit
                                                                                       else "")}
         if self.low is not None:
@@ -161,9 +170,15 @@ class RequestSchema:
         return out
 
     def openapi(self) -> dict[str, Any]:
-        return {"type": "object", "additionalProperties": False,
-                "required": [f.name for f in self.fields if f.required],
-                "properties": {f.name: f.openapi() for f in self.fields}}
+        out = {"type": "object", "additionalProperties": False, "required": [f.name for f in self.fields if f.required],
+               "properties": {f.name: f.openapi() for f in self.fields},
+               "description": "Rules across fields (answered 422 naming the field): v_max above v_min, fz_max above "
+                              "fz_min, a design whose NES roller stays on its track (r2 + r3 > (sqrt(3)/4)(r1 + r2))."}
+        if self.name == "study":
+            out["dependentRequired"] = {"parameter2": ["values2"], "values2": ["parameter2"]}
+            out["description"] += (f" Study: each value within its parameter's range; at most "
+                                   f"{settings.MAX_STUDY_UNITS} designs x configurations.")
+        return out
 
 
 def _check_study(out: dict[str, Any]) -> None:

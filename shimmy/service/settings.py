@@ -28,7 +28,7 @@ MAX_STUDY_UNITS = 200  # diagrams per study (designs x configurations, ~0.5-2 s 
 #: Admission control of jobs, shared by the API and the workbench pages (SHIMMY_MAX_RUNNING_JOBS,
 #: SHIMMY_MAX_QUEUED_JOBS): at most this many run at once on this host, each in its own process;
 #: at most this many more wait queued, holding no process; beyond that a submission is refused
-#: (503 with Retry-After: JOB_RETRY_AFTER_SECONDS).
+#: (429 with Retry-After: JOB_RETRY_AFTER_SECONDS; a 4xx, not a server error).
 MAX_RUNNING_JOBS = int(os.environ.get("SHIMMY_MAX_RUNNING_JOBS", "2"))
 MAX_QUEUED_JOBS = int(os.environ.get("SHIMMY_MAX_QUEUED_JOBS", "8"))
 JOB_RETRY_AFTER_SECONDS = int(os.environ.get("SHIMMY_JOB_RETRY_AFTER_SECONDS", "30"))
