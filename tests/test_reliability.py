@@ -439,3 +439,36 @@ def test_body_shorter_than_its_content_length_is_answered_408_in_bounded_time(sr
     assert head.startswith(b"HTTP/1.1 408"), answer[:200]
     assert json.loads(body)["field"] == "body"
     assert elapsed < 3 + 20  # the limit (3 s here) plus a generous margin, far from gunicorn's 120 s timeout
+
+
+def _download(srv, output, value):
+    dep = next(d for d in _dependencies(srv) if d["output"] == output)
+    body = {"output": output, "outputs": _outputs(output),
+            "inputs": [{"id": i["id"], "property": i["property"], "value": 1} for i in dep["inputs"]],
+            "state": [{"id": json.loads(dep["state"][0]["id"]) if dep["state"][0]["id"].startswith("{")
+                       else dep["state"][0]["id"], "property": "data", "value": value}],
+            "changedPropIds": [f"{dep['inputs'][0]['id']}.n_clicks"]}
+    t0 = time.perf_counter()
+    status, _, _ = srv.request("POST", "/_dash-update-component", body)
+    return status, time.perf_counter() - t0
+
+
+def test_crafted_downloads_never_compute(srv):
+    """Download callbacks given requests the client made up serialise only what is cached: nothing is computed."""
+    from shimmy.service import cache, schemas
+
+    cancel_all(srv)
+    maps = [{"config": c, "resolution": 40, "fz_max": 880000.0} for c in ("original", "nes", "pd", "nes_pd")]
+    history = {"config": "nes", "V": 33.0, "Fz": 150000.0, "t_end": 600.0, "include_series": True}
+    design = {"params": {"r2": 0.0811}}
+    for output, value, analysis, requests in [("map-download.data", maps, "map", maps),
+                                              ("th-download.data", [history], "simulate", [history]),
+                                              ("dev-download.data", design, "devices", [design])]:
+        status, elapsed = _download(srv, output, value)
+        assert status in (200, 204) and elapsed < 30, output  # the map alone would take minutes
+        assert not _workers(srv)
+        with srv.cache_env():
+            assert all(cache.get(analysis, schemas.validate(analysis, r)) is None for r in requests), output
+    # A list longer than a page can send is refused, not served.
+    many = [{"config": "nes", "resolution": 2, "fz_max": 400000.0 + k} for k in range(20)]
+    assert _download(srv, "map-download.data", many)[0] in (200, 204)
