@@ -98,6 +98,16 @@ def test_cmd_is_gunicorn_without_debug():
                      "--timeout", "120", "--no-control-socket"]]
 
 
+def test_the_image_runs_the_slow_client_safe_worker():
+    """The CMD runs in WORKDIR /app, where gunicorn reads gunicorn.conf.py: it must reach the image."""
+    workdirs = [a for k, a in instructions() if k == "WORKDIR"]
+    assert workdirs[-1] == "/app" and not any(k == "CMD" and "--config" in a for k, a in instructions())
+    ignored = [line.strip() for line in (ROOT / ".dockerignore").read_text().splitlines()
+               if line.strip() and not line.startswith("#")]
+    assert not any(pattern in ("gunicorn.conf.py", "*.py", "gunicorn*") for pattern in ignored)
+    assert 'worker_class = "shimmy.service.buffered.BufferingWorker"' in (ROOT / "gunicorn.conf.py").read_text()
+
+
 @pytest.mark.parametrize("path", ["Dockerfile", "compose.yaml", "compose.dask.yaml"])
 def test_no_debug_mode(path):
     text = (ROOT / path).read_text()
