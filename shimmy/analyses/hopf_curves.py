@@ -42,15 +42,22 @@ class HopfCurvesResult:
     elapsed_s: float
     warnings: list[str] = field(default_factory=list)
 
-    @property
-    def fz_minimum(self) -> dict[str, float] | None:
-        """The lowest load on any Hopf curve (located turning point, or a box edge)."""
+    @staticmethod
+    def _lowest(curves: list[HopfCurve]) -> dict[str, float] | None:
+        """The lowest load on the curves: a located turning point, or an end of a curve."""
         best = None
-        for c in self.curves:
+        for c in curves:
+            if c.p.size == 0:
+                continue
             for e in c.extrema + [{"p": c.p[i].tolist(), "omega": float(c.omega[i])} for i in (0, -1)]:
                 if best is None or e["p"][1] < best["Fz"]:
                     best = {"V": e["p"][0], "Fz": e["p"][1], "frequency_hz": e["omega"] / (2 * math.pi)}
         return best
+
+    @property
+    def fz_minimum(self) -> dict[str, float] | None:
+        """The lowest load on any Hopf curve (located turning point, or a box edge)."""
+        return self._lowest(self.curves)
 
     @property
     def gh_points(self) -> list[dict[str, float]]:
@@ -72,14 +79,7 @@ class HopfCurvesResult:
     def lateral_minimum(self) -> dict[str, float] | None:
         """The lowest load on a lateral Hopf curve (its located turning point, or a box edge): the
         lateral bending boundary's lowest point."""
-        best = None
-        for c in self.curves:
-            if c.p.size == 0 or self.mode_of_curve(c) != "lateral":
-                continue
-            for e in c.extrema + [{"p": c.p[i].tolist(), "omega": float(c.omega[i])} for i in (0, -1)]:
-                if best is None or e["p"][1] < best["Fz"]:
-                    best = {"V": e["p"][0], "Fz": e["p"][1], "frequency_hz": e["omega"] / (2 * math.pi)}
-        return best
+        return self._lowest([c for c in self.curves if c.p.size and self.mode_of_curve(c) == "lateral"])
 
     @property
     def double_hopf_points(self) -> list[dict[str, float]]:
