@@ -100,3 +100,11 @@ def server(tmp_path_factory):
     srv = start_server(tmp_path_factory.mktemp("shimmy-cache"))
     yield srv
     stop_server(srv)
+
+
+def process_group(pid):
+    """The process group of ``pid``, or None once the process is gone."""
+    try:
+        return os.getpgid(pid)
+    except OSError:
+        return None

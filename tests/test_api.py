@@ -8,6 +8,7 @@ import signal
 import time
 
 import pytest
+from conftest import process_group
 
 OK_BODIES = {
     "/api/v1/simulate": {"config": "nes_pd", "V": 30, "Fz": 150000, "t_end": 20},
@@ -233,18 +234,11 @@ def _group_gone(pgid, timeout=30):
 
     deadline = time.time() + timeout
     while time.time() < deadline:
-        left = [p for p in psutil.process_iter(["pid"]) if _pgid(p.pid) == pgid]
+        left = [p for p in psutil.process_iter(["pid"]) if process_group(p.pid) == pgid]
         if not left:
             return True
         time.sleep(0.2)
     return False
-
-
-def _pgid(pid):
-    try:
-        return os.getpgid(pid)
-    except OSError:
-        return None
 
 
 def test_job_cancelled_and_deleted_leaves_no_process(server):

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import concurrent.futures
 import json
-import os
 import random
 import shutil
 import signal
@@ -21,7 +20,7 @@ import time
 import psutil
 import pytest
 
-from conftest import start_server, stop_server
+from conftest import process_group, start_server, stop_server
 
 pytestmark = pytest.mark.slow
 
@@ -297,7 +296,7 @@ def test_killed_web_worker_leaves_no_orphan_or_zombie(srv):
     assert status == 200
     _until(lambda: not psutil.pid_exists(worker.pid), what="the worker to end and be reaped")
     _until(lambda: not _zombies_below(srv.proc.pid), what="no zombie below the arbiter")
-    assert not [p for p in psutil.process_iter() if _pgid(p.pid) == worker.pid]
+    assert not [p for p in psutil.process_iter() if process_group(p.pid) == worker.pid]
 
 
 def test_killed_job_worker_fails_its_job_and_takes_its_group_with_it(srv):
@@ -314,15 +313,8 @@ def test_killed_job_worker_fails_its_job_and_takes_its_group_with_it(srv):
     _until(lambda: not _zombies_below(srv.proc.pid), what="no zombie below the arbiter")
 
 
-def _pgid(pid):
-    try:
-        return os.getpgid(pid)
-    except OSError:
-        return None
-
-
 def _group(pgid):
-    return [p.pid for p in psutil.process_iter() if _pgid(p.pid) == pgid]
+    return [p.pid for p in psutil.process_iter() if process_group(p.pid) == pgid]
 
 
 def test_corrupted_result_entry_is_a_miss_and_recomputed(srv):

@@ -39,6 +39,7 @@ from ..model.equations import build_model, jacobian, parameter_jacobian, rhs
 from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation
 from .hopf_curves import hopf_curves
+from .polylines import near_polyline
 from .executors import open_executor, run_units
 from .stability import hopf_points
 
@@ -333,20 +334,13 @@ def _on_curve(curve: GearCycleCurve, start: Start, l_g: float) -> bool:
     """Whether a start point lies on a continued curve: within a fifth of the local step of its
     polyline in (V, Fz) (scaled) with a torsional and lateral amplitude within 5 %."""
     c = curve.curve
-    p = c.p / np.array([V_SCALE, FZ_SCALE])
-    q = np.array([start.point.p / V_SCALE, start.Fz / FZ_SCALE])
-    if len(p) < 2:
+    scale = np.array([V_SCALE, FZ_SCALE])
+    hit = near_polyline(c.p / scale, np.array([start.point.p, start.Fz]) / scale)
+    if hit is None:
         return False
-    a, b = p[:-1], p[1:]
-    d = b - a
-    length2 = np.maximum(np.sum(d * d, axis=1), 1e-300)
-    s = np.clip(np.sum((q - a) * d, axis=1) / length2, 0.0, 1.0)
-    dist = np.linalg.norm(a + s[:, None] * d - q, axis=1)
-    i = int(np.argmin(dist))
-    if dist[i] > 0.2 * math.sqrt(length2[i]) + 1e-6:
-        return False
+    i, s = hit
     amp = 0.5 * (c.x_max - c.x_min)
-    here = amp[i] + s[i] * (amp[i + 1] - amp[i])
+    here = amp[i] + s * (amp[i + 1] - amp[i])
     xmax, xmin = np.array(start.point.data["x_max"]), np.array(start.point.data["x_min"])
     theirs = 0.5 * (xmax - xmin)
     scale = STATE_SCALE[:len(theirs)]

@@ -24,6 +24,7 @@ from ..continuation import ContinuationOptions
 from ..model.equations import build_model, jacobian, parameter_jacobian, rhs
 from ..continuation.hopf import HopfCurve, TwoParameterField, hopf_curve
 from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
+from .polylines import near_polyline
 from .response import torsional_share
 from .stability import hopf_points
 
@@ -166,12 +167,5 @@ def hopf_curves(config: Configuration | str, params: Parameters | None = None,
 def _on_curve(curve: HopfCurve, V: float, Fz: float) -> bool:
     """Whether (V, Fz) lies on a computed curve: within a fifth of the local step of its polyline
     (in the scaled metric), far above the chord error of the polyline at its step sizes."""
-    p = curve.p / np.array([V_SCALE, FZ_SCALE])
-    q = np.array([V / V_SCALE, Fz / FZ_SCALE])
-    a, b = p[:-1], p[1:]
-    d = b - a
-    length2 = np.maximum(np.sum(d * d, axis=1), 1e-300)
-    s = np.clip(np.sum((q - a) * d, axis=1) / length2, 0.0, 1.0)
-    dist = np.linalg.norm(a + s[:, None] * d - q, axis=1)
-    i = int(np.argmin(dist))
-    return bool(dist[i] <= 0.2 * math.sqrt(length2[i]) + 1e-6)
+    scale = np.array([V_SCALE, FZ_SCALE])
+    return near_polyline(curve.p / scale, np.array([V, Fz]) / scale) is not None
