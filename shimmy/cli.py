@@ -18,7 +18,7 @@ import numpy as np
 from .model.configurations import Configuration
 from .continuation.errors import InvalidInputError
 from .errors import EXPECTED_ERRORS, GeometryError, InvalidParameterError
-from .model.parameters import FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters
+from .model.parameters import DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 1
@@ -288,12 +288,14 @@ def _cmd_map(args) -> int:
     payload["metrics"] = figures
     if args.csv:
         smap.write_csv(args.csv)
-    counts = {t: sum(row.count(t) for row in smap.types) for t in ("Stable", "Torsion", "Lateral", "Bistable",
-                                                                    "Both")}
-    lines = [f"{smap.config.value}: {len(smap.Fz)} slices x {len(smap.V)} speeds, V {smap.v_range[0]:g}.."
+    counts = {t: sum(row.count(t) for row in smap.shading) for t in ("Stable", "Torsion", "Lateral", "Bistable",
+                                                                      "Both")}
+    lines = [f"{smap.config.value}: {len(smap.Fz)} classified slices, {len(smap.shading_Fz)} x {len(smap.V)} grid, "
+             f"V {smap.v_range[0]:g}.."
              f"{smap.v_range[1]:g} m/s, Fz {smap.fz_range[0]:g}..{smap.fz_range[1]:g} N "
              f"({smap.elapsed_s:.1f} s, {smap.executor})",
-             "  grid points by type: " + ", ".join(f"{t} {n}" for t, n in counts.items()),
+             "  grid points by type: " + ", ".join(f"{t} {n}" for t, n in counts.items())
+             + f"; {len(smap.regions)} region polygons",
              f"  Hopf curves {len(smap.hopf.curves)}, GH points {len(smap.hopf.gh_points)}, "
              f"fold curves {len(smap.fold_curves)}, torus curves {len(smap.torus_curves)}"]
     if smap.min_shimmy:
@@ -487,7 +489,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("map", help="(V, Fz) stability map: Hopf, fold and torus curves, shimmy types")
     p.add_argument("--config", required=True, choices=configs)
     plane(p)
-    p.add_argument("--resolution", default=40, help="number of Fz slices")
+    p.add_argument("--resolution", default=DEFAULT_MAP_SLICES,
+                   help="classified Fz slices, evenly spaced (one more is added through each region between the "
+                        "curves that they miss)")
     p.add_argument("--n-v", default=100, help="number of speeds per slice on the output grid")
     p.add_argument("--metrics-Fz", default=150e3, help="load (N) of the speed-interval and amplitude metrics")
     p.add_argument("--csv", metavar="FILE", help="write the classified grid to FILE")
@@ -503,7 +507,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("metrics", help="design figures of merit of configurations against original")
     p.add_argument("--configs", default="original,nes,pd,nes_pd", help="comma-separated configurations")
     p.add_argument("--Fz", default=150e3, help="load (N) of the speed-interval and amplitude metrics")
-    p.add_argument("--resolution", default=40, help="number of Fz slices of each map")
+    p.add_argument("--resolution", default=DEFAULT_MAP_SLICES, help="classified Fz slices of each map")
     _add_common(p)
     p.set_defaults(func=_cmd_metrics)
 

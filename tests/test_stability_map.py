@@ -17,6 +17,7 @@ from shimmy.errors import InvalidParameterError
 from shimmy.analyses.executors import InlineExecutor
 from shimmy.analyses.simulation import simulate
 from shimmy.analyses.stability import hopf_points
+from shimmy.analyses import map_shading
 from shimmy.analyses.stability_map import SHIMMY_TYPES, attractors_at, classify, shimmy_type, stability_map
 
 RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"}
@@ -84,6 +85,8 @@ SAMPLES = [
     ("nes", 30.0, 150e3, "Torsion"),
     ("pd", 180.0, 850e3, "Lateral"),
     ("pd", 50.0, 350e3, "Lateral"),  # D: the particle damper leaves no stable torsional cycle
+    ("original", 50.0, 850e3, "Bistable"),  # the torsional isola between two folds above ~720 kN
+    ("nes", 50.0, 850e3, "Bistable"),
 ]
 
 
@@ -119,12 +122,17 @@ def test_classification_is_confirmed_by_simulation_from_several_starts(config, V
 
 
 def test_map_grid_and_the_classifier_agree(original_map):
+    """The classified slices are the 12 asked for and those through regions they miss; at a
+    slice load the classifier (the same computation) gives the map's answer."""
     m = original_map
-    assert m.Fz.size == 12 and m.V.size == 60
+    asked = np.linspace(1.0e4, 9.0e5, 12)
+    assert all(np.min(np.abs(m.Fz - f)) < 1e-6 for f in asked) and list(m.Fz) == sorted(m.Fz)
+    assert 12 <= m.Fz.size <= 12 + 16 and m.V.size == 60
     assert all(len(row) == 60 and set(row) <= set(SHIMMY_TYPES) for row in m.types)
     # Every type occurs on this map (see the simulation test for what each is).
-    assert {t for row in m.types for t in row} == set(SHIMMY_TYPES)
-    for i, j in ((3, 10), (4, 40), (6, 5), (6, 45), (9, 30), (11, 59)):
+    assert {t for row in m.shading for t in row} == set(SHIMMY_TYPES)
+    for f, j in ((3, 10), (4, 40), (6, 5), (6, 45), (9, 30), (11, 59)):
+        i = int(np.argmin(np.abs(m.Fz - asked[f])))
         answer = classify("original", float(m.V[j]), float(m.Fz[i]))
         assert answer["shimmy_type"] == m.types[i][j], (m.V[j], m.Fz[i])
 
@@ -283,3 +291,87 @@ def test_shading_changes_only_at_the_curves_or_where_the_slices_change():
     assert fallbacks == 0
     assert (row[V < edge - 0.5] == "Torsion").all() and (row[V > edge + 0.5] == "Stable").all()
     assert lengths[0]["Torsion"] == pytest.approx(edge - 1.0) and lengths[0]["Stable"] == pytest.approx(200.0 - edge)
+
+
+def test_shading_is_on_the_right_side_of_every_hopf_curve(original_map):
+    """Independent of the read-off: on every shading row, x = 0 is unstable (eigenvalues at that
+    very load) exactly where the shading says shimmy of some kind is possible from small
+    disturbances, up to one grid cell: no cell is Stable where x = 0 is unstable, and below the
+    GH loads (every Hopf point supercritical) no cell is unstable-free and shaded."""
+    m = original_map
+    cell = float(m.V[1] - m.V[0])
+    gh_low = min(g["Fz"] for g in m.hopf.gh_points)
+    checked = 0
+    for Fz, row in zip(m.shading_Fz[::6], m.shading[::6], strict=True):
+        unstable = hopf_points("original", float(Fz), v_min=1.0, v_max=200.0).unstable_intervals
+        for V, t in zip(m.V, row, strict=True):
+            inside = any(a + cell < V < b - cell for a, b in unstable)
+            outside = all(V < a - cell or V > b + cell for a, b in unstable)
+            if inside:
+                assert t != "Stable", (Fz, V, t)
+                checked += 1
+            elif outside and Fz < gh_low:
+                assert t == "Stable", (Fz, V, t)
+                checked += 1
+    assert checked > 500
+
+
+def test_region_polygons_tile_the_shading(original_map):
+    """Each type's polygons have the area of its row measures (trapezoidal in Fz); a point in
+    the middle of each polygon has the polygon's type in the shading."""
+    m = original_map
+    data = m.to_dict()
+    assert data["regions"] and data["methods"]["regions"]
+    rows = np.asarray(m.shading_Fz) / 1e3
+    for t in SHIMMY_TYPES:
+        polygons = [p for p in m.regions if p["type"] == t]
+        area = sum(map_shading.polygon_area(p) for p in polygons) / 1e3
+        lengths = np.array([r.get(t, 0.0) for r in m.shading_lengths])
+        assert area == pytest.approx(float(np.trapezoid(lengths, rows)), rel=0.02, abs=50.0), t
+    for p in m.regions:
+        k = len(p["V"]) // 2  # rows go up the low-speed edge and down the high-speed edge
+        lo, hi, Fz = p["V"][k // 2], p["V"][len(p["V"]) - 1 - k // 2], p["Fz"][k // 2]
+        if hi - lo < 3 * (m.V[1] - m.V[0]):
+            continue
+        V = 0.5 * (lo + hi)
+        assert m.type_at(V, Fz) == p["type"], (p["type"], V, Fz)
+
+
+def _reached(config, V, Fz):
+    """Response types reached from the three standard starts (psi = 0.001 rad, psi = 0.2 rad,
+    l_g delta = 0.1 m)."""
+    n = 7 if "nes" in config else 5
+    out = set()
+    for index, value in ((0, 0.001), (0, 0.2), (2, 0.05)):
+        x0 = np.zeros(n)
+        x0[index] = value
+        out.add(_settle(config, V, Fz, x0).response_type.value)
+    return out
+
+
+@pytest.mark.slow
+def test_every_region_of_the_map_is_confirmed_by_simulation_from_three_starts(original_map):
+    """At the middle of each region polygon wide enough (6 cells), the types reached by time
+    simulation from the three standard starts are what the region's type says."""
+    m = original_map
+    cell = float(m.V[1] - m.V[0])
+    checked = set()
+    for p in m.regions:
+        k = len(p["V"]) // 2
+        lo, hi, Fz = p["V"][k // 2], p["V"][len(p["V"]) - 1 - k // 2], p["Fz"][k // 2]
+        if hi - lo < 6 * cell or Fz < 2e4:
+            continue
+        V = 0.5 * (lo + hi)
+        reached = _reached("original", V, Fz)
+        t = p["type"]
+        if t == "Stable":
+            assert reached == {"Stable"}, (V, Fz, reached)
+        elif t in ("Torsion", "Lateral"):
+            other = "Lateral" if t == "Torsion" else "Torsion"
+            assert t in reached and other not in reached, (t, V, Fz, reached)
+        elif t == "Bistable":
+            assert {"Torsion", "Lateral"} <= reached, (V, Fz, reached)
+        else:
+            assert "Both" in reached, (V, Fz, reached)
+        checked.add(t)
+    assert checked == set(SHIMMY_TYPES), checked

@@ -282,3 +282,6 @@ def check_operating_point(V: Any, Fz: Any) -> tuple[float, float]:
 #: Operating ranges of the continuation parameters (MODEL.md).
 V_RANGE = (1.0, 500.0)
 FZ_RANGE = (1.0e4, 9.0e5)
+#: Classified Fz slices of a stability map by default (its boundaries are continued curves; the
+#: slices tell the regions' types, and more are added through regions they miss).
+DEFAULT_MAP_SLICES = 10

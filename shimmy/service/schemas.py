@@ -15,8 +15,8 @@ from typing import Any, Mapping
 from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
 from . import settings
-from ..model.parameters import (FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters, check_number,
-                                unknown_name_error)
+from ..model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters,
+                                check_number, unknown_name_error)
 
 CONFIGS = tuple(c.value for c in Configuration)
 
@@ -276,7 +276,8 @@ SCHEMAS: dict[str, RequestSchema] = {
         _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
         _range("fz_min", FZ_RANGE[0], FZ_RANGE, "N", "lowest load"),
         _range("fz_max", FZ_RANGE[1], FZ_RANGE, "N", "highest load"),
-        Field("resolution", "integer", "number of Fz slices", default=40, low=2, high=settings.MAX_MAP_SLICES),
+        Field("resolution", "integer", "classified Fz slices (more through regions they miss)",
+              default=DEFAULT_MAP_SLICES, low=2, high=settings.MAX_MAP_SLICES),
         Field("n_v", "integer", "speeds per slice on the output grid", default=100, low=10,
               high=settings.MAX_MAP_SPEEDS),
         Field("metrics_Fz", "number", "load of the speed-interval and amplitude metrics", default=150e3,
