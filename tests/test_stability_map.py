@@ -163,11 +163,16 @@ def test_fold_curves_end_at_the_generalised_hopf_points(original_map):
 
 
 def test_every_fold_and_torus_point_of_a_slice_lies_on_a_drawn_curve(original_map):
-    """The curves are continued in two parameters; their crossings of each slice's load are
-    located, and every LPC / NS point of every slice's diagram is one of them (to 1e-6 m/s)."""
+    """The curves are continued in two parameters; their crossings of the loads of the slices
+    asked for are located, and every LPC / NS point of those slices' diagrams is one of them (to
+    1e-6 m/s). (The slices added through regions the others miss come after the curves.)"""
     m = original_map
     checked = 0
+    marked = m.cycles["loads"]
+    assert len(marked) == 12
     for s in m.slices:
+        if min(abs(s.Fz - f) for f in marked) > 1e-6:
+            continue
         crossings = {kind: [x["V"] for c in m.cycles["curves"] if c["kind"] == kind for x in c["crossings"]
                             if abs(x["Fz"] - s.Fz) < 1e-3] for kind in ("LPC", "NS")}
         for p in s.special_points:
@@ -271,26 +276,58 @@ def test_shading_read_off_the_curves_agrees_with_the_classifier_away_from_bounda
         assert classify("original", V, Fz)["shimmy_type"] == grid[i, j], (V, Fz)
 
 
+class _Slice:
+    def __init__(self, Fz, intervals):
+        self.Fz, self.intervals = Fz, intervals
+
+
 def test_shading_changes_only_at_the_curves_or_where_the_slices_change():
     """Read-off by construction: within one row, between two consecutive boundary crossings, the
-    shading repeats the slice interval it is mapped from."""
-    from shimmy.analyses import map_shading
-
-    class S:
-        def __init__(self, Fz, intervals):
-            self.Fz, self.intervals = Fz, intervals
-
-    # one vertical boundary at V = 50 + Fz / 1e4 (moves with the load); Torsion left of it on both slices
+    shading repeats the slice interval it is mapped from; a change of type inside an interval (a
+    cycle's mode) moves linearly in Fz between the slices below and above."""
+    # one boundary at V = 50 + Fz / 1e4 (moves with the load); Torsion left of it on both slices,
+    # with a mode change (Both below 20 m/s on the lower slice, below 40 m/s on the upper one)
     curve = ("b", np.array([[50.0, 0.0], [150.0, 1.0e6]]))
-    slices = [S(1e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 60.0}]),
-              S(3e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 80.0}])]
-    V = np.linspace(1.0, 200.0, 400)
-    rows, lengths, fallbacks = map_shading.shade(slices, [curve], V, np.array([2e5]), (1.0, 200.0))
+    slices = [_Slice(1e5, [{"type": "Both", "V_start": 1.0, "V_end": 20.0},
+                           {"type": "Torsion", "V_start": 20.0, "V_end": 60.0}]),
+              _Slice(3e5, [{"type": "Both", "V_start": 1.0, "V_end": 40.0},
+                           {"type": "Torsion", "V_start": 40.0, "V_end": 80.0}])]
+    rows, fallbacks = map_shading.row_segments(slices, [curve], [2e5], (1.0, 200.0))
     edge = 50.0 + 2e5 / 1e4  # the boundary at the row's load: 70 m/s, between the slices' 60 and 80
-    row = np.array(rows[0])
+    # the mode change at the same fraction of the interval [1, edge] as the slices' average
+    f = 0.5 * ((20.0 - 1.0) / (60.0 - 1.0) + (40.0 - 1.0) / (80.0 - 1.0))
+    change = 1.0 + f * (edge - 1.0)
     assert fallbacks == 0
-    assert (row[V < edge - 0.5] == "Torsion").all() and (row[V > edge + 0.5] == "Stable").all()
-    assert lengths[0]["Torsion"] == pytest.approx(edge - 1.0) and lengths[0]["Stable"] == pytest.approx(200.0 - edge)
+    assert [t for _, _, t in rows[0]] == ["Both", "Torsion", "Stable"]
+    assert rows[0][0][1] == pytest.approx(change) and rows[0][1][1] == pytest.approx(edge)
+    V = np.linspace(1.0, 200.0, 400)
+    row = np.array(map_shading.grid(rows, V)[0])
+    assert (row[(V > change + 0.5) & (V < edge - 0.5)] == "Torsion").all() and (row[V > edge + 0.5] == "Stable").all()
+    lengths = map_shading.measures(rows[0])
+    assert lengths["Torsion"] == pytest.approx(edge - change) and lengths["Stable"] == pytest.approx(200.0 - edge)
+
+
+def test_region_polygons_follow_the_rows_and_split_where_a_region_does():
+    """A wedge of Torsion opening upwards between two boundaries, and above a load a Lateral
+    island splitting it: the polygons' areas are the trapezoid rule over the rows, and each
+    polygon is one type."""
+    fz_rows = np.linspace(0.0, 1.0e5, 11)
+    rows = []
+    for Fz in fz_rows:
+        w = 10.0 + Fz / 1e3  # Torsion on [100 - w, 100 + w]
+        if Fz >= 5e4:  # a Lateral island in the middle, growing
+            g = (Fz - 4e4) / 1e4
+            rows.append([(0.0, 100 - w, "Stable"), (100 - w, 100 - g, "Torsion"), (100 - g, 100 + g, "Lateral"),
+                         (100 + g, 100 + w, "Torsion"), (100 + w, 300.0, "Stable")])
+        else:
+            rows.append([(0.0, 100 - w, "Stable"), (100 - w, 100 + w, "Torsion"), (100 + w, 300.0, "Stable")])
+    polygons = map_shading.polygons(rows, fz_rows)
+    for t in ("Stable", "Torsion", "Lateral"):
+        area = sum(map_shading.polygon_area(p) for p in polygons if p["type"] == t)
+        lengths = [sum(b - a for a, b, u in r if u == t) for r in rows]
+        assert area == pytest.approx(float(np.trapezoid(lengths, fz_rows)), rel=0.02), t
+    torsion = [p for p in polygons if p["type"] == "Torsion"]
+    assert len(torsion) == 3  # the wedge below the split, then its two arms
 
 
 def test_shading_is_on_the_right_side_of_every_hopf_curve(original_map):

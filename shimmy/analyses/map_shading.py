@@ -215,7 +215,8 @@ def polygons(rows: Sequence[Sequence[Segment]], fz_rows: Sequence[float]) -> lis
     the high-speed edge downwards). Between consecutive rows each segment is joined to the
     overlapping segments of its type in the other row (cut at the middle of the gaps where it meets
     several): trapezoids that tile the region; those of one region are chained into one polygon
-    until it splits or merges."""
+    until it splits or merges. A segment with nothing of its type above (below) it tapers to
+    its middle at the next (previous) row."""
     chains: list[dict[str, Any]] = []
     open_at: dict[int, dict[str, Any]] = {}  # segment index in the current row -> chain ending there whole
     for r in range(len(rows) - 1):
@@ -232,15 +233,30 @@ def polygons(rows: Sequence[Sequence[Segment]], fz_rows: Sequence[float]) -> lis
         part_b = {(i, j): part for j, is_ in pred.items()
                   for i, part in zip(is_, _split(B[j], [A[i] for i in is_]), strict=True)}
         following: dict[int, dict[str, Any]] = {}
+        lower, upper = float(fz_rows[r]), float(fz_rows[r + 1])
+        for i, a in enumerate(A):  # a region ending between the rows: a tip at the next row
+            if i not in succ:
+                mid = 0.5 * (a[0] + a[1])
+                chain = open_at.pop(i, None)
+                if chain is None:
+                    chain = {"type": a[2], "rows": [(lower, a[0], a[1])]}
+                    chains.append(chain)
+                chain["rows"].append((upper, mid, mid))
+        for j, b in enumerate(B):  # a region starting between the rows: a tip at the row below
+            if j not in pred:
+                mid = 0.5 * (b[0] + b[1])
+                chain = {"type": b[2], "rows": [(lower, mid, mid), (upper, b[0], b[1])]}
+                chains.append(chain)
+                following[j] = chain
         for i, js in succ.items():
             for j in js:
                 chain = open_at.pop(i, None) if len(js) == 1 else None
                 if chain is None:
                     lo, hi = part_a[(i, j)]
-                    chain = {"type": A[i][2], "rows": [(float(fz_rows[r]), lo, hi)]}
+                    chain = {"type": A[i][2], "rows": [(lower, lo, hi)]}
                     chains.append(chain)
                 lo, hi = part_b[(i, j)]
-                chain["rows"].append((float(fz_rows[r + 1]), lo, hi))
+                chain["rows"].append((upper, lo, hi))
                 if len(pred[j]) == 1:
                     following[j] = chain
         open_at = following
