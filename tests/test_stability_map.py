@@ -388,7 +388,7 @@ def _reached(config, V, Fz):
 
 @pytest.mark.slow
 def test_every_region_of_the_map_is_confirmed_by_simulation_from_three_starts(original_map):
-    """At the middle of each region polygon wide enough (6 cells), the types reached by time
+    """At the middle of each region polygon wide enough (3 cells), the types reached by time
     simulation from the three standard starts are what the region's type says."""
     m = original_map
     cell = float(m.V[1] - m.V[0])
@@ -396,7 +396,7 @@ def test_every_region_of_the_map_is_confirmed_by_simulation_from_three_starts(or
     for p in m.regions:
         k = len(p["V"]) // 2
         lo, hi, Fz = p["V"][k // 2], p["V"][len(p["V"]) - 1 - k // 2], p["Fz"][k // 2]
-        if hi - lo < 6 * cell or Fz < 2e4:
+        if hi - lo < 3 * cell or Fz < 2e4:
             continue
         V = 0.5 * (lo + hi)
         reached = _reached("original", V, Fz)

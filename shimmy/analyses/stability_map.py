@@ -207,14 +207,15 @@ def _slice_types(result: BifurcationResult, fine: np.ndarray, coarse_step: int, 
 
 def _intervals(fine: np.ndarray, types: list[str], critical: list[float] = ()) -> list[dict[str, Any]]:
     """Maximal V intervals of one type other than Stable. An end between two grid points moves to
-    the located Hopf / fold / torus point between them, if there is one (exact), else it is the
-    grid point inside the interval (within one fine step)."""
+    the located Hopf / fold / torus point between them, if there is one (exact), else to the
+    middle between them (within half a fine step: a cycle's mode changing), so that two
+    intervals that meet share their end."""
     crit = np.sort(np.asarray(list(critical), float))
 
     def snap(inside: int, outside: int) -> float:
         lo, hi = sorted((fine[inside], fine[outside]))
         hits = crit[(crit >= lo) & (crit <= hi)]
-        return float(hits[0]) if hits.size else float(fine[inside])
+        return float(hits[0]) if hits.size else float(0.5 * (lo + hi))
 
     out = []
     start = 0
