@@ -220,7 +220,7 @@ def ground_run(config: Configuration | str, profile: Any, params: Parameters | N
             warnings.append(f"fold and torus crossings not computed: {exc}")
         crossings.sort(key=lambda c: c["t"])
     above = (np.abs(states[0]) > options.psi_threshold) | (np.abs(lateral) > options.lateral_threshold)
-    onsets = _onsets(crossings, above, t, V, Fz, options.dt_out)
+    onsets = _onsets(crossings, above, shimmy, t, V, Fz)
     return GroundRunResult(
         config=config, profile=profile, params=params, options=options, t=t, V=V, Fz=Fz, states=states,
         envelope_psi=envelope_psi, envelope_lateral=envelope_lateral, time_in_shimmy_s=in_shimmy,
@@ -250,26 +250,25 @@ def _intervals(mask: np.ndarray, t, V, dt: float) -> list[dict[str, float]]:
              "duration_s": float((b - a + 1) * dt)} for a, b in zip(starts, ends, strict=True)]
 
 
-def _onsets(crossings, above, t, V, Fz, dt: float) -> list[dict[str, Any]]:
+def _onsets(crossings, above, shimmy, t, V, Fz) -> list[dict[str, Any]]:
     """For each entry into the unstable region (and for a run starting in it) the first sample after it
-    where the amplitude exceeds its threshold."""
+    where |psi| or |l_g delta| exceeds its threshold (``above``), unless the envelope is above it
+    already at the entry (``shimmy``: the oscillation of an earlier stretch is still there)."""
     if t.size == 0:
         return []
-    entries = [(c["t"], c["V"], c["Fz"], True) for c in crossings
-               if c["curve"] == "hopf" and c["unstable_before"] == 0 and c["unstable_after"] > 0]
-    starts_unstable = [c for c in crossings if c["curve"] == "hopf"]
-    first = starts_unstable[0]["unstable_before"] if starts_unstable else None
-    out = []
-    if first is not None and first > 0:
+    hopf = [c for c in crossings if c["curve"] == "hopf"]
+    entries = [(c["t"], c["V"], c["Fz"], True) for c in hopf if c["unstable_before"] == 0 and c["unstable_after"] > 0]
+    if hopf and hopf[0]["unstable_before"] > 0:  # the run starts where straight rolling is unstable
         entries.insert(0, (float(t[0]), float(V[0]), float(Fz[0]), False))
-    for k, (tc, vc, fc, crossed) in enumerate(entries):
+    out = []
+    for tc, vc, fc, crossed in entries:
         i = int(np.searchsorted(t, tc))
         hits = np.flatnonzero(above[i:])
         entry = {"t_unstable": tc, "V_unstable": vc, "Fz_unstable": fc, "crossed": crossed,
                  "t_onset": None, "V_onset": None, "Fz_onset": None, "delay_s": None}
         if hits.size:
             j = i + int(hits[0])
-            if j > i or not above[max(i - 1, 0)]:  # already above at the crossing: no onset of its own
+            if not shimmy[min(i, shimmy.size - 1)]:  # already in shimmy at the crossing: no onset of its own
                 entry.update(t_onset=float(t[j]), V_onset=float(V[j]), Fz_onset=float(Fz[j]),
                              delay_s=float(t[j] - tc) if crossed else None)
         out.append(entry)
@@ -350,7 +349,7 @@ def cycle_curve_crossings(config: Configuration, params: Parameters, profile: Gr
     for kind, points in _cycle_curve_polylines(config, params, v_max):
         q = points / scale
         for j in range(len(path) - 1):
-            for s, u in _segment_hits(path[j], path[j + 1], q):
+            for s, _ in _segment_hits(path[j], path[j + 1], q):
                 tc = float(times[j] + s * (times[j + 1] - times[j]))
                 V, Fz = (float(v) for v in (path[j] + s * (path[j + 1] - path[j])) * scale)
                 out.append({"t": tc, "V": V, "Fz": Fz, "curve": CURVE_NAMES[kind]})
