@@ -211,3 +211,37 @@ def test_integration_failure_is_reported_with_the_part_computed():
     run = ground_run("original", "takeoff", max_steps=500)
     assert not run.success and "step budget" in run.message
     assert 0 < run.t.size < 30001 and run.t.size == run.envelope_psi.size
+
+
+def _cli(*args):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "shimmy", "ground-run", *args], capture_output=True, text=True,
+                          timeout=120)
+
+
+def test_command_line_json_csv_and_refusals(tmp_path):
+    import json
+
+    out = _cli("--config", "nes", "--profile", "takeoff", "--profile-set", "V_rotate=70", "--set", "e_p=0.002",
+               "--json", "--csv", str(tmp_path / "run.csv"))
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    for key in ("t", "V", "Fz", "psi", "lateral", "envelope_psi", "envelope_lateral", "time_in_shimmy_s",
+                "peak_psi", "peak_lateral", "boundary_crossings", "onset_delay_s"):
+        assert key in data, key
+    assert data["V"][-1] == pytest.approx(70.0) and data["params"]["e_p"] == 0.002
+    assert data["t"][1] - data["t"][0] == pytest.approx(0.01)
+    assert (tmp_path / "run.csv").read_text().startswith("t,V,Fz,psi,lateral,envelope_psi")
+    table = tmp_path / "profile.csv"
+    table.write_text("t,V,Fz\n# a ramp\n0,5,150000\n20,40,120000\n")
+    out = _cli("--config", "all", "--profile", str(table))
+    assert out.returncode == 0, out.stderr
+    assert all(name in out.stdout for name in CONFIGS) and "crosses the hopf curve" in out.stdout
+    table.write_text("t,V,Fz\n0,5,150000\n\n20,600,120000\n")
+    out = _cli("--config", "nes", "--profile", str(table))
+    assert out.returncode == 2
+    assert "line 4: profile[1].V=600.0 (row 2 of the table) is out of range" in out.stderr
+    out = _cli("--config", "nes", "--profile", "takeoff", "--profile-set", "V_rotate=200")
+    assert out.returncode == 2 and "V_rotate=200.0 is out of range; allowed: a number in [20, 150] m/s" in out.stderr
