@@ -166,6 +166,16 @@ def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dic
     return out
 
 
+def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """A ground-run preset's table rows [t, V, Fz], its complete settings, each setting's range and
+    its assumptions, for a profile editor (a table of a few hundred points: nothing to cache)."""
+    from ..analyses.ground_profiles import preset, preset_fields
+
+    profile = preset(name, options)
+    return {"name": name, "rows": profile.rows(), "settings": profile.settings, "fields": preset_fields(name),
+            "assumptions": profile.assumptions}
+
+
 RUNNERS: dict[str, Callable[[dict[str, Any], Progress | None], dict[str, Any]]] = {
     "simulate": simulate, "hopf": hopf, "stability": stability, "devices": devices,
     "bifurcation": bifurcation, "hopf_curves": hopf_curves, "map": stability_map, "study": study,
