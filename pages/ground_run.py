@@ -18,8 +18,9 @@ dash.register_page(__name__, path="/ground-run", name="Ground run", order=4.5)
 CONFIGS = tuple(style.CONFIG_COLOURS)
 PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi"}
 SERIES_DT = 0.02  # s: the envelopes are smooth; 1500 points per configuration for a 30 s take-off
-TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto"},
-               "style_cell": {"fontFamily": "inherit", "fontSize": "13px", "padding": "3px 8px", "textAlign": "left"},
+TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overflowX": "auto"},
+               "style_cell": {"fontFamily": "inherit", "fontSize": "13px", "padding": "3px 8px", "textAlign": "left",
+                              "whiteSpace": "normal", "height": "auto"},
                "style_header": {"backgroundColor": "#eef2f8", "fontWeight": "600"}}
 
 
@@ -71,7 +72,7 @@ def layout(preset: str = "takeoff", config: str = "original", psi_thr: str = "0.
                          className="downloads"),
                 html.P(id="gr-source", className="hint"),
             ]),
-        ], className="grid-2"),
+        ], style={"display": "grid", "gridTemplateColumns": "minmax(0, 3fr) minmax(15em, 2fr)", "gap": "16px"}),
         html.Div(id="gr-error", className="error", role="alert"),
         html.Div(id="gr-summary"),
         ui.graph("gr-plane", figure=style.message_figure("Computing the take-off for the four configurations…")),
@@ -103,7 +104,7 @@ def preset_table(settings, _reset, name):
         profile = analyses.preset_profile(name, _settings(settings))
     except InvalidParameterError as exc:
         return no_update, no_update, no_update, str(exc)
-    rows = [{"t": round(t, 6), "V": round(v, 6), "Fz": round(f / 1e3, 6)} for t, v, f in profile["rows"]]
+    rows = [{"t": round(t, 4), "V": round(v, 4), "Fz": round(f / 1e3, 3)} for t, v, f in profile["rows"]]
     return rows, rows, profile["assumptions"], ""
 
 
@@ -191,7 +192,7 @@ def plane(result):
     """The trajectory on the (V, Fz) plane over the configuration's Hopf curves, its shimmy stretches and crossings."""
     config = result["config"]
     label, colour = style.CONFIG_LABELS[config], style.CONFIG_COLOURS[config]
-    fig = style.figure(f"Trajectory on the (V, Fz) plane, Hopf curves of {label} (x = 0 unstable inside)",
+    fig = style.figure(f"Trajectory over the Hopf curves of {label}",
                        "forward speed V (m/s)", "nose-gear load Fz (kN)", height=460)
     for i, curve in enumerate(result.get("hopf_curves") or []):
         fig.add_scatter(x=curve["V"], y=[f / 1e3 for f in curve["Fz"]], mode="lines", name=f"Hopf curve ({label})",
