@@ -245,3 +245,22 @@ def test_command_line_json_csv_and_refusals(tmp_path):
     assert "line 4: profile[1].V=600.0 (row 2 of the table) is out of range" in out.stderr
     out = _cli("--config", "nes", "--profile", "takeoff", "--profile-set", "V_rotate=200")
     assert out.returncode == 2 and "V_rotate=200.0 is out of range; allowed: a number in [20, 150] m/s" in out.stderr
+
+
+@pytest.mark.slow
+def test_fold_and_torus_crossings_agree_with_the_one_parameter_diagram():
+    """A taxi at 600 kN crosses the fold and torus curves of `original` (continued in two parameters) where the
+    diagram in V at that load has its LPC and NS points."""
+    run = ground_run("original", "taxi", preset_options={"Fz_static": 600e3}, cycle_curves=True)
+    assert run.success and not run.warnings
+    kinds = [c["curve"] for c in run.boundary_crossings]
+    assert kinds.count("fold") == 2 and kinds.count("torus") == 2  # out on the way up and back on the way down
+    diagram = bifurcation("original", 600e3, 1.0, 20.0)
+    located = {"fold": [], "torus": []}
+    for b in diagram.branches:
+        for s in b.special_points:
+            if s["kind"] in ("LPC", "NS"):
+                located["fold" if s["kind"] == "LPC" else "torus"].append(s["V"])
+    for c in run.boundary_crossings:
+        assert c["Fz"] == pytest.approx(600e3)
+        assert min(abs(v - c["V"]) for v in located[c["curve"]]) < 0.01 * c["V"]  # the polyline's chord error
