@@ -81,3 +81,20 @@ def test_ground_run_job_over_http(server):
     assert "job_ground_run" in doc["components"]["schemas"]
     profile = doc["components"]["schemas"]["job_ground_run"]["properties"]["profile"]
     assert profile["maxItems"] == 2000 and profile["items"]["maxItems"] == 3
+
+
+@pytest.mark.parametrize("body, field", [
+    ({"preset_options": {"V_rotate": "70"}}, "preset_options.V_rotate"),
+    ({"preset_options": {"V_rotate": 10 ** 400}}, "preset_options.V_rotate"),
+    ({"preset_options": {"V_rotate": [70]}}, "preset_options.V_rotate"),
+    ({"preset_options": "fast"}, "preset_options"),
+    ({"profile": [[0, 10, 150000], [5, 10 ** 400, 1e5]]}, "profile[1].V"),
+    ({"profile": [[0, 10, 150000], {"t": 5}]}, "profile[1]"),
+    ({"profile": [[0, 10, 150000], 5]}, "profile[1]"),
+    ({"profile": [[0, 10, 150000], [5, [10], 1e5]]}, "profile[1].V"),
+])
+def test_hostile_values_are_refused_by_name(body, field):
+    with pytest.raises(InvalidParameterError) as e:
+        schemas.validate("ground_run", {"config": "original", **body})
+    assert e.value.field == field
+    assert field.split(".")[-1].split("[")[0] in str(e.value)

@@ -233,6 +233,8 @@ def profile_from_table(rows: Any, name: str = "table", settings: Mapping[str, fl
             else:
                 try:
                     number = float(value)
+                except OverflowError:  # an integer beyond float range
+                    reason = "is not finite"
                 except (TypeError, ValueError):
                     reason = "is not a number"
                 else:

@@ -237,7 +237,10 @@ def _check_ground_run(out: dict[str, Any]) -> None:
         out["preset"], out["preset_options"] = None, {}
         out["profile"] = profile.rows()
     else:
-        profile = preset(out["preset"], out["preset_options"])
+        for name, value in out["preset_options"].items():  # JSON numbers only, as for every other number
+            if isinstance(value, (str, bool)) or value is None:
+                raise InvalidParameterError(f"preset_options.{_key(name)}", value, "a number", "is not a number")
+        profile = preset(out["preset"], {k: _huge(v) for k, v in out["preset_options"].items()})
         out["preset_options"] = dict(profile.settings)
     if profile.duration > settings.MAX_T_END:
         raise InvalidParameterError("profile" if out["preset"] is None else "preset_options", profile.duration,
