@@ -2,9 +2,9 @@
 
 The model (MODEL.md) and its analyses: parameters, devices, equations with analytic
 Jacobians, time histories, ground runs (take-off, landing roll, taxi), linear stability with
-Hopf points, calibration, and a continuation engine (equilibria, periodic orbits with Floquet multipliers, LPC/NS/PD
-points, Hopf curves) with the gear's bifurcation diagrams (``shimmy.analyses.bifurcation``,
-``shimmy.analyses.hopf_curves``, imported on demand).
+Hopf points, calibration, and a continuation engine (equilibria, periodic orbits with
+Floquet multipliers, LPC/NS/PD points, Hopf curves) with the gear's bifurcation diagrams
+(``shimmy.analyses.bifurcation``, ``shimmy.analyses.hopf_curves``, imported on demand).
 """
 
 __version__ = "0.1.0"
