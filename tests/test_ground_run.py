@@ -29,6 +29,11 @@ def test_a_constant_profile_reproduces_simulate(config):
     # interior table points cut the steps (no step crosses a kink): the history agrees to the tolerance
     run = ground_run(config, [[0, 30.0, 150e3], [17.3, 30.0, 150e3], [40.0, 30.0, 150e3], [60.0, 30.0, 150e3]])
     window = run.t >= 40.0
+    # table points closer together than a step can resolve are passed, not stepped to
+    close = ground_run(config, [[0, 30.0, 150e3], [16.0, 30.0, 150e3], [16.0 + 4e-15, 30.0, 150e3],
+                                [16.0 + 1e-13, 30.0, 150e3], [60.0, 30.0, 150e3]])
+    assert close.success
+    assert peak_amplitude(close.psi[window]) == pytest.approx(reference.amplitude["psi"], rel=1e-6)
     assert peak_amplitude(run.psi[window]) == pytest.approx(reference.amplitude["psi"], rel=1e-6)
     assert peak_amplitude(run.lateral[window]) == pytest.approx(reference.amplitude["lateral"], rel=1e-6)
 

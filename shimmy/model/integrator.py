@@ -118,6 +118,9 @@ def integrate_profile(x0, t_end, dt_out, table_t, table_v, table_fz, c, has_nes,
             return MAX_STEPS, accepted, rejected, n_calls, written
         if h < 1e-14 * max(1.0, t):
             return STEP_TOO_SMALL, accepted, rejected, n_calls, written
+        # a table point closer than rounding to t is passed (a step to it could not be taken)
+        while seg < last_seg and table_t[seg + 1] - t <= 1e-12 * max(1.0, abs(t)):
+            seg += 1
         t0, v0, f0, sv, sf = table_t[seg], table_v[seg], table_fz[seg], slope_v[seg], slope_fz[seg]
         h_free = h
         to_kink = False
