@@ -44,12 +44,12 @@ from scipy.ndimage import maximum_filter1d
 from .. import __version__
 from ..errors import InvalidParameterError
 from ..model import integrator
-from ..model.configurations import ALL_CONFIGURATIONS, STATE_NAMES, Configuration
+from ..model.configurations import ALL_CONFIGURATIONS, Configuration
 from ..model.equations import build_model, jacobian
 from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number
 from .ground_profiles import GroundProfile, as_profile
 from .response import torsional_share
-from .simulation import _STATUS_MESSAGES, DEFAULT_PSI0, SimulationOptions
+from .simulation import _STATUS_MESSAGES, SimulationOptions, initial_state
 
 CROSSING_GRID = 0.05  # s: spacing of the eigenvalue checks along the trajectory
 CROSSING_TOL = 1e-9  # s
@@ -177,17 +177,7 @@ def ground_run(config: Configuration | str, profile: Any, params: Parameters | N
         options = GroundRunOptions(**{**options.to_dict(), **option_overrides})
     model = build_model(config, params, exact_nes=options.exact_nes)
     n = model.n_states
-    start = np.zeros(integrator.N_FULL)
-    if x0 is None:
-        start[0] = DEFAULT_PSI0
-    else:
-        x0 = np.asarray(x0, dtype=float)
-        if x0.shape != (n,):
-            raise InvalidParameterError("x0", x0.tolist(), f"{n} numbers ({', '.join(STATE_NAMES[:n])})",
-                                        "has the wrong length")
-        if not np.all(np.isfinite(x0)):
-            raise InvalidParameterError("x0", x0.tolist(), "finite numbers", "is not finite")
-        start[:n] = x0
+    start = initial_state(x0, n)
 
     clock = time.perf_counter()
     t0 = float(profile.t[0])
