@@ -23,7 +23,9 @@ author = "the shimmy developers"
 copyright = "the shimmy developers"
 version = release = shimmy.__version__
 
-extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.mathjax", "sphinx.ext.viewcode", "shimmy_docs"]
+# sphinx-mathjax-offline ships MathJax into the site, so the equations render without a network.
+extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.mathjax", "sphinx-mathjax-offline", "sphinx.ext.viewcode",
+              "shimmy_docs"]
 source_suffix = {".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build"]
