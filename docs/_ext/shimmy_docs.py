@@ -3,6 +3,8 @@
 * ``shimmy-parameters`` (option ``:group: gear|nes|pd``): every parameter of
   :data:`shimmy.model.parameters.PARAMETER_SPECS` with unit, default, range and provenance.
 * ``shimmy-operating-points``: the nine operating points of :mod:`shimmy.model.configurations`.
+* ``shimmy-calibration-targets``: the published results the calibration fits
+  (:mod:`shimmy.analyses.calibration`).
 * ``shimmy-endpoints``: method, path, summary and status codes of every path of the OpenAPI document
   (:func:`shimmy.service.api.openapi_document`).
 * ``shimmy-request NAME``: the fields of one request schema (:data:`shimmy.service.schemas.SCHEMAS`).
@@ -84,6 +86,22 @@ class OperatingPoints(SphinxDirective):
         band = lambda fz: "low" if fz < 250e3 else ("medium" if fz <= 450e3 else "high")  # noqa: E731
         rows = [[name, _number(V), _number(Fz / 1e3), band(Fz)] for name, (V, Fz) in OPERATING_POINTS.items()]
         return [table(["point", "V (m/s)", "Fz (kN)", "load band"], rows)]
+
+
+class CalibrationTargets(SphinxDirective):
+    FIXES = {"original": "k_lam (about 0.002)", "nes": "I_nes, c_nes (about 4.84 kg m², 80.1 N m s/rad)",
+             "nes_pd": "I_pd (about 4.9 kg m²)"}
+
+    def run(self):
+        from shimmy.analyses import calibration as cal
+        rows = [[_literal(config), f"Hopf points of x = 0 in V at Fz = {cal.FZ_REFERENCE / 1e3:g} kN",
+                 " and ".join(f"{v:g}" for v in targets) + " m/s", self.FIXES.get(config, "")]
+                for config, targets in cal.HOPF_TARGETS.items()]
+        t = cal.AMPLITUDE_TARGET
+        rows.append([_literal(t["config"]), f"steady torsional amplitude at V = {t['V']:g} m/s, Fz = "
+                     f"{t['Fz'] / 1e3:g} kN", f"about {t['psi']:g} rad",
+                     "the PD damping level (g_p and/or f, inside their ranges)"])
+        return [table(["configuration", "what", "published value", "fixes"], rows, [2, 6, 3, 5])]
 
 
 class Endpoints(SphinxDirective):
@@ -288,6 +306,7 @@ def setup(app):
     app.connect("autodoc-process-docstring", escape_absolute_values)
     app.connect("missing-reference", resolve_alias)
     for name, cls in (("shimmy-parameters", Parameters), ("shimmy-operating-points", OperatingPoints),
+                      ("shimmy-calibration-targets", CalibrationTargets),
                       ("shimmy-endpoints", Endpoints), ("shimmy-request", Request),
                       ("shimmy-job-statuses", JobStatuses), ("shimmy-limits", Limits), ("shimmy-openapi", OpenAPI),
                       ("shimmy-cli", CommandLine)):
