@@ -126,3 +126,27 @@ def test_every_documented_command_line_parses(page, command):
         build_parser().parse_args(args)
     except SystemExit:
         pytest.fail(f"{page}: {command!r} is not a valid command line")
+
+
+def _examples_with_output() -> list[tuple[str, str, str]]:
+    """(page, code, printed output) of every ```python block followed directly by a ```text block
+    on the tutorial pages whose output does not depend on timing (the Dask page's does)."""
+    found = []
+    for name in ("tutorials/reproduce-study.md", "tutorials/new-nes-design.md"):
+        text = (DOCS / name).read_text()
+        for code, output in re.findall(r"```python\n(.*?)```\n\n```text\n(.*?)```", text, flags=re.S):
+            found.append((name, code, output))
+    return found
+
+
+def test_the_tutorials_show_python_examples():
+    assert {page for page, _, _ in _examples_with_output()} == {"tutorials/reproduce-study.md",
+                                                                "tutorials/new-nes-design.md"}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page,code,output", _examples_with_output())
+def test_tutorial_examples_print_what_the_page_shows(page, code, output):
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == output, f"{page}: the example now prints\n{done.stdout}"
