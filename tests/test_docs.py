@@ -150,3 +150,14 @@ def test_tutorial_examples_print_what_the_page_shows(page, code, output):
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd=ROOT)
     assert done.returncode == 0, done.stderr
     assert done.stdout == output, f"{page}: the example now prints\n{done.stdout}"
+
+
+def test_the_tests_and_files_the_docs_cite_exist():
+    pages = "\n".join(page.read_text() for page in DOCS.rglob("*.md"))
+    cited_tests = set(re.findall(r"`(?:tests/\w+\.py::)?(test_\w+)`", pages))
+    defined = set(re.findall(r"def (test_\w+)", "\n".join(p.read_text() for p in (ROOT / "tests").glob("*.py"))))
+    assert cited_tests and not cited_tests - defined, sorted(cited_tests - defined)
+    cited_files = set(re.findall(r"`((?:tests|shimmy|scripts|benchmarks|docs)/[\w/.-]+\.(?:py|sh|md))", pages))
+    assert cited_files and not [f for f in cited_files if not (ROOT / f).is_file()]
+    for name in re.findall(r"`((?:compose|gunicorn)[\w.]*\.(?:yaml|py))`", pages):
+        assert (ROOT / name).is_file(), name
