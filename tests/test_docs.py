@@ -119,7 +119,8 @@ def test_the_docs_show_commands():
     assert {"tutorials/reproduce-study.md", "tutorials/new-nes-design.md", "tutorials/dask-map.md"} <= pages
 
 
-@pytest.mark.parametrize("page,command", _documented_commands())
+@pytest.mark.parametrize("page,command", _documented_commands(),
+                         ids=[f"{page}:{k}" for k, (page, _) in enumerate(_documented_commands())])
 def test_every_documented_command_line_parses(page, command):
     args = shlex.split(command)[3:]
     try:
@@ -145,7 +146,8 @@ def test_the_tutorials_show_python_examples():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("page,code,output", _examples_with_output())
+@pytest.mark.parametrize("page,code,output", _examples_with_output(),
+                         ids=[f"{page}:{k}" for k, (page, _, _) in enumerate(_examples_with_output())])
 def test_tutorial_examples_print_what_the_page_shows(page, code, output):
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd=ROOT)
     assert done.returncode == 0, done.stderr
