@@ -1,6 +1,6 @@
 """shimmy: nose-landing-gear shimmy with a torsional NES and an annular particle damper.
 
-The model (MODEL.md) and its analyses: parameters, devices, equations with analytic
+The model (docs/model.md) and its analyses: parameters, devices, equations with analytic
 Jacobians, time histories, ground runs (take-off, landing roll, taxi), linear stability with
 Hopf points, calibration, and a continuation engine (equilibria, periodic orbits with
 Floquet multipliers, LPC/NS/PD points, Hopf curves) with the gear's bifurcation diagrams

@@ -102,7 +102,7 @@ def _operating_point_unit(task: tuple) -> dict[str, Any]:
 
 def operating_point_types(configs: Sequence[str], params: Parameters | None = None, executor=None,
                           progress: Callable[[float, str], None] | None = None) -> dict[str, dict[str, Any]]:
-    """{config: {point: classify(...)}} at REFERENCE.md's nine operating points."""
+    """{config: {point: classify(...)}} at the nine operating points (docs/model.md)."""
     params = params if params is not None else Parameters()
     configs = [Configuration.parse(c).value for c in configs]
     by_load: dict[float, list[str]] = {}

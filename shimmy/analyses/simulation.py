@@ -138,7 +138,7 @@ def simulate(config: Configuration | str, V: float, Fz: float, params: Parameter
              **option_overrides) -> SimulationResult:
     """Integrate the model at forward speed V (m/s) and vertical load Fz (N).
 
-    ``x0`` defaults to psi = 0.001 rad with all else zero (REFERENCE.md). Options may be
+    ``x0`` defaults to psi = 0.001 rad with all else zero (the study's start). Options may be
     given as a :class:`SimulationOptions` or as keyword overrides (``rtol=...``).
     Integration failures (divergence, step budget, NES out of range) do not raise:
     the result has ``success=False``, a ``message`` and the part that was computed.
