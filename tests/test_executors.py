@@ -40,12 +40,15 @@ def test_run_dynamic_runs_the_most_urgent_unit_first_including_units_added_on_th
         assert result == math.sqrt(unit)
         return [(0, 100.0), (0, 121.0)] if unit == 4.0 else []
 
+    messages = []
     with ProcessPoolExecutor(max_workers=1) as pool:
         count = run_dynamic(math.sqrt, [(2, 9.0), (1, 4.0), (3, 16.0), (2, 25.0)], pool, done,
-                            lambda f, m: seen.append(f))
+                            lambda f, m: (seen.append(f), messages.append(m)),
+                            tally=lambda u: "large" if u > 50 else "small")
     assert count == 6
     assert order == [4.0, 100.0, 121.0, 9.0, 25.0, 16.0]
     assert seen == sorted(seen) and seen[-1] == 1.0
+    assert messages[0].endswith("(1/4 small, 0/2 large)") and messages[-1].endswith("(4/4 small, 2/2 large)")
 
 
 def test_a_failing_unit_fails_the_call():

@@ -141,7 +141,7 @@ def run_units(fn: Callable[[Any], Any], units: Sequence[Any], executor: Executor
 def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], executor: Executor,
                 on_done: Callable[[Any, Any], Sequence[tuple[float, Any]]],
                 progress: Callable[[float, str], None] | None = None,
-                describe_unit: Callable[[Any], str] = str) -> int:
+                describe_unit: Callable[[Any], str] = str, tally: Callable[[Any], str] | None = None) -> int:
     """Run ``(priority, unit)`` pairs through ``executor``, lowest priority value first;
     ``on_done(unit, result)`` (called in this process, in the order units finish) returns more
     ``(priority, unit)`` pairs to run. Returns the number of units run.
@@ -150,7 +150,8 @@ def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], ex
     created late (the longest one, on the critical path) starts at the next free worker instead
     of queueing behind the rest; other executors (Dask, which schedules by itself; inline) get
     each unit when it is ready. ``progress`` gets finished / (finished + known) units, never
-    decreasing although units are added on the way."""
+    decreasing although units are added on the way; with ``tally`` (unit -> the plural noun it is
+    counted as) the message counts per noun, finished of known: "(3/10 slices, 2/5 curve units)"."""
     report = progress or (lambda fraction, message: None)
     width = getattr(executor, "_max_workers", None) or 10 ** 9
     order = itertools.count()
@@ -159,6 +160,17 @@ def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], ex
         heapq.heappush(ready, (priority, next(order), unit))
     running: dict[Future, Any] = {}
     finished, shown = 0, 0.0
+    done_by: dict[str, int] = {}
+    known_by: dict[str, int] = {}
+
+    def count(unit: Any) -> None:
+        if tally is not None:
+            noun = tally(unit)
+            known_by[noun] = known_by.get(noun, 0) + 1
+            done_by.setdefault(noun, 0)
+
+    for _, unit in units:
+        count(unit)
     try:
         while ready or running:
             while ready and len(running) < width:
@@ -171,9 +183,15 @@ def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], ex
                 finished += 1
                 for priority, more in on_done(unit, result):
                     heapq.heappush(ready, (priority, next(order), more))
+                    count(more)
                 total = finished + len(running) + len(ready)
                 shown = max(shown, finished / total)
-                report(shown, f"{describe_unit(unit)} done ({finished}/{total})")
+                if tally is not None:
+                    done_by[tally(unit)] += 1
+                    counted = ", ".join(f"{done_by[n]}/{known_by[n]} {n}" for n in known_by)
+                else:
+                    counted = f"{finished}/{total}"
+                report(shown, f"{describe_unit(unit)} done ({counted})")
     finally:
         for future in running:
             future.cancel()

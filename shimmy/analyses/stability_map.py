@@ -467,7 +467,8 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
 
     units = [(0, ("hopf_curves", config, params, (v_min, v_max), (f_min, f_max)))]
     units += [(2, slice_unit(Fz)) for Fz in loads]
-    run_dynamic(_unit, units, executor, done, report, _describe)
+    run_dynamic(_unit, units, executor, done, report, _describe,
+                lambda task: "slices" if task[0] == "slice" else "curve units")
     hopf: HopfCurvesResult = found["hopf"]
     slices: list[SliceResult] = sorted(found["slices"], key=lambda s: s.Fz)
     cycles = search.result(time.perf_counter() - clock).to_dict()
