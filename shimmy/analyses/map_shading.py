@@ -4,14 +4,16 @@ that they follow the Hopf, fold and torus curves instead of stepping from slice 
 Between two consecutive boundary crossings of a row (a fixed load) the set of attractors, and so
 the shimmy type, changes only where a stable cycle's mode changes (torsional / lateral / both:
 a threshold on its amplitudes, not a bifurcation). Each interval of a row is named by the curves
-that bound it (which curve, and which of its crossings of the row counted from low V); the same
-interval exists on every slice between which and the row no boundary turns in Fz. The row's
+that bound it (which curve, and which of its crossings of the row counted from low V) and by
+the run of loads over which that name persists (:func:`labelled`): the same region on every
+slice between which and the row the name does not vanish. The row's
 interval takes the types of that interval on the slices that have it, as fractions of the
 interval: the nearest slice below and above the row that have it, their breakpoints (mode
 changes) interpolated linearly in Fz where both show the same sequence of types, else the
-nearer one. An interval that no slice has (a region pinched between curves that no slice load
-crosses) is what :func:`uncovered` reports, so that the map classifies a slice through it; one
-left over is read off the nearest slice at the same speed, and counted.
+nearer one. A region that no slice crosses (pinched between curves between two slice loads) is
+what :func:`uncovered` reports, so that the map classifies a slice through it; one left over
+(thinner than a grid cell or smaller than the map's threshold) is read off the nearest slice at
+the same speed, and counted.
 
 The result is, per row, segments (V_low, V_high, type) whose ends lie on the curves (to the
 polyline accuracy of the curves); from them the grid (:func:`grid`), the measure of each type
@@ -98,41 +100,62 @@ def _interpolated(below, above, w: float):
     return [(p[0] + w * (q[0] - p[0]), p[1] + w * (q[1] - p[1]), p[2]) for p, q in zip(below, above, strict=True)]
 
 
-class _Slices:
-    """The classified slices, each with its named intervals, for reading rows off."""
+def labelled(curves: Sequence[Curve], loads: Sequence[float], v_range: tuple[float, float]):
+    """{load: [(V_low, V_high, region)]} for the loads in ascending order, where a region is an
+    interval name with the number of its run: a name that vanishes between two loads (the curves
+    bounding it pinch off or turn) and appears again names another region at the other load (the
+    k-th crossings of two curves can bound the Torsion interval of low loads and a pocket of a
+    high load alike)."""
+    out: dict[float, list] = {}
+    runs: dict[Any, int] = defaultdict(int)
+    before: set = set()
+    for Fz in sorted(set(float(f) for f in loads)):
+        intervals = named_intervals(curves, Fz, v_range)
+        names = {name for _, _, name in intervals}
+        for name in names - before:
+            runs[name] += 1
+        before = names
+        out[Fz] = [(lo, hi, (name, runs[name])) for lo, hi, name in intervals]
+    return out
 
-    def __init__(self, slices: Sequence[Any], curves: Sequence[Curve], v_range: tuple[float, float]):
+
+class _Slices:
+    """The classified slices, each with its regions (:func:`labelled` over the rows and slice
+    loads together), for reading rows off."""
+
+    def __init__(self, slices: Sequence[Any], regions: dict[float, list]):
         self.slices = sorted(slices, key=lambda s: s.Fz)
         self.loads = np.array([s.Fz for s in self.slices])
-        self.named = [{name: (lo, hi) for lo, hi, name in named_intervals(curves, s.Fz, v_range)}
-                      for s in self.slices]
+        self.named = [{region: (lo, hi) for lo, hi, region in regions[float(s.Fz)]} for s in self.slices]
 
-    def having(self, name) -> list[int]:
-        return [k for k, named in enumerate(self.named) if name in named]
+    def having(self, region) -> list[int]:
+        return [k for k, named in enumerate(self.named) if region in named]
 
-    def pieces(self, k: int, name):
-        a, b = self.named[k][name]
+    def pieces(self, k: int, region):
+        a, b = self.named[k][region]
         return _pieces(self.slices[k].intervals, a, b)
 
 
 def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequence[float],
                  v_range: tuple[float, float]) -> tuple[list[list[Segment]], int]:
     """Each row's segments (V_low, V_high, type), merged, covering the speed range; and how many
-    row intervals no slice has (read off the nearest slice at the same speed instead).
-    ``slices`` carry ``Fz`` and ``intervals`` (see :class:`~shimmy.analyses.stability_map.SliceResult`)."""
-    known = _Slices(slices, curves, v_range)
+    row intervals lie in a region no slice crosses (read off the nearest slice at the same speed
+    instead). ``slices`` carry ``Fz`` and ``intervals`` (see
+    :class:`~shimmy.analyses.stability_map.SliceResult`)."""
+    regions = labelled(curves, [float(f) for f in fz_rows] + [float(s.Fz) for s in slices], v_range)
+    known = _Slices(slices, regions)
     rows, fallbacks = [], 0
     for Fz in fz_rows:
         segments: list[list] = []
-        for lo, hi, name in named_intervals(curves, float(Fz), v_range):
-            have = known.having(name)
+        for lo, hi, region in regions[float(Fz)]:
+            have = known.having(region)
             below = [k for k in have if known.loads[k] <= Fz]
             above = [k for k in have if known.loads[k] >= Fz]
             if have:
                 k0 = below[-1] if below else None
                 k1 = above[0] if above else None
-                p0 = known.pieces(k0, name) if k0 is not None else None
-                p1 = known.pieces(k1, name) if k1 is not None else None
+                p0 = known.pieces(k0, region) if k0 is not None else None
+                p1 = known.pieces(k1, region) if k1 is not None else None
                 if p0 is not None and p1 is not None and k0 != k1 and [p[2] for p in p0] == [p[2] for p in p1]:
                     w = (Fz - known.loads[k0]) / (known.loads[k1] - known.loads[k0])
                     parts = _interpolated(p0, p1, float(w))
@@ -140,13 +163,12 @@ def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequen
                     parts = p0
                 else:
                     parts = p1
-                pieces = [(lo + f0 * (hi - lo), lo + f1 * (hi - lo), t) for f0, f1, t in parts]
             else:
                 fallbacks += 1
                 near = known.slices[int(np.argmin(np.abs(known.loads - Fz)))]
                 parts = _pieces(near.intervals, lo, hi)
-                pieces = [(lo + f0 * (hi - lo), lo + f1 * (hi - lo), t) for f0, f1, t in parts]
-            for a, b, t in pieces:
+            for f0, f1, t in parts:
+                a, b = lo + f0 * (hi - lo), lo + f1 * (hi - lo)
                 if segments and segments[-1][2] == t:
                     segments[-1][1] = b
                 elif b > a or not segments:
@@ -156,27 +178,34 @@ def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequen
 
 
 def uncovered(loads: Sequence[float], curves: Sequence[Curve], fz_rows: Sequence[float],
-              v_range: tuple[float, float], at_most: int = 8) -> list[float]:
-    """Loads of further slices, so that every row interval (wider than a millionth of the range)
-    exists on a slice at one of ``loads`` or at one of these: for each interval name no load has,
-    the middle row load of those that have it, a load covering several names once; at most
-    ``at_most``."""
+              v_range: tuple[float, float], min_width: float = 0.0, min_area: float = 0.0,
+              at_most: int = 8) -> list[float]:
+    """Loads of further slices, so that every region between the curves that is at least
+    ``min_width`` (m/s) wide on some row and covers ``min_area`` (m/s x N, over the rows) is
+    crossed by a slice at one of ``loads`` or at one of these: for each such region no load
+    crosses, largest first, the row load where it is widest; a load crossing several once; at
+    most ``at_most``. (A thinner sliver is read off the nearest slice at the same speed.)"""
+    regions = labelled(curves, [float(f) for f in fz_rows] + [float(f) for f in loads], v_range)
     have = set()
     for Fz in loads:
-        have |= {name for _, _, name in named_intervals(curves, float(Fz), v_range)}
-    width = v_range[1] - v_range[0]
-    missing: dict[Any, list[float]] = defaultdict(list)
+        have |= {region for _, _, region in regions[float(Fz)]}
+    step = float(fz_rows[1] - fz_rows[0]) if len(fz_rows) > 1 else 0.0
+    area: dict[Any, float] = defaultdict(float)
+    widest: dict[Any, tuple[float, float]] = {}
     for Fz in fz_rows:
-        for lo, hi, name in named_intervals(curves, float(Fz), v_range):
-            if hi - lo > 1e-6 * width and name not in have:
-                missing[name].append(float(Fz))
+        for lo, hi, region in regions[float(Fz)]:
+            if region in have or hi <= lo:
+                continue
+            area[region] += (hi - lo) * step
+            if hi - lo > widest.get(region, (0.0, 0.0))[0]:
+                widest[region] = (hi - lo, float(Fz))
     extra: list[float] = []
-    for name, at in sorted(missing.items(), key=lambda item: -len(item[1])):
-        if name in have:
+    for region in sorted(area, key=lambda r: -area[r]):
+        if region in have or widest[region][0] < min_width or area[region] < min_area:
             continue
-        Fz = at[len(at) // 2]
+        Fz = widest[region][1]
         extra.append(Fz)
-        have |= {n for _, _, n in named_intervals(curves, Fz, v_range)}
+        have |= {r for _, _, r in regions[Fz]}
         if len(extra) == at_most:
             break
     return sorted(extra)

@@ -59,6 +59,9 @@ from .response import ResponseType
 SHIMMY_TYPES = ("Stable", "Torsion", "Lateral", "Bistable", "Both")
 SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
 COVERAGE_ROUNDS = 2  # rounds of further slices through regions no slice crosses
+#: ... that are at least one grid cell wide and cover this fraction of the map (thinner slivers
+#: between curves that nearly meet are read off the nearest slice at the same speed, and counted)
+COVERAGE_AREA = 2e-4
 DEFAULT_V_RANGE = (1.0, 200.0)
 DEFAULT_FZ_RANGE = (1.0e4, 9.0e5)
 #: Simulated V per slice at most where no stable equilibrium or cycle exists; the other grid
@@ -445,7 +448,9 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
         a region's boundaries are does not depend on the slices, only on the curves."""
         if found["rounds"] == COVERAGE_ROUNDS:
             return []
-        extra = map_shading.uncovered(found["loads"], _boundaries(found["hopf"], search), rows, (v_min, v_max))
+        extra = map_shading.uncovered(found["loads"], _boundaries(found["hopf"], search), rows, (v_min, v_max),
+                                      min_width=(v_max - v_min) / (n_v - 1),
+                                      min_area=COVERAGE_AREA * (v_max - v_min) * (f_max - f_min))
         found["rounds"] += bool(extra)
         found["loads"] += extra
         search.expect_sources(len(extra))
