@@ -95,13 +95,14 @@ def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
     for k, b in enumerate(result.branches):
         if b.kind != "periodic" or b.V.size < 2:
             continue
-        segments = [(i, i + 1) for i in range(b.V.size - 1)]
+        first = np.arange(b.V.size - 1)
         if b.stop_reason.startswith("closed branch"):  # a loop: its last orbit joins its first
-            segments.append((b.V.size - 1, 0))
-        for i, j in segments:
+            first = np.append(first, b.V.size - 1)
+        second = (first + 1) % b.V.size
+        v0s, v1s = b.V[first], b.V[second]
+        hits = np.nonzero((np.minimum(v0s, v1s) - tol <= V) & (V <= np.maximum(v0s, v1s) + tol) & (v0s != v1s))[0]
+        for i, j in zip(first[hits].tolist(), second[hits].tolist(), strict=True):
             v0, v1 = b.V[i], b.V[j]
-            if not min(v0, v1) - tol <= V <= max(v0, v1) + tol or v0 == v1:
-                continue
             f = min(max((V - v0) / (v1 - v0), 0.0), 1.0)
             near = i if f <= 0.5 else j
             stable = bool(b.stable[i]) if b.stable[i] == b.stable[j] else bool(b.stable[near])
