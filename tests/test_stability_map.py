@@ -330,6 +330,38 @@ def test_region_polygons_follow_the_rows_and_split_where_a_region_does():
     assert len(torsion) == 3  # the wedge below the split, then its two arms
 
 
+def _inside(polygon, V, Fz):
+    """Ray casting: whether (V, Fz) lies inside a polygon ring."""
+    xs, ys = polygon["V"], polygon["Fz"]
+    hit = False
+    for k in range(len(xs)):
+        x0, y0, x1, y1 = xs[k - 1], ys[k - 1], xs[k], ys[k]
+        if (y0 > Fz) != (y1 > Fz) and V < x0 + (Fz - y0) * (x1 - x0) / (y1 - y0):
+            hit = not hit
+    return hit
+
+
+@pytest.mark.parametrize("rows", [
+    # a Torsion region ending between the rows between two other types (Both, Lateral)
+    [[(0, 40, "Both"), (40, 60, "Torsion"), (60, 100, "Lateral")], [(0, 45, "Both"), (45, 100, "Lateral")]],
+    # two regions starting in one gap, and one ending at the row's edge
+    [[(0, 10, "Stable"), (10, 50, "Torsion"), (50, 100, "Lateral")],
+     [(0, 30, "Torsion"), (30, 35, "Both"), (35, 45, "Bistable"), (45, 100, "Lateral")]],
+    # a split and a merge with a different type in the middle, regions ending and starting in one gap
+    [[(0, 20, "Stable"), (20, 30, "Both"), (30, 70, "Stable"), (70, 100, "Torsion")],
+     [(0, 40, "Stable"), (40, 50, "Lateral"), (50, 60, "Stable"), (60, 100, "Bistable")]],
+])
+def test_region_polygons_cover_every_point_once(rows):
+    """Between two rows the polygons tile the strip: every point lies in exactly one polygon, of
+    the type of a segment of a row next to it."""
+    polygons = map_shading.polygons(rows, [0.0, 1.0])
+    rng = np.random.default_rng(3)
+    for V, Fz in zip(rng.uniform(0.01, 99.99, 2000), rng.uniform(0.01, 0.99, 2000), strict=True):
+        hits = [p["type"] for p in polygons if _inside(p, V, Fz)]
+        assert len(hits) == 1, (V, Fz, hits)
+        assert hits[0] in {t for row in rows for _, _, t in row}
+
+
 def test_shading_is_on_the_right_side_of_every_hopf_curve(original_map):
     """Independent of the read-off: on every shading row, x = 0 is unstable (eigenvalues at that
     very load) exactly where the shading says shimmy of some kind is possible from small

@@ -62,7 +62,7 @@ def gear_cycle_field(config: Configuration, params: Parameters) -> TwoParameterV
                                    f"{config.value} in (V, Fz)")
 
 
-@dataclass
+@dataclass(eq=False)  # compared by identity: list.remove takes the very start
 class Start:
     kind: str
     point: SpecialPoint  # located on a branch in V, with its solution
@@ -187,7 +187,8 @@ class CurveSearch:
     at a time (two starts may lie on one curve, and which do is known only once it is continued:
     two double-Hopf points joined by a torus curve); starts born at a codimension-2 point go
     first, in the order of those points; a diagram's starts wait until every diagram expected
-    (:meth:`expect_sources`) and every branch beside a point is in, then go by load and speed.
+    (:meth:`expect_sources`), the Hopf curves and every branch beside a point are in, then go by
+    load and speed within each batch of diagrams.
     So the curves, and the start each is continued from, do not depend on the order in which
     units finish: a map or a set of curves is the same on any executor.
     :func:`cycle_curves` and the stability maps both drive it."""
@@ -202,8 +203,9 @@ class CurveSearch:
         self.curves: list[GearCycleCurve] = []
         self.warnings: list[str] = []
         self.tried = 0
-        self.beside_order: list[str] = []  # origins of the units beside codimension-2 points
-        self.beside_in: dict[str, tuple[list[Start], list[str]]] = {}
+        self.hopf_pending = True  # the Hopf curves (and so the units beside their points) not yet in
+        self.beside_order: list[tuple] = []  # the units beside codimension-2 points, in order
+        self.beside_in: dict[int, tuple[list[Start], list[str]]] = {}
         self.beside_taken = 0
         self.sources_pending = 0  # diagrams expected and not yet in
         self.source_buffer: list[Start] = []
@@ -222,7 +224,8 @@ class CurveSearch:
         units += [("beside", self.config, self.params, g, "NS", self.box,
                    f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
                   for g in self.hh if "NS" in self.kinds]
-        self.beside_order += [u[6] for u in units]
+        self.hopf_pending = False
+        self.beside_order += units
         return units
 
     def _usable(self, starts: list[Start]) -> list[Start]:
@@ -230,9 +233,9 @@ class CurveSearch:
 
     def add_beside(self, task: tuple, starts: list[Start], warnings: list[str]) -> None:
         """A unit beside a codimension-2 point is in; its starts count in the order of the points."""
-        self.beside_in[task[6]] = (starts, warnings)
-        while self.beside_taken < len(self.beside_order) and self.beside_order[self.beside_taken] in self.beside_in:
-            starts, warnings = self.beside_in.pop(self.beside_order[self.beside_taken])
+        self.beside_in[next(k for k, u in enumerate(self.beside_order) if u is task)] = (starts, warnings)
+        while self.beside_taken in self.beside_in:
+            starts, warnings = self.beside_in.pop(self.beside_taken)
             self.starts += self._usable(starts)
             self.warnings += list(warnings)
             self.beside_taken += 1
@@ -252,14 +255,14 @@ class CurveSearch:
             self.source_buffer = []
 
     def _gathering(self) -> bool:
-        return self.beside_taken < len(self.beside_order) or self.sources_pending > 0
+        return self.hopf_pending or self.beside_taken < len(self.beside_order) or self.sources_pending > 0
 
     def _may_go(self, start: Start) -> bool:
         """Born at a point: at once; another start beside a point: once every branch beside a point
         is in; a diagram's: once every diagram is in, too."""
         if start.eager:
             return True
-        if self.beside_taken < len(self.beside_order):
+        if self.hopf_pending or self.beside_taken < len(self.beside_order):
             return False
         return not (start.from_diagram and self.sources_pending > 0)
 
@@ -411,7 +414,7 @@ def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
 
 
 def _same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:
-    """Whether a curve continued in the same round as another is that curve again (its start, the
+    """Whether a curve continued while another was under way is that curve again (its start, the
     first point of its half traced first, lies on the other)."""
     if new.kind != old.kind:
         return False
@@ -448,8 +451,8 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
 
 def _on_curve(curve: GearCycleCurve, start: Start, l_g: float) -> bool:
     """Whether a start point lies on a continued curve: within a fifth of the local step of its
-    polyline in (V, Fz) (scaled) with amplitudes within 5 % (of its own, or of the curve's largest
-    where that is more)."""
+    polyline in (V, Fz) (scaled) with amplitudes within 5 % (of its own, or of the curve's there
+    where that is more) plus half their change along that step."""
     c = curve.curve
     scale = np.array([V_SCALE, FZ_SCALE])
     hit = near_polyline(c.p / scale, np.array([start.point.p, start.Fz]) / scale)
@@ -462,6 +465,8 @@ def _on_curve(curve: GearCycleCurve, start: Start, l_g: float) -> bool:
     theirs = 0.5 * (xmax - xmin)
     scale = STATE_SCALE[:len(theirs)]
     # near a zero-amplitude end the amplitude varies like the root of the distance and the
-    # polyline's linear interpolation is poor: 5 % of the curve's largest amplitude at least
-    largest = float(np.max(np.abs(amp) / scale))
-    return bool(np.max(np.abs(here - theirs) / scale) <= 0.05 * max(np.max(np.abs(theirs) / scale), largest, 1e-12))
+    # polyline's linear interpolation is poor: the change of amplitude along the segment counts too
+    local = float(np.max(np.abs(amp[i:i + 2]) / scale))
+    change = float(np.max(np.abs(amp[i + 1] - amp[i]) / scale))
+    return bool(np.max(np.abs(here - theirs) / scale)
+                <= 0.05 * max(np.max(np.abs(theirs) / scale), local, 1e-12) + 0.5 * change)

@@ -143,22 +143,24 @@ def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], ex
                 progress: Callable[[float, str], None] | None = None,
                 describe_unit: Callable[[Any], str] = str, tally: Callable[[Any], str] | None = None) -> int:
     """Run ``(priority, unit)`` pairs through ``executor``, lowest priority value first;
-    ``on_done(unit, result)`` (called in this process, in the order units finish) returns more
+    ``on_done(unit, result)`` (called in this process as units finish) returns more
     ``(priority, unit)`` pairs to run. Returns the number of units run.
 
-    On a local process pool at most one unit per worker is in flight, so that an urgent unit
-    created late (the longest one, on the critical path) starts at the next free worker instead
-    of queueing behind the rest; other executors (Dask, which schedules by itself; inline) get
-    each unit when it is ready. ``progress`` gets finished / (finished + known) units, never
-    decreasing although units are added on the way; with ``tally`` (unit -> the plural noun it is
-    counted as) the message counts per noun, finished of known: "(3/10 slices, 2/5 curve units)"."""
+    At most one unit per worker is in flight (a local pool's processes, a Dask cluster's threads;
+    inline: one), so that an urgent unit created late (the longest one, on the critical path)
+    starts at the next free worker instead of queueing behind the rest. Units that finish
+    together are handed to ``on_done`` in the order they were submitted. ``progress`` gets
+    finished / (finished + known) units, never decreasing although units are added on the way;
+    with ``tally`` (unit -> the plural noun it is counted as) the message counts per noun,
+    finished of known: "(3/10 slices, 2/5 curve units)"."""
     report = progress or (lambda fraction, message: None)
-    width = getattr(executor, "_max_workers", None) or 10 ** 9
     order = itertools.count()
     ready: list[tuple[float, int, Any]] = []
     for priority, unit in units:
         heapq.heappush(ready, (priority, next(order), unit))
-    running: dict[Future, Any] = {}
+    width = _width(executor)
+    running: dict[Future, tuple[int, Any]] = {}
+    submitted = itertools.count()
     finished, shown = 0, 0.0
     done_by: dict[str, int] = {}
     known_by: dict[str, int] = {}
@@ -175,10 +177,10 @@ def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], ex
         while ready or running:
             while ready and len(running) < width:
                 _, _, unit = heapq.heappop(ready)
-                running[executor.submit(fn, unit)] = unit
+                running[executor.submit(fn, unit)] = (next(submitted), unit)
             done, _ = wait(list(running), return_when=FIRST_COMPLETED)
-            for future in done:
-                unit = running.pop(future)
+            for future in sorted(done, key=lambda f: running[f][0]):  # finished together: as submitted
+                _, unit = running.pop(future)
                 result = future.result()
                 finished += 1
                 for priority, more in on_done(unit, result):
@@ -196,3 +198,19 @@ def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], ex
         for future in running:
             future.cancel()
     return finished
+
+
+def _width(executor: Executor) -> int:
+    """Units in flight at once on ``executor``: its workers (threads of a Dask cluster)."""
+    if isinstance(executor, InlineExecutor):
+        return 1
+    workers = getattr(executor, "_max_workers", None)
+    if workers:
+        return int(workers)
+    client = getattr(executor, "_client", None)  # distributed's ClientExecutor
+    if client is not None:
+        try:
+            return max(1, sum(client.nthreads().values()))
+        except Exception:  # noqa: BLE001 - a cluster that cannot say: no limit, Dask queues them
+            return 10 ** 9
+    return 10 ** 9

@@ -243,9 +243,9 @@ def polygons(rows: Sequence[Sequence[Segment]], fz_rows: Sequence[float]) -> lis
     """The regions as polygons ``{"type", "V", "Fz"}`` (rings: the low-speed edge upwards, then
     the high-speed edge downwards). Between consecutive rows each segment is joined to the
     overlapping segments of its type in the other row (cut at the middle of the gaps where it meets
-    several): trapezoids that tile the region; those of one region are chained into one polygon
-    until it splits or merges. A segment with nothing of its type above (below) it tapers to
-    its middle at the next (previous) row."""
+    several), and those with nothing of their type in the other row fill the gaps between those
+    joins as triangles: pieces that tile the strip between the rows. Those of one region are
+    chained into one polygon until it splits or merges."""
     chains: list[dict[str, Any]] = []
     open_at: dict[int, dict[str, Any]] = {}  # segment index in the current row -> chain ending there whole
     for r in range(len(rows) - 1):
@@ -263,20 +263,36 @@ def polygons(rows: Sequence[Sequence[Segment]], fz_rows: Sequence[float]) -> lis
                   for i, part in zip(is_, _split(B[j], [A[i] for i in is_]), strict=True)}
         following: dict[int, dict[str, Any]] = {}
         lower, upper = float(fz_rows[r]), float(fz_rows[r + 1])
-        for i, a in enumerate(A):  # a region ending between the rows: a tip at the next row
-            if i not in succ:
-                mid = 0.5 * (a[0] + a[1])
-                chain = open_at.pop(i, None)
-                if chain is None:
-                    chain = {"type": a[2], "rows": [(lower, a[0], a[1])]}
+        # Between consecutive links (and the row ends) lies a gap: [bottom_lo, bottom_hi] on this row,
+        # [top_lo, top_hi] on the next, holding segments of this row with nothing of their type above
+        # (regions ending between the rows) and of the next with nothing below (regions starting).
+        # The diagonal from (top_lo, next row) to (bottom_hi, this row) cuts the gap in two triangles:
+        # the ending segments fan out from its top corner, the starting ones from its bottom corner,
+        # so that the pieces tile the gap.
+        links = sorted(part_a, key=lambda key: part_a[key][0])
+        edges_a = [A[0][0]] + [x for key in links for x in part_a[key]] + [A[-1][1]]
+        edges_b = [B[0][0]] + [x for key in links for x in part_b[key]] + [B[-1][1]]
+        ending = [i for i in range(len(A)) if i not in succ]
+        starting = [j for j in range(len(B)) if j not in pred]
+        for g in range(len(links) + 1):
+            bottom_lo, bottom_hi = edges_a[2 * g], edges_a[2 * g + 1]
+            top_lo, top_hi = edges_b[2 * g], edges_b[2 * g + 1]
+            for i in ending:
+                a = A[i]
+                if bottom_lo <= 0.5 * (a[0] + a[1]) <= bottom_hi:
+                    chain = open_at.pop(i, None)
+                    if chain is None:
+                        chain = {"type": a[2], "rows": [(lower, a[0], a[1])]}
+                        chains.append(chain)
+                    chain["rows"].append((upper, top_lo, top_lo))
+            for j in starting:
+                b = B[j]
+                if top_lo <= 0.5 * (b[0] + b[1]) <= top_hi:
+                    chain = {"type": b[2], "rows": [(lower, bottom_hi, bottom_hi), (upper, b[0], b[1])]}
                     chains.append(chain)
-                chain["rows"].append((upper, mid, mid))
-        for j, b in enumerate(B):  # a region starting between the rows: a tip at the row below
-            if j not in pred:
-                mid = 0.5 * (b[0] + b[1])
-                chain = {"type": b[2], "rows": [(lower, mid, mid), (upper, b[0], b[1])]}
-                chains.append(chain)
-                following[j] = chain
+                    following[j] = chain
+            ending = [i for i in ending if not bottom_lo <= 0.5 * (A[i][0] + A[i][1]) <= bottom_hi]
+            starting = [j for j in starting if not top_lo <= 0.5 * (B[j][0] + B[j][1]) <= top_hi]
         for i, js in succ.items():
             for j in js:
                 chain = open_at.pop(i, None) if len(js) == 1 else None

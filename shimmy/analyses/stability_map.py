@@ -307,7 +307,7 @@ class StabilityMap:
     types: list[list[str]]  # [i_Fz][j_V] on the classified slices (Fz: their loads, ascending)
     slices: list[SliceResult]
     hopf: HopfCurvesResult
-    cycles: dict[str, Any]  # fold and torus curves with their details (:func:`_cycle_curves_unit`)
+    cycles: dict[str, Any]  # fold and torus curves with their details (:meth:`CycleCurvesResult.to_dict`)
     shading_Fz: np.ndarray  # rows of the shading (N), on the grid V
     shading: list[list[str]]  # [i_row][j_V]: types read off the slices along the curves
     shading_lengths: list[dict[str, float]]  # per row: measure (m/s) of each type, exact for the read-off
@@ -460,8 +460,8 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     def done(task: tuple, result: Any) -> list[tuple[int, tuple]]:
         if task[0] == "hopf_curves":
             found["hopf"] = result
-            return [(0, u) for u in search.start_units(result)]
-        if task[0] == "slice":
+            more = [(0, u) for u in search.start_units(result)] + [(0, u) for u in search.continuations()]
+        elif task[0] == "slice":
             found["slices"].append(result)
             search.add_source(result.starts)
             more = [(0, u) for u in search.continuations()]
@@ -494,7 +494,7 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
 def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, np.ndarray]]:
     """The region boundaries: every Hopf, fold and torus curve as a polyline in (V, Fz)."""
     out = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
-    out += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(search.curves)]
+    out += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(search.result(0.0).curves)]
     return out
 
 

@@ -385,6 +385,7 @@ class CycleCurveProblem:
 
     def accept(self, u: np.ndarray) -> None:
         self.cycle.accept(self.cycle_u(u))
+        self._memo = None  # accepting moves the phase condition: the bordered matrix at u changes
         self.update_borders(u)
 
     def update_borders(self, u: np.ndarray, sweeps: int = 1) -> None:
