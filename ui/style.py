@@ -9,13 +9,23 @@ CONFIG_LABELS = {"original": "original", "nes": "NES", "pd": "PD", "nes_pd": "NE
 SHIMMY_TYPE_COLOURS = {"Stable": "#FFFFFF", "Torsion": "#E69F00", "Lateral": "#56B4E9", "Bistable": "#CC79A7",
                        "Both": "#D55E00"}
 ACCENT = "#0072B2"
+#: Room above the plot for the figure toolbar and, below it, the title (they never overlap).
+MARGIN = {"l": 64, "r": 16, "t": 76, "b": 52}
+
+
+def title(text: str) -> dict:
+    """A title just above the plot area, left-aligned: under the toolbar at the top right, whatever the width."""
+    return {"text": text, "x": 0, "xref": "paper", "xanchor": "left", "y": 1, "yref": "paper", "yanchor": "bottom",
+            "pad": {"b": 12}, "font": {"size": 15}}
+
+
+_title = title
 
 
 def figure(title: str, x: str, y: str, height: int = 380) -> go.Figure:
     """An empty figure with axis titles (units included by the caller) and the house style."""
     fig = go.Figure()
-    fig.update_layout(title={"text": title, "x": 0.01, "font": {"size": 15}}, height=height,
-                      margin={"l": 64, "r": 16, "t": 44, "b": 52}, template="plotly_white",
+    fig.update_layout(title=_title(title), height=height, margin=MARGIN, template="plotly_white",
                       legend={"orientation": "h", "y": -0.22, "x": 0}, hovermode="closest",
                       font={"family": "system-ui, -apple-system, Segoe UI, Roboto, sans-serif", "size": 12})
     fig.update_xaxes(title_text=x, showline=True, linecolor="#888", mirror=True, zeroline=False)
@@ -35,8 +45,7 @@ def message_figure(text: str, height: int = 300) -> go.Figure:
 def layout(title: str, x: str, y: str, height: int = 380, x_log: bool = False) -> dict:
     """The house layout as a plain dict (for figures rebuilt on every slider move: no validation cost)."""
     axis = {"showline": True, "linecolor": "#888", "mirror": True, "zeroline": False, "gridcolor": "#e5e8ef"}
-    return {"title": {"text": title, "x": 0.01, "font": {"size": 15}}, "height": height,
-            "margin": {"l": 64, "r": 16, "t": 44, "b": 52}, "template": "plotly_white",
+    return {"title": _title(title), "height": height, "margin": dict(MARGIN), "template": "plotly_white",
             "legend": {"orientation": "h", "y": -0.22, "x": 0}, "hovermode": "closest",
             "font": {"family": "system-ui, -apple-system, Segoe UI, Roboto, sans-serif", "size": 12},
             "plot_bgcolor": "#ffffff", "paper_bgcolor": "#ffffff",

@@ -112,22 +112,32 @@ def open_executor(max_workers: int | None = None, scheduler: str | None = None) 
 
 def run_units(fn: Callable[[Any], Any], units: Sequence[Any], executor: Executor | None = None,
               progress: Callable[[float, str], None] | None = None,
-              describe_unit: Callable[[Any], str] = str) -> list[Any]:
+              describe_unit: Callable[[Any], str] = str, tally: Callable[[Any], str] | None = None) -> list[Any]:
     """``[fn(u) for u in units]`` through ``executor`` (default: :func:`open_executor`),
-    reporting ``progress(finished / total, "<unit> done")`` per finished unit."""
+    reporting ``progress(finished / total, "<unit> done (k/n)")`` per finished unit. With ``tally``
+    (unit -> the plural noun it is counted as, e.g. "slices"), the count is per noun, so that it
+    counts what the caller asked for: "(3/40 slices, 1/2 curve sets)"."""
     if executor is None:
         with open_executor() as own:
-            return run_units(fn, units, own, progress, describe_unit)
+            return run_units(fn, units, own, progress, describe_unit, tally)
     report = progress or (lambda fraction, message: None)
     futures = {executor.submit(fn, unit): k for k, unit in enumerate(units)}
     results: list[Any] = [None] * len(units)
+    nouns = [tally(u) for u in units] if tally else None
+    totals = {n: nouns.count(n) for n in dict.fromkeys(nouns)} if nouns else {}
+    counts = dict.fromkeys(totals, 0)
     finished = 0
     try:
         for future in as_completed(futures):
             k = futures[future]
             results[k] = future.result()
             finished += 1
-            report(finished / len(units), f"{describe_unit(units[k])} done ({finished}/{len(units)})")
+            if nouns:
+                counts[nouns[k]] += 1
+                count = ", ".join(f"{counts[n]}/{totals[n]} {n}" for n in totals)
+            else:
+                count = f"{finished}/{len(units)}"
+            report(finished / len(units), f"{describe_unit(units[k])} done ({count})")
     finally:
         for future in futures:
             future.cancel()

@@ -407,7 +407,8 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     tasks = [("cycle_curves", config, params, (v_min, v_max), (f_min, f_max), [float(f) for f in loads]),
              ("hopf_curves", config, params, (v_min, v_max), (f_min, f_max))]
     tasks += [("slice", config, float(Fz), v_min, v_max, n_v, params, options) for Fz in loads]
-    results = run_units(_unit, tasks, executor, progress, _describe)
+    results = run_units(_unit, tasks, executor, progress, _describe,
+                        lambda task: "slices" if task[0] == "slice" else "curve sets")
     cycles: dict[str, Any] = results[0]
     hopf: HopfCurvesResult = results[1]
     slices: list[SliceResult] = results[2:]
