@@ -122,6 +122,7 @@ def _file_stem(results):
 
 jobs.register(
     "th", "simulate", requests=_requests, blank=lambda: (*_placeholders("Refused: see the message above"), ""),
+    running=lambda: (*_placeholders("Running the time history…"), ""),
     render=lambda results: (*_figures(results[0]), _metrics(results[0]), settled(results[0])),
     notice=lambda results: "" if results[0]["success"] else results[0]["message"],
     outputs=[Output("th-series", "figure"), Output("th-spectrum", "figure"), Output("th-phase", "figure"),

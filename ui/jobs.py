@@ -76,7 +76,7 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
              download: Download, lock: Sequence[str] = (), store: str | None = None,
              error: str | None = None, triggers: Sequence[Input] = (), initial: bool | str = "cached",
              notice: Callable[[list[dict[str, Any]]], str] | None = None,
-             blank: Callable[[], tuple] | None = None) -> None:
+             blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None) -> None:
     """Wire the job of one page.
 
     ``requests(*trigger values, *state values)`` -> the analysis requests (may raise
@@ -87,7 +87,7 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
     loads, ``initial="cached"`` shows the answer to the page's controls if the cache has it (and
     computes nothing otherwise), ``True`` computes it, ``False`` does nothing. ``blank()`` -> the
     outputs that replace a shown result when the controls are refused (the old result no longer
-    answers them).
+    answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay).
     """
     store = store or f"{prefix}-requests"
     error = error or f"{prefix}-error"
@@ -128,7 +128,8 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
                    if done is None]
         except jobs.QueueFull as exc:
             return refused(f"The service is busy: {exc}.")
-        return ((no_update,) * (n_out + len(tail)) + ({"jobs": ids, "requests": wanted}, False, True, False)
+        busy = running() if running is not None else (no_update,) * n_out
+        return (tuple(busy) + (no_update,) * len(tail) + ({"jobs": ids, "requests": wanted}, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-poll", "n_intervals"),

@@ -51,3 +51,24 @@ def layout(title: str, x: str, y: str, height: int = 380, x_log: bool = False) -
             "plot_bgcolor": "#ffffff", "paper_bgcolor": "#ffffff",
             "xaxis": {**axis, "title": {"text": x}, "type": "log" if x_log else "linear"},
             "yaxis": {**axis, "title": {"text": y}}}
+
+
+def legend_key(fig, name: str, legend: str = "legend", group: str | None = None, **trace) -> None:
+    """A legend entry that draws nothing (its meaning is shared by many traces: a colour, a line
+    style, a marker kind). ``group``: the legendgroup of the traces it stands for (a click toggles them)."""
+    fig.add_scatter(x=[None], y=[None], name=name, legend=legend, legendgroup=group or f"key-{legend}-{name}",
+                    showlegend=True, hoverinfo="skip", **trace)
+
+
+def legends(fig, titles: list[str], height: int, bottom: int) -> None:
+    """Separate legends (legend, legend2, ...) stacked under the plot, each with its title on its left:
+    which colour is which configuration apart from what a line style or a marker kind means.
+    ``bottom`` is the figure's bottom margin (px) they live in."""
+    layout = {}
+    for k, text in enumerate(titles):
+        key = "legend" if k == 0 else f"legend{k + 1}"
+        y_px = bottom - 54 - 26 * k
+        layout[key] = {"title": {"text": text + ":", "side": "left"}, "orientation": "h", "x": 0, "xanchor": "left",
+                       "y": y_px / height, "yref": "container", "yanchor": "top", "font": {"size": 11},
+                       "bgcolor": "rgba(255,255,255,0)", "tracegroupgap": 4}
+    fig.update_layout(**layout)
