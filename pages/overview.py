@@ -89,7 +89,7 @@ def update(design, fz_kn, v_max):
         freq = data["hopf_points"][0]["frequency_hz"] if data["hopf_points"] else None
         rows.append([style.CONFIG_LABELS[config],
                      ", ".join(f"{a:.4g}–{b:.4g}" for a, b in intervals) or "stable",
-                     ui.fmt(onset), ui.fmt(end), "–" if d_onset is None else f"{d_onset:+.3g}", ui.fmt(freq),
+                     ui.fmt(onset), ui.fmt(end), ui.signed(d_onset), ui.fmt(freq),
                      ", ".join(h["criticality"] for h in data["hopf_points"]) or "–"])
     lay = style.layout(f"Growth rate of straight rolling at Fz = {fz_kn:g} kN", "forward speed V (m/s)",
                        "largest eigenvalue real part (1/s)", x_log=True)

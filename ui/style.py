@@ -7,7 +7,7 @@ import plotly.graph_objects as go
 CONFIG_COLOURS = {"original": "#000000", "nes": "#E69F00", "pd": "#0072B2", "nes_pd": "#009E73"}
 CONFIG_LABELS = {"original": "original", "nes": "NES", "pd": "PD", "nes_pd": "NES + PD"}
 SHIMMY_TYPE_COLOURS = {"Stable": "#FFFFFF", "Torsion": "#E69F00", "Lateral": "#56B4E9", "Bistable": "#CC79A7",
-                       "Both": "#D55E00"}
+                       "Both": "#117733"}  # Both: a dark green, far from Torsion's orange
 ACCENT = "#0072B2"
 #: Room above the plot for the figure toolbar and, below it, the title (they never overlap).
 MARGIN = {"l": 64, "r": 16, "t": 76, "b": 52}
