@@ -210,7 +210,7 @@ def open_time_history(click, requests):
     point = click["points"][0]
     V, fz_kn = float(point["x"]), float(point["y"])
     request = requests[0]
-    query = {"config": request["config"], "V": f"{V:.6g}", "Fz": f"{fz_kn:.6g}"}
+    query = {"config": request["config"], "V": f"{V:.6g}", "Fz": f"{fz_kn:.6g}", "run": "1"}
     query.update({k: f"{v:.10g}" for k, v in (request.get("params") or {}).items()})
     if request.get("material") not in (None, "steel"):
         query["material"] = request["material"]

@@ -39,7 +39,7 @@ def _start_of(psi0, lateral0) -> str:
 
 
 def layout(config: str | None = None, V: str | None = None, Fz: str | None = None, t_end: str | None = None,
-           psi0: str | None = None, lateral0: str | None = None, **query):
+           psi0: str | None = None, lateral0: str | None = None, run: str | None = None, **query):
     config, bad_config = fields.choice("config", config, list(style.CONFIG_COLOURS), "nes_pd", "a configuration")
     problems = [bad_config]
     v, problem_v = SPEED.from_url("V", V, 30)
@@ -79,6 +79,8 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
         html.Div([ui.graph("th-spectrum", figure=spectrum), ui.graph("th-phase", figure=phase)], className="grid-2"),
         ui.downloads("th"),
         *jobs.stores("th", "th-request"),
+        # ?run=1 (a click on a map point): run once the page is drawn, as if Run had been pressed.
+        dcc.Interval(id="th-autorun", interval=200, max_intervals=1, disabled=run != "1"),
     )
 
 
@@ -104,7 +106,7 @@ def start(choice, psi0, lateral0):
     return _start_of(psi0, lateral0), no_update, no_update
 
 
-def _requests(V, fz_kn, config, t_end, psi0, lateral0, design):
+def _requests(V, fz_kn, _autorun, config, t_end, psi0, lateral0, design):
     return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": T_END.read(t_end),
              "psi0": PSI0.read(psi0), "lateral0": LATERAL0.read(lateral0), "include_series": True, **design}]
 
@@ -127,7 +129,7 @@ jobs.register(
     notice=lambda results: "" if results[0]["success"] else results[0]["message"],
     outputs=[Output("th-series", "figure"), Output("th-spectrum", "figure"), Output("th-phase", "figure"),
              Output("th-metrics", "children"), Output("th-settled", "children")],
-    triggers=[Input("th-v", "value"), Input("th-fz", "value")],
+    triggers=[Input("th-v", "value"), Input("th-fz", "value"), Input("th-autorun", "n_intervals")],
     states=[State("th-config", "value"), State("th-tend", "value"), State("th-psi0", "value"),
             State("th-lat0", "value"), State(design_id("th"), "data")],
     store="th-request", download=jobs.Download("th", "time_history", _csv_rows, single=True, filename=_file_stem))
@@ -216,4 +218,4 @@ def _metrics(result):
 def remember(config, V, fz, t_end, psi0, lateral0):
     standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,
-            "lateral0": None if standard else lateral0}
+            "lateral0": None if standard else lateral0, "run": None}
