@@ -173,7 +173,7 @@ def _figures(result):
     spectrum.update_yaxes(type="log", range=[np.log10(floor), 0.3], dtick=1, exponentformat="power",
                           showexponent="all")
     n_window = int(round(result["options"]["window"] / result["series_dt"]))
-    phase = style.figure("Torsional phase portrait (steady window)", "psi (rad)", "dpsi/dt (rad/s)")
+    phase = style.figure("Torsional phase portrait", "psi (rad), steady window", "dpsi/dt (rad/s)")
     phase.add_scatter(x=s["psi"][-n_window:], y=s["dpsi"][-n_window:], mode="lines", name="orbit",
                       line={"color": colour, "width": 1})
     return series, spectrum, phase

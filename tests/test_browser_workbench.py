@@ -301,6 +301,19 @@ def test_every_page_fits_the_window_and_is_photographed(server, browser, size):
     assert _severe(browser) == []
 
 
+def test_plots_shrink_when_the_window_narrows(server, browser):
+    _open(browser, server, "/devices", (1440, 900))
+    _wait_for(lambda: _trace_count(browser, "dev-pd") >= 3, what="the damper curves")
+    wide = browser.execute_script("return +document.querySelector('#dev-pd .main-svg').getAttribute('width')")
+    browser.set_window_size(1024, 768)
+    _wait_for(lambda: browser.execute_script("return +document.querySelector('#dev-pd .main-svg')"
+                                             ".getAttribute('width')") < wide - 300, timeout=10,
+              what="the figure to shrink")
+    widths = browser.execute_script("return [document.documentElement.scrollWidth, "
+                                    "document.documentElement.clientWidth]")
+    assert widths[0] <= widths[1]
+
+
 def test_paired_fields_share_a_row_and_the_sidebar_collapses(server, browser):
     _open(browser, server, "/stability-map", (1024, 768))
     tops = [browser.find_element(By.ID, i).location["y"] for i in ("map-fzmin", "map-fzmax")]
