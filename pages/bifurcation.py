@@ -85,7 +85,7 @@ jobs.register(
 
 KIND_NAMES = {"H": "Hopf", "LPC": "fold of cycles", "NS": "torus", "PD": "period doubling",
               "BPC": "branch point of cycles", "BP": "branch point"}
-HEIGHT, BOTTOM = 760, 170
+HEIGHT, BOTTOM = 780, 190
 
 
 def _labelled(results):

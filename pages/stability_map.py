@@ -28,7 +28,7 @@ V_MIN = Quantity("map", "v_min", "V from", "m/s")
 V_MAX = Quantity("map", "v_max", "V to", "m/s")
 SLICES = Quantity("map", "resolution", "Fz slices", "")
 WAITING = "Press Compute: about 35 s per configuration at 40 slices cold on 2 cores, instant from the cache"
-HEIGHT, BOTTOM = 720, 150
+HEIGHT, BOTTOM = 740, 176
 
 
 def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | None = None,
@@ -107,7 +107,7 @@ jobs.register(
     blank=lambda: (style.message_figure("Refused: see the message above", 600), None))
 
 
-MARKERS = {"gh_points": ("GH point", "diamond", 12), "double_hopf_points": ("double-Hopf point", "star", 13)}
+MARKERS = {"gh_points": ("GH", "diamond", 12), "double_hopf_points": ("double Hopf", "star", 13)}
 
 
 def figure(results):
@@ -149,7 +149,7 @@ def figure(results):
     if inside:
         fig.add_scatter(x=[v for _, v, _ in inside], y=[f for _, _, f in inside], mode="markers+text",
                         text=[name for name, _, _ in inside], textposition="top right",
-                        textfont={"size": 13, "color": "#111"}, name="operating points A-I", legend="legend2",
+                        textfont={"size": 13, "color": "#111"}, name="points A-I", legend="legend2",
                         marker={"symbol": "circle", "size": 9, "color": "#fff", "line": {"width": 2, "color": "#111"}},
                         hovertemplate="operating point %{text}<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN<extra></extra>")
     for result in results:
@@ -157,7 +157,7 @@ def figure(results):
         style.legend_key(fig, style.CONFIG_LABELS[config], "legend", group=config, mode="lines",
                          line={"color": style.CONFIG_COLOURS[config], "width": 3})
     for kind, dash_style, width in CURVE_STYLES.values():
-        style.legend_key(fig, f"{kind} curve", "legend2", mode="lines",
+        style.legend_key(fig, kind, "legend2", mode="lines",
                          line={"color": "#444", "dash": dash_style, "width": width})
     for kind, symbol, size in MARKERS.values():
         style.legend_key(fig, kind, "legend2", mode="markers",
@@ -169,7 +169,7 @@ def figure(results):
     fig.update_xaxes(range=[min(V), max(V)])
     fig.update_yaxes(range=[min(Fz), max(Fz)])
     fig.update_layout(margin={**style.MARGIN, "b": BOTTOM})
-    style.legends(fig, ["configuration (colour)", "curves and points", "shimmy type (shading)"], HEIGHT, BOTTOM)
+    style.legends(fig, ["configuration (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM)
     return fig
 
 

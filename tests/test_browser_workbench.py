@@ -219,7 +219,7 @@ def test_map_operating_points_colours_cancel_progress_and_cached_return(server, 
     _wait_for(lambda: _trace_count(browser, "map-graph") > 5, what="the map's traces")
     info = browser.execute_script("""
         const g = document.querySelector('#map-graph .js-plotly-plot');
-        const op = g.data.find(t => t.name === 'operating points A-I');
+        const op = g.data.find(t => t.name === 'points A-I');
         const key = n => g.data.find(t => t.legend === 'legend3' && t.name === n).marker.color;
         return {op: op ? op.text : null, torsion: key('Torsion'), both: key('Both'),
                 legends: [g.layout.legend.title.text, g.layout.legend2.title.text, g.layout.legend3.title.text]};""")

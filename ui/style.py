@@ -67,7 +67,7 @@ def legends(fig, titles: list[str], height: int, bottom: int) -> None:
     layout = {}
     for k, text in enumerate(titles):
         key = "legend" if k == 0 else f"legend{k + 1}"
-        y_px = bottom - 54 - 26 * k
+        y_px = bottom - 54 - 34 * k  # room for one wrapped line at 1024 px
         layout[key] = {"title": {"text": text + ":", "side": "left"}, "orientation": "h", "x": 0, "xanchor": "left",
                        "y": y_px / height, "yref": "container", "yanchor": "top", "font": {"size": 11},
                        "bgcolor": "rgba(255,255,255,0)", "tracegroupgap": 4}
