@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import math
+
 import dash
 import numpy as np
 from dash import Input, Output, State, dcc, html, no_update
 from plotly.subplots import make_subplots
 
+from shimmy.service import settings
 from ui import components as ui
 from ui import fields, jobs
 from ui import style
@@ -107,8 +110,11 @@ def start(choice, psi0, lateral0):
 
 
 def _requests(V, fz_kn, _autorun, config, t_end, psi0, lateral0, design):
-    return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": T_END.read(t_end),
-             "psi0": PSI0.read(psi0), "lateral0": LATERAL0.read(lateral0), "include_series": True, **design}]
+    t = T_END.read(t_end)
+    # The series is thinned for a long run: every t_end the field allows can be drawn.
+    series_dt = max(0.002, math.ceil(1000 * t / (settings.MAX_SERIES_POINTS - 1)) / 1000)
+    return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": t, "psi0": PSI0.read(psi0),
+             "lateral0": LATERAL0.read(lateral0), "include_series": True, "series_dt": series_dt, **design}]
 
 
 def _csv_rows(results):
