@@ -87,7 +87,6 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
     )
 
 
-
 @dash.callback(Output("th-v", "value"), Output("th-fz", "value"),
                Input({"type": "th-op", "name": dash.ALL}, "n_clicks"), prevent_initial_call=True)
 def operating_point(_clicks):
