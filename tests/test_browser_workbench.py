@@ -14,10 +14,31 @@ import pytest
 pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
-import test_browser  # noqa: E402
-from test_browser import PAGES, SHOTS, _idle, _severe, _trace_count, _wait_for  # noqa: E402
+from selenium import webdriver  # noqa: E402
+from selenium.webdriver.chrome.service import Service  # noqa: E402
+from test_browser import (CHROMEDRIVER, CHROMIUM, PAGES, ROOT, SHOTS, _ensure_chromium, _idle,  # noqa: E402
+                          _severe, _trace_count, _wait_for)
 
-browser = test_browser.browser  # the same headless Chromium fixture (one per module)
+
+@pytest.fixture(scope="module")
+def browser():
+    """Headless Chromium as in test_browser.py, with a profile of its own: a second browser on the
+    same profile, started while the first is still closing, would hand its pages to that one."""
+    _ensure_chromium()
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = CHROMIUM
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                "--disable-dev-shm-usage", "--window-size=1440,900"):
+        opts.add_argument(arg)
+    opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / 'chromium-profile-workbench'}")
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
+    driver.set_page_load_timeout(60)
+    SHOTS.mkdir(exist_ok=True)
+    yield driver
+    driver.quit()
+
 
 SIZES = ((1440, 900), (1024, 768))
 
@@ -251,9 +272,10 @@ def test_study_skips_what_a_parameter_cannot_affect_and_refuses_empty_values(ser
     values = browser.find_element(By.ID, "study-values")
     assert browser.execute_script("return arguments[0].scrollWidth <= arguments[0].clientWidth", values)
     browser.find_element(By.ID, "study-run").click()
-    rows = _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#study-summary tbody tr"), timeout=120,
-                     what="the study table")
-    assert [r.find_elements(By.TAG_NAME, "td")[1].text for r in rows] == ["NES", "NES"]  # original skipped
+    configs = ("return [...document.querySelectorAll('#study-summary tbody tr')].map(r => r.cells[1].innerText);")
+    _wait_for(lambda: browser.execute_script(configs), timeout=120, what="the study table")
+    _idle(browser)
+    assert browser.execute_script(configs) == ["NES", "NES"]  # original skipped
     browser.find_elements(By.CSS_SELECTOR, "#study-view input")[1].click()
     _wait_for(lambda: browser.find_element(By.ID, "study-pivot").is_displayed(), timeout=10, what="the pivot")
     assert not browser.find_element(By.ID, "study-summary").is_displayed()
