@@ -120,7 +120,8 @@ def test_help_is_complete_plain_text_and_shows_the_shared_limits():
 
 
 @pytest.mark.parametrize("argv, needle", [
-    (["map", "--config", "nes", "--resolution", "81"], "resolution=81.0 is out of range; allowed: an integer in [2, 80]"),
+    (["map", "--config", "nes", "--resolution", "81"],
+     "resolution=81.0 is out of range; allowed: an integer in [2, 80]"),
     (["simulate", "--config", "nes", "--V", "30", "--Fz", "150000", "--t-end", "601"],
      "t_end=601.0 is out of range; allowed: a number in [0.1, 600] s"),
     (["bifurcation", "--config", "nes", "--Fz", "150000", "--ntst", "5"], "ntst"),
