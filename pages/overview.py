@@ -50,6 +50,18 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
                   html.Button("Download boundary JSON", id="ovb-json", className="secondary", disabled=True),
                   dcc.Download(id="ovb-download")], className="downloads"),
         *jobs.stores("ov-boundary", "ovb-requests"),
+        html.H2("Regions and curves of cycles in (V, Fz)"),
+        html.P("The stability maps of the four configurations: the regions of original shaded by shimmy type, "
+               "bounded by its Hopf, fold-of-cycles and torus curves; every configuration's curves in its colour "
+               "(the same maps as on the Stability map page, shared through the cache).", className="hint"),
+        html.Div(jobs.controls("ov-regions", "Compute maps"), className="controls"),
+        html.Div(id="ov-regions-error", className="error", role="alert"),
+        ui.graph("ov-regions-graph", figure=style.message_figure("Press 'Compute maps' (about 10-20 s per "
+                                                                  "configuration cold, instant when cached)")),
+        html.Div([html.Button("Download regions CSV", id="ovr-csv", className="secondary", disabled=True),
+                  html.Button("Download maps JSON", id="ovr-json", className="secondary", disabled=True),
+                  dcc.Download(id="ovr-download")], className="downloads"),
+        *jobs.stores("ov-regions", "ovr-requests"),
     ])
 
 
@@ -148,3 +160,25 @@ jobs.register(
     "ov-boundary", "hopf_curves", requests=_boundary_requests, render=lambda results: (boundary_figure(results),),
     outputs=[Output("ov-boundary-graph", "figure")], states=[State(design_id("ov"), "data")],
     store="ovb-requests", download=jobs.Download("ovb", "hopf_curves", _boundary_rows))
+
+
+def _regions_requests(design):
+    return [{"config": config, **design} for config in CONFIGS]
+
+
+def _regions_figure(results):
+    from pages.stability_map import figure  # the map page's drawing: regions, curves, points
+
+    return figure(results)
+
+
+def _region_rows(results):
+    rows = [[r["config"], k, region["type"], V, Fz] for r in results for k, region in enumerate(r["regions"])
+            for V, Fz in zip(region["V"], region["Fz"], strict=True)]
+    return ["config", "region", "shimmy_type", "V_m_s", "Fz_N"], rows
+
+
+jobs.register(
+    "ov-regions", "map", requests=_regions_requests, render=lambda results: (_regions_figure(results),),
+    outputs=[Output("ov-regions-graph", "figure")], states=[State(design_id("ov"), "data")],
+    store="ovr-requests", download=jobs.Download("ovr", "stability_maps", _region_rows))

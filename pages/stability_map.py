@@ -27,7 +27,7 @@ FZ_MAX = Quantity("map", "fz_max", "Fz to", "kN", 1e3)
 V_MIN = Quantity("map", "v_min", "V from", "m/s")
 V_MAX = Quantity("map", "v_max", "V to", "m/s")
 SLICES = Quantity("map", "resolution", "Fz slices", "")
-WAITING = "Press Compute: about 35 s per configuration at 40 slices cold on 2 cores, instant from the cache"
+WAITING = "Press Compute: tens of seconds per configuration cold on 2 cores, instant from the cache"
 HEIGHT, BOTTOM = 740, 176
 
 
@@ -40,7 +40,7 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
     values, problems = {}, [bad_shade, bad_overlay]
     for key, q, raw, default in (("fz_min", FZ_MIN, fz_min, 10), ("fz_max", FZ_MAX, fz_max, 900),
                                  ("v_min", V_MIN, v_min, 1), ("v_max", V_MAX, v_max, 200),
-                                 ("resolution", SLICES, resolution, 40)):
+                                 ("resolution", SLICES, resolution, SLICES.spec.default)):
         values[key], problem = q.from_url(key, raw, default)
         problems.append(problem)
     return page(

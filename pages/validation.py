@@ -1,4 +1,4 @@
-"""Validation: computed against the published results of REFERENCE.md, disagreement included."""
+"""Validation: computed against the published results of the study (docs/validation.md), disagreement included."""
 
 from __future__ import annotations
 
@@ -19,7 +19,8 @@ PUBLISHED_AMPLITUDE = 0.017  # rad, nes_pd at V = 30 m/s, Fz = 150 kN
 def layout(**query):
     return page(
         query, "val",
-        ui.header("Validation", "The calibrated defaults against the published study (REFERENCE.md), at "
+        ui.header("Validation", "The calibrated defaults against the published study (docs/validation.md in the "
+                  "repository describes the fit and the disagreement), at "
                   "Fz = 150 kN. These use the default design, whatever the panel says: they check the model, "
                   "not a design."),
         html.Div(id="val-content", children=html.P("computing…", className="hint")),
@@ -59,7 +60,7 @@ def build(_n):
          ui.pct(100 * (amp / PUBLISHED_AMPLITUDE - 1), 1)]], "val-amplitude")
     a08, a09 = _amplitude("nes_pd", 30.0, {"a_p": 0.8}), _amplitude("nes_pd", 30.0, {"a_p": 0.9})
     tungsten = _amplitude("nes_pd", 30.0, material="tungsten")
-    sanity = ui.table(["sanity check (REFERENCE.md)", "expected", "computed"], [
+    sanity = ui.table(["sanity check (not a target)", "expected", "computed"], [
         ["a_p 0.8 -> 0.9 lowers the nes_pd amplitude", "about -10 %", ui.pct(100 * (a09 / a08 - 1), 1)],
         ["tungsten powder damps more than steel shot", "tungsten < steel",
          f"{tungsten:.4f} < {amp:.4f} rad" if tungsten < amp else f"{tungsten:.4f} >= {amp:.4f} rad (FAILS)"]],

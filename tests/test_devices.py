@@ -76,7 +76,7 @@ def test_exact_torque_is_refused_outside_the_track(angle):
 
 
 def _hand_pd_coefficients(a_p, rho_p, g_p, e_r, d_p, f, phi_f, rho_m_frac=0.9, d=0.06, h_c=0.1, I2D=1.0):
-    """MODEL.md's formulas, written out independently of shimmy.model.particle_damper."""
+    """The model's formulas (docs/model.md), written out independently of shimmy.model.particle_damper."""
     rho_m = rho_m_frac * rho_p
     cbar = 9 / 16 * math.pi ** 3 * d ** 2 * h_c * rho_m
     alpha0 = 1 / 5 * (6 * (1 - e_r) * a_p ** 2 * g_p * rho_p * d_p / (math.pi * d ** 2 * rho_m)) ** 0.5

@@ -12,8 +12,8 @@ import pytest
 
 from shimmy.errors import InvalidParameterError
 from shimmy.service.dask_cluster import loopback_cluster
-from shimmy.analyses.executors import (DASK_ENV, WORKERS_ENV, InlineExecutor, describe, open_executor, run_units,
-                                       worker_count)
+from shimmy.analyses.executors import (DASK_ENV, WORKERS_ENV, InlineExecutor, describe, open_executor, run_dynamic,
+                                       run_units, worker_count)
 from shimmy.analyses.stability_map import stability_map
 from shimmy.analyses.studies import study
 
@@ -28,6 +28,27 @@ def test_run_units_keeps_the_order_and_reports_each_unit():
     assert out == [4.0, 1.0, 9.0, 2.0]
     assert [f for f, _ in seen] == [0.25, 0.5, 0.75, 1.0]
     assert all("done" in m for _, m in seen)
+
+
+def test_run_dynamic_runs_the_most_urgent_unit_first_including_units_added_on_the_way():
+    """One worker: units run strictly by priority; a unit's result adds more, which overtake the
+    waiting ones of lower priority; progress never decreases although the total grows."""
+    order, seen = [], []
+
+    def done(unit, result):
+        order.append(unit)
+        assert result == math.sqrt(unit)
+        return [(0, 100.0), (0, 121.0)] if unit == 4.0 else []
+
+    messages = []
+    with ProcessPoolExecutor(max_workers=1) as pool:
+        count = run_dynamic(math.sqrt, [(2, 9.0), (1, 4.0), (3, 16.0), (2, 25.0)], pool, done,
+                            lambda f, m: (seen.append(f), messages.append(m)),
+                            tally=lambda u: "large" if u > 50 else "small")
+    assert count == 6
+    assert order == [4.0, 100.0, 121.0, 9.0, 25.0, 16.0]
+    assert seen == sorted(seen) and seen[-1] == 1.0
+    assert messages[0].endswith("(1/4 small, 0/2 large)") and messages[-1].endswith("(4/4 small, 2/2 large)")
 
 
 def test_a_failing_unit_fails_the_call():

@@ -17,6 +17,7 @@ from shimmy.errors import InvalidParameterError
 from shimmy.analyses.executors import InlineExecutor
 from shimmy.analyses.simulation import simulate
 from shimmy.analyses.stability import hopf_points
+from shimmy.analyses import map_shading
 from shimmy.analyses.stability_map import SHIMMY_TYPES, attractors_at, classify, shimmy_type, stability_map
 
 RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"}
@@ -84,6 +85,8 @@ SAMPLES = [
     ("nes", 30.0, 150e3, "Torsion"),
     ("pd", 180.0, 850e3, "Lateral"),
     ("pd", 50.0, 350e3, "Lateral"),  # D: the particle damper leaves no stable torsional cycle
+    ("original", 50.0, 850e3, "Bistable"),  # the torsional isola between two folds above ~720 kN
+    ("nes", 50.0, 850e3, "Bistable"),
 ]
 
 
@@ -119,12 +122,17 @@ def test_classification_is_confirmed_by_simulation_from_several_starts(config, V
 
 
 def test_map_grid_and_the_classifier_agree(original_map):
+    """The classified slices are the 12 asked for and those through regions they miss; at a
+    slice load the classifier (the same computation) gives the map's answer."""
     m = original_map
-    assert m.Fz.size == 12 and m.V.size == 60
+    asked = np.linspace(1.0e4, 9.0e5, 12)
+    assert all(np.min(np.abs(m.Fz - f)) < 1e-6 for f in asked) and list(m.Fz) == sorted(m.Fz)
+    assert 12 <= m.Fz.size <= 12 + 16 and m.V.size == 60
     assert all(len(row) == 60 and set(row) <= set(SHIMMY_TYPES) for row in m.types)
     # Every type occurs on this map (see the simulation test for what each is).
-    assert {t for row in m.types for t in row} == set(SHIMMY_TYPES)
-    for i, j in ((3, 10), (4, 40), (6, 5), (6, 45), (9, 30), (11, 59)):
+    assert {t for row in m.shading for t in row} == set(SHIMMY_TYPES)
+    for f, j in ((3, 10), (4, 40), (6, 5), (6, 45), (9, 30), (11, 59)):
+        i = int(np.argmin(np.abs(m.Fz - asked[f])))
         answer = classify("original", float(m.V[j]), float(m.Fz[i]))
         assert answer["shimmy_type"] == m.types[i][j], (m.V[j], m.Fz[i])
 
@@ -155,11 +163,16 @@ def test_fold_curves_end_at_the_generalised_hopf_points(original_map):
 
 
 def test_every_fold_and_torus_point_of_a_slice_lies_on_a_drawn_curve(original_map):
-    """The curves are continued in two parameters; their crossings of each slice's load are
-    located, and every LPC / NS point of every slice's diagram is one of them (to 1e-6 m/s)."""
+    """The curves are continued in two parameters; their crossings of the loads of the slices
+    asked for are located, and every LPC / NS point of those slices' diagrams is one of them (to
+    1e-6 m/s). (The slices added through regions the others miss come after the curves.)"""
     m = original_map
     checked = 0
+    marked = m.cycles["loads"]
+    assert len(marked) == 12
     for s in m.slices:
+        if min(abs(s.Fz - f) for f in marked) > 1e-6:
+            continue
         crossings = {kind: [x["V"] for c in m.cycles["curves"] if c["kind"] == kind for x in c["crossings"]
                             if abs(x["Fz"] - s.Fz) < 1e-3] for kind in ("LPC", "NS")}
         for p in s.special_points:
@@ -263,23 +276,146 @@ def test_shading_read_off_the_curves_agrees_with_the_classifier_away_from_bounda
         assert classify("original", V, Fz)["shimmy_type"] == grid[i, j], (V, Fz)
 
 
+class _Slice:
+    def __init__(self, Fz, intervals):
+        self.Fz, self.intervals = Fz, intervals
+
+
 def test_shading_changes_only_at_the_curves_or_where_the_slices_change():
     """Read-off by construction: within one row, between two consecutive boundary crossings, the
-    shading repeats the slice interval it is mapped from."""
-    from shimmy.analyses import map_shading
-
-    class S:
-        def __init__(self, Fz, intervals):
-            self.Fz, self.intervals = Fz, intervals
-
-    # one vertical boundary at V = 50 + Fz / 1e4 (moves with the load); Torsion left of it on both slices
+    shading repeats the slice interval it is mapped from; a change of type inside an interval (a
+    cycle's mode) moves linearly in Fz between the slices below and above."""
+    # one boundary at V = 50 + Fz / 1e4 (moves with the load); Torsion left of it on both slices,
+    # with a mode change (Both below 20 m/s on the lower slice, below 40 m/s on the upper one)
     curve = ("b", np.array([[50.0, 0.0], [150.0, 1.0e6]]))
-    slices = [S(1e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 60.0}]),
-              S(3e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 80.0}])]
-    V = np.linspace(1.0, 200.0, 400)
-    rows, lengths, fallbacks = map_shading.shade(slices, [curve], V, np.array([2e5]), (1.0, 200.0))
+    slices = [_Slice(1e5, [{"type": "Both", "V_start": 1.0, "V_end": 20.0},
+                           {"type": "Torsion", "V_start": 20.0, "V_end": 60.0}]),
+              _Slice(3e5, [{"type": "Both", "V_start": 1.0, "V_end": 40.0},
+                           {"type": "Torsion", "V_start": 40.0, "V_end": 80.0}])]
+    rows, fallbacks = map_shading.row_segments(slices, [curve], [2e5], (1.0, 200.0))
     edge = 50.0 + 2e5 / 1e4  # the boundary at the row's load: 70 m/s, between the slices' 60 and 80
-    row = np.array(rows[0])
+    # the mode change at the same fraction of the interval [1, edge] as the slices' average
+    f = 0.5 * ((20.0 - 1.0) / (60.0 - 1.0) + (40.0 - 1.0) / (80.0 - 1.0))
+    change = 1.0 + f * (edge - 1.0)
     assert fallbacks == 0
-    assert (row[V < edge - 0.5] == "Torsion").all() and (row[V > edge + 0.5] == "Stable").all()
-    assert lengths[0]["Torsion"] == pytest.approx(edge - 1.0) and lengths[0]["Stable"] == pytest.approx(200.0 - edge)
+    assert [t for _, _, t in rows[0]] == ["Both", "Torsion", "Stable"]
+    assert rows[0][0][1] == pytest.approx(change) and rows[0][1][1] == pytest.approx(edge)
+    V = np.linspace(1.0, 200.0, 400)
+    row = np.array(map_shading.grid(rows, V)[0])
+    assert (row[(V > change + 0.5) & (V < edge - 0.5)] == "Torsion").all() and (row[V > edge + 0.5] == "Stable").all()
+    lengths = map_shading.measures(rows[0])
+    assert lengths["Torsion"] == pytest.approx(edge - change) and lengths["Stable"] == pytest.approx(200.0 - edge)
+
+
+def test_region_polygons_follow_the_rows_and_split_where_a_region_does():
+    """A wedge of Torsion opening upwards between two boundaries, and above a load a Lateral
+    island splitting it: the polygons' areas are the trapezoid rule over the rows, and each
+    polygon is one type."""
+    fz_rows = np.linspace(0.0, 1.0e5, 11)
+    rows = []
+    for Fz in fz_rows:
+        w = 10.0 + Fz / 1e3  # Torsion on [100 - w, 100 + w]
+        if Fz >= 5e4:  # a Lateral island in the middle, growing
+            g = (Fz - 4e4) / 1e4
+            rows.append([(0.0, 100 - w, "Stable"), (100 - w, 100 - g, "Torsion"), (100 - g, 100 + g, "Lateral"),
+                         (100 + g, 100 + w, "Torsion"), (100 + w, 300.0, "Stable")])
+        else:
+            rows.append([(0.0, 100 - w, "Stable"), (100 - w, 100 + w, "Torsion"), (100 + w, 300.0, "Stable")])
+    polygons = map_shading.polygons(rows, fz_rows)
+    for t in ("Stable", "Torsion", "Lateral"):
+        area = sum(map_shading.polygon_area(p) for p in polygons if p["type"] == t)
+        lengths = [sum(b - a for a, b, u in r if u == t) for r in rows]
+        assert area == pytest.approx(float(np.trapezoid(lengths, fz_rows)), rel=0.02), t
+    torsion = [p for p in polygons if p["type"] == "Torsion"]
+    assert len(torsion) == 3  # the wedge below the split, then its two arms
+
+
+def test_shading_is_on_the_right_side_of_every_hopf_curve(original_map):
+    """Independent of the read-off: on every shading row, x = 0 is unstable (eigenvalues at that
+    very load) exactly where the shading says shimmy of some kind is possible from small
+    disturbances, up to one grid cell: no cell is Stable where x = 0 is unstable, and below the
+    GH loads (every Hopf point supercritical) no cell is unstable-free and shaded."""
+    m = original_map
+    cell = float(m.V[1] - m.V[0])
+    gh_low = min(g["Fz"] for g in m.hopf.gh_points)
+    checked = 0
+    for Fz, row in zip(m.shading_Fz[::6], m.shading[::6], strict=True):
+        unstable = hopf_points("original", float(Fz), v_min=1.0, v_max=200.0).unstable_intervals
+        for V, t in zip(m.V, row, strict=True):
+            inside = any(a + cell < V < b - cell for a, b in unstable)
+            outside = all(V < a - cell or V > b + cell for a, b in unstable)
+            if inside:
+                assert t != "Stable", (Fz, V, t)
+                checked += 1
+            elif outside and Fz < gh_low:
+                assert t == "Stable", (Fz, V, t)
+                checked += 1
+    assert checked > 500
+
+
+def test_region_polygons_tile_the_shading(original_map):
+    """Each type's polygons have the area of its row measures (trapezoidal in Fz); a point in
+    the middle of each polygon has the polygon's type in the shading."""
+    m = original_map
+    data = m.to_dict()
+    assert data["regions"] and data["methods"]["regions"]
+    rows = np.asarray(m.shading_Fz) / 1e3
+    for t in SHIMMY_TYPES:
+        polygons = [p for p in m.regions if p["type"] == t]
+        area = sum(map_shading.polygon_area(p) for p in polygons) / 1e3
+        lengths = np.array([r.get(t, 0.0) for r in m.shading_lengths])
+        assert area == pytest.approx(float(np.trapezoid(lengths, rows)), rel=0.02, abs=50.0), t
+    for p in m.regions:
+        lo, hi, Fz = _widest_row(p)
+        if hi - lo < 3 * (m.V[1] - m.V[0]):
+            continue
+        V = 0.5 * (lo + hi)
+        assert m.type_at(V, Fz) == p["type"], (p["type"], V, Fz)
+
+
+def _widest_row(polygon):
+    """(V_low, V_high, Fz) of the widest row of a region polygon (its rows go up the low-speed
+    edge and back down the high-speed edge)."""
+    V, Fz = polygon["V"], polygon["Fz"]
+    rows = len(V) // 2
+    r = max(range(rows), key=lambda k: V[len(V) - 1 - k] - V[k])
+    return V[r], V[len(V) - 1 - r], Fz[r]
+
+
+def _reached(config, V, Fz):
+    """Response types reached from the three standard starts (psi = 0.001 rad, psi = 0.2 rad,
+    l_g delta = 0.1 m)."""
+    n = 7 if "nes" in config else 5
+    out = set()
+    for index, value in ((0, 0.001), (0, 0.2), (2, 0.05)):
+        x0 = np.zeros(n)
+        x0[index] = value
+        out.add(_settle(config, V, Fz, x0).response_type.value)
+    return out
+
+
+@pytest.mark.slow
+def test_every_region_of_the_map_is_confirmed_by_simulation_from_three_starts(original_map):
+    """In the middle of the widest row of each region polygon (if 3 cells wide), the types reached by time
+    simulation from the three standard starts are what the region's type says."""
+    m = original_map
+    cell = float(m.V[1] - m.V[0])
+    checked = set()
+    for p in m.regions:
+        lo, hi, Fz = _widest_row(p)
+        if hi - lo < 3 * cell or Fz < 2e4:
+            continue
+        V = 0.5 * (lo + hi)
+        reached = _reached("original", V, Fz)
+        t = p["type"]
+        if t == "Stable":
+            assert reached == {"Stable"}, (V, Fz, reached)
+        elif t in ("Torsion", "Lateral"):
+            other = "Lateral" if t == "Torsion" else "Torsion"
+            assert t in reached and other not in reached, (t, V, Fz, reached)
+        elif t == "Bistable":
+            assert {"Torsion", "Lateral"} <= reached, (V, Fz, reached)
+        else:
+            assert "Both" in reached, (V, Fz, reached)
+        checked.add(t)
+    assert checked == set(SHIMMY_TYPES), checked

@@ -1,10 +1,10 @@
-"""Fit of the constants the published study does not give (REFERENCE.md).
+"""Fit of the constants the published study does not give (docs/validation.md).
 
 Run ``python -m shimmy.analyses.calibration`` (or ``python -m shimmy calibrate``) to refit and
 print the values and residuals. The defaults in :mod:`shimmy.model.parameters` are this
 fit's output rounded to five significant digits; a test reruns the fit and compares.
 
-The fit is sequential, in the order of REFERENCE.md's table, because each step only
+The fit is sequential, in the order of the targets' table (docs/validation.md), because each step only
 depends on the ones before it:
 
 1. ``k_lam``: least squares on the relative errors of the two Hopf points of
@@ -145,7 +145,7 @@ def calibrate(base: Parameters | None = None) -> CalibrationResult:
 
 
 def format_report(result: CalibrationResult) -> str:
-    lines = ["Calibration against REFERENCE.md (Fz = 150 kN)", "",
+    lines = ["Calibration against the published study (Fz = 150 kN)", "",
              f"{'parameter':<10}{'fitted':>16}{'default':>14}"]
     for name, value in result.values.items():
         lines.append(f"{name:<10}{value:>16.8g}{PARAMETER_SPECS[name].default:>14.8g}")

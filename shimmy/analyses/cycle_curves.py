@@ -40,7 +40,7 @@ from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, chec
 from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation
 from .hopf_curves import hopf_curves
 from .polylines import near_polyline
-from .executors import open_executor, run_units
+from .executors import open_executor, run_dynamic
 from .stability import hopf_points
 
 KINDS = ("LPC", "NS", "PD")
@@ -69,6 +69,10 @@ class Start:
     Fz: float
     ncol: int
     origin: str
+    #: next to the codimension-2 point it was found beside, where a curve is born: continued
+    #: before the other starts (a diagram's points mostly lie on curves already started)
+    eager: bool = False
+    from_diagram: bool = False  # a point of a one-parameter diagram (a slice or a scan)
 
 
 @dataclass
@@ -172,6 +176,152 @@ def _close(a: dict, b: dict, tol: float) -> bool:
     return abs(a["V"] - b["V"]) <= tol * V_SCALE and abs(a["Fz"] - b["Fz"]) <= tol * FZ_SCALE
 
 
+class CurveSearch:
+    """The state of a search for every curve of some kinds in a box: the starts found so far,
+    the curves continued from them, the continuations under way. Units (see :func:`search_unit`)
+    come from :meth:`start_units` (branches beside codimension-2 points of the Hopf curves) and
+    from :meth:`continuations`; whoever runs them hands back their results (:meth:`add_beside`,
+    :meth:`add_source` for a diagram's points, :meth:`add_curve`).
+
+    A start is continued only if it lies on no curve known; one curve of each kind is under way
+    at a time (two starts may lie on one curve, and which do is known only once it is continued:
+    two double-Hopf points joined by a torus curve); starts born at a codimension-2 point go
+    first, in the order of those points; a diagram's starts wait until every diagram expected
+    (:meth:`expect_sources`) and every branch beside a point is in, then go by load and speed.
+    So the curves, and the start each is continued from, do not depend on the order in which
+    units finish: a map or a set of curves is the same on any executor.
+    :func:`cycle_curves` and the stability maps both drive it."""
+
+    def __init__(self, config: Configuration, params: Parameters, box, kinds: tuple[str, ...],
+                 loads: tuple[float, ...]):
+        self.config, self.params, self.box, self.kinds, self.loads = config, params, box, kinds, loads
+        self.gh: list[dict[str, float]] = []
+        self.hh: list[dict[str, Any]] = []
+        self.starts: list[Start] = []
+        self.running: list[Start] = []
+        self.curves: list[GearCycleCurve] = []
+        self.warnings: list[str] = []
+        self.tried = 0
+        self.beside_order: list[str] = []  # origins of the units beside codimension-2 points
+        self.beside_in: dict[str, tuple[list[Start], list[str]]] = {}
+        self.beside_taken = 0
+        self.sources_pending = 0  # diagrams expected and not yet in
+        self.source_buffer: list[Start] = []
+
+    def start_units(self, hopf) -> list[tuple]:
+        """The branches beside the GH points (fold curves) and double-Hopf points (torus curves)."""
+        self.gh = [{"V": g["p"][0], "Fz": g["p"][1]} for c in hopf.curves for g in c.gh_points]
+        for c in hopf.curves:
+            for g in c.double_hopf:
+                entry = {"V": g["p"][0], "Fz": g["p"][1], "omega": g["omega"], "omega2": g["omega2"]}
+                if not any(_close(entry, e, 1e-4) for e in self.hh):
+                    self.hh.append(entry)
+        units = [("beside", self.config, self.params, g, "LPC", self.box,
+                  f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+                 for g in self.gh if "LPC" in self.kinds]
+        units += [("beside", self.config, self.params, g, "NS", self.box,
+                   f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+                  for g in self.hh if "NS" in self.kinds]
+        self.beside_order += [u[6] for u in units]
+        return units
+
+    def _usable(self, starts: list[Start]) -> list[Start]:
+        return [s for s in starts if s.kind in self.kinds and s.point.solution is not None]
+
+    def add_beside(self, task: tuple, starts: list[Start], warnings: list[str]) -> None:
+        """A unit beside a codimension-2 point is in; its starts count in the order of the points."""
+        self.beside_in[task[6]] = (starts, warnings)
+        while self.beside_taken < len(self.beside_order) and self.beside_order[self.beside_taken] in self.beside_in:
+            starts, warnings = self.beside_in.pop(self.beside_order[self.beside_taken])
+            self.starts += self._usable(starts)
+            self.warnings += list(warnings)
+            self.beside_taken += 1
+
+    def expect_sources(self, count: int) -> None:
+        """``count`` more diagrams will hand in their starts (:meth:`add_source`)."""
+        self.sources_pending += count
+
+    def add_source(self, starts: list[Start], warnings: list[str] = ()) -> None:
+        """A diagram's starts; they count once every diagram expected is in."""
+        self.source_buffer += self._usable(starts)
+        self.warnings += list(warnings)
+        self.sources_pending -= 1
+        if self.sources_pending <= 0:
+            self.sources_pending = 0
+            self.starts += sorted(self.source_buffer, key=lambda s: (s.Fz, s.point.p, s.kind))
+            self.source_buffer = []
+
+    def _gathering(self) -> bool:
+        return self.beside_taken < len(self.beside_order) or self.sources_pending > 0
+
+    def _may_go(self, start: Start) -> bool:
+        """Born at a point: at once; another start beside a point: once every branch beside a point
+        is in; a diagram's: once every diagram is in, too."""
+        if start.eager:
+            return True
+        if self.beside_taken < len(self.beside_order):
+            return False
+        return not (start.from_diagram and self.sources_pending > 0)
+
+    def add_curve(self, start: Start, curve: GearCycleCurve | None, warning: str | None) -> None:
+        self.running.remove(start)
+        self.tried += 1
+        if warning:
+            self.warnings.append(warning)
+        elif curve is not None and not any(_same_curve(curve, c, self.params.gear.l_g) for c in self.curves):
+            self.curves.append(curve)
+
+    def idle(self) -> bool:
+        """Nothing under way, waiting or expected: the curves stand as they are."""
+        return not (self.running or self.starts or self._gathering())
+
+    def continuations(self) -> list[tuple]:
+        """Units continuing the waiting starts that may (see the class)."""
+        l_g = self.params.gear.l_g
+        self.starts = [s for s in self.starts
+                       if not any(_on_curve(c, s, l_g) for c in self.curves if c.kind == s.kind)]
+        units = []
+        for s in sorted(self.starts, key=lambda s: (not s.eager, s.from_diagram)):
+            if any(r.kind == s.kind for r in self.running) or not self._may_go(s):
+                continue
+            self.starts.remove(s)
+            self.running.append(s)
+            units.append(("continue", self.config, self.params, s, self.box, self.loads))
+        return units
+
+    def result(self, elapsed_s: float) -> CycleCurvesResult:
+        (v_lo, v_hi), (f_lo, f_hi) = self.box
+        hh = [{"V": e["V"], "Fz": e["Fz"], "omega": e["omega"], "omega2": e["omega2"]} for e in self.hh]
+        curves = sorted(self.curves, key=lambda c: KINDS.index(c.kind))  # each kind's in the order continued
+        return CycleCurvesResult(self.config, self.params, (v_lo, v_hi), (f_lo, f_hi), self.kinds, curves,
+                                 self.gh, hh, self.loads, elapsed_s, self.tried, sorted(self.warnings))
+
+
+def search_unit(task: tuple) -> Any:
+    """One unit of a curve search, in any process: ("beside" | "scan", ...) -> (starts, warnings);
+    ("continue", ...) -> (curve or None, warning or None)."""
+    if task[0] == "continue":
+        return _continue(task[1:])
+    return _find_starts(task)
+
+
+def describe_search_unit(task: tuple) -> str:
+    if task[0] == "continue":
+        return f"{task[3].kind} curve from V = {task[3].point.p:.4g} m/s, Fz = {task[3].Fz / 1e3:.4g} kN"
+    return _describe_task(task)
+
+
+def search_done(search: CurveSearch, task: tuple, result: Any) -> list[tuple]:
+    """Hand a finished search unit's result to ``search``; the continuations it makes possible."""
+    if task[0] == "continue":
+        search.add_curve(task[3], *result)
+    elif task[0] == "beside":
+        search.add_beside(task, *result)
+    else:
+        search.add_source(*result)
+    return search.continuations()
+
+
 def cycle_curves(config: Configuration | str, params: Parameters | None = None,
                  v_range: tuple[float, float] = (V_RANGE[0], 200.0), fz_range: tuple[float, float] = FZ_RANGE,
                  kinds: tuple[str, ...] = KINDS, loads: tuple[float, ...] = (),
@@ -182,9 +332,9 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
 
     The starts (branches beside each codimension-2 point, a diagram and large-amplitude starts
     per scan load) are independent units, and so are the continuations of starts that lie on no
-    curve yet: both go through ``executor`` (default :func:`~.executors.open_executor`: one
-    process per core, or a Dask cluster); a start that lies on a curve continued in an earlier
-    round is skipped.
+    curve yet (:class:`CurveSearch`): all go through ``executor`` (default
+    :func:`~.executors.open_executor`: one process per core, or a Dask cluster), a curve's
+    continuation as soon as a start for it is known and before the remaining starts.
     """
     clock = time.perf_counter()
     config = Configuration.parse(config)
@@ -206,47 +356,21 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
 
     report(0.0, "Hopf curves and their GH and double-Hopf points")
     hopf = hopf_curves(config, params, (v_lo, v_hi), (f_lo, f_hi))
-    gh = [{"V": g["p"][0], "Fz": g["p"][1]} for c in hopf.curves for g in c.gh_points]
-    hh: list[dict[str, float]] = []
-    for c in hopf.curves:
-        for g in c.double_hopf:
-            entry = {"V": g["p"][0], "Fz": g["p"][1], "omega": g["omega"], "omega2": g["omega2"]}
-            if not any(_close(entry, e, 1e-4) for e in hh):
-                hh.append(entry)
-
-    tasks = [("beside", config, params, g, "LPC", box, f"beside the GH point at V = {g['V']:.5g} m/s, "
-              f"Fz = {g['Fz']:.6g} N") for g in gh if "LPC" in kinds]
-    tasks += [("beside", config, params, g, "NS", box, f"beside the double-Hopf point at V = {g['V']:.5g} m/s, "
-               f"Fz = {g['Fz']:.6g} N") for g in hh if "NS" in kinds]
-    tasks += [("scan", config, params, f_lo + fr * (f_hi - f_lo), box) for fr in SCAN_FRACTIONS]
-    found = run_units(_find_starts, tasks, executor, lambda f, m: report(0.05 + 0.45 * f, m), _describe_task)
-    starts = [s for part, _ in found for s in part if s.kind in kinds and s.point.solution is not None]
-    warnings = [w for _, part in found for w in part]
-
-    curves: list[GearCycleCurve] = []
-    tried = 0
-    width = max(1, getattr(executor, "_max_workers", 2) or 2)
-    while True:
-        pending = [s for s in starts if not any(_on_curve(c, s, params.gear.l_g) for c in curves if c.kind == s.kind)]
-        if not pending:
-            break
-        batch = [pending[0]]
-        for s in pending[1:]:  # one start per curve as far as can be told before continuing
-            if len(batch) < width and all(s.kind != b.kind or _far(s, b) for b in batch):
-                batch.append(s)
-        report(0.5 + 0.5 * len(curves) / (len(curves) + len(pending)), f"continuing {len(batch)} curve(s)")
-        results = run_units(_continue, [(config, params, s, box, loads) for s in batch], executor)
-        tried += len(batch)
-        for s, (curve, warning) in zip(batch, results, strict=True):
-            starts.remove(s)
-            if warning:
-                warnings.append(warning)
-            elif curve is not None and not any(_same_curve(curve, c, params.gear.l_g) for c in curves):
-                curves.append(curve)
+    search = CurveSearch(config, params, box, kinds, loads)
+    search.expect_sources(len(SCAN_FRACTIONS))
+    units = [(1, u) for u in search.start_units(hopf)]
+    units += [(2, ("scan", config, params, f_lo + fr * (f_hi - f_lo), box)) for fr in SCAN_FRACTIONS]
+    run_dynamic(search_unit, units, executor, lambda task, result: [(0, u) for u in search_done(search, task, result)],
+                lambda f, m: report(0.05 + 0.95 * f, m), describe_search_unit)
     report(1.0, "done")
-    return CycleCurvesResult(config, params, (v_lo, v_hi), (f_lo, f_hi), kinds, curves, gh,
-                             [{"V": e["V"], "Fz": e["Fz"], "omega": e["omega"], "omega2": e["omega2"]} for e in hh],
-                             loads, time.perf_counter() - clock, tried, warnings)
+    return search.result(time.perf_counter() - clock)
+
+
+def starts_of_diagram(diagram, Fz: float) -> list[Start]:
+    """The located LPC, NS and PD points (with their orbits) of a diagram's periodic branches."""
+    return [Start(s.kind, s, Fz, b.raw.ncol, f"{b.origin}, diagram at Fz = {Fz:.6g} N", from_diagram=True)
+            for b in diagram.branches if b.kind == "periodic" and b.raw is not None
+            for s in b.raw.special_points if s.kind in KINDS]
 
 
 def _describe_task(task: tuple) -> str:
@@ -263,15 +387,11 @@ def _find_starts(task: tuple) -> tuple[list[Start], list[str]]:
         model = build_model(config, params)
         return _starts_beside(config, model, params, point, kind, box[0], box[1], origin), []
     _, config, params, Fz, box = task
-    warnings: list[str] = []
     try:
         diagram = bifurcation(config, Fz, box[0][0], box[0][1], params, BifurcationOptions(mesh_check=False))
     except ContinuationError as exc:
         return [], [f"diagram at Fz = {Fz:.6g} N failed: {exc}"]
-    starts = [Start(s.kind, s, Fz, b.raw.ncol, f"{b.origin}, diagram at Fz = {Fz:.6g} N")
-              for b in diagram.branches if b.kind == "periodic" and b.raw is not None
-              for s in b.raw.special_points if s.kind in KINDS]
-    return starts, warnings
+    return starts_of_diagram(diagram, Fz), []
 
 
 def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
@@ -288,12 +408,6 @@ def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
         return None, (f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin}) "
                       f"not continued: {exc}")
     return GearCycleCurve(start.kind, curve, start.origin), None
-
-
-def _far(a: Start, b: Start) -> bool:
-    """Whether two starts of a kind are unlikely to lie on one curve (they are continued together)."""
-    return abs(a.point.p - b.point.p) > 0.5 * V_SCALE or abs(a.Fz - b.Fz) > 0.5 * FZ_SCALE \
-        or abs(a.point.data["x_max"][0] - b.point.data["x_max"][0]) > 0.2 * max(abs(a.point.data["x_max"][0]), 1e-6)
 
 
 def _same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:
@@ -326,13 +440,16 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
             found, ncol = start_beside(system, kind, np.zeros(n), np.array([h.V, Fz]), v_range, STATE_SCALE[:n],
                                        V_SCALE, options, limits=_limits(model))
             if found is not None:
-                out.append(Start(kind, found, Fz, ncol, origin))
+                # eager when born at the point (a branch beside it may fold or lose stability
+                # first on another curve, far away: that start waits like a diagram's)
+                out.append(Start(kind, found, Fz, ncol, origin, eager=abs(found.p - point["V"]) <= 0.1 * point["V"]))
     return out
 
 
 def _on_curve(curve: GearCycleCurve, start: Start, l_g: float) -> bool:
     """Whether a start point lies on a continued curve: within a fifth of the local step of its
-    polyline in (V, Fz) (scaled) with a torsional and lateral amplitude within 5 %."""
+    polyline in (V, Fz) (scaled) with amplitudes within 5 % (of its own, or of the curve's largest
+    where that is more)."""
     c = curve.curve
     scale = np.array([V_SCALE, FZ_SCALE])
     hit = near_polyline(c.p / scale, np.array([start.point.p, start.Fz]) / scale)
@@ -344,4 +461,7 @@ def _on_curve(curve: GearCycleCurve, start: Start, l_g: float) -> bool:
     xmax, xmin = np.array(start.point.data["x_max"]), np.array(start.point.data["x_min"])
     theirs = 0.5 * (xmax - xmin)
     scale = STATE_SCALE[:len(theirs)]
-    return bool(np.max(np.abs(here - theirs) / scale) <= 0.05 * max(np.max(np.abs(theirs) / scale), 1e-12))
+    # near a zero-amplitude end the amplitude varies like the root of the distance and the
+    # polyline's linear interpolation is poor: 5 % of the curve's largest amplitude at least
+    largest = float(np.max(np.abs(amp) / scale))
+    return bool(np.max(np.abs(here - theirs) / scale) <= 0.05 * max(np.max(np.abs(theirs) / scale), largest, 1e-12))

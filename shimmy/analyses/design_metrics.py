@@ -24,7 +24,7 @@ import numpy as np
 
 from .bifurcation import BifurcationOptions
 from ..model.configurations import OPERATING_POINTS, Configuration
-from ..model.parameters import Parameters
+from ..model.parameters import DEFAULT_MAP_SLICES, Parameters
 from .executors import run_units
 from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, classify, map_slice, stability_map
 
@@ -102,7 +102,7 @@ def _operating_point_unit(task: tuple) -> dict[str, Any]:
 
 def operating_point_types(configs: Sequence[str], params: Parameters | None = None, executor=None,
                           progress: Callable[[float, str], None] | None = None) -> dict[str, dict[str, Any]]:
-    """{config: {point: classify(...)}} at REFERENCE.md's nine operating points."""
+    """{config: {point: classify(...)}} at the nine operating points (docs/model.md)."""
     params = params if params is not None else Parameters()
     configs = [Configuration.parse(c).value for c in configs]
     by_load: dict[float, list[str]] = {}
@@ -118,7 +118,7 @@ def operating_point_types(configs: Sequence[str], params: Parameters | None = No
 
 
 def design_report(configs: Sequence[str] = ("original", "nes", "pd", "nes_pd"), params: Parameters | None = None,
-                  Fz: float = 150e3, resolution: int = 40, executor=None,
+                  Fz: float = 150e3, resolution: int = DEFAULT_MAP_SLICES, executor=None,
                   progress: Callable[[float, str], None] | None = None) -> dict[str, Any]:
     """Maps and figures of merit of several configurations, each against ``original``."""
     configs = [Configuration.parse(c).value for c in configs]

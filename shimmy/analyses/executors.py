@@ -13,18 +13,22 @@
 * ``max_workers=1`` (or ``SHIMMY_WORKERS=1``) runs the units in the calling process.
 
 :func:`run_units` submits every unit, reports progress each time one finishes and returns
-the results in the order of the units. A unit that raises makes the whole call raise (the
-remaining units are cancelled): units are pure functions of their arguments, so a failure
-is a bug or bad input, never something to hide in a partial result.
+the results in the order of the units. :func:`run_dynamic` runs units whose results create
+more units (a curve continued from a start that a diagram found), most urgent first. A unit
+that raises makes the whole call raise (the remaining units are cancelled): units are pure
+functions of their arguments, so a failure is a bug or bad input, never something to hide in
+a partial result.
 """
 
 from __future__ import annotations
 
 import contextlib
+import heapq
+import itertools
 import multiprocessing
 import os
 import threading
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, as_completed, wait
 from typing import Any, Callable, Iterator, Sequence
 
 from ..errors import InvalidParameterError
@@ -112,33 +116,83 @@ def open_executor(max_workers: int | None = None, scheduler: str | None = None) 
 
 def run_units(fn: Callable[[Any], Any], units: Sequence[Any], executor: Executor | None = None,
               progress: Callable[[float, str], None] | None = None,
-              describe_unit: Callable[[Any], str] = str, tally: Callable[[Any], str] | None = None) -> list[Any]:
+              describe_unit: Callable[[Any], str] = str) -> list[Any]:
     """``[fn(u) for u in units]`` through ``executor`` (default: :func:`open_executor`),
-    reporting ``progress(finished / total, "<unit> done (k/n)")`` per finished unit. With ``tally``
-    (unit -> the plural noun it is counted as, e.g. "slices"), the count is per noun, so that it
-    counts what the caller asked for: "(3/40 slices, 1/2 curve sets)"."""
+    reporting ``progress(finished / total, "<unit> done")`` per finished unit."""
     if executor is None:
         with open_executor() as own:
-            return run_units(fn, units, own, progress, describe_unit, tally)
+            return run_units(fn, units, own, progress, describe_unit)
     report = progress or (lambda fraction, message: None)
     futures = {executor.submit(fn, unit): k for k, unit in enumerate(units)}
     results: list[Any] = [None] * len(units)
-    nouns = [tally(u) for u in units] if tally else None
-    totals = {n: nouns.count(n) for n in dict.fromkeys(nouns)} if nouns else {}
-    counts = dict.fromkeys(totals, 0)
     finished = 0
     try:
         for future in as_completed(futures):
             k = futures[future]
             results[k] = future.result()
             finished += 1
-            if nouns:
-                counts[nouns[k]] += 1
-                count = ", ".join(f"{counts[n]}/{totals[n]} {n}" for n in totals)
-            else:
-                count = f"{finished}/{len(units)}"
-            report(finished / len(units), f"{describe_unit(units[k])} done ({count})")
+            report(finished / len(units), f"{describe_unit(units[k])} done ({finished}/{len(units)})")
     finally:
         for future in futures:
             future.cancel()
     return results
+
+
+def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], executor: Executor,
+                on_done: Callable[[Any, Any], Sequence[tuple[float, Any]]],
+                progress: Callable[[float, str], None] | None = None,
+                describe_unit: Callable[[Any], str] = str, tally: Callable[[Any], str] | None = None) -> int:
+    """Run ``(priority, unit)`` pairs through ``executor``, lowest priority value first;
+    ``on_done(unit, result)`` (called in this process, in the order units finish) returns more
+    ``(priority, unit)`` pairs to run. Returns the number of units run.
+
+    On a local process pool at most one unit per worker is in flight, so that an urgent unit
+    created late (the longest one, on the critical path) starts at the next free worker instead
+    of queueing behind the rest; other executors (Dask, which schedules by itself; inline) get
+    each unit when it is ready. ``progress`` gets finished / (finished + known) units, never
+    decreasing although units are added on the way; with ``tally`` (unit -> the plural noun it is
+    counted as) the message counts per noun, finished of known: "(3/10 slices, 2/5 curve units)"."""
+    report = progress or (lambda fraction, message: None)
+    width = getattr(executor, "_max_workers", None) or 10 ** 9
+    order = itertools.count()
+    ready: list[tuple[float, int, Any]] = []
+    for priority, unit in units:
+        heapq.heappush(ready, (priority, next(order), unit))
+    running: dict[Future, Any] = {}
+    finished, shown = 0, 0.0
+    done_by: dict[str, int] = {}
+    known_by: dict[str, int] = {}
+
+    def count(unit: Any) -> None:
+        if tally is not None:
+            noun = tally(unit)
+            known_by[noun] = known_by.get(noun, 0) + 1
+            done_by.setdefault(noun, 0)
+
+    for _, unit in units:
+        count(unit)
+    try:
+        while ready or running:
+            while ready and len(running) < width:
+                _, _, unit = heapq.heappop(ready)
+                running[executor.submit(fn, unit)] = unit
+            done, _ = wait(list(running), return_when=FIRST_COMPLETED)
+            for future in done:
+                unit = running.pop(future)
+                result = future.result()
+                finished += 1
+                for priority, more in on_done(unit, result):
+                    heapq.heappush(ready, (priority, next(order), more))
+                    count(more)
+                total = finished + len(running) + len(ready)
+                shown = max(shown, finished / total)
+                if tally is not None:
+                    done_by[tally(unit)] += 1
+                    counted = ", ".join(f"{done_by[n]}/{known_by[n]} {n}" for n in known_by)
+                else:
+                    counted = f"{finished}/{total}"
+                report(shown, f"{describe_unit(unit)} done ({counted})")
+    finally:
+        for future in running:
+            future.cancel()
+    return finished

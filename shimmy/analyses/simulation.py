@@ -138,7 +138,7 @@ def simulate(config: Configuration | str, V: float, Fz: float, params: Parameter
              **option_overrides) -> SimulationResult:
     """Integrate the model at forward speed V (m/s) and vertical load Fz (N).
 
-    ``x0`` defaults to psi = 0.001 rad with all else zero (REFERENCE.md). Options may be
+    ``x0`` defaults to psi = 0.001 rad with all else zero (the study's start). Options may be
     given as a :class:`SimulationOptions` or as keyword overrides (``rtol=...``).
     Integration failures (divergence, step budget, NES out of range) do not raise:
     the result has ``success=False``, a ``message`` and the part that was computed.
@@ -154,17 +154,7 @@ def simulate(config: Configuration | str, V: float, Fz: float, params: Parameter
         options = SimulationOptions(**{**options.to_dict(), **option_overrides})
     model = build_model(config, params, exact_nes=options.exact_nes)
     n = model.n_states
-    start = np.zeros(integrator.N_FULL)
-    if x0 is None:
-        start[0] = DEFAULT_PSI0
-    else:
-        x0 = np.asarray(x0, dtype=float)
-        if x0.shape != (n,):
-            raise InvalidParameterError("x0", x0.tolist(), f"{n} numbers ({', '.join(STATE_NAMES[:n])})",
-                                        "has the wrong length")
-        if not np.all(np.isfinite(x0)):
-            raise InvalidParameterError("x0", x0.tolist(), "finite numbers", "is not finite")
-        start[:n] = x0
+    start = initial_state(x0, n)
 
     n_out = int(round(options.t_end / options.dt_out)) + 1
     out = np.empty((n_out, integrator.N_FULL))
@@ -182,6 +172,22 @@ def simulate(config: Configuration | str, V: float, Fz: float, params: Parameter
         success=status == integrator.SUCCESS, status=int(status), message=_STATUS_MESSAGES[status],
         counters={"steps": int(accepted), "rejected": int(rejected), "rhs_calls": int(calls)},
         elapsed_s=elapsed, **measures)
+
+
+def initial_state(x0, n: int) -> np.ndarray:
+    """The integrator's full start vector from ``x0`` (n numbers; None: psi = 0.001 rad, all else zero)."""
+    start = np.zeros(integrator.N_FULL)
+    if x0 is None:
+        start[0] = DEFAULT_PSI0
+        return start
+    x0 = np.asarray(x0, dtype=float)
+    if x0.shape != (n,):
+        raise InvalidParameterError("x0", x0.tolist(), f"{n} numbers ({', '.join(STATE_NAMES[:n])})",
+                                    "has the wrong length")
+    if not np.all(np.isfinite(x0)):
+        raise InvalidParameterError("x0", x0.tolist(), "finite numbers", "is not finite")
+    start[:n] = x0
+    return start
 
 
 def _steady_measures(states: np.ndarray, x0: np.ndarray, params: Parameters,

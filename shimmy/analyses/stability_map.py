@@ -2,29 +2,36 @@
 
 How a map is built (what :func:`stability_map` returns says the same in ``methods``):
 
-* **Hopf curves and GH points**: two-parameter continuation of the Hopf points of x = 0
-  (:func:`shimmy.analyses.hopf_curves.hopf_curves`; the extended system, l1 along the curve).
-* **Fold-of-cycles (LPC) and torus (NS) curves**: two-parameter continuation of each curve
-  (:func:`shimmy.analyses.cycle_curves.cycle_curves`: minimally augmented systems, started from
-  the GH and double-Hopf points, one-parameter diagrams and large-amplitude starts), exact in V
-  and Fz; each curve's crossings of the slice loads are located, so the slices' LPC and NS
-  points lie on the drawn curves. Double-Hopf points are reported beside the GH points.
-* **Shimmy type** on every slice: the stable attractors at each V read off the slice's
-  bifurcation diagram (:func:`attractors_at`): x = 0 where its eigenvalues say so, and every
-  periodic branch point with all nontrivial Floquet multipliers inside the unit circle, with
-  its mode (torsional / lateral / both, :func:`shimmy.analyses.response.mode_of`). The type
+* **Region boundaries are continued curves**, exact in V and Fz: the Hopf curves and their GH and
+  double-Hopf points (:func:`shimmy.analyses.hopf_curves.hopf_curves`; the extended system, l1
+  along the curve), and every fold-of-cycles (LPC) and torus (NS) curve
+  (:class:`shimmy.analyses.cycle_curves.CurveSearch`: minimally augmented systems, started from
+  the GH and double-Hopf points and from the LPC / NS points of the slices' diagrams, whose seeds
+  include large-amplitude starts). Each curve's crossings of the first slices' loads are
+  located, so those slices' LPC and NS points lie on the drawn curves.
+* **The regions' types** come from classified slices: the stable attractors at each V read off
+  a slice's bifurcation diagram (:func:`attractors_at`): x = 0 where its eigenvalues say so, and
+  every periodic branch point with all nontrivial Floquet multipliers inside the unit circle,
+  with its mode (torsional / lateral / both, :func:`shimmy.analyses.response.mode_of`). The type
   (:func:`shimmy_type`) is Bistable if a torsional and a lateral cycle are both stable, else
   Both if a stable cycle has both motions large, else Torsion or Lateral after the stable
   cycle, else Stable. Where neither x = 0 nor any cycle is stable (past a torus point the
   attractor is quasi-periodic), the type comes from a time simulation from the standard
   start (psi = 0.001 rad) at that V; the attractor is then reported with
-  ``"kind": "simulation"``.
+  ``"kind": "simulation"``. ``resolution`` slices evenly spaced in Fz, and one more through
+  each region between the curves that none of them crosses (:func:`map_shading.uncovered`).
+* **Shading and region polygons** are read off the slices along the curves
+  (:mod:`shimmy.analyses.map_shading`): each row interval between two boundary crossings takes
+  the types of the same interval on the nearest slices (mode changes inside it interpolated
+  in Fz), on 180 rows (at least four per slice); the polygons chain the rows' segments.
 
-:func:`classify` runs exactly the slice computation at one Fz and reads the answer at V,
-so at a map's grid points it gives the map's answer.
+:func:`classify` runs exactly the slice computation at one Fz and reads the answer at V: at a
+slice load it gives the map's answer; between slices it agrees with the shading wherever the
+type is set by the curves (a mode change inside a region is interpolated by the shading).
 
-Slices are independent units of work and go through :mod:`shimmy.analyses.executors` (a local
-process pool, or a Dask cluster).
+All units of a map (the Hopf curves, branches beside codimension-2 points, curve continuations,
+slices) go through :mod:`shimmy.analyses.executors` (a local process pool, or a Dask cluster),
+most urgent first (:func:`~shimmy.analyses.executors.run_dynamic`).
 """
 
 from __future__ import annotations
@@ -41,14 +48,20 @@ from .bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
 from . import map_shading
-from .cycle_curves import cycle_curves
-from .executors import InlineExecutor, name_of, run_units
+from .cycle_curves import (CurveSearch, describe_search_unit, search_done, search_unit,
+                           starts_of_diagram)
+from .executors import name_of, open_executor, run_dynamic
 from .hopf_curves import HopfCurvesResult, hopf_curves
-from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_operating_point, check_range
+from ..model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, V_RANGE, Parameters, check_number,
+                                check_operating_point, check_range)
 from .response import ResponseType
 
 SHIMMY_TYPES = ("Stable", "Torsion", "Lateral", "Bistable", "Both")
 SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
+COVERAGE_ROUNDS = 2  # rounds of further slices through regions no slice crosses
+#: ... that are at least one grid cell wide and cover this fraction of the map (thinner slivers
+#: between curves that nearly meet are read off the nearest slice at the same speed, and counted)
+COVERAGE_AREA = 2e-4
 DEFAULT_V_RANGE = (1.0, 200.0)
 DEFAULT_FZ_RANGE = (1.0e4, 9.0e5)
 #: Simulated V per slice at most where no stable equilibrium or cycle exists; the other grid
@@ -66,7 +79,6 @@ BAND_V = (1.0, 200.0)  # m/s
 #: (V - V_H)^2 from the Hopf point) and count.
 TRIVIAL_PSI = 1e-6
 TRIVIAL_LATERAL = 1e-7
-#: Curve joining: slice-to-slice match if |ln(V1 / V2)| is below this (a 50 % change).
 
 
 # --------------------------------------------------------------------------- attractors
@@ -83,13 +95,14 @@ def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
     for k, b in enumerate(result.branches):
         if b.kind != "periodic" or b.V.size < 2:
             continue
-        segments = [(i, i + 1) for i in range(b.V.size - 1)]
+        first = np.arange(b.V.size - 1)
         if b.stop_reason.startswith("closed branch"):  # a loop: its last orbit joins its first
-            segments.append((b.V.size - 1, 0))
-        for i, j in segments:
+            first = np.append(first, b.V.size - 1)
+        second = (first + 1) % b.V.size
+        v0s, v1s = b.V[first], b.V[second]
+        hits = np.nonzero((np.minimum(v0s, v1s) - tol <= V) & (V <= np.maximum(v0s, v1s) + tol) & (v0s != v1s))[0]
+        for i, j in zip(first[hits].tolist(), second[hits].tolist(), strict=True):
             v0, v1 = b.V[i], b.V[j]
-            if not min(v0, v1) - tol <= V <= max(v0, v1) + tol or v0 == v1:
-                continue
             f = min(max((V - v0) / (v1 - v0), 0.0), 1.0)
             near = i if f <= 0.5 else j
             stable = bool(b.stable[i]) if b.stable[i] == b.stable[j] else bool(b.stable[near])
@@ -159,6 +172,9 @@ class SliceResult:
     simulated: list[float]  # V where the type came from a simulation
     warnings: list[str]
     elapsed_s: float
+    #: the diagram's located LPC / NS / PD points with their orbits: starts of the map's curves
+    #: (not in :meth:`to_dict`)
+    starts: list = field(default_factory=list, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         return {"Fz": self.Fz, "hopf_points": self.hopf_points, "special_points": self.special_points,
@@ -195,14 +211,15 @@ def _slice_types(result: BifurcationResult, fine: np.ndarray, coarse_step: int, 
 
 def _intervals(fine: np.ndarray, types: list[str], critical: list[float] = ()) -> list[dict[str, Any]]:
     """Maximal V intervals of one type other than Stable. An end between two grid points moves to
-    the located Hopf / fold / torus point between them, if there is one (exact), else it is the
-    grid point inside the interval (within one fine step)."""
+    the located Hopf / fold / torus point between them, if there is one (exact), else to the
+    middle between them (within half a fine step: a cycle's mode changing), so that two
+    intervals that meet share their end."""
     crit = np.sort(np.asarray(list(critical), float))
 
     def snap(inside: int, outside: int) -> float:
         lo, hi = sorted((fine[inside], fine[outside]))
         hits = crit[(crit >= lo) & (crit <= hi)]
-        return float(hits[0]) if hits.size else float(fine[inside])
+        return float(hits[0]) if hits.size else float(0.5 * (lo + hi))
 
     out = []
     start = 0
@@ -251,7 +268,7 @@ def map_slice(config: Configuration | str, Fz: float, v_min: float, v_max: float
     critical = [h["V"] for h in hopf] + [p["V"] for p in special]
     return SliceResult(Fz, coarse, types_fine[::FINE], hopf, special, _intervals(fine, types_fine, critical),
                        _lengths(fine, types_fine), result.max_psi, result.max_psi_V, simulated,
-                       list(result.warnings), time.perf_counter() - clock)
+                       list(result.warnings), time.perf_counter() - clock, starts_of_diagram(result, Fz))
 
 
 # --------------------------------------------------------------------------- classify
@@ -287,7 +304,7 @@ class StabilityMap:
     fz_range: tuple[float, float]
     V: np.ndarray
     Fz: np.ndarray
-    types: list[list[str]]  # [i_Fz][j_V]
+    types: list[list[str]]  # [i_Fz][j_V] on the classified slices (Fz: their loads, ascending)
     slices: list[SliceResult]
     hopf: HopfCurvesResult
     cycles: dict[str, Any]  # fold and torus curves with their details (:func:`_cycle_curves_unit`)
@@ -295,6 +312,7 @@ class StabilityMap:
     shading: list[list[str]]  # [i_row][j_V]: types read off the slices along the curves
     shading_lengths: list[dict[str, float]]  # per row: measure (m/s) of each type, exact for the read-off
     shading_fallbacks: int  # row intervals read off the nearest slice at the same speed instead
+    regions: list[dict[str, Any]]  # polygons {"type", "V", "Fz"} (:func:`map_shading.polygons`)
     min_shimmy: dict[str, Any] | None
     executor: str
     elapsed_s: float
@@ -317,10 +335,10 @@ class StabilityMap:
         return [[{"V": float(p[0]), "Fz": float(p[1])} for p in c.p] for c in self.hopf.curves]
 
     def type_at(self, V: float, Fz: float) -> str:
-        """The type of the grid point nearest to (V, Fz)."""
-        i = int(np.argmin(np.abs(self.Fz - Fz)))
+        """The shading's type at the grid point nearest to (V, Fz)."""
+        i = int(np.argmin(np.abs(self.shading_Fz - Fz)))
         j = int(np.argmin(np.abs(self.V - V)))
-        return self.types[i][j]
+        return self.shading[i][j]
 
     def to_dict(self) -> dict[str, Any]:
         return {"config": self.config.value, "params": self.params.to_dict(),
@@ -334,39 +352,39 @@ class StabilityMap:
                 "slices": [s.to_dict() for s in self.slices],
                 "shading": {"V": self.V.tolist(), "Fz": self.shading_Fz.tolist(), "types": self.shading,
                             "fallback_intervals": self.shading_fallbacks},
+                "regions": self.regions,
                 "methods": {
                     "hopf_curves": "two-parameter continuation of Hopf points (extended system)",
                     "gh_points": "sign changes of the first Lyapunov coefficient along the Hopf curves "
                                  "(not defined with the particle damper: not smooth at x = 0)",
                     "double_hopf_points": "sign changes of the other eigenvalues' real parts along the Hopf curves",
                     "fold_curves": "two-parameter continuation of folds of cycles (minimally augmented system on the "
-                                   "collocation mesh), exact in V and Fz",
+                                   "collocation mesh), started from GH points and the slices' LPC points; exact in V "
+                                   "and Fz",
                     "torus_curves": "two-parameter continuation of Neimark-Sacker points of cycles (minimally "
-                                    "augmented system), exact in V and Fz",
-                    "types": "stable attractors of each slice's diagram; simulation where none is stable",
-                    "shading": "each row's intervals between the Hopf, fold and torus curves take the type of the "
-                               "same interval on the nearest slice, mapped linearly (read off the curves)"},
+                                    "augmented system), started from double-Hopf points and the slices' NS points; "
+                                    "exact in V and Fz",
+                    "types": "stable attractors of each slice's one-parameter diagram (equilibrium eigenvalues, "
+                             "Floquet multipliers, cycle modes); a time simulation where none is stable; slices "
+                             "evenly spaced plus one through each region between the curves that they miss",
+                    "shading": "each row's intervals between the Hopf, fold and torus curves take the types of the "
+                               "same interval on the nearest slices, as fractions of it (mode changes inside it "
+                               "interpolated in Fz between the slices below and above)",
+                    "regions": "polygons of the shading's row segments between consecutive rows, one per region "
+                               "until it splits or merges; their edges are the curves' crossings of the rows"},
                 "executor": self.executor, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
                 "version": __version__}
 
     def write_csv(self, path) -> None:
+        """The shading (the map's answer on its fine grid): one row per (Fz, V)."""
         import csv
 
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow(["Fz_N", "V_m_s", "shimmy_type"])
-            for Fz, row in zip(self.Fz, self.types, strict=True):
+            for Fz, row in zip(self.shading_Fz, self.shading, strict=True):
                 for V, t in zip(self.V, row, strict=True):
                     w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
-
-
-def _cycle_curves_unit(config, params, v_range, fz_range, loads) -> dict[str, Any]:
-    """The fold and torus curves of a map, with their crossings of the slice loads (one unit: run in
-    one process, its own units inline)."""
-    result = cycle_curves(config, params, v_range, fz_range, kinds=("LPC", "NS"), loads=tuple(loads),
-                          executor=InlineExecutor())
-    data = result.to_dict()
-    return {key: data[key] for key in ("fold_curves", "torus_curves", "curves", "codim2_points", "warnings")}
 
 
 def _unit(task: tuple) -> Any:
@@ -374,26 +392,34 @@ def _unit(task: tuple) -> Any:
     if task[0] == "hopf_curves":
         _, config, params, v_range, fz_range = task
         return hopf_curves(config, params, v_range=v_range, fz_range=fz_range)
-    if task[0] == "cycle_curves":
-        return _cycle_curves_unit(*task[1:])
-    _, config, Fz, v_min, v_max, n_v, params, options = task
-    return map_slice(config, Fz, v_min, v_max, n_v, params, options)
+    if task[0] == "slice":
+        _, config, Fz, v_min, v_max, n_v, params, options = task
+        return map_slice(config, Fz, v_min, v_max, n_v, params, options)
+    return search_unit(task)
 
 
 def _describe(task: tuple) -> str:
-    if task[0] in ("hopf_curves", "cycle_curves"):
-        return {"hopf_curves": "Hopf curves", "cycle_curves": "fold and torus curves"}[task[0]]
-    return f"slice Fz = {task[2] / 1e3:.4g} kN"
+    if task[0] == "hopf_curves":
+        return "Hopf curves"
+    if task[0] == "slice":
+        return f"slice Fz = {task[2] / 1e3:.4g} kN"
+    return describe_search_unit(task)
 
 
 def stability_map(config: Configuration | str, v_range: tuple[float, float] = DEFAULT_V_RANGE,
-                  fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = 40,
+                  fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = DEFAULT_MAP_SLICES,
                   params: Parameters | None = None, n_v: int = 100, executor=None,
                   progress: Callable[[float, str], None] | None = None,
                   options: BifurcationOptions | None = None) -> StabilityMap:
-    """The (V, Fz) stability map of one configuration: ``resolution`` Fz slices, ``n_v`` speeds.
+    """The (V, Fz) stability map of one configuration: its region boundaries continued as curves,
+    the regions' types from ``resolution`` classified Fz slices (and further ones where a region
+    lies between them), read off on a fine grid with ``n_v`` speeds.
 
-    ``executor`` is any :class:`concurrent.futures.Executor` (default: see :mod:`shimmy.analyses.executors`)."""
+    One computation of units through ``executor`` (any :class:`concurrent.futures.Executor`;
+    default: see :mod:`shimmy.analyses.executors`), most urgent first: the Hopf curves, then the
+    branches beside their GH and double-Hopf points, and the slices' diagrams; each fold or torus
+    curve is continued as soon as a start for it is known (a GH or double-Hopf point, or a
+    slice's LPC / NS point), ahead of the remaining slices."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
@@ -401,29 +427,75 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     f_min, f_max = check_range("fz", fz_range, FZ_RANGE, "N")
     resolution = int(check_number("resolution", resolution, 2, 400, integer=True))
     n_v = int(check_number("n_v", n_v, 2, 2000, integer=True))
+    if executor is None:
+        with open_executor() as own:
+            smap = stability_map(config, v_range, fz_range, resolution, params, n_v, own, progress, options)
+        smap.executor = name_of(None)
+        return smap
     options = options or BifurcationOptions(mesh_check=False)
+    report = progress or (lambda fraction, message: None)
     loads = np.linspace(f_min, f_max, resolution)
-    # The curves go first: each one unit, longer than a slice.
-    tasks = [("cycle_curves", config, params, (v_min, v_max), (f_min, f_max), [float(f) for f in loads]),
-             ("hopf_curves", config, params, (v_min, v_max), (f_min, f_max))]
-    tasks += [("slice", config, float(Fz), v_min, v_max, n_v, params, options) for Fz in loads]
-    results = run_units(_unit, tasks, executor, progress, _describe,
-                        lambda task: "slices" if task[0] == "slice" else "curve sets")
-    cycles: dict[str, Any] = results[0]
-    hopf: HopfCurvesResult = results[1]
-    slices: list[SliceResult] = results[2:]
+    search = CurveSearch(config, params, ((v_min, v_max), (f_min, f_max)), ("LPC", "NS"),
+                         tuple(float(f) for f in loads))
+    rows = np.linspace(f_min, f_max, max(SHADING_ROWS, 4 * resolution))
+    found: dict[str, Any] = {"hopf": None, "slices": [], "loads": list(loads), "rounds": 0}
+    search.expect_sources(len(loads))
+
+    def slice_unit(Fz: float) -> tuple:
+        return ("slice", config, float(Fz), v_min, v_max, n_v, params, options)
+
+    def coverage() -> list[tuple[int, tuple]]:
+        """Slices through the regions that no slice load (computed or under way) crosses: what
+        a region's boundaries are does not depend on the slices, only on the curves."""
+        if found["rounds"] == COVERAGE_ROUNDS:
+            return []
+        extra = map_shading.uncovered(found["loads"], _boundaries(found["hopf"], search), rows, (v_min, v_max),
+                                      min_width=(v_max - v_min) / (n_v - 1),
+                                      min_area=COVERAGE_AREA * (v_max - v_min) * (f_max - f_min))
+        found["rounds"] += bool(extra)
+        found["loads"] += extra
+        search.expect_sources(len(extra))
+        return [(2, slice_unit(Fz)) for Fz in extra]
+
+    def done(task: tuple, result: Any) -> list[tuple[int, tuple]]:
+        if task[0] == "hopf_curves":
+            found["hopf"] = result
+            return [(0, u) for u in search.start_units(result)]
+        if task[0] == "slice":
+            found["slices"].append(result)
+            search.add_source(result.starts)
+            more = [(0, u) for u in search.continuations()]
+        else:
+            more = [(0, u) for u in search_done(search, task, result)]
+        if search.idle() and found["hopf"] is not None:  # the curves as they stand
+            more += coverage()
+        return more
+
+    units = [(0, ("hopf_curves", config, params, (v_min, v_max), (f_min, f_max)))]
+    units += [(2, slice_unit(Fz)) for Fz in loads]
+    run_dynamic(_unit, units, executor, done, report, _describe,
+                lambda task: "slices" if task[0] == "slice" else "curve units")
+    hopf: HopfCurvesResult = found["hopf"]
+    slices: list[SliceResult] = sorted(found["slices"], key=lambda s: s.Fz)
+    cycles = search.result(time.perf_counter() - clock).to_dict()
     warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
     for s in slices:
         warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
-    boundaries = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
-    for key in ("fold_curves", "torus_curves"):
-        boundaries += [(f"{key}{i}", np.array([[p["V"], p["Fz"]] for p in c])) for i, c in enumerate(cycles[key])]
-    rows = np.linspace(f_min, f_max, max(SHADING_ROWS, 4 * resolution))
-    shading, lengths, fallbacks = map_shading.shade(slices, boundaries, slices[0].V, rows, (v_min, v_max))
-    return StabilityMap(config, params, (v_min, v_max), (f_min, f_max), slices[0].V, loads,
-                        [s.types for s in slices], slices, hopf, cycles, rows, shading, lengths, fallbacks,
-                        _min_shimmy(hopf, cycles, slices), name_of(executor),
-                        time.perf_counter() - clock, warnings)
+    segments, fallbacks = map_shading.row_segments(slices, _boundaries(hopf, search), rows, (v_min, v_max))
+    V = slices[0].V
+    report(1.0, "done")
+    return StabilityMap(config, params, (v_min, v_max), (f_min, f_max), V, np.array([s.Fz for s in slices]),
+                        [s.types for s in slices], slices, hopf, cycles, rows, map_shading.grid(segments, V),
+                        [map_shading.measures(r) for r in segments], fallbacks,
+                        map_shading.polygons(segments, rows), _min_shimmy(hopf, cycles, slices),
+                        type(executor).__name__, time.perf_counter() - clock, warnings)
+
+
+def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, np.ndarray]]:
+    """The region boundaries: every Hopf, fold and torus curve as a polyline in (V, Fz)."""
+    out = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
+    out += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(search.curves)]
+    return out
 
 
 def _min_shimmy(hopf: HopfCurvesResult, cycles: dict[str, Any], slices: list[SliceResult]) -> dict[str, Any] | None:

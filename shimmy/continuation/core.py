@@ -11,9 +11,11 @@ Generic: nothing here knows the landing gear. A *curve problem* supplies
 Each step: predictor u_pred = u + h t (t the unit tangent in the w-norm), corrector =
 Newton on [F(u); <t, u - u_pred>_w] = 0 with the bordered Jacobian [F_u; (w t)^T]
 (sparse LU when F_u is sparse). Converged when the w-norm of the Newton correction is
-below ``tol`` and |F|_inf below ``residual_tol``; at most ``max_newton`` iterations.
-Step control: h grows by ``grow`` after a step that converged in <= 3 iterations,
-shrinks by ``shrink`` on failure, and the branch stops (with a message) when h would
+below ``tol`` and |F|_inf below ``residual_tol``; chord iterations, the Jacobian refactored
+when a correction fails to halve, at most ``max_newton`` factorisations and 3 ``max_newton``
+iterations. Step control: h grows by ``grow`` after a step that converged in <= 4
+iterations with the tangent turned by at most half of ``max_angle``, shrinks by ``shrink``
+on failure, and the branch stops (with a message) when h would
 fall below ``ds_min``. Special points are located by :func:`locate`: the secant
 (Illinois) method on the step length from the last point, every trial point being a
 converged point of the curve.

@@ -299,44 +299,56 @@ class CycleCurveProblem:
     def _solve(self, M: sp.csc_matrix, rhs: np.ndarray, trans: bool) -> np.ndarray | None:
         """M^-1 rhs (or M^-T rhs) by iterative refinement on the last LU factors (those of a nearby
         point: a Newton iterate, the previous point); None if the residual does not reach 1e-13
-        of the solution (a looser 1e-12 leaves the test functions noisy enough to slow Newton)."""
+        of the solution (a looser 1e-12 leaves the test functions noisy enough to slow Newton), or
+        stops shrinking fast (by 4 per sweep: the factors are too far off, better refactor)."""
         if self._lu is None:
             return None
         op = M.T if trans else M
         mode = "T" if trans else "N"
         z = self._lu.solve(rhs, trans=mode)
         scale = max(float(np.abs(rhs).max()), 1e-300)
+        last = math.inf
         for _ in range(6):
             r = rhs - op @ z
-            if float(np.abs(r).max()) <= 1e-13 * scale * max(1.0, float(np.abs(z).max())):
+            size = float(np.abs(r).max())
+            if size <= 1e-13 * scale * max(1.0, float(np.abs(z).max())):
                 return z
+            if size > 0.25 * last:
+                return None
+            last = size
             z = z + self._lu.solve(r, trans=mode)
         return None
 
-    def analyse(self, u: np.ndarray) -> dict:
-        """Kernel vectors V, left vectors W and the 2x2 (or 1x1) G of the bordered test matrix at u
-        (memoised for the last u). The bordered matrix is factored afresh only when refinement on
-        the last factors does not converge: most Newton iterates and trial points reuse them."""
+    def analyse(self, u: np.ndarray, left: bool = True) -> dict:
+        """Kernel vectors V, the 2x2 (or 1x1) G and (``left``) the left vectors W of the bordered
+        test matrix at u (memoised for the last u). The bordered matrix is factored afresh only
+        when refinement on the last factors does not converge: most Newton iterates and trial
+        points reuse them. The test values need only the right solve; gradients need both."""
         key = u.tobytes()
-        if self._memo is not None and self._memo[0] == key:
+        if self._memo is not None and self._memo[0] == key and (not left or "W" in self._memo[1]):
             return self._memo[1]
         M = self._bordered(u)
         k, m = self.k, self.m
         rhs = np.zeros((m + k, k))
         rhs[m:, :] = np.eye(k)
-        right, left = self._solve(M, rhs, False), None
-        if right is not None:
-            left = self._solve(M, rhs, True)
-        if right is None or left is None:
+        out = self._memo[1] if self._memo is not None and self._memo[0] == key else {}
+        right = out.get("_right")
+        if right is None:
+            right = self._solve(M, rhs, False)
+        solved = right is not None and (not left or (lhs := self._solve(M, rhs, True)) is not None)
+        if not solved:
             self._lu = splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
             right = self._lu.solve(rhs)
-            left = self._lu.solve(rhs, trans="T")
-        out = {"V": right[:m], "G": right[m:], "W": left[:m], "GT": left[m:]}
+            if left:
+                lhs = self._lu.solve(rhs, trans="T")
+        out = {"_right": right, "V": right[:m], "G": right[m:]}
+        if left:
+            out.update({"W": lhs[:m], "GT": lhs[m:]})
         self._memo = (key, out)
         return out
 
     def test_values(self, u: np.ndarray) -> np.ndarray:
-        G = self.analyse(u)["G"]
+        G = self.analyse(u, left=False)["G"]
         return np.array([G[i, j] for i, j in self.entries])
 
     def _gradient(self, u: np.ndarray, i: int, j: int, data: dict) -> np.ndarray:

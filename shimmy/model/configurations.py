@@ -61,7 +61,7 @@ def affects(parameter: str, config: "Configuration | str") -> bool:
 STATE_NAMES = ("psi", "dpsi", "delta", "ddelta", "lam", "psis", "dpsis")
 STATE_UNITS = ("rad", "rad/s", "rad", "rad/s", "m", "rad", "rad/s")
 
-#: REFERENCE.md's operating points: name -> (V in m/s, Fz in N). A-C low load (< 250 kN),
+#: The study's operating points (docs/model.md): name -> (V in m/s, Fz in N). A-C low load (< 250 kN),
 #: D-F medium (250-450 kN), G-I high (> 450 kN).
 OPERATING_POINTS = {"A": (30.0, 150e3), "B": (110.0, 200e3), "C": (170.0, 150e3), "D": (50.0, 350e3),
                     "E": (135.0, 350e3), "F": (180.0, 350e3), "G": (50.0, 550e3), "H": (110.0, 550e3),

@@ -1,4 +1,4 @@
-"""Equations of motion of MODEL.md: right-hand side and analytic Jacobians.
+"""Equations of motion of docs/model.md: right-hand side and analytic Jacobians.
 
 The state is ``x = [psi, dpsi, delta, ddelta, lam]`` plus ``[psis, dpsis]`` with an NES.
 All functions are vectorised: ``x`` may be one state ``(n,)`` or many columns ``(n, m)``,

@@ -50,11 +50,40 @@ def _f(y, out, V, Fz, c, has_nes, has_pd, exact_nes):
 
 @njit(cache=True)
 def integrate(x0, t_end, dt_out, V, Fz, c, has_nes, has_pd, exact_nes, rtol, atol, max_steps, out):
-    """Integrate from t = 0 and write the state at t = k dt_out into ``out[k]``.
+    """Integrate from t = 0 at constant (V, Fz) and write the state at t = k dt_out into ``out[k]``.
 
     Returns (status, accepted steps, rejected steps, right-hand-side calls, samples written).
     """
+    table_t = np.zeros(1)
+    table_v = np.full(1, V)
+    table_fz = np.full(1, Fz)
+    return integrate_profile(x0, t_end, dt_out, table_t, table_v, table_fz, c, has_nes, has_pd, exact_nes,
+                             rtol, atol, max_steps, out)
+
+
+@njit(cache=True)
+def integrate_profile(x0, t_end, dt_out, table_t, table_v, table_fz, c, has_nes, has_pd, exact_nes, rtol, atol,
+                      max_steps, out):
+    """Integrate from t = 0 with V(t) and Fz(t) interpolated linearly in the table (table_t[0] = 0,
+    increasing; the last segment extends past its end) and write the state at t = k dt_out into ``out[k]``.
+
+    No step crosses an interior point of the table (a kink of V or Fz would cost rejected steps
+    and accuracy): a step that would reach it, or land within 1 % of a step short of it, ends on it.
+    A one-row table is a constant (V, Fz), stepped exactly as :func:`integrate` would.
+    Returns (status, accepted steps, rejected steps, right-hand-side calls, samples written).
+    """
     n_out = out.shape[0]
+    n_table = table_t.shape[0]
+    slope_v = np.zeros(n_table)
+    slope_fz = np.zeros(n_table)
+    for j in range(n_table - 1):
+        slope_v[j] = (table_v[j + 1] - table_v[j]) / (table_t[j + 1] - table_t[j])
+        slope_fz[j] = (table_fz[j + 1] - table_fz[j]) / (table_t[j + 1] - table_t[j])
+    if n_table > 1:  # the last segment's slope holds past the end of the table
+        slope_v[n_table - 1] = slope_v[n_table - 2]
+        slope_fz[n_table - 1] = slope_fz[n_table - 2]
+    seg = 0
+    last_seg = max(0, n_table - 2)  # segments 0..last_seg; points 1..n_table-2 are interior
     y = x0.copy()
     k1 = np.empty(N_FULL)
     k2 = np.empty(N_FULL)
@@ -65,7 +94,8 @@ def integrate(x0, t_end, dt_out, V, Fz, c, has_nes, has_pd, exact_nes, rtol, ato
     k7 = np.empty(N_FULL)
     tmp = np.empty(N_FULL)
     y_new = np.empty(N_FULL)
-    _f(y, k1, V, Fz, c, has_nes, has_pd, exact_nes)
+    t0, v0, f0, sv, sf = table_t[0], table_v[0], table_fz[0], slope_v[0], slope_fz[0]
+    _f(y, k1, v0, f0, c, has_nes, has_pd, exact_nes)
     n_calls = 1
     out[0, :] = y
     written = 1
@@ -88,24 +118,40 @@ def integrate(x0, t_end, dt_out, V, Fz, c, has_nes, has_pd, exact_nes, rtol, ato
             return MAX_STEPS, accepted, rejected, n_calls, written
         if h < 1e-14 * max(1.0, t):
             return STEP_TOO_SMALL, accepted, rejected, n_calls, written
+        # a table point closer than rounding to t is passed (a step to it could not be taken)
+        while seg < last_seg and table_t[seg + 1] - t <= 1e-12 * max(1.0, abs(t)):
+            seg += 1
+        t0, v0, f0, sv, sf = table_t[seg], table_v[seg], table_fz[seg], slope_v[seg], slope_fz[seg]
+        h_free = h
+        to_kink = False
+        if seg < last_seg and t + 1.01 * h >= table_t[seg + 1]:
+            h = table_t[seg + 1] - t
+            to_kink = True
         for i in range(N_FULL):
             tmp[i] = y[i] + h * A21 * k1[i]
-        _f(tmp, k2, V, Fz, c, has_nes, has_pd, exact_nes)
+        ts = t + C2 * h - t0
+        _f(tmp, k2, v0 + ts * sv, f0 + ts * sf, c, has_nes, has_pd, exact_nes)
         for i in range(N_FULL):
             tmp[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
-        _f(tmp, k3, V, Fz, c, has_nes, has_pd, exact_nes)
+        ts = t + C3 * h - t0
+        _f(tmp, k3, v0 + ts * sv, f0 + ts * sf, c, has_nes, has_pd, exact_nes)
         for i in range(N_FULL):
             tmp[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-        _f(tmp, k4, V, Fz, c, has_nes, has_pd, exact_nes)
+        ts = t + C4 * h - t0
+        _f(tmp, k4, v0 + ts * sv, f0 + ts * sf, c, has_nes, has_pd, exact_nes)
         for i in range(N_FULL):
             tmp[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-        _f(tmp, k5, V, Fz, c, has_nes, has_pd, exact_nes)
+        ts = t + C5 * h - t0
+        _f(tmp, k5, v0 + ts * sv, f0 + ts * sf, c, has_nes, has_pd, exact_nes)
         for i in range(N_FULL):
             tmp[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-        _f(tmp, k6, V, Fz, c, has_nes, has_pd, exact_nes)
+        t_new = table_t[seg + 1] if to_kink else t + h
+        ts = t_new - t0
+        v1, f1 = v0 + ts * sv, f0 + ts * sf
+        _f(tmp, k6, v1, f1, c, has_nes, has_pd, exact_nes)
         for i in range(N_FULL):
             y_new[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-        _f(y_new, k7, V, Fz, c, has_nes, has_pd, exact_nes)
+        _f(y_new, k7, v1, f1, c, has_nes, has_pd, exact_nes)
         n_calls += 6
         err = 0.0
         finite = True
@@ -123,7 +169,6 @@ def integrate(x0, t_end, dt_out, V, Fz, c, has_nes, has_pd, exact_nes, rtol, ato
             rejected += 1
             continue
         if err <= 1.0:
-            t_new = t + h
             # Dense output on the uniform grid inside (t, t_new].
             while written < n_out and written * dt_out <= t_new:
                 s = (written * dt_out - t) / h
@@ -145,7 +190,12 @@ def integrate(x0, t_end, dt_out, V, Fz, c, has_nes, has_pd, exact_nes, rtol, ato
                 factor = 5.0
             else:
                 factor = min(5.0, max(0.2, 0.9 * err ** -0.2))
-            h *= factor
+            if to_kink:
+                seg += 1
+                # the step was cut short to end on the kink: the step before the cut is still a good guess
+                h = max(h * factor, min(h_free, h * 5.0))
+            else:
+                h *= factor
         else:
             h *= max(0.2, 0.9 * err ** -0.2)
             rejected += 1

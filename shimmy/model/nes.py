@@ -1,6 +1,6 @@
 """Torsional nonlinear energy sink: restoring torque from the roller-spring geometry.
 
-MODEL.md: four roller-spring units on a track engaged over pi/3. For a relative rotation
+docs/model.md: four roller-spring units on a track engaged over pi/3. For a relative rotation
 ``a`` (rad) between the strut and the absorber,
 
     A     = (sqrt(3)/2)(r1 + r2),       rho = r2 + r3
@@ -37,7 +37,7 @@ N_UNITS = 4
 
 
 def geometry(r1: float, r2: float, r3: float) -> tuple[float, float, float]:
-    """(A, rho, Delta0) of MODEL.md: track-centre distance, r2 + r3, Delta at a = 0 (m)."""
+    """(A, rho, Delta0) of docs/model.md: track-centre distance, r2 + r3, Delta at a = 0 (m)."""
     A = 0.5 * math.sqrt(3.0) * (r1 + r2)
     rho = r2 + r3
     return A, rho, A - rho

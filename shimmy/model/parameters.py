@@ -1,11 +1,11 @@
-"""Typed, immutable parameter sets of the shimmy model (MODEL.md), in SI units.
+"""Typed, immutable parameter sets of the shimmy model (docs/model.md), in SI units.
 
 Every parameter is declared once, as a dataclass field whose metadata carries its
 unit, allowed range, description and provenance. Everything else (the CLI listing,
 the API schema, UI slider ranges, validation) reads these declarations, so a range
 is never written twice.
 
-Ranges: where MODEL.md gives a range it is used as is; for the gear and tyre
+Ranges: where the published study gives a range it is used as is; for the gear and tyre
 constants, which the study gives as single values, the range is a plausible
 engineering envelope around the nominal value (documented per field).
 """
@@ -24,8 +24,8 @@ from ..errors import InvalidParameterError
 
 PUBLISHED = "published study"
 ENVELOPE = "published value; range is an engineering envelope around it"
-CALIBRATED = "calibrated by shimmy.analyses.calibration against REFERENCE.md"
-FIXED = "MODEL.md"
+CALIBRATED = "calibrated by shimmy.analyses.calibration against the published study (docs/validation.md)"
+FIXED = "docs/model.md"
 
 
 def _param(default: float, low: float, high: float, unit: str, description: str,
@@ -179,7 +179,7 @@ class PDParameters:
 
 GROUPS: dict[str, type] = {"gear": GearParameters, "nes": NESParameters, "pd": PDParameters}
 
-#: PD material presets (MODEL.md): the fields each preset sets.
+#: PD material presets (docs/model.md): the fields each preset sets.
 MATERIALS: dict[str, dict[str, float]] = {
     "steel": {"rho_p": 7800.0, "e_r": 0.8},
     "tungsten": {"rho_p": 16500.0, "e_r": 0.6},
@@ -274,11 +274,14 @@ def canonical_digest(obj: Any) -> str:
 
 
 def check_operating_point(V: Any, Fz: Any) -> tuple[float, float]:
-    """Validate forward speed V (m/s) and vertical load Fz (N) against MODEL.md's ranges."""
+    """Validate forward speed V (m/s) and vertical load Fz (N) against the model's ranges (docs/model.md)."""
     return (check_number("V", V, V_RANGE[0], V_RANGE[1], "m/s"),
             check_number("Fz", Fz, FZ_RANGE[0], FZ_RANGE[1], "N"))
 
 
-#: Operating ranges of the continuation parameters (MODEL.md).
+#: Operating ranges of the continuation parameters (docs/model.md).
 V_RANGE = (1.0, 500.0)
 FZ_RANGE = (1.0e4, 9.0e5)
+#: Classified Fz slices of a stability map by default (its boundaries are continued curves; the
+#: slices tell the regions' types, and more are added through regions they miss).
+DEFAULT_MAP_SLICES = 10

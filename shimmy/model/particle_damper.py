@@ -1,6 +1,6 @@
 """Annular particle damper: equivalent viscous damping of the gas-solid two-phase model.
 
-MODEL.md gives the damping per unit tangential speed of one segment,
+The model (docs/model.md) gives the damping per unit tangential speed of one segment,
 
     c*(v) = c_c + c_f + c_k
           = (c11 + c13) v^(1/2) + (c21 + c12 + c23) v - (c31 + c33) v^(3/2) + c22 v^2 + c32 v^3,
@@ -24,7 +24,7 @@ from .parameters import PDParameters
 
 @dataclass(frozen=True)
 class DampingCoefficients:
-    """The nine c_ij of MODEL.md (SI units) and the series of c*(v) they add up to."""
+    """The nine c_ij of the model (docs/model.md, SI units) and the series of c*(v) they add up to."""
 
     c11: float
     c21: float
@@ -47,7 +47,7 @@ class DampingCoefficients:
 
 
 def damping_coefficients(pd: PDParameters) -> DampingCoefficients:
-    """Evaluate the c_ij of the two-phase-flow model for one chamber (MODEL.md)."""
+    """Evaluate the c_ij of the two-phase-flow model for one chamber (docs/model.md)."""
     d, h_c = pd.d_chamber, pd.h_chamber
     a_p, rho_p, g_p, e_r, d_p, f = pd.a_p, pd.rho_p, pd.g_p, pd.e_r, pd.d_p, pd.f
     rho_m = pd.rho_m_frac * rho_p

@@ -1,4 +1,4 @@
-"""A plain, per-call Python right-hand side written line by line from MODEL.md.
+"""A plain, per-call Python right-hand side written line by line from the equations of docs/model.md.
 
 It shares no code with :mod:`shimmy.model.equations` beyond the parameter set and the
 device coefficient formulas, so it serves two purposes: the tests check the

@@ -147,9 +147,43 @@ def study(request: dict[str, Any], progress: Progress | None = None) -> dict[str
                       **common).to_dict()
 
 
+def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """One configuration through the profile; with ``hopf_curves`` its Hopf curves (from the shared cache)."""
+    from ..analyses.ground_run import GroundRunOptions, ground_run as run_ground_run
+
+    report = progress or (lambda fraction, message: None)
+    profile = request["profile"] if request["profile"] is not None else request["preset"]
+    options = GroundRunOptions(psi_threshold=request["psi_threshold"], lateral_threshold=request["lateral_threshold"],
+                               exact_nes=request["exact_nes"], cycle_curves=request["fold_torus"])
+    report(0.0, f"ground run of {request['config']}")
+    result = run_ground_run(request["config"], profile, _params(request), options=options,
+                            preset_options=request["preset_options"] if request["profile"] is None else None)
+    stride = max(1, int(round(request["series_dt"] / options.dt_out)))
+    out = result.to_dict(stride)
+    if request["hopf_curves"]:
+        report(0.6, "Hopf curves")
+        curves_request = schemas.validate("hopf_curves", {"config": request["config"], "params": request["params"]})
+        curves, _ = run_canonical("hopf_curves", curves_request)
+        out["hopf_curves"] = [{"V": [p["V"] for p in c["points"]], "Fz": [p["Fz"] for p in c["points"]]}
+                              for c in curves["curves"]]
+    report(1.0, "done")
+    return out
+
+
+def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
+    """A ground-run preset's table rows [t, V, Fz], its complete settings, each setting's range and
+    its assumptions, for a profile editor (a table of a few hundred points: nothing to cache)."""
+    from ..analyses.ground_profiles import preset, preset_fields
+
+    profile = preset(name, options)
+    return {"name": name, "rows": profile.rows(), "settings": profile.settings, "fields": preset_fields(name),
+            "assumptions": profile.assumptions}
+
+
 RUNNERS: dict[str, Callable[[dict[str, Any], Progress | None], dict[str, Any]]] = {
     "simulate": simulate, "hopf": hopf, "stability": stability, "devices": devices,
-    "bifurcation": bifurcation, "hopf_curves": hopf_curves, "map": stability_map, "study": study}
+    "bifurcation": bifurcation, "hopf_curves": hopf_curves, "map": stability_map, "study": study,
+    "ground_run": ground_run}
 assert set(RUNNERS) == set(schemas.SCHEMAS)
 
 

@@ -15,8 +15,9 @@ from typing import Any, Mapping
 from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
 from . import settings
-from ..model.parameters import (FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters, check_number,
-                                unknown_name_error)
+from ..analyses.ground_profiles import MAX_PROFILE_POINTS, PRESETS
+from ..model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters,
+                                check_number, unknown_name_error)
 
 CONFIGS = tuple(c.value for c in Configuration)
 
@@ -37,7 +38,7 @@ def _huge(value: Any) -> Any:
 @dataclass(frozen=True)
 class Field:
     name: str
-    kind: str  # number | integer | string | boolean | object | numbers | strings (arrays)
+    kind: str  # number | integer | string | boolean | object | numbers | strings (arrays) | table (rows of numbers)
     description: str
     required: bool = False
     default: Any = None
@@ -61,6 +62,8 @@ class Field:
             return f"a list of 1 to {self.high:g} numbers"
         if self.kind == "strings":
             return f"a non-empty list of {', '.join(self.choices or ())}"
+        if self.kind == "table":
+            return f"a list of 2 to {self.high:g} rows [t (s), V (m/s), Fz (N)]"
         return "a string"
 
     def check(self, value: Any) -> Any:
@@ -95,6 +98,11 @@ class Field:
                 if not isinstance(v, str) or v not in (self.choices or ()):
                     raise InvalidParameterError(f"{self.name}[{k}]", v, "one of " + ", ".join(self.choices or ()))
             return list(dict.fromkeys(value))
+        if self.kind == "table":  # the rows themselves are checked by the analysis's profile check, by row
+            if not isinstance(value, list) or not 2 <= len(value) <= self.high:
+                size = f"{len(value)} rows" if isinstance(value, list) else type(value).__name__
+                raise InvalidParameterError(self.name, size, self.allowed)
+            return [list(row) if isinstance(row, list) else row for row in value]
         if not isinstance(value, Mapping):
             raise InvalidParameterError(self.name, value, self.allowed, "is not an object")
         return dict(value)
@@ -123,6 +131,11 @@ class Field:
                 name: {"type": "integer" if spec.integer else "number", "minimum": spec.low, "maximum": spec.high,
                        "description": spec.description + (f" ({spec.unit})" if spec.unit else "")}
                 for name, spec in PARAMETER_SPECS.items()}
+        if self.kind == "table":
+            out.update(type="array", minItems=2, maxItems=int(self.high),
+                       items={"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3})
+            out.pop("minimum", None)
+            out.pop("maximum", None)
         if self.kind in ("numbers", "strings"):
             out["type"] = "array"
             out.pop("minimum", None)
@@ -170,6 +183,8 @@ class RequestSchema:
             out["params"] = design(out.pop("params") or {}, out.pop("material", None))
         if self.name == "study":
             _check_study(out)
+        if self.name == "ground_run":
+            _check_ground_run(out)
         for low, high in (("v_min", "v_max"), ("fz_min", "fz_max")):
             if low in out and high in out and not out[high] > out[low]:
                 raise InvalidParameterError(high, out[high], f"a number above {low} = {out[low]:g}",
@@ -181,6 +196,11 @@ class RequestSchema:
                "properties": {f.name: f.openapi() for f in self.fields},
                "description": "Rules across fields (answered 422 naming the field): v_max above v_min, fz_max above "
                               "fz_min, a design whose NES roller stays on its track (r2 + r3 > (sqrt(3)/4)(r1 + r2))."}
+        if self.name == "ground_run":
+            out["description"] += (f" Ground run: profile rows [t, V, Fz] with t increasing, V and Fz within their "
+                                   f"ranges, a run of at most {settings.MAX_T_END:g} s (refusals name profile[i].t, "
+                                   ".V or .Fz); without a profile, the preset with preset_options (its settings: "
+                                   "python -m shimmy ground-run --help, shimmy.analyses.ground_profiles).")
         if self.name == "study":
             out["dependentRequired"] = {"parameter2": ["values2"], "values2": ["parameter2"]}
             out["description"] += (f" Study: each value within its parameter's range; at most "
@@ -209,6 +229,33 @@ def _check_study(out: dict[str, Any]) -> None:
     if units > settings.MAX_STUDY_UNITS:
         raise InvalidParameterError("values", units, f"at most {settings.MAX_STUDY_UNITS} designs x configurations",
                                     "asks for too many diagrams")
+
+
+def _check_ground_run(out: dict[str, Any]) -> None:
+    """The profile as checked rows (a table) or as the preset's complete settings; the run and its series
+    within the service's limits."""
+    from ..analyses.ground_profiles import preset, profile_from_table
+
+    if out["profile"] is not None:
+        if out["preset_options"]:
+            raise InvalidParameterError("preset_options", out["preset_options"], "only with a preset (no profile)",
+                                        "is given with a profile table")
+        profile = profile_from_table(out["profile"])
+        out["preset"], out["preset_options"] = None, {}
+        out["profile"] = profile.rows()
+    else:
+        for name, value in out["preset_options"].items():  # JSON numbers only, as for every other number
+            if isinstance(value, (str, bool)) or value is None:
+                raise InvalidParameterError(f"preset_options.{_key(name)}", value, "a number", "is not a number")
+        profile = preset(out["preset"], {k: _huge(v) for k, v in out["preset_options"].items()})
+        out["preset_options"] = dict(profile.settings)
+    if profile.duration > settings.MAX_T_END:
+        raise InvalidParameterError("profile" if out["preset"] is None else "preset_options", profile.duration,
+                                    f"a run of at most {settings.MAX_T_END:g} s", "makes the run too long (s)")
+    if profile.duration / out["series_dt"] > settings.MAX_SERIES_POINTS:
+        raise InvalidParameterError("series_dt", out["series_dt"],
+                                    f"at least {profile.duration / settings.MAX_SERIES_POINTS:g} s for a "
+                                    f"{profile.duration:g} s run", "gives too many samples")
 
 
 def design(overrides: Mapping[str, Any], material: str | None) -> dict[str, float]:
@@ -287,7 +334,8 @@ SCHEMAS: dict[str, RequestSchema] = {
         _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
         _range("fz_min", FZ_RANGE[0], FZ_RANGE, "N", "lowest load"),
         _range("fz_max", FZ_RANGE[1], FZ_RANGE, "N", "highest load"),
-        Field("resolution", "integer", "number of Fz slices", default=40, low=2, high=settings.MAX_MAP_SLICES),
+        Field("resolution", "integer", "classified Fz slices (more through regions they miss)",
+              default=DEFAULT_MAP_SLICES, low=2, high=settings.MAX_MAP_SLICES),
         Field("n_v", "integer", "speeds per slice on the output grid", default=100, low=10,
               high=settings.MAX_MAP_SPEEDS),
         Field("metrics_Fz", "number", "load of the speed-interval and amplitude metrics", default=150e3,
@@ -305,10 +353,31 @@ SCHEMAS: dict[str, RequestSchema] = {
         _range("v_min", 1.0, V_RANGE, "m/s", "lowest speed"),
         _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
         PARAMS, MATERIAL)),
+    "ground_run": RequestSchema("ground_run", "ground run: take-off, landing roll, taxi or a (t, V, Fz) table; "
+                                "envelopes, time in shimmy, peaks, boundary crossings, onset delay", (
+        _config(),
+        Field("profile", "table", "rows [t (s), V (m/s), Fz (N)], linearly interpolated (instead of a preset)",
+              high=MAX_PROFILE_POINTS),
+        Field("preset", "string", "preset profile, used when no profile table is given", default="takeoff",
+              choices=tuple(PRESETS)),
+        Field("preset_options", "object", "the preset's settings {name: value}; the rest at their defaults",
+              default={}),
+        Field("psi_threshold", "number", "torsional amplitude counted as shimmy", default=0.01, low=1e-6, high=1.0,
+              unit="rad"),
+        Field("lateral_threshold", "number", "lateral amplitude l_g delta counted as shimmy", default=0.001,
+              low=1e-7, high=1.0, unit="m"),
+        Field("series_dt", "number", "sampling interval of the returned series (a multiple of 1 ms)", default=0.01,
+              low=0.001, high=1.0, unit="s"),
+        Field("fold_torus", "boolean", "also the crossings of the fold and torus curves of cycles (seconds per "
+              "configuration)", default=False),
+        Field("hopf_curves", "boolean", "include the configuration's Hopf curves (V 1-500 m/s, Fz 10-900 kN)",
+              default=False),
+        Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
+        PARAMS, MATERIAL)),
 }
 
 #: Analyses that run as background jobs (POST /api/v1/jobs).
-JOB_ANALYSES = ("simulate", "bifurcation", "hopf_curves", "map", "study")
+JOB_ANALYSES = ("simulate", "bifurcation", "hopf_curves", "map", "study", "ground_run")
 
 
 def validate(analysis: str, body: Any, extra: tuple[str, ...] = ()) -> dict[str, Any]:

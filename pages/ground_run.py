@@ -1,0 +1,284 @@
+"""Ground runs: a take-off, landing roll, taxi or any (t, V, Fz) table for the four configurations."""
+
+from __future__ import annotations
+
+import dash
+from dash import Input, Output, State, dash_table, dcc, html, no_update
+from plotly.subplots import make_subplots
+
+from shimmy.errors import InvalidParameterError
+from shimmy.service import analyses
+from ui import components as ui
+from ui import jobs
+from ui import style
+from ui.layout import design_id, page
+
+dash.register_page(__name__, path="/ground-run", name="Ground run", order=4.5)
+
+CONFIGS = tuple(style.CONFIG_COLOURS)
+PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi"}
+SERIES_DT = 0.02  # s: the envelopes are smooth; 1500 points per configuration for a 30 s take-off
+TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overflowX": "auto"},
+               "style_cell": {"fontFamily": "inherit", "fontSize": "13px", "padding": "3px 8px", "textAlign": "left",
+                              "whiteSpace": "normal", "height": "auto"},
+               "style_header": {"backgroundColor": "#eef2f8", "fontWeight": "600"}}
+
+
+def layout(preset: str = "takeoff", config: str = "original", psi_thr: str = "0.01", lat_thr: str = "1", **query):
+    preset = preset if preset in PRESET_LABELS else "takeoff"
+    config = config if config in CONFIGS else "original"
+    return page(
+        query, "gr",
+        ui.header("Ground run", "The gear through a take-off, a landing roll or a taxi: forward speed and nose-gear "
+                  "load change with time along a profile (a preset with its stated assumptions, or your own table, "
+                  "linearly interpolated). Envelopes of the torsional and lateral amplitudes, time in shimmy, peaks, "
+                  "where the run crosses the Hopf curves, and how long shimmy takes to build up after it does, for "
+                  "the four configurations."),
+        html.Div([
+            ui.field("Profile preset", dcc.Dropdown(id="gr-preset", value=preset, clearable=False,
+                                                    style={"width": "160px"},
+                                                    options=[{"label": v, "value": k}
+                                                             for k, v in PRESET_LABELS.items()])),
+            ui.field("Map and curves of", dcc.Dropdown(id="gr-config", value=config, clearable=False,
+                                                       style={"width": "150px"},
+                                                       options=[{"label": style.CONFIG_LABELS[c], "value": c}
+                                                                for c in CONFIGS])),
+            ui.field("Shimmy threshold |psi| (rad)", dcc.Input(id="gr-psi-thr", type="number", min=1e-6, max=1,
+                                                               step="any", value=ui.number(psi_thr, 0.01))),
+            ui.field("Shimmy threshold |l_g delta| (mm)", dcc.Input(id="gr-lat-thr", type="number", min=1e-4,
+                                                                    max=1000, step="any",
+                                                                    value=ui.number(lat_thr, 1))),
+            *jobs.controls("gr", "Run"),
+        ], className="controls"),
+        html.Div([
+            html.Div([
+                html.H2("Preset settings"),
+                dash_table.DataTable(id="gr-settings", editable=True, **TABLE_STYLE, columns=[
+                    {"name": "setting", "id": "name", "editable": False},
+                    {"name": "value", "id": "value", "type": "numeric"},
+                    {"name": "unit", "id": "unit", "editable": False},
+                    {"name": "range", "id": "range", "editable": False},
+                    {"name": "meaning", "id": "description", "editable": False}]),
+                html.P(id="gr-assumptions", className="hint"),
+            ]),
+            html.Div([
+                html.H2("Profile table"),
+                dash_table.DataTable(id="gr-table", editable=True, row_deletable=True, **TABLE_STYLE, columns=[
+                    {"name": "t (s)", "id": "t", "type": "numeric"},
+                    {"name": "V (m/s)", "id": "V", "type": "numeric"},
+                    {"name": "Fz (kN)", "id": "Fz", "type": "numeric"}]),
+                html.Div([html.Button("Add row", id="gr-add-row", className="secondary"),
+                          html.Button("Back to the preset", id="gr-reset", className="secondary")],
+                         className="downloads"),
+                html.P(id="gr-source", className="hint"),
+            ]),
+        ], style={"display": "grid", "gridTemplateColumns": "minmax(0, 3fr) minmax(15em, 2fr)", "gap": "16px"}),
+        html.Div(id="gr-error", className="error", role="alert"),
+        html.Div(id="gr-summary"),
+        ui.graph("gr-plane", figure=style.message_figure("Computing the take-off for the four configurations…")),
+        ui.graph("gr-time"),
+        ui.graph("gr-speed"),
+        ui.downloads("gr"),
+        *jobs.stores("gr"),
+        dcc.Store(id="gr-preset-rows"),
+    )
+
+
+@dash.callback(Output("gr-settings", "data"), Input("gr-preset", "value"))
+def preset_settings(name):
+    """The preset's settings at their defaults (a new preset starts from its documented defaults)."""
+    fields = analyses.preset_profile(name)["fields"]
+    return [{"name": f["name"], "value": f["default"], "unit": f["unit"], "range": f"{f['low']:g} – {f['high']:g}",
+             "description": f["description"]} for f in fields]
+
+
+@dash.callback(Output("gr-table", "data"), Output("gr-preset-rows", "data"), Output("gr-assumptions", "children"),
+               Output("gr-error", "children", allow_duplicate=True),
+               Input("gr-settings", "data"), Input("gr-reset", "n_clicks"), State("gr-preset", "value"),
+               prevent_initial_call="initial_duplicate")
+def preset_table(settings, _reset, name):
+    """The preset's table for its settings (shown in the profile table, which may then be edited)."""
+    if not settings:
+        return no_update, no_update, no_update, no_update
+    try:
+        profile = analyses.preset_profile(name, _settings(settings))
+    except InvalidParameterError as exc:
+        return no_update, no_update, no_update, str(exc)
+    rows = [{"t": round(t, 4), "V": round(v, 4), "Fz": round(f / 1e3, 3)} for t, v, f in profile["rows"]]
+    return rows, rows, profile["assumptions"], ""
+
+
+@dash.callback(Output("gr-table", "data", allow_duplicate=True), Input("gr-add-row", "n_clicks"),
+               State("gr-table", "data"), prevent_initial_call=True)
+def add_row(_n, rows):
+    rows = list(rows or [])
+    last = rows[-1] if rows else {"t": 0.0, "V": 10.0, "Fz": 150.0}
+    t = last.get("t") if isinstance(last.get("t"), (int, float)) else 0.0
+    return [*rows, {"t": t + 1.0, "V": last.get("V"), "Fz": last.get("Fz")}]
+
+
+@dash.callback(Output("gr-source", "children"), Input("gr-table", "data"), State("gr-preset-rows", "data"),
+               State("gr-preset", "value"))
+def source(rows, preset_rows, name):
+    if rows and preset_rows and _same(rows, preset_rows):
+        return f"Runs the {PRESET_LABELS[name].lower()} preset ({len(rows)} points). Edit a cell to run your own table."
+    return f"Runs your table ({len(rows or [])} points; t in s, V in m/s, Fz in kN, linearly interpolated)."
+
+
+def _settings(rows) -> dict:
+    return {r["name"]: r["value"] for r in rows or [] if r.get("value") not in (None, "")}
+
+
+def _same(rows, preset_rows) -> bool:
+    if len(rows) != len(preset_rows):
+        return False
+    for a, b in zip(rows, preset_rows, strict=True):
+        for k in ("t", "V", "Fz"):
+            if not isinstance(a.get(k), (int, float)) or abs(a[k] - b[k]) > 1e-9 * max(1.0, abs(b[k])):
+                return False
+    return True
+
+
+def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, design):
+    """One request per configuration, the one whose map is drawn first."""
+    if rows and not (preset_rows and _same(rows, preset_rows)):
+        profile = {"profile": [[r.get("t"), r.get("V"), _newtons(r.get("Fz"))] for r in rows]}
+    else:
+        profile = {"preset": name, "preset_options": _settings(settings)}
+    lateral = None if lat_thr is None else float(lat_thr) / 1e3
+    order = [config] + [c for c in CONFIGS if c != config]
+    return [{"config": c, **profile, "psi_threshold": psi_thr, "lateral_threshold": lateral, "series_dt": SERIES_DT,
+             "hopf_curves": True, **design} for c in order]
+
+
+def _newtons(fz_kn):
+    return fz_kn * 1e3 if isinstance(fz_kn, (int, float)) and not isinstance(fz_kn, bool) else fz_kn
+
+
+def _csv_rows(results):
+    keys = ["t", "V", "Fz", "psi", "lateral", "envelope_psi", "envelope_lateral"]
+    rows = [[r["config"], *values] for r in sorted(results, key=lambda r: CONFIGS.index(r["config"]))
+            for values in zip(*(r[k] for k in keys), strict=True)]
+    return ["config", "t_s", "V_m_s", "Fz_N", "psi_rad", "lateral_m", "envelope_psi_rad", "envelope_lateral_m"], rows
+
+
+def _file_stem(results):
+    return f"ground_run_{results[0]['profile']['name']}"
+
+
+def _notice(results):
+    failed = [f"{r['config']}: {r['message']}" for r in results if not r["success"]]
+    return "; ".join(failed)
+
+
+jobs.register(
+    "gr", "ground_run", requests=_requests, initial=True, notice=_notice,
+    render=lambda results: (plane(results[0]), envelopes(results, "t"), envelopes(results, "V"), summary(results)),
+    outputs=[Output("gr-plane", "figure"), Output("gr-time", "figure"), Output("gr-speed", "figure"),
+             Output("gr-summary", "children")],
+    triggers=[Input("gr-config", "value")],
+    states=[State("gr-preset", "value"), State("gr-settings", "data"), State("gr-table", "data"),
+            State("gr-preset-rows", "data"), State("gr-psi-thr", "value"), State("gr-lat-thr", "value"),
+            State(design_id("gr"), "data")],
+    lock=["gr-preset"],
+    download=jobs.Download("gr", "ground_run", _csv_rows, filename=_file_stem))
+
+
+def _ordered(results):
+    return sorted(results, key=lambda r: CONFIGS.index(r["config"]))
+
+
+def plane(result):
+    """The trajectory on the (V, Fz) plane over the configuration's Hopf curves, its shimmy stretches and crossings."""
+    config = result["config"]
+    label, colour = style.CONFIG_LABELS[config], style.CONFIG_COLOURS[config]
+    fig = style.figure(f"Trajectory over the Hopf curves of {label}",
+                       "forward speed V (m/s)", "nose-gear load Fz (kN)", height=460)
+    for i, curve in enumerate(result.get("hopf_curves") or []):
+        fig.add_scatter(x=curve["V"], y=[f / 1e3 for f in curve["Fz"]], mode="lines", name=f"Hopf curve ({label})",
+                        legendgroup="hopf", showlegend=i == 0, line={"color": "#888", "width": 2},
+                        hovertemplate="Hopf curve<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN<extra></extra>")
+    rows = result["profile"]["rows"]
+    fig.add_scatter(x=[r[1] for r in rows], y=[r[2] / 1e3 for r in rows], mode="lines", name="trajectory",
+                    line={"color": style.ACCENT, "width": 2}, customdata=[r[0] for r in rows],
+                    hovertemplate="t %{customdata:.4g} s<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN<extra></extra>")
+    thr_psi, thr_lat = result["options"]["psi_threshold"], result["options"]["lateral_threshold"]
+    xs, ys = [], []
+    for v, f, a, b in zip(result["V"], result["Fz"], result["envelope_psi"], result["envelope_lateral"], strict=True):
+        inside = a > thr_psi or b > thr_lat
+        xs.append(v if inside else None)
+        ys.append(f / 1e3 if inside else None)
+    fig.add_scatter(x=xs, y=ys, mode="lines", name=f"{label} in shimmy", line={"color": colour, "width": 7},
+                    opacity=0.55, hoverinfo="skip")
+    fig.add_scatter(x=[rows[0][1]], y=[rows[0][2] / 1e3], mode="markers+text", text=["start"], textposition="top right",
+                    name="start", showlegend=False, marker={"symbol": "circle", "size": 10, "color": style.ACCENT})
+    crossings = result["boundary_crossings"]
+    if crossings:
+        fig.add_scatter(x=[c["V"] for c in crossings], y=[c["Fz"] / 1e3 for c in crossings], mode="markers",
+                        name="crossings of the Hopf curves", customdata=[c["t"] for c in crossings],
+                        marker={"symbol": "x", "size": 12, "color": "#D55E00", "line": {"width": 2}},
+                        hovertemplate="crosses at t %{customdata:.4g} s<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN"
+                                      "<extra></extra>")
+    v_max = max(r[1] for r in rows)
+    f_max = max(r[2] for r in rows) / 1e3
+    fig.update_xaxes(range=[0, max(20.0, 1.25 * v_max)])
+    fig.update_yaxes(range=[0, min(900.0, max(50.0, 1.4 * f_max))])
+    return fig
+
+
+def envelopes(results, against: str):
+    """Torsional and lateral envelopes of the four configurations against time or speed, with the thresholds."""
+    x_title = "time t (s)" if against == "t" else "forward speed V (m/s)"
+    fig = make_subplots(rows=2, cols=1, shared_xaxes=True, vertical_spacing=0.08)
+    for r in _ordered(results):
+        config = r["config"]
+        common = {"mode": "lines", "line": {"color": style.CONFIG_COLOURS[config], "width": 1.6},
+                  "legendgroup": config}
+        fig.add_scatter(x=r[against], y=r["envelope_psi"], name=style.CONFIG_LABELS[config], row=1, col=1, **common)
+        fig.add_scatter(x=r[against], y=[1e3 * v for v in r["envelope_lateral"]], name=style.CONFIG_LABELS[config],
+                        showlegend=False, row=2, col=1, **common)
+    options = results[0]["options"]
+    for row, value, text in ((1, options["psi_threshold"], "threshold"),
+                             (2, 1e3 * options["lateral_threshold"], "threshold")):
+        fig.add_hline(y=value, line={"color": "#D55E00", "dash": "dash", "width": 1}, annotation_text=text,
+                      annotation_position="top left", row=row, col=1)
+    title = ("Amplitude envelopes against time" if against == "t" else
+             "Amplitude envelopes against forward speed (along the run)")
+    fig.update_layout(title={"text": title, "x": 0.01, "font": {"size": 15}}, height=520, template="plotly_white",
+                      margin={"l": 70, "r": 16, "t": 44, "b": 48}, legend={"orientation": "h", "y": -0.14, "x": 0},
+                      hovermode="x unified" if against == "t" else "closest")
+    fig.update_yaxes(title_text="envelope of |psi| (rad)", row=1, col=1)
+    fig.update_yaxes(title_text="envelope of |l_g delta| (mm)", row=2, col=1)
+    fig.update_xaxes(title_text=x_title, row=2, col=1)
+    fig.update_xaxes(showline=True, linecolor="#888", mirror=True)
+    fig.update_yaxes(showline=True, linecolor="#888", mirror=True)
+    return fig
+
+
+def summary(results):
+    ordered = _ordered(results)
+    base = next((r for r in ordered if r["config"] == "original"), None)
+    rows = []
+    for r in ordered:
+        speeds = "–" if r["speed_range"] is None else f"{r['speed_range'][0]:.4g} – {r['speed_range'][1]:.4g}"
+        p, q = r["peak_psi"], r["peak_lateral"]
+        psi = f"{p['value']:.4g} at {p['t']:.3g} s, {p['V']:.3g} m/s"
+        lat = f"{1e3 * q['value']:.4g} at {q['t']:.3g} s"
+        time_in = f"{r['time_in_shimmy_s']:.2f}"
+        if base is not None and r is not base:
+            time_in += f" ({r['time_in_shimmy_s'] - base['time_in_shimmy_s']:+.2f})"
+            if base["peak_psi"]["value"] > 0:
+                psi += f" (×{p['value'] / base['peak_psi']['value']:.2f})"
+        crossings = ", ".join(f"{c['V']:.4g} m/s" for c in r["boundary_crossings"]) or "none"
+        delay = ui.fmt(r["onset_delay_s"], 3)
+        rows.append([style.CONFIG_LABELS[r["config"]], time_in, speeds, psi, lat, crossings, delay])
+    return ui.table(["configuration", "time in shimmy (s, against original)", "speed range in shimmy (m/s)",
+                     "peak |psi| (rad)", "peak |l_g delta| (mm)", "crosses the Hopf curves at", "onset delay (s)"],
+                    rows, "gr-summary-table")
+
+
+@dash.callback(Output("url-update", "data", allow_duplicate=True), Input("gr-preset", "value"),
+               Input("gr-config", "value"), Input("gr-psi-thr", "value"), Input("gr-lat-thr", "value"),
+               prevent_initial_call=True)
+def remember(preset, config, psi_thr, lat_thr):
+    return {"preset": preset, "config": config, "psi_thr": psi_thr, "lat_thr": lat_thr}

@@ -1,0 +1,90 @@
+"""The Ground run page in real headless Chromium against gunicorn (the set-up of test_browser.py)."""
+
+from __future__ import annotations
+
+import csv
+import io
+
+import pytest
+
+pytest.importorskip("selenium")
+from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
+from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.webdriver.common.keys import Keys  # noqa: E402
+
+from test_browser import DOWNLOADS, SHOTS, _idle, _severe, _trace_count, _wait_for, browser  # noqa: E402,F401
+
+NAMES = ["original", "NES", "PD", "NES + PD"]
+
+
+def _summary(driver) -> list[list[str]]:
+    """The summary table's cells, read in one script (no stale references while Dash redraws it)."""
+    return driver.execute_script(
+        "return Array.from(document.querySelectorAll('#gr-summary-table tbody tr'))"
+        ".map(r => Array.from(r.cells).map(c => c.innerText));")
+
+
+def _text(driver, element_id: str) -> str:
+    """The text of an element, empty until the page has rendered it."""
+    return driver.execute_script(f"const e = document.getElementById('{element_id}'); return e ? e.innerText : '';")
+
+
+def _edit_cell(driver, row: int, column: str, text: str) -> None:
+    cell = driver.find_elements(By.CSS_SELECTOR, f"#gr-table td[data-dash-column='{column}']")[row]
+    driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", cell)  # not under the sticky bar
+    cell.click()  # selects it; typing then replaces its value
+    ActionChains(driver).send_keys(text).send_keys(Keys.ENTER).perform()
+
+
+def test_ground_run_page_runs_the_presets_and_a_table(server, browser):  # noqa: F811
+    browser.get_log("browser")
+    browser.set_window_size(1440, 900)
+    browser.get(server.base + "/ground-run")
+    rows = _wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=120,
+                     what="the take-off of the four configurations")
+    assert [r[0] for r in rows] == NAMES
+    assert float(rows[0][1]) > float(rows[3][1].split()[0]) > 0  # NES + PD spends less time in shimmy
+    _wait_for(lambda: _trace_count(browser, "gr-time") == 8 and _trace_count(browser, "gr-speed") == 8,
+              what="two envelopes of four configurations against t and V")
+    assert _trace_count(browser, "gr-plane") >= 4  # Hopf curve(s), trajectory, shimmy stretch, start, crossings
+    assert "take-off preset" in browser.find_element(By.ID, "gr-source").text
+    _idle(browser)
+    browser.save_screenshot(str(SHOTS / "ground-run-1440.png"))
+    origins = browser.execute_script("return performance.getEntriesByType('resource').map(e => e.name);")
+    assert all(u.startswith(server.base) for u in origins)
+    assert _severe(browser) == []
+
+    # The downloads serialise what is drawn.
+    for f in DOWNLOADS.glob("ground_run_*"):
+        f.unlink()
+    browser.find_element(By.ID, "gr-csv").click()
+    path = DOWNLOADS / "ground_run_takeoff.csv"
+    _wait_for(lambda: path.exists() and path.stat().st_size > 0, timeout=20, what="the CSV download")
+    table = list(csv.reader(io.StringIO(path.read_text())))
+    assert table[0][:4] == ["config", "t_s", "V_m_s", "Fz_N"]
+    assert {r[0] for r in table[1:]} == {"original", "nes", "pd", "nes_pd"}
+
+    # An edited table runs instead of the preset: start at 30 m/s (inside the unstable region).
+    before = _summary(browser)
+    _edit_cell(browser, 0, "V", "30")
+    _wait_for(lambda: "your table" in _text(browser, "gr-source"), timeout=10, what="the table to be the profile")
+    browser.find_element(By.ID, "gr-run").click()
+    _wait_for(lambda: (s := _summary(browser)) and s != before and s, timeout=120, what="the run of the table")
+    assert _severe(browser) == []
+
+    # A bad row is refused, naming its row and column.
+    _edit_cell(browser, 1, "V", "600")
+    browser.find_element(By.ID, "gr-run").click()
+    message = _wait_for(lambda: _text(browser, "gr-error"), timeout=20, what="the refusal")
+    assert "profile[1].V=600" in message and "row 2 of the table" in message and "[1, 500] m/s" in message
+
+    # The landing roll from the URL, at the smaller window.
+    browser.set_window_size(1024, 768)
+    browser.get(server.base + "/ground-run?preset=landing&config=nes")
+    _wait_for(lambda: "landing roll preset" in _text(browser, "gr-source"), timeout=30, what="the landing preset")
+    rows = _wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=120, what="the landing roll")
+    assert "Hopf curves of NES" in browser.find_element(By.CSS_SELECTOR, "#gr-plane .gtitle").text
+    _idle(browser)
+    browser.save_screenshot(str(SHOTS / "ground-run-1024.png"))
+    assert _severe(browser) == []
+    browser.set_window_size(1500, 1100)
