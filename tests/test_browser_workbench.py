@@ -76,7 +76,7 @@ def _open(driver, server, path, size=(1440, 900)):
 
 def test_design_box_slider_and_url_stay_in_sync(server, browser):
     _open(browser, server, "/")
-    box = _by_id(browser, _pattern("r2", "param-box"))
+    box = _wait_for(lambda: _by_id(browser, _pattern("r2", "param-box")), what="the r2 box")
     assert box.get_attribute("value") == "0.08"  # the value is visible before any drag
     _type(browser, box, "0.0853")
     _wait_for(lambda: "r2=0.0853" in browser.current_url, timeout=10, what="the URL to carry the typed r2")
@@ -89,7 +89,8 @@ def test_design_box_slider_and_url_stay_in_sync(server, browser):
     _wait_for(lambda: "r2=0.07" in browser.current_url, timeout=10, what="the URL to follow the slider")
     browser.get(server.base + "/?k_s=1234567")  # the URL sets the box and the slider
     _idle(browser)
-    assert _by_id(browser, _pattern("k_s", "param-box")).get_attribute("value") == "1234567"
+    k_s = _wait_for(lambda: _by_id(browser, _pattern("k_s", "param-box")), what="the k_s box")
+    assert k_s.get_attribute("value") == "1234567"
     assert _severe(browser) == []
 
 
