@@ -302,13 +302,15 @@ def test_devices_current_design_does_not_hide_the_steel_preset(server, browser):
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 def test_every_page_fits_the_window_and_is_photographed(server, browser, size):
-    for name, path in PAGES.items():
+    for name, path in {**PAGES, "ground-run": "/ground-run"}.items():
         _open(browser, server, path, size)
         time.sleep(0.8)
         browser.save_screenshot(str(SHOTS / f"{name}-{size[0]}x{size[1]}.png"))
         widths = browser.execute_script("return [document.documentElement.scrollWidth, "
                                         "document.documentElement.clientWidth]")
         assert widths[0] <= widths[1], (name, widths)  # no horizontal scrollbar
+        assert browser.find_element(By.CSS_SELECTOR, ".navbar").size["height"] < 60, name  # one line: the
+        # panel's sticky top sits right under it
         # The panel's column is painted the full height; pages that ignore the design do not show it.
         panel = browser.find_element(By.ID, "design-panel")
         assert panel.is_displayed() == (name not in ("validation", "api")), name

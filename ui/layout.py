@@ -128,7 +128,7 @@ def navigation() -> html.Nav:
     # Plain links: their href is kept carrying the design by the clientside URL updater below.
     links = [html.A(p["name"], href=p["relative_path"], className="nav-link")
              for p in dash.page_registry.values()]
-    toggle = html.Button("Design panel", id="design-toggle", className="nav-toggle",
+    toggle = html.Button("Design", id="design-toggle", className="nav-toggle",
                          title="Hide or show the design panel", **{"aria-pressed": "true"})
     return html.Nav([toggle, html.Span("shimmy", className="brand"), html.Span("workbench", className="brand-sub"),
                      *links], className="navbar")
