@@ -45,7 +45,7 @@ def _text(page: Path) -> str:
 def test_docs_build_in_strict_mode_with_every_page(site):
     for page in ("index", "model", "numerics", "validation", "http-api", "openapi", "cli", "python-api",
                  "continuation", "tutorials/index", "tutorials/reproduce-study", "tutorials/new-nes-design",
-                 "tutorials/dask-map"):
+                 "tutorials/dask-map", "tutorials/ground-runs"):
         assert (site / f"{page}.html").is_file(), page
 
 
@@ -65,6 +65,12 @@ def test_generated_tables_come_from_the_code(site):
     for schema in schemas.SCHEMAS.values():
         for f in schema.fields:
             assert f.allowed.replace("<", "&lt;") in api, (schema.name, f.name)
+    from shimmy.analyses.ground_profiles import PRESETS, preset_fields
+
+    numerics = _text(site / "numerics.html")
+    for name in PRESETS:
+        for f in preset_fields(name):
+            assert f"{f['low']:g} to {f['high']:g}" in numerics and f["description"] in numerics, (name, f["name"])
     cli = _text(site / "cli.html")
     sub = next(a for a in build_parser()._actions if hasattr(a, "choices") and isinstance(a.choices, dict))
     for command in sub.choices:
@@ -116,7 +122,8 @@ def _documented_commands() -> list[tuple[str, str]]:
 
 def test_the_docs_show_commands():
     pages = {page for page, _ in _documented_commands()}
-    assert {"tutorials/reproduce-study.md", "tutorials/new-nes-design.md", "tutorials/dask-map.md"} <= pages
+    assert {"tutorials/reproduce-study.md", "tutorials/new-nes-design.md", "tutorials/dask-map.md",
+            "tutorials/ground-runs.md"} <= pages
 
 
 @pytest.mark.parametrize("page,command", _documented_commands(),
@@ -133,7 +140,7 @@ def _examples_with_output() -> list[tuple[str, str, str]]:
     """(page, code, printed output) of every ```python block followed directly by a ```text block
     on the tutorial pages whose output does not depend on timing (the Dask page's does)."""
     found = []
-    for name in ("tutorials/reproduce-study.md", "tutorials/new-nes-design.md"):
+    for name in ("tutorials/reproduce-study.md", "tutorials/new-nes-design.md", "tutorials/ground-runs.md"):
         text = (DOCS / name).read_text()
         for code, output in re.findall(r"```python\n(.*?)```\n\n```text\n(.*?)```", text, flags=re.S):
             found.append((name, code, output))
@@ -142,7 +149,8 @@ def _examples_with_output() -> list[tuple[str, str, str]]:
 
 def test_the_tutorials_show_python_examples():
     assert {page for page, _, _ in _examples_with_output()} == {"tutorials/reproduce-study.md",
-                                                                "tutorials/new-nes-design.md"}
+                                                                "tutorials/new-nes-design.md",
+                                                                "tutorials/ground-runs.md"}
 
 
 @pytest.mark.slow

@@ -12,6 +12,8 @@
 * ``shimmy-limits``: the service's limits and environment variables (:mod:`shimmy.service.settings`).
 * ``shimmy-openapi``: the whole OpenAPI document as JSON.
 * ``shimmy-cli``: every subcommand of :func:`shimmy.cli.build_parser` with its options.
+* ``shimmy-ground-presets``: every setting of the ground-run presets with default and range
+  (:func:`shimmy.analyses.ground_profiles.preset_fields`).
 """
 
 from __future__ import annotations
@@ -174,6 +176,15 @@ class Limits(SphinxDirective):
         return [table(["limit", "value (default)", "environment variable"], rows, [6, 3, 4])]
 
 
+class GroundPresets(SphinxDirective):
+    def run(self):
+        from shimmy.analyses.ground_profiles import PRESETS, preset_fields
+        rows = [[_literal(name), _literal(f["name"]), f["unit"] or "–", _number(f["default"]),
+                 f"{_number(f['low'])} to {_number(f['high'])}", f["description"]]
+                for name in PRESETS for f in preset_fields(name)]
+        return [table(["preset", "setting", "unit", "default", "range", "meaning"], rows, [2, 3, 2, 2, 3, 6])]
+
+
 class OpenAPI(SphinxDirective):
     def run(self):
         from shimmy.service.api import openapi_document
@@ -309,6 +320,6 @@ def setup(app):
                       ("shimmy-calibration-targets", CalibrationTargets),
                       ("shimmy-endpoints", Endpoints), ("shimmy-request", Request),
                       ("shimmy-job-statuses", JobStatuses), ("shimmy-limits", Limits), ("shimmy-openapi", OpenAPI),
-                      ("shimmy-cli", CommandLine)):
+                      ("shimmy-cli", CommandLine), ("shimmy-ground-presets", GroundPresets)):
         app.add_directive(name, cls)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -18,9 +18,9 @@ profile gives the same history) and reports what a landing-gear engineer asks of
   bisection to 1e-9 s. These are the trajectory's intersections with the Hopf curves of
   :mod:`shimmy.analyses.hopf_curves`, found without continuing them (a test checks each lies on
   a continued curve). With ``cycle_curves=True`` also the crossings of the fold-of-cycles and
-  torus curves of :mod:`shimmy.analyses.cycle_curves` (several seconds per configuration the
-  first time, then kept for the process): intersections of the trajectory's table segments with
-  the curves' polylines.
+  torus curves of :mod:`shimmy.analyses.cycle_curves` (tens of seconds per configuration the
+  first time: the curves are continued over the whole load range; then kept for the process):
+  intersections of the trajectory's table segments with the curves' polylines.
 * **Onset delay**: from each crossing into the unstable region (x = 0 losing stability) to the
   first moment |psi| or |l_g delta| itself exceeds its threshold. A slowly varying parameter
   delays the onset well past the static Hopf point (the oscillation grows from the small
@@ -60,6 +60,9 @@ class GroundRunOptions:
     """Numerical settings and thresholds of a ground run (validated at construction).
 
     dt_out, rtol, atol, max_steps, exact_nes: as :class:`~shimmy.analyses.simulation.SimulationOptions`.
+    psi_threshold (rad, 1e-6 to 1) and lateral_threshold (m, of l_g delta, 1e-7 to 1): the envelope
+    above either counts as shimmy. envelope_window (s, 0.01 to 5): the centred window of the
+    envelopes' running maximum. cycle_curves: also the crossings of the fold and torus curves.
     """
 
     dt_out: float = 0.001
@@ -361,7 +364,11 @@ def _segment_hits(a: np.ndarray, b: np.ndarray, q: np.ndarray) -> list[tuple[flo
 
 @dataclass(frozen=True)
 class GroundRunComparison:
-    """One profile run for several configurations, each measure against ``original``."""
+    """One profile run for several configurations, each measure against ``original``.
+
+    :meth:`table` gives one row per configuration (time in shimmy, peaks, onset delay, speed range)
+    with, when ``original`` is among the runs, the change of the time in shimmy (s) and the ratios of
+    the peaks to those of ``original``."""
 
     profile: GroundProfile
     runs: dict[str, GroundRunResult]
