@@ -37,5 +37,11 @@ from ui import guard, layout  # noqa: E402  (needs the registered pages)
 app.layout = layout.shell()
 guard.install(app)
 
+# Dash sets itself up on a worker's first request (copying the registered callbacks into its map);
+# two first requests on a threaded worker raced there ("dictionary changed size during iteration",
+# a 500 for a page's scripts or layout). Done once here, at import, before any request.
+with server.test_request_context("/"):
+    app._setup_server()
+
 if __name__ == "__main__":
     app.run(host="127.0.0.1", port=int(os.environ.get("PORT", "8050")), debug=False)

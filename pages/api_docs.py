@@ -65,4 +65,4 @@ def layout(**query):
                  html.P("400 malformed body, 404 unknown endpoint or job, 405 wrong method, 413 body too large, "
                         "422 a field out of its range, of the wrong type, missing, NaN/inf, an unknown parameter or "
                         "configuration, or a solver that did not converge.", className="hint")]
-    return page(query, "api", *sections)
+    return page(query, "api", *sections, design=False)

@@ -48,12 +48,19 @@ def update(design):
                       line={"color": "#E69F00", "dash": "dash"})
     pd = style.figure("Particle damper: equivalent torsional damping", "tangential speed v = r |dpsi| (m/s)",
                       "c_eq = n r^2 c*(v) (N m s/rad)")
-    for curve in result["pd"]:
-        current = curve["material"] == "design"
-        pd.add_scatter(x=curve["speed"], y=curve["torsional_damping"],
-                       name="current design" if current else f"{curve['material']} preset",
-                       line={"color": MATERIAL_COLOURS.get(curve["material"], "#555"), "width": 3 if current else 2,
-                             "dash": "solid" if current else "dot"})
+    # The current design first, as a wide translucent band, then the presets over it as thin lines: a
+    # design equal to a preset shows both (the preset line runs inside the band), and says so.
+    curves = sorted(result["pd"], key=lambda c: c["material"] != "design")
+    design = next((c for c in curves if c["material"] == "design"), None)
+    same = [c["material"] for c in curves if design is not None and c is not design
+            and c["torsional_damping"] == design["torsional_damping"]]
+    for curve in curves:
+        current = curve is design
+        name = ("current design" + (f" (= {same[0]} preset)" if same else "")) if current \
+            else f"{curve['material']} preset"
+        colour = MATERIAL_COLOURS.get(curve["material"], "#555")
+        pd.add_scatter(x=curve["speed"], y=curve["torsional_damping"], name=name, opacity=0.45 if current else 1.0,
+                       line={"color": colour, "width": 7 if current else 2, "dash": "solid" if current else "dot"})
     errors = result["nes_cubic_error"]
     metrics = [_metric("k1 (N m/rad)", f"{nes['k1']:.5g}"), _metric("k3 (N m/rad^3)", f"{nes['k3']:.5g}")]
     metrics += [_metric(f"cubic error, |a| <= {a} rad", f"{100 * e:.2f} %") for a, e in errors.items()]

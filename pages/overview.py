@@ -9,6 +9,7 @@ from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
 from ui import jobs
+from ui.fields import Quantity
 from ui.layout import design_id, page
 from ui import style
 
@@ -17,18 +18,22 @@ dash.register_page(__name__, path="/", name="Overview", order=0)
 CONFIGS = ("original", "nes", "pd", "nes_pd")
 
 
-def layout(Fz: str = "150", vmax: str = "200", **query):
-    return layout_page(dict(query, Fz=Fz), [
+FZ = Quantity("stability", "Fz", "Fz", "kN", 1e3)
+V_MAX = Quantity("stability", "v_max", "highest speed", "m/s")
+
+
+def layout(Fz: str | None = None, vmax: str | None = None, **query):
+    fz, p_fz = FZ.from_url("Fz", Fz, 150)
+    v_max, p_v = V_MAX.from_url("vmax", vmax, 200)
+    return layout_page(query, [
         ui.header("Overview", "Linear stability of straight rolling for the four configurations at the current "
                   "design: the largest eigenvalue real part against speed (shimmy grows where it is positive), the "
                   "Hopf speed interval of each, and the (V, Fz) stability boundary."),
         html.Div([
-            ui.field("Vertical load Fz (kN)", dcc.Input(id="ov-fz", type="number", value=ui.number(Fz, 150), min=10,
-                                                       max=900, step="any", debounce=True)),
-            ui.field("Highest speed (m/s)", dcc.Input(id="ov-vmax", type="number", value=ui.number(vmax, 200), min=2,
-                                                     max=500, step="any", debounce=True)),
+            ui.field("Vertical load Fz (kN)", FZ.box("ov-fz", fz, debounce=True)),
+            ui.field("Highest speed (m/s)", V_MAX.box("ov-vmax", v_max, debounce=True)),
         ], className="controls"),
-        html.Div(id="ov-error", className="error", role="alert"),
+        html.Div(" ".join(p for p in (p_fz, p_v) if p), id="ov-error", className="error", role="alert"),
         ui.graph("ov-growth"),
         html.H2("Hopf speed interval at this load"),
         html.Div(id="ov-table"),
@@ -73,13 +78,12 @@ def layout_page(query, children):
     prevent_initial_call="initial_duplicate",
 )
 def update(design, fz_kn, v_max):
-    if fz_kn is None or v_max is None:
-        return (no_update,) * 3 + ("Fz must be a number in [10, 900] kN and the highest speed in [2, 500] m/s",
-                                   True, True, no_update)
     try:
-        result, _ = analyses.run("stability", {"Fz": float(fz_kn) * 1e3, "v_max": float(v_max), "n_points": 120,
+        result, _ = analyses.run("stability", {"Fz": FZ.read(fz_kn), "v_max": V_MAX.read(v_max), "n_points": 120,
                                               **design})
     except InvalidParameterError as exc:
+        if dash.ctx.triggered_id is None:  # the first drawing: the layout already says what of the address failed
+            return no_update, no_update, no_update, no_update, True, True, no_update
         return no_update, no_update, no_update, str(exc), True, True, no_update
     traces = []
     rows = []
@@ -101,7 +105,7 @@ def update(design, fz_kn, v_max):
         freq = data["hopf_points"][0]["frequency_hz"] if data["hopf_points"] else None
         rows.append([style.CONFIG_LABELS[config],
                      ", ".join(f"{a:.4g}–{b:.4g}" for a, b in intervals) or "stable",
-                     ui.fmt(onset), ui.fmt(end), "–" if d_onset is None else f"{d_onset:+.3g}", ui.fmt(freq),
+                     ui.fmt(onset), ui.fmt(end), ui.signed(d_onset), ui.fmt(freq),
                      ", ".join(h["criticality"] for h in data["hopf_points"]) or "–"])
     lay = style.layout(f"Growth rate of straight rolling at Fz = {fz_kn:g} kN", "forward speed V (m/s)",
                        "largest eigenvalue real part (1/s)", x_log=True)

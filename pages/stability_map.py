@@ -7,9 +7,11 @@ from urllib.parse import urlencode
 import dash
 from dash import Input, Output, State, dcc, html, no_update
 
+from shimmy.errors import InvalidParameterError
 from ui import components as ui
-from ui import jobs
+from ui import fields, jobs
 from ui import style
+from ui.fields import Quantity
 from ui.layout import design_id, page
 
 dash.register_page(__name__, path="/stability-map", name="Stability map", order=4)
@@ -20,40 +22,51 @@ CURVE_STYLES = {"hopf_curves": ("Hopf", "solid", 2.6), "fold_curves": ("fold of 
                 "torus_curves": ("torus", "dot", 2.2)}
 
 
-def layout(shade: str = "original", overlay: str = "", fz_min: str = "10", fz_max: str = "900", v_min: str = "1",
-           v_max: str = "200", resolution: str = "40", **query):
-    shade = shade if shade in CONFIGS else "original"
-    others = [c for c in overlay.split(",") if c in CONFIGS and c != shade]
+FZ_MIN = Quantity("map", "fz_min", "Fz from", "kN", 1e3)
+FZ_MAX = Quantity("map", "fz_max", "Fz to", "kN", 1e3)
+V_MIN = Quantity("map", "v_min", "V from", "m/s")
+V_MAX = Quantity("map", "v_max", "V to", "m/s")
+SLICES = Quantity("map", "resolution", "Fz slices", "")
+WAITING = "Press Compute: tens of seconds per configuration cold on 2 cores, instant from the cache"
+HEIGHT, BOTTOM = 740, 176
+
+
+def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | None = None,
+           fz_max: str | None = None, v_min: str | None = None, v_max: str | None = None,
+           resolution: str | None = None, **query):
+    shade, bad_shade = fields.choice("shade", shade, list(CONFIGS), "original", "a configuration")
+    others, bad_overlay = fields.choices_list("overlay", overlay, CONFIGS, [], "a configuration")
+    others = [c for c in others if c != shade]
+    values, problems = {}, [bad_shade, bad_overlay]
+    for key, q, raw, default in (("fz_min", FZ_MIN, fz_min, 10), ("fz_max", FZ_MAX, fz_max, 900),
+                                 ("v_min", V_MIN, v_min, 1), ("v_max", V_MAX, v_max, 200),
+                                 ("resolution", SLICES, resolution, SLICES.spec.default)):
+        values[key], problem = q.from_url(key, raw, default)
+        problems.append(problem)
     return page(
         query, "map",
         ui.header("Stability map", "The (V, Fz) plane shaded by shimmy type, from the stable attractors on each load "
                   "slice (equilibrium, torsional and lateral limit cycles, including those reached from large "
                   "torsional and lateral starts; simulation where none is stable). Hopf, fold-of-cycles and torus "
-                  "curves, GH and double-Hopf points by two-parameter continuation. Click a point to open its "
-                  "time history."),
+                  "curves, GH and double-Hopf points by two-parameter continuation; the operating points A-I "
+                  "marked. Click a point to open its time history."),
         html.Div([
             ui.field("Shade by", dcc.Dropdown(id="map-shade", value=shade, clearable=False, style={"width": "150px"},
                                               options=[{"label": style.CONFIG_LABELS[c], "value": c}
                                                        for c in CONFIGS])),
             ui.field("Overlay curves of", dcc.Checklist(id="map-overlay", value=others, inline=True, options=[
                 {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
-            ui.field("Fz from (kN)", dcc.Input(id="map-fzmin", type="number", value=ui.number(fz_min, 10), min=10,
-                                               max=900, step="any")),
-            ui.field("to (kN)", dcc.Input(id="map-fzmax", type="number", value=ui.number(fz_max, 900), min=10,
-                                          max=900, step="any")),
-            ui.field("V from (m/s)", dcc.Input(id="map-vmin", type="number", value=ui.number(v_min, 1), min=1,
-                                               max=500, step="any")),
-            ui.field("to (m/s)", dcc.Input(id="map-vmax", type="number", value=ui.number(v_max, 200), min=1,
-                                           max=500, step="any")),
-            ui.field("Fz slices", dcc.Input(id="map-res", type="number", value=ui.number(resolution, 40), min=2,
-                                            max=80, step=1)),
+            html.Div([ui.field("Fz from (kN)", FZ_MIN.box("map-fzmin", values["fz_min"])),
+                      ui.field("to (kN)", FZ_MAX.box("map-fzmax", values["fz_max"]))], className="pair"),
+            html.Div([ui.field("V from (m/s)", V_MIN.box("map-vmin", values["v_min"])),
+                      ui.field("to (m/s)", V_MAX.box("map-vmax", values["v_max"]))], className="pair"),
+            ui.field(f"Fz slices ({SLICES.low:g}-{SLICES.high:g})", SLICES.box("map-res", values["resolution"])),
             *jobs.controls("map"),
         ], className="controls"),
-        html.Div(id="map-error", className="error", role="alert"),
-        ui.graph("map-graph", figure=style.message_figure("Press Compute: about 35 s per configuration at 40 slices "
-                                                          "cold on 2 cores, instant from the cache", 600)),
+        html.Div(" ".join(p for p in problems if p), id="map-error", className="error", role="alert"),
+        ui.graph("map-graph", figure=style.message_figure(WAITING, 600)),
         html.Div(id="map-hint", className="hint"),
-        html.Div(id="map-table"),
+        html.Div(id="map-table", className="table-wrap"),
         ui.downloads("map"),
         *jobs.stores("map"),
         dcc.Location(id="map-nav", refresh="callback-nav"),
@@ -62,12 +75,17 @@ def layout(shade: str = "original", overlay: str = "", fz_min: str = "10", fz_ma
 
 def _requests(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, design):
     configs = [shade] + [c for c in overlay or [] if c != shade]
-
-    def kn(x):
-        return None if x is None else float(x) * 1e3
-
-    return [{"config": c, "fz_min": kn(fz_min), "fz_max": kn(fz_max), "v_min": v_min, "v_max": v_max,
-             "resolution": resolution, **design} for c in configs]
+    lo, hi = FZ_MIN.read(fz_min), FZ_MAX.read(fz_max)
+    if not hi > lo:
+        raise InvalidParameterError("fz_max", fz_max, f"above {fz_min:g} kN",
+                                    message=f"Fz to = {fz_max:g} kN must exceed Fz from = {fz_min:g} kN")
+    v_lo, v_hi = V_MIN.read(v_min), V_MAX.read(v_max)
+    if not v_hi > v_lo:
+        raise InvalidParameterError("v_max", v_max, f"above {v_min:g} m/s",
+                                    message=f"V to = {v_max:g} m/s must exceed V from = {v_min:g} m/s")
+    slices = SLICES.read(resolution)
+    return [{"config": c, "fz_min": lo, "fz_max": hi, "v_min": v_lo, "v_max": v_hi, "resolution": slices, **design}
+            for c in configs]
 
 
 CONTROLS = (State("map-shade", "value"), State("map-overlay", "value"), State("map-fzmin", "value"),
@@ -85,11 +103,17 @@ jobs.register(
     "map", "map", requests=_requests, render=lambda results: (figure(results), summary(results)),
     outputs=[Output("map-graph", "figure"), Output("map-table", "children")], states=CONTROLS,
     lock=["map-shade", "map-res", "map-fzmin", "map-fzmax", "map-vmin", "map-vmax"],
-    download=jobs.Download("map", "stability_map", _csv_rows))
+    download=jobs.Download("map", "stability_map", _csv_rows),
+    blank=lambda: (style.message_figure("Refused: see the message above", 600), None))
+
+
+MARKERS = {"gh_points": ("GH", "diamond", 12), "double_hopf_points": ("double Hopf", "star", 13)}
 
 
 def figure(results):
-    """The first map shaded by type; the curves of every map in its configuration's colour."""
+    """The first map shaded by type; the curves of every map in its configuration's colour; the
+    operating points A-I. Three legends: configuration (colour), curve and point kind (line style,
+    marker), shimmy type (shading)."""
     shaded = results[0]
     grid = shaded.get("shading") or shaded  # read off the curves; a map without it: its slices
     V, Fz = grid["V"], [f / 1e3 for f in grid["Fz"]]
@@ -99,47 +123,59 @@ def figure(results):
     for k, t in enumerate(TYPES):  # a stepped scale: code k -> its type's colour
         scale += [[k / n, style.SHIMMY_TYPE_COLOURS[t]], [(k + 1) / n, style.SHIMMY_TYPE_COLOURS[t]]]
     fig = style.figure(f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)",
-                       "forward speed V (m/s)", "vertical load Fz (kN)", height=640)
-    fig.add_heatmap(x=V, y=Fz, z=codes, zmin=0, zmax=n, colorscale=scale, showscale=False, opacity=0.55,
-                    customdata=grid["types"], name="shimmy type",
+                       "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    fig.add_heatmap(x=V, y=Fz, z=codes, zmin=0, zmax=n, colorscale=scale, showscale=False, opacity=0.6,
+                    customdata=grid["types"], name="shimmy type", showlegend=False,
                     hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history</extra>")
-    for t in TYPES:  # legend entries for the shading
-        fig.add_scatter(x=[None], y=[None], mode="markers", name=t, legendgroup="types",
-                        marker={"symbol": "square", "size": 13, "color": style.SHIMMY_TYPE_COLOURS[t],
-                                "line": {"width": 1, "color": "#888"}})
     for result in results:
         config = result["config"]
         colour, label = style.CONFIG_COLOURS[config], style.CONFIG_LABELS[config]
         for key, (kind, dash_style, width) in CURVE_STYLES.items():
-            for i, curve in enumerate(result[key]):
+            for curve in result[key]:
                 fig.add_scatter(x=[p["V"] for p in curve], y=[p["Fz"] / 1e3 for p in curve], mode="lines",
-                                name=f"{label}: {kind}", legendgroup=f"{config}-{key}", showlegend=i == 0,
+                                name=f"{label}: {kind}", legendgroup=config, showlegend=False,
                                 line={"color": colour, "dash": dash_style, "width": width},
-                                marker={"size": 4, "color": colour},
                                 hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
-        if result["gh_points"]:
-            fig.add_scatter(x=[g["V"] for g in result["gh_points"]], y=[g["Fz"] / 1e3 for g in result["gh_points"]],
-                            mode="markers", name=f"{label}: GH", legendgroup=f"{config}-gh",
-                            marker={"symbol": "diamond", "size": 12, "color": colour,
-                                    "line": {"width": 1.5, "color": "#fff"}},
-                            hovertemplate=f"{label} GH point<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
-        hh = result.get("double_hopf_points") or []
-        if hh:  # where two Hopf curves cross and torus curves are born
-            fig.add_scatter(x=[g["V"] for g in hh], y=[g["Fz"] / 1e3 for g in hh], mode="markers",
-                            name=f"{label}: double Hopf", legendgroup=f"{config}-hh",
-                            marker={"symbol": "star", "size": 13, "color": colour,
-                                    "line": {"width": 1.5, "color": "#fff"}},
-                            hovertemplate=f"{label} double-Hopf point<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN"
-                                          "<extra></extra>")
+        for key, (kind, symbol, size) in MARKERS.items():
+            points = result.get(key) or []
+            if points:
+                fig.add_scatter(x=[g["V"] for g in points], y=[g["Fz"] / 1e3 for g in points], mode="markers",
+                                name=f"{label}: {kind}", legendgroup=config, showlegend=False,
+                                marker={"symbol": symbol, "size": size, "color": colour,
+                                        "line": {"width": 1.5, "color": "#fff"}},
+                                hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
+    inside = [(name, v, f) for name, (v, f) in ui.OPERATING_POINTS.items()
+              if min(V) <= v <= max(V) and min(Fz) <= f <= max(Fz)]
+    if inside:
+        fig.add_scatter(x=[v for _, v, _ in inside], y=[f for _, _, f in inside], mode="markers+text",
+                        text=[name for name, _, _ in inside], textposition="top right",
+                        textfont={"size": 13, "color": "#111"}, name="points A-I", legend="legend2",
+                        marker={"symbol": "circle", "size": 9, "color": "#fff", "line": {"width": 2, "color": "#111"}},
+                        hovertemplate="operating point %{text}<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN<extra></extra>")
+    for result in results:
+        config = result["config"]
+        style.legend_key(fig, style.CONFIG_LABELS[config], "legend", group=config, mode="lines",
+                         line={"color": style.CONFIG_COLOURS[config], "width": 3})
+    for kind, dash_style, width in CURVE_STYLES.values():
+        style.legend_key(fig, kind, "legend2", mode="lines",
+                         line={"color": "#444", "dash": dash_style, "width": width})
+    for kind, symbol, size in MARKERS.values():
+        style.legend_key(fig, kind, "legend2", mode="markers",
+                         marker={"symbol": symbol, "size": size - 2, "color": "#444"})
+    for t in TYPES:
+        style.legend_key(fig, t, "legend3", mode="markers",
+                         marker={"symbol": "square", "size": 13, "color": style.SHIMMY_TYPE_COLOURS[t],
+                                 "opacity": 0.75, "line": {"width": 1, "color": "#888"}})
     fig.update_xaxes(range=[min(V), max(V)])
     fig.update_yaxes(range=[min(Fz), max(Fz)])
-    fig.update_layout(legend={"orientation": "h", "y": -0.13, "x": 0})
+    fig.update_layout(margin={**style.MARGIN, "b": BOTTOM})
+    style.legends(fig, ["configuration (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM)
     return fig
 
 
 def _pct(value, base):
     """Relative change against original, for the table."""
-    return "–" if value is None or not base else f"{100 * (value - base) / base:+.1f} %"
+    return "–" if value is None or not base else ui.pct(100 * (value - base) / base, 1)
 
 
 def summary(results):
@@ -174,7 +210,7 @@ def open_time_history(click, requests):
     point = click["points"][0]
     V, fz_kn = float(point["x"]), float(point["y"])
     request = requests[0]
-    query = {"config": request["config"], "V": f"{V:.6g}", "Fz": f"{fz_kn:.6g}"}
+    query = {"config": request["config"], "V": f"{V:.6g}", "Fz": f"{fz_kn:.6g}", "run": "1"}
     query.update({k: f"{v:.10g}" for k, v in (request.get("params") or {}).items()})
     if request.get("material") not in (None, "steel"):
         query["material"] = request["material"]

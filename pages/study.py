@@ -7,10 +7,12 @@ from dash import Input, Output, State, dcc, html
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
+from shimmy.model.configurations import affects
 from shimmy.model.parameters import PARAMETER_SPECS
 from ui import components as ui
-from ui import jobs
+from ui import fields, jobs
 from ui import style
+from ui.fields import Quantity
 from ui.layout import design_id, page
 
 dash.register_page(__name__, path="/study", name="Parametric study", order=5)
@@ -24,35 +26,46 @@ def _unit(name: str) -> str:
     return f" ({unit})" if unit else ""
 
 
-def layout(parameter: str = "e_p", values: str = DEFAULT_VALUES, configs: str = "original,nes,pd,nes_pd",
-           Fz: str = "150", **query):
-    parameter = parameter if parameter in PARAMETER_SPECS else "e_p"
-    chosen = [c for c in configs.split(",") if c in CONFIGS] or list(CONFIGS)
+FZ = Quantity("study", "Fz", "Fz", "kN", 1e3)
+WAITING = "Press Compute: about 0.5-2 s per design and configuration cold, instant from the cache"
+TABLE_VIEWS = {"long": "one row per value and configuration", "pivot": "one row per value, configurations side by side"}
+
+
+def layout(parameter: str | None = None, values: str = DEFAULT_VALUES, configs: str | None = None,
+           Fz: str | None = None, table: str | None = None, **query):
+    parameter, bad_parameter = fields.choice("parameter", parameter, list(PARAMETER_SPECS), "e_p", "a parameter")
+    chosen, bad_configs = fields.choices_list("configs", configs, CONFIGS, list(CONFIGS), "a configuration")
+    fz, bad_fz = FZ.from_url("Fz", Fz, 150)
+    view, bad_view = fields.choice("table", table, list(TABLE_VIEWS), "long", "a table layout")
+    problems = " ".join(p for p in (bad_parameter, bad_configs, bad_fz, bad_view) if p)
     return page(
         query, "study",
         ui.header("Parametric study", "Sweep one design parameter (the others at the current design) and tabulate, "
                   "per configuration, the first and last Hopf speed of straight rolling (shimmy onset and end of the "
                   "linear instability) and the largest torsional amplitude of a stable limit cycle, from a "
-                  "bifurcation diagram per design. Two-parameter grids: API and command line."),
+                  "bifurcation diagram per design. A device's parameter is studied only in the configurations that "
+                  "have the device. Two-parameter grids: API and command line."),
         html.Div([
             ui.field("Parameter", dcc.Dropdown(id="study-param", value=parameter, clearable=False,
-                                               style={"width": "150px"},
+                                               style={"width": "170px"},
                                                options=[{"label": f"{n}{_unit(n)}", "value": n}
                                                         for n in PARAMETER_SPECS])),
-            ui.field("Values (comma-separated)", dcc.Input(id="study-values", type="text", value=values,
-                                                           style={"width": "300px"}),
-                     hint=""),
-            ui.field("Fz (kN)", dcc.Input(id="study-fz", type="number", value=ui.number(Fz, 150), min=10, max=900,
-                                          step="any")),
+            html.Div(ui.field("Values (comma-separated)", dcc.Input(id="study-values", type="text", value=values,
+                                                                    debounce=True)), className="wide"),
+            ui.field("Fz (kN)", FZ.box("study-fz", fz)),
             ui.field("Configurations", dcc.Checklist(id="study-configs", value=chosen, inline=True, options=[
                 {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
             *jobs.controls("study"),
         ], className="controls"),
         html.Div(id="study-range", className="hint"),
-        html.Div(id="study-error", className="error", role="alert"),
-        ui.graph("study-graph", figure=style.message_figure("Press Compute: about 0.5-2 s per design and "
-                                                            "configuration cold, instant from the cache", 560)),
-        html.Div(id="study-table"),
+        html.Div(problems, id="study-error", className="error", role="alert"),
+        html.Div(id="study-skipped", className="hint", role="status"),
+        html.Div([ui.field("Amplitude axis", dcc.Checklist(id="study-log", value=[], inline=True,
+                                                           options=[{"label": "logarithmic", "value": "log"}])),
+                  ui.field("Table", dcc.RadioItems(id="study-view", value=view, inline=True, options=[
+                      {"label": label, "value": k} for k, label in TABLE_VIEWS.items()]))], className="controls"),
+        ui.graph("study-graph", figure=style.message_figure(WAITING, 560)),
+        html.Div(id="study-table", className=f"table-wrap view-{view}"),
         ui.downloads("study"),
         *jobs.stores("study", "study-request"),
     )
@@ -64,18 +77,49 @@ def allowed(name):
     return f"{name}: {spec.description}; {spec.allowed}; current default {spec.default:g}"
 
 
+@dash.callback(Output("study-skipped", "children"), Input("study-param", "value"), Input("study-configs", "value"))
+def skipped(name, configs):
+    """Which chosen configurations the parameter cannot affect (they are left out of the study)."""
+    out = [c for c in configs or [] if not affects(name, c)]
+    if not out:
+        return ""
+    device = {"nes": "the NES", "pd": "the particle damper"}.get(PARAMETER_SPECS[name].group, "")
+    return (f"Skipped: {', '.join(style.CONFIG_LABELS[c] for c in out)} — {name} is a parameter of {device}, "
+            f"which {'this configuration does' if len(out) == 1 else 'these configurations do'} not have "
+            "(its curve would be a flat line).")
+
+
 def _request(parameter, text, fz_kn, configs, design):
     """The study request; a value that is not a number is reported by its position, like the API does."""
+    spec = PARAMETER_SPECS[parameter]
+    if not text or not text.strip():
+        raise InvalidParameterError("values", text, spec.allowed,
+                                    message=f"Values is empty: enter comma-separated values of {parameter}, "
+                                            f"each {spec.allowed}")
     values = []
-    for k, item in enumerate(t.strip() for t in (text or "").split(",")):
+    for k, item in enumerate(t.strip() for t in text.split(",")):
         if not item:
             continue
         try:
             values.append(float(item))
         except ValueError:
-            raise InvalidParameterError(f"values[{k}]", item, "a number", "is not a number") from None
-    return {"parameter": parameter, "values": values, "configs": configs or [],
-            "Fz": None if fz_kn is None else float(fz_kn) * 1e3, **design}
+            raise InvalidParameterError(f"values[{k}]", item, spec.allowed,
+                                        message=f"value {k + 1} ({item!r}) is not a number; enter "
+                                                f"{spec.allowed}") from None
+        if not spec.low <= values[-1] <= spec.high:
+            unit = f" {spec.unit}" if spec.unit else ""
+            raise InvalidParameterError(f"values[{k}]", values[-1], spec.allowed,
+                                        message=f"value {k + 1}: {parameter} = {item}{unit} is outside "
+                                                f"[{spec.low:g}, {spec.high:g}]{unit}")
+    if not configs:
+        raise InvalidParameterError("configs", "", ", ".join(CONFIGS), message="Configurations: none chosen; "
+                                    "choose at least one")
+    studied = [c for c in configs if affects(parameter, c)]
+    if not studied:
+        raise InvalidParameterError("configs", ",".join(configs), "a configuration the parameter enters",
+                                    message=f"{parameter} enters none of the chosen configurations: choose one "
+                                            "with its device")
+    return {"parameter": parameter, "values": values, "configs": studied, "Fz": FZ.read(fz_kn), **design}
 
 
 CONTROLS = (State("study-param", "value"), State("study-values", "value"), State("study-fz", "value"),
@@ -95,7 +139,8 @@ jobs.register(
     render=lambda results: (figure(results[0]), summary(results[0])),
     outputs=[Output("study-graph", "figure"), Output("study-table", "children")], states=CONTROLS,
     lock=["study-param", "study-values", "study-fz"], store="study-request",
-    download=jobs.Download("study", "study", _csv_rows, single=True))
+    download=jobs.Download("study", "study", _csv_rows, single=True),
+    blank=lambda: (style.message_figure("Refused: see the message above", 560), None))
 
 
 def figure(result):
@@ -109,8 +154,8 @@ def figure(result):
             fig.add_scatter(x=x, y=[r[key] for r in rows], mode="lines+markers", name=label, legendgroup=config,
                             showlegend=row == 1, line={"color": colour, "width": 2}, marker={"size": 7},
                             hovertemplate=f"{label}<br>{name} %{{x:.4g}}<br>%{{y:.5g}}<extra></extra>", row=row, col=1)
-    fig.update_layout(title={"text": f"Study in {name} at Fz = {result['Fz'] / 1e3:g} kN", "x": 0.01}, height=640,
-                      template="plotly_white", margin={"l": 70, "r": 16, "t": 44, "b": 48},
+    fig.update_layout(title=style.title(f"Study in {name} at Fz = {result['Fz'] / 1e3:g} kN"), height=660,
+                      template="plotly_white", margin={**style.MARGIN, "l": 70},
                       legend={"orientation": "h", "y": -0.1})
     fig.update_xaxes(title_text=f"{name}{_unit(name)}", row=3, col=1)
     fig.update_yaxes(title_text="first Hopf V (m/s)", row=1, col=1)
@@ -120,16 +165,55 @@ def figure(result):
 
 
 def summary(result):
+    """Both layouts of the table (the page shows the one chosen): long, and pivoted by configuration."""
     name = result["parameters"][0]
+    ordered = sorted(result["rows"], key=lambda r: (r[name], CONFIGS.index(r["config"])))
     rows = [[f"{r[name]:.6g}", style.CONFIG_LABELS[r["config"]], ui.fmt(r["hopf_start"], 6), ui.fmt(r["hopf_end"], 6),
              ui.fmt(r["max_psi"], 5), ui.fmt(r["max_psi_V"], 4), "; ".join(r["warnings"]) or "–"]
-            for r in sorted(result["rows"], key=lambda r: (r[name], CONFIGS.index(r["config"])))]
-    return ui.table([f"{name}{_unit(name)}", "configuration", "first Hopf V (m/s)", "last Hopf V (m/s)",
+            for r in ordered]
+    long = ui.table([f"{name}{_unit(name)}", "configuration", "first Hopf V (m/s)", "last Hopf V (m/s)",
                      "max stable |psi| (rad)", "at V (m/s)", "warnings"], rows, "study-summary")
+    configs = [c for c in CONFIGS if c in result["configs"]]
+    by_value: dict[float, dict[str, dict]] = {}
+    for r in ordered:
+        by_value.setdefault(r[name], {})[r["config"]] = r
+    columns = [f"{name}{_unit(name)}"]
+    for what in ("first Hopf V (m/s)", "last Hopf V (m/s)", "max |psi| (rad)"):
+        columns += [f"{what}, {style.CONFIG_LABELS[c]}" for c in configs]
+    pivot_rows = []
+    for value, per in by_value.items():
+        row = [f"{value:.6g}"]
+        for key, digits in (("hopf_start", 6), ("hopf_end", 6), ("max_psi", 5)):
+            row += [ui.fmt(per[c][key], digits) if c in per else "–" for c in configs]
+        pivot_rows.append(row)
+    pivot = ui.table(columns, pivot_rows, "study-pivot")
+    return [html.Div(long, className="study-long"), html.Div(pivot, className="study-pivot")]
+
+
+# The table layout and the amplitude axis are views of the shown result: switched in the browser.
+dash.clientside_callback(
+    """function(view) { return "table-wrap view-" + (view || "long"); }""",
+    Output("study-table", "className"), Input("study-view", "value"))
+
+dash.clientside_callback(
+    """
+    function(log, fig) {
+        const C = window.dash_clientside;
+        if (!fig || !fig.layout || !fig.layout.yaxis3) { return C.no_update; }
+        const type = (log || []).includes("log") ? "log" : "linear";
+        if ((fig.layout.yaxis3.type || "linear") === type) { return C.no_update; }
+        const layout = Object.assign({}, fig.layout, {yaxis3: Object.assign({}, fig.layout.yaxis3, {type: type,
+                                     autorange: true})});
+        return Object.assign({}, fig, {layout: layout});
+    }
+    """,
+    Output("study-graph", "figure", allow_duplicate=True), Input("study-log", "value"), Input("study-graph", "figure"),
+    prevent_initial_call=True)
 
 
 @dash.callback(Output("url-update", "data", allow_duplicate=True),
                Input("study-param", "value"), Input("study-values", "value"), Input("study-fz", "value"),
-               Input("study-configs", "value"), prevent_initial_call=True)
-def remember(parameter, values, fz, configs):
-    return {"parameter": parameter, "values": values, "Fz": fz, "configs": ",".join(configs or [])}
+               Input("study-configs", "value"), Input("study-view", "value"), prevent_initial_call=True)
+def remember(parameter, values, fz, configs, view):
+    return {"parameter": parameter, "values": values, "Fz": fz, "configs": ",".join(configs or []),
+            "table": None if view == "long" else view}

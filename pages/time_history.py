@@ -2,52 +2,88 @@
 
 from __future__ import annotations
 
+import math
+
 import dash
 import numpy as np
 from dash import Input, Output, State, dcc, html, no_update
 from plotly.subplots import make_subplots
 
-from shimmy.errors import InvalidParameterError
-from shimmy.service import schemas
+from shimmy.service import settings
 from ui import components as ui
-from ui import jobs
+from ui import fields, jobs
 from ui import style
+from ui.fields import Quantity
 from ui.layout import design_id, page
 
 dash.register_page(__name__, path="/time-history", name="Time history", order=2)
 
 CONFIG_OPTIONS = [{"label": style.CONFIG_LABELS[c], "value": c} for c in style.CONFIG_COLOURS]
+SPEED = Quantity("simulate", "V", "V", "m/s")
+FZ = Quantity("simulate", "Fz", "Fz", "kN", 1e3)
+T_END = Quantity("simulate", "t_end", "simulated time", "s")
+PSI0 = Quantity("simulate", "psi0", "initial psi", "rad")
+LATERAL0 = Quantity("simulate", "lateral0", "initial l_g delta", "m")
+#: The starts offered: REFERENCE.md's, and one large enough to reach each attractor of a bistable point.
+STARTS = {"standard": ("standard: psi = 0.001 rad", 0.001, 0.0),
+          "torsional": ("large torsional: psi = 0.2 rad", 0.2, 0.0),
+          "lateral": ("large lateral: l_g delta = 0.1 m", 0.0, 0.1),
+          "typed": ("values typed below", None, None)}
+WAITING = "Choose an operating point and press Run (a result already in the cache is shown at once)"
 
 
+def _placeholders(text: str = WAITING) -> tuple:
+    return (style.message_figure(text, 420), style.message_figure("The spectrum of the steady window appears here"),
+            style.message_figure("The phase portrait appears here"), [])
 
-def layout(config: str = "nes_pd", V: str = "30", Fz: str = "150", t_end: str = "60", **query):
-    config = config if config in style.CONFIG_COLOURS else "nes_pd"
+
+def _start_of(psi0, lateral0) -> str:
+    return next((k for k, (_, p, q) in STARTS.items() if p == psi0 and q == lateral0), "typed")
+
+
+def layout(config: str | None = None, V: str | None = None, Fz: str | None = None, t_end: str | None = None,
+           psi0: str | None = None, lateral0: str | None = None, run: str | None = None, **query):
+    config, bad_config = fields.choice("config", config, list(style.CONFIG_COLOURS), "nes_pd", "a configuration")
+    problems = [bad_config]
+    v, problem_v = SPEED.from_url("V", V, 30)
+    fz, problem_fz = FZ.from_url("Fz", Fz, 150)
+    t, problem_t = T_END.from_url("t_end", t_end, 60)
+    p0, problem_p = PSI0.from_url("psi0", psi0, 0.001)
+    l0, problem_l = LATERAL0.from_url("lateral0", lateral0, 0.0)
+    problems += [problem_v, problem_fz, problem_t, problem_p, problem_l]
+    series, spectrum, phase, _ = _placeholders()
     return page(
         query, "th",
-        ui.header("Time history", "The gear at one operating point, started from psi = 0.001 rad (REFERENCE.md): "
-                  "torsion and lateral bending against time, the spectrum of the steady window with its dominant "
-                  "frequency, and the torsional phase portrait. Runs in the background; repeated questions come "
-                  "from the cache."),
+        ui.header("Time history", "The gear at one operating point, from a start you choose (REFERENCE.md's is "
+                  "psi = 0.001 rad, the rest at rest): torsion and lateral bending against time, the spectrum of the "
+                  "steady window with its dominant frequency, and the torsional phase portrait. A bistable point "
+                  "settles on a different limit cycle from a large torsional or a large lateral start. Runs in the "
+                  "background; repeated questions come from the cache."),
         html.Div([
             ui.field("Configuration", dcc.Dropdown(id="th-config", options=CONFIG_OPTIONS, value=config,
                                                    clearable=False, style={"width": "160px"})),
-            ui.field("V (m/s)", dcc.Input(id="th-v", type="number", value=ui.number(V, 30), min=1, max=500, step="any",
-                                          debounce=True)),
-            ui.field("Fz (kN)", dcc.Input(id="th-fz", type="number", value=ui.number(Fz, 150), min=10, max=900,
-                                          debounce=True, step="any")),
-            ui.field("Simulated time (s)", dcc.Input(id="th-tend", type="number", value=ui.number(t_end, 60), min=1,
-                                                     max=600, step="any")),
+            ui.field("V (m/s)", SPEED.box("th-v", v, debounce=True)),
+            ui.field("Fz (kN)", FZ.box("th-fz", fz, debounce=True)),
+            ui.field("Simulated time (s)", T_END.box("th-tend", t)),
+            ui.field("Start", dcc.Dropdown(id="th-start", value=_start_of(p0, l0), clearable=False,
+                                           style={"width": "250px"}, options=[
+                                               {"label": label, "value": k} for k, (label, _, _) in STARTS.items()])),
+            html.Div([ui.field("psi0 (rad)", PSI0.box("th-psi0", p0)),
+                      ui.field("l_g delta0 (m)", LATERAL0.box("th-lat0", l0))], className="pair"),
             *jobs.controls("th", "Run"),
         ], className="controls"),
         html.Div([html.Span("Operating points: ", className="hint"),
                   *[html.Button(f"{name} ({v} m/s, {f} kN)", id={"type": "th-op", "name": name}, className="secondary")
                     for name, (v, f) in ui.OPERATING_POINTS.items()]], className="op-buttons"),
-        html.Div(id="th-error", className="error", role="alert"),
+        html.Div(" ".join(p for p in problems if p), id="th-error", className="error", role="alert"),
+        html.Div(id="th-settled", className="settled", role="status"),
         html.Div(id="th-metrics", className="metrics"),
-        ui.graph("th-series", figure=style.message_figure("Choose an operating point and press Run")),
-        html.Div([ui.graph("th-spectrum"), ui.graph("th-phase")], className="grid-2"),
+        ui.graph("th-series", figure=series),
+        html.Div([ui.graph("th-spectrum", figure=spectrum), ui.graph("th-phase", figure=phase)], className="grid-2"),
         ui.downloads("th"),
         *jobs.stores("th", "th-request"),
+        # ?run=1 (a click on a map point): run once the page is drawn, as if Run had been pressed.
+        dcc.Interval(id="th-autorun", interval=200, max_intervals=1, disabled=run != "1"),
     )
 
 
@@ -61,21 +97,23 @@ def operating_point(_clicks):
     return v, f
 
 
-def _request(V, fz_kn, config, t_end, design):
-    return {"config": config, "V": V, "Fz": None if fz_kn is None else float(fz_kn) * 1e3, "t_end": t_end,
-            "include_series": True, **design}
+@dash.callback(Output("th-start", "value"), Output("th-psi0", "value"), Output("th-lat0", "value"),
+               Input("th-start", "value"), Input("th-psi0", "value"), Input("th-lat0", "value"),
+               prevent_initial_call=True)
+def start(choice, psi0, lateral0):
+    """A start chosen fills its values in; values typed in make the choice "typed" (unless they are a preset's)."""
+    if dash.ctx.triggered_id == "th-start":
+        _, p, q = STARTS.get(choice, STARTS["typed"])
+        return no_update, (psi0 if p is None else p), (lateral0 if q is None else q)
+    return _start_of(psi0, lateral0), no_update, no_update
 
 
-def _requests(V, fz_kn, config, t_end, design):
-    request = _request(V, fz_kn, config, t_end, design)
-    try:
-        schemas.validate("simulate", request)
-    except InvalidParameterError as exc:
-        if exc.field == "Fz":
-            raise InvalidParameterError("Fz", fz_kn, "a number in [10, 900] kN",
-                                        message=f"Fz={fz_kn!r} kN is outside [10, 900] kN") from None
-        raise
-    return [request]
+def _requests(V, fz_kn, _autorun, config, t_end, psi0, lateral0, design):
+    t = T_END.read(t_end)
+    # The series is thinned for a long run: every t_end the field allows can be drawn.
+    series_dt = max(0.002, math.ceil(1000 * t / (settings.MAX_SERIES_POINTS - 1)) / 1000)
+    return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": t, "psi0": PSI0.read(psi0),
+             "lateral0": LATERAL0.read(lateral0), "include_series": True, "series_dt": series_dt, **design}]
 
 
 def _csv_rows(results):
@@ -90,13 +128,15 @@ def _file_stem(results):
 
 
 jobs.register(
-    "th", "simulate", requests=_requests, initial=True,
-    render=lambda results: (*_figures(results[0]), _metrics(results[0])),
+    "th", "simulate", requests=_requests, blank=lambda: (*_placeholders("Refused: see the message above"), ""),
+    running=lambda: (*_placeholders("Running the time history…"), ""),
+    render=lambda results: (*_figures(results[0]), _metrics(results[0]), settled(results[0])),
     notice=lambda results: "" if results[0]["success"] else results[0]["message"],
     outputs=[Output("th-series", "figure"), Output("th-spectrum", "figure"), Output("th-phase", "figure"),
-             Output("th-metrics", "children")],
-    triggers=[Input("th-v", "value"), Input("th-fz", "value")],
-    states=[State("th-config", "value"), State("th-tend", "value"), State(design_id("th"), "data")],
+             Output("th-metrics", "children"), Output("th-settled", "children")],
+    triggers=[Input("th-v", "value"), Input("th-fz", "value"), Input("th-autorun", "n_intervals")],
+    states=[State("th-config", "value"), State("th-tend", "value"), State("th-psi0", "value"),
+            State("th-lat0", "value"), State(design_id("th"), "data")],
     store="th-request", download=jobs.Download("th", "time_history", _csv_rows, single=True, filename=_file_stem))
 
 
@@ -118,27 +158,51 @@ def _figures(result):
         series.add_scatter(x=t, y=relative, name="NES relative rotation psi - psis (rad)",
                            line={"color": "#D55E00", "width": 1}, row=4, col=1)
         series.update_yaxes(title_text="psi - psis (rad)", row=4, col=1)
-    series.update_layout(title={"text": title, "x": 0.01}, height=180 * rows + 100, template="plotly_white",
-                         margin={"l": 70, "r": 16, "t": 44, "b": 48}, legend={"orientation": "h", "y": -0.08})
+    series.update_layout(title=style.title(title), height=180 * rows + 110, template="plotly_white",
+                         margin={**style.MARGIN, "l": 70}, legend={"orientation": "h", "y": -0.08})
     series.update_xaxes(title_text="time t (s)", row=rows, col=1)
     series.update_yaxes(title_text="psi (rad)", row=1, col=1)
     series.update_yaxes(title_text="l_g delta (m)", row=2, col=1)
     series.update_yaxes(title_text="lam (m)", row=3, col=1)
     sp = result["spectrum"]
     spectrum = style.figure("Spectrum of the steady window", "frequency (Hz)", "power (normalised)")
+    floor = 1e-6  # six decades below the peak: the tones, not the round-off
     for key, name, c in (("psi", "torsion psi", colour), ("lateral", "lateral l_g delta", "#56B4E9")):
         p = np.asarray(sp[key])
-        spectrum.add_scatter(x=sp["frequency_hz"], y=p / p.max() if p.max() > 0 else p, name=name,
+        scale = p.max() if p.size and p.max() > 0 else 1.0
+        spectrum.add_scatter(x=sp["frequency_hz"], y=np.maximum(p / scale, floor * 0.5), name=name,
                              line={"color": c})
     if sp["dominant_hz"] is not None:
         spectrum.add_vline(x=sp["dominant_hz"], line={"color": "#D55E00", "dash": "dash"},
                            annotation_text=f"{sp['dominant_hz']:.3f} Hz", annotation_position="top right")
-    spectrum.update_yaxes(type="log")
+    spectrum.update_yaxes(type="log", range=[np.log10(floor), 0.3], dtick=1, exponentformat="power",
+                          showexponent="all")
     n_window = int(round(result["options"]["window"] / result["series_dt"]))
-    phase = style.figure("Torsional phase portrait (steady window)", "psi (rad)", "dpsi/dt (rad/s)")
+    phase = style.figure("Torsional phase portrait", "psi (rad), steady window", "dpsi/dt (rad/s)")
     phase.add_scatter(x=s["psi"][-n_window:], y=s["dpsi"][-n_window:], mode="lines", name="orbit",
                       line={"color": colour, "width": 1})
     return series, spectrum, phase
+
+
+MODE_WORDS = {"Torsion": "a torsional limit cycle", "Lateral": "a lateral limit cycle",
+              "Both": "a limit cycle with both torsion and lateral bending large",
+              "Stable": "straight rolling (the motion decayed)"}
+
+
+def settled(result):
+    """Which attractor the run settled on, and from where it started."""
+    o = result.get("options", {})
+    start = result.get("start") or {}
+    psi0, lat0 = start.get("psi0"), start.get("lateral0")
+    where = "" if psi0 is None else f"From psi0 = {psi0:g} rad, l_g delta0 = {lat0:g} m the run "
+    verb = "settled on" if result["steady"] else "was still approaching (not yet steady at t_end)"
+    f = result["frequency_hz"]
+    amp = result["amplitude"]
+    detail = "" if result["response_type"] == "Stable" else (
+        f": max |psi| {amp['psi']:.3g} rad, max |l_g delta| {amp['lateral']:.3g} m"
+        + ("" if f is None else f", {f:.2f} Hz"))
+    text = f"{where or 'The run '}{verb} {MODE_WORDS.get(result['response_type'], result['response_type'])}{detail}"
+    return text + (f" after {o['t_end']:g} s." if "t_end" in o else ".")
 
 
 def _metrics(result):
@@ -155,6 +219,8 @@ def _metrics(result):
 
 @dash.callback(Output("url-update", "data", allow_duplicate=True),
                Input("th-config", "value"), Input("th-v", "value"), Input("th-fz", "value"), Input("th-tend", "value"),
-               prevent_initial_call=True)
-def remember(config, V, fz, t_end):
-    return {"config": config, "V": V, "Fz": fz, "t_end": t_end}
+               Input("th-psi0", "value"), Input("th-lat0", "value"), prevent_initial_call=True)
+def remember(config, V, fz, t_end, psi0, lateral0):
+    standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
+    return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,
+            "lateral0": None if standard else lateral0, "run": None}

@@ -1,8 +1,10 @@
-"""Command line: ``python -m shimmy {params,hopf,eigen,simulate,ground-run,bifurcation,hopf-curves,curves,map,
-classify,metrics,study,devices,calibrate} ...``.
+"""Command line: ``python -m shimmy COMMAND ...`` (``python -m shimmy --help`` lists the commands).
 
 Results go to stdout (JSON with ``--json``, a short table otherwise). Bad input exits
 with status 2 and a message on stderr naming the field, its value and what is allowed.
+The limits of every option that the API also takes (t_end, resolution, ntst, ...) are the
+API's, read from its request schemas. Long commands report progress on stderr: a bar on a
+terminal, plain lines otherwise (``--progress``).
 """
 
 from __future__ import annotations
@@ -18,10 +20,19 @@ import numpy as np
 from .model.configurations import Configuration
 from .continuation.errors import InvalidInputError
 from .errors import EXPECTED_ERRORS, GeometryError, InvalidParameterError
-from .model.parameters import DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters
+from .model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters,
+                               check_number)
+from .service import schemas
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 1
+
+
+def _limit(analysis: str, name: str, value: Any) -> float | int:
+    """``value`` checked against the limits the API gives field ``name`` of ``analysis`` (one definition)."""
+    f = schemas.SCHEMAS[analysis].field(name)
+    number = check_number(name, value, f.low, f.high, f.unit, f.kind == "integer")
+    return int(number) if f.kind == "integer" else number
 
 
 def _parse_sets(items: Sequence[str] | None) -> dict[str, str]:
@@ -101,7 +112,7 @@ def _cmd_eigen(args) -> int:
 def _cmd_simulate(args) -> int:
     from .analyses.simulation import simulate
 
-    result = simulate(args.config, args.V, args.Fz, _params(args), t_end=args.t_end,
+    result = simulate(args.config, args.V, args.Fz, _params(args), t_end=_limit("simulate", "t_end", args.t_end),
                       exact_nes=args.exact_nes)
     if args.csv:
         result.write_csv(args.csv)
@@ -213,7 +224,7 @@ def _cmd_devices(args) -> int:
 
     params = _params(args)
     nes_c = nes_curve(params)
-    pds = pd_curves(params, v_max=args.v_max)
+    pds = pd_curves(params, v_max=_limit("devices", "v_max", args.v_max))
     payload = {"params": params.to_dict(), "nes": nes_c.to_dict(), "pd": [c.to_dict() for c in pds]}
     err = nes_c.cubic_error_at
     lines = [f"NES: k1 = {nes_c.k1:.6g} N m/rad, k3 = {nes_c.k3:.6g} N m/rad^3; cubic vs exact torque: "
@@ -227,17 +238,30 @@ def _cmd_devices(args) -> int:
 
 
 class _ProgressBar:
-    """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
+    """Progress on stderr: a one-line bar on a terminal, plain log lines anywhere else (a script, a
+    notebook, a CI log), or nothing. ``mode``: "auto" (bar on a terminal, lines otherwise), "bar",
+    "log" or "none". Lines are written when the message changes or the fraction moves by 5 %."""
 
-    def __init__(self, stream=None, width: int = 30):
+    def __init__(self, stream=None, width: int = 30, mode: str = "auto"):
         self.stream = stream or sys.stderr
         self.width = width
-        self.enabled = self.stream.isatty()
+        if mode == "auto":
+            mode = "bar" if self.stream.isatty() else "log"
+        self.mode = mode
+        self.enabled = mode == "bar"
+        self._last: tuple[float, str] | None = None
 
     def __call__(self, fraction: float, message: str) -> None:
+        fraction = min(max(fraction, 0.0), 1.0)
+        if self.mode == "log":
+            if self._last is None or message != self._last[1] or fraction - self._last[0] >= 0.05 or fraction == 1:
+                self.stream.write(f"[{100 * fraction:5.1f} %] {message}\n")
+                self.stream.flush()
+                self._last = (fraction, message)
+            return
         if not self.enabled:
             return
-        filled = int(round(self.width * min(max(fraction, 0.0), 1.0)))
+        filled = int(round(self.width * fraction))
         self.stream.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f} % {message[:50]:<50}")
         self.stream.flush()
 
@@ -247,16 +271,18 @@ class _ProgressBar:
             self.stream.flush()
 
 
+def _bar(args) -> _ProgressBar:
+    return _ProgressBar(mode=getattr(args, "progress", "auto"))
+
+
 def _cmd_bifurcation(args) -> int:
     from .analyses.bifurcation import BifurcationOptions, bifurcation
 
-    from .model.parameters import check_number
-
-    ntst = int(check_number("ntst", args.ntst, 4, 2000, integer=True))
+    ntst = _limit("bifurcation", "ntst", args.ntst)
     ds_max = check_number("ds_max", args.ds_max, 1e-3, 10.0)
     options = BifurcationOptions(ntst=ntst, ds=min(BifurcationOptions.ds, ds_max), ds_max=ds_max,
                                  exact_nes=args.exact_nes, seeds=not args.no_seeds)
-    bar = _ProgressBar()
+    bar = _bar(args)
     try:
         result = bifurcation(args.config, args.Fz, args.v_min, args.v_max, _params(args), options, progress=bar)
     finally:
@@ -289,7 +315,7 @@ def _cmd_bifurcation(args) -> int:
 def _cmd_hopf_curves(args) -> int:
     from .analyses.hopf_curves import hopf_curves
 
-    bar = _ProgressBar()
+    bar = _bar(args)
     try:
         result = hopf_curves(args.config, _params(args), (args.v_min, args.v_max), (args.fz_min, args.fz_max),
                              progress=bar)
@@ -322,7 +348,7 @@ def _cmd_curves(args) -> int:
             raise InvalidParameterError("kinds", args.kinds, "comma-separated kinds among lpc, ns, pd",
                                         f"names an unknown kind ({k.lower()})")
     loads = tuple(_float_list("at_fz", args.at_fz)) if args.at_fz else ()
-    bar = _ProgressBar()
+    bar = _bar(args)
     try:
         result = cycle_curves(args.config, _params(args), (args.v_min, args.v_max), (args.fz_min, args.fz_max),
                               kinds, loads, progress=bar)
@@ -362,16 +388,15 @@ def _float_list(name: str, text: str) -> list[float]:
 
 def _cmd_map(args) -> int:
     from .analyses.design_metrics import metrics
-    from .model.parameters import check_number
     from .analyses.stability_map import stability_map
 
-    resolution = int(check_number("resolution", args.resolution, 2, 400, integer=True))
-    n_v = int(check_number("n_v", args.n_v, 2, 2000, integer=True))
-    bar = _ProgressBar()
+    resolution = _limit("map", "resolution", args.resolution)
+    n_v = _limit("map", "n_v", args.n_v)
+    bar = _bar(args)
     try:
         smap = stability_map(args.config, (args.v_min, args.v_max), (args.fz_min, args.fz_max), resolution,
                              _params(args), n_v=n_v, progress=bar)
-        figures = metrics(smap, float(check_number("metrics_Fz", args.metrics_Fz, *FZ_RANGE, "N")))
+        figures = metrics(smap, _limit("map", "metrics_Fz", args.metrics_Fz))
     finally:
         bar.close()
     payload = smap.to_dict()
@@ -416,11 +441,10 @@ def _cmd_classify(args) -> int:
 
 def _cmd_metrics(args) -> int:
     from .analyses.design_metrics import design_report
-    from .model.parameters import check_number
 
-    resolution = int(check_number("resolution", args.resolution, 2, 400, integer=True))
+    resolution = _limit("map", "resolution", args.resolution)
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
-    bar = _ProgressBar()
+    bar = _bar(args)
     try:
         report = design_report(configs, _params(args), float(check_number("Fz", args.Fz, *FZ_RANGE, "N")),
                                resolution, progress=bar)
@@ -456,7 +480,7 @@ def _cmd_study(args) -> int:
     from .analyses.studies import study, study_grid
 
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
-    bar = _ProgressBar()
+    bar = _bar(args)
     try:
         if args.param2:
             result = study_grid((args.param, args.param2),
@@ -503,17 +527,63 @@ def _add_common(p: argparse.ArgumentParser, design: bool = True) -> None:
         p.add_argument("--material", choices=sorted(MATERIALS), help="particle-damper material preset")
 
 
+DESCRIPTION = """\
+Nose-landing-gear shimmy and its suppression by a torsional nonlinear energy sink (NES) and a
+particle damper (PD), in four configurations: original, nes, pd, nes_pd. Every command prints a
+short table, or JSON with --json; bad input exits with status 2 and a message naming the field,
+its value and what is allowed. Units are SI: V in m/s, Fz in N."""
+
+EPILOG = """\
+examples:
+  python -m shimmy params
+  python -m shimmy hopf --config nes --Fz 150000
+  python -m shimmy simulate --config original --V 50 --Fz 850000 --t-end 60
+  python -m shimmy map --config nes_pd --resolution 10 --json > map.json
+  python -m shimmy study --param e_p --values 0.0005,0.001,0.005 --configs nes,nes_pd
+
+'python -m shimmy COMMAND --help' describes a command and its options."""
+
+
+def _limits(analysis: str, name: str) -> str:
+    """" (LOW-HIGH UNIT)" of a field, for an option's help."""
+    f = schemas.SCHEMAS[analysis].field(name)
+    return f" ({f.low:g} to {f.high:g}{' ' + f.unit if f.unit else ''})"
+
+
+class _Formatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Defaults shown where there is one (not "default: None" on a flag or an optional file)."""
+
+    def _get_help_string(self, action):
+        if action.default in (None, False) or action.default is argparse.SUPPRESS:
+            return action.help
+        return super()._get_help_string(action)
+
+
+def _add_progress(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--progress", choices=("auto", "bar", "log", "none"), default="auto",
+                   help="progress on stderr: a bar (bar), plain lines that work in scripts and notebooks (log), "
+                        "nothing (none); auto draws the bar on a terminal and writes lines otherwise")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m shimmy", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser = argparse.ArgumentParser(prog="python -m shimmy", description=DESCRIPTION, epilog=EPILOG,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     configs = [c.value for c in Configuration]
+
+    class sub:  # every command's --help opens with its description and shows the defaults
+        @staticmethod
+        def add_parser(name: str, help: str) -> argparse.ArgumentParser:
+            p = commands.add_parser(name, help=help, description=help[0].upper() + help[1:] + ".",
+                                    formatter_class=_Formatter)
+            return p
 
     p = sub.add_parser("params", help="list every parameter with unit, default, range")
     _add_common(p, design=False)
     p.set_defaults(func=_cmd_params)
 
     p = sub.add_parser("hopf", help="Hopf points of straight rolling in V at one load")
-    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--config", required=True, choices=configs, help="configuration")
     p.add_argument("--Fz", required=True, help="vertical load (N)")
     p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
     p.add_argument("--v-max", default=V_RANGE[1], help="highest speed (m/s)")
@@ -521,7 +591,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_hopf)
 
     def operating_point(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--config", required=True, choices=configs)
+        p.add_argument("--config", required=True, choices=configs, help="configuration")
         p.add_argument("--V", required=True, help="forward speed (m/s)")
         p.add_argument("--Fz", required=True, help="vertical load (N)")
         _add_common(p)
@@ -532,7 +602,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("simulate", help="time history at one operating point")
     operating_point(p)
-    p.add_argument("--t-end", default=60.0, help="simulated time (s)")
+    p.add_argument("--t-end", default=60.0, help="simulated time (s)" + _limits("simulate", "t_end"))
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
     p.set_defaults(func=_cmd_simulate)
@@ -554,29 +624,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_ground_run)
 
     p = sub.add_parser("bifurcation", help="bifurcation diagram in V: equilibrium and periodic branches")
-    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--config", required=True, choices=configs, help="configuration")
     p.add_argument("--Fz", required=True, help="vertical load (N)")
     p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
     p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
-    p.add_argument("--ntst", default=40, help="collocation mesh intervals")
+    p.add_argument("--ntst", default=40, help="collocation mesh intervals" + _limits("bifurcation", "ntst"))
     p.add_argument("--ds-max", default=0.5, help="largest continuation step (scaled arclength)")
     p.add_argument("--no-seeds", action="store_true", help="do not look for branches by simulation")
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the branch points to FILE")
     _add_common(p)
+    _add_progress(p)
     p.set_defaults(func=_cmd_bifurcation)
 
     p = sub.add_parser("hopf-curves", help="Hopf curves of straight rolling in (V, Fz) with GH points")
-    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--config", required=True, choices=configs, help="configuration")
     p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
     p.add_argument("--v-max", default=V_RANGE[1], help="highest speed (m/s)")
     p.add_argument("--fz-min", default=FZ_RANGE[0], help="lowest load (N)")
     p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
     _add_common(p)
+    _add_progress(p)
     p.set_defaults(func=_cmd_hopf_curves)
 
     p = sub.add_parser("curves", help="fold, torus and period-doubling curves of cycles in (V, Fz)")
-    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--config", required=True, choices=configs, help="configuration")
     p.add_argument("--kinds", default="lpc,ns,pd", help="comma-separated: lpc, ns, pd")
     p.add_argument("--v-min", default=1.0, help="lowest speed (m/s)")
     p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
@@ -584,6 +656,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
     p.add_argument("--at-fz", default="", help="loads (N, comma-separated) where each curve's crossings are located")
     _add_common(p)
+    _add_progress(p)
     p.set_defaults(func=_cmd_curves)
 
     def plane(p: argparse.ArgumentParser) -> None:
@@ -593,15 +666,16 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
 
     p = sub.add_parser("map", help="(V, Fz) stability map: Hopf, fold and torus curves, shimmy types")
-    p.add_argument("--config", required=True, choices=configs)
+    p.add_argument("--config", required=True, choices=configs, help="configuration")
     plane(p)
     p.add_argument("--resolution", default=DEFAULT_MAP_SLICES,
                    help="classified Fz slices, evenly spaced (one more is added through each region between the "
-                        "curves that they miss)")
-    p.add_argument("--n-v", default=100, help="number of speeds per slice on the output grid")
+                        "curves that they miss)" + _limits("map", "resolution"))
+    p.add_argument("--n-v", default=100, help="number of speeds per slice on the output grid" + _limits("map", "n_v"))
     p.add_argument("--metrics-Fz", default=150e3, help="load (N) of the speed-interval and amplitude metrics")
     p.add_argument("--csv", metavar="FILE", help="write the classified grid to FILE")
     _add_common(p)
+    _add_progress(p)
     p.set_defaults(func=_cmd_map)
 
     p = sub.add_parser("classify", help="shimmy type and stable attractors at one operating point")
@@ -613,8 +687,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("metrics", help="design figures of merit of configurations against original")
     p.add_argument("--configs", default="original,nes,pd,nes_pd", help="comma-separated configurations")
     p.add_argument("--Fz", default=150e3, help="load (N) of the speed-interval and amplitude metrics")
-    p.add_argument("--resolution", default=DEFAULT_MAP_SLICES, help="classified Fz slices of each map")
+    p.add_argument("--resolution", default=DEFAULT_MAP_SLICES,
+                   help="classified Fz slices of each map" + _limits("map", "resolution"))
     _add_common(p)
+    _add_progress(p)
     p.set_defaults(func=_cmd_metrics)
 
     p = sub.add_parser("study", help="parametric study: Hopf speeds and max amplitude against parameters")
@@ -628,10 +704,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
     p.add_argument("--csv", action="store_true", help="write the table as CSV to stdout")
     _add_common(p)
+    _add_progress(p)
     p.set_defaults(func=_cmd_study)
 
     p = sub.add_parser("devices", help="NES torque/stiffness and PD damping curves")
-    p.add_argument("--v-max", default=2.0, help="largest PD tangential speed (m/s)")
+    p.add_argument("--v-max", default=2.0, help="largest PD tangential speed (m/s)" + _limits("devices", "v_max"))
     _add_common(p)
     p.set_defaults(func=_cmd_devices)
 

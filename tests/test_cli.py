@@ -77,7 +77,7 @@ def test_eigen_json_matches_the_library():
     assert data["stable"] is False  # point A lies between the Hopf points
 
 
-def test_progress_bar_draws_only_on_a_terminal():
+def test_progress_is_a_bar_on_a_terminal_and_plain_lines_elsewhere():
     import io
 
     from shimmy.cli import _ProgressBar
@@ -86,15 +86,53 @@ def test_progress_bar_draws_only_on_a_terminal():
         def isatty(self):
             return True
 
-    tty, pipe = Terminal(), io.StringIO()
-    for stream in (tty, pipe):
-        bar = _ProgressBar(stream, width=10)
+    tty, pipe, quiet = Terminal(), io.StringIO(), io.StringIO()
+    for stream, mode in ((tty, "auto"), (pipe, "auto"), (quiet, "none")):
+        bar = _ProgressBar(stream, width=10, mode=mode)
         bar(0.5, "periodic branch")
+        bar(0.51, "periodic branch")  # same message, under 5 % further: no new line
         bar(1.0, "done")
         bar.close()
-    assert pipe.getvalue() == ""
     assert "[#####.....]  50.0 % periodic branch" in tty.getvalue()
     assert "[##########] 100.0 % done" in tty.getvalue()
+    assert pipe.getvalue() == "[ 50.0 %] periodic branch\n[100.0 %] done\n"
+    assert quiet.getvalue() == ""
+
+
+def test_map_without_a_terminal_logs_its_progress_counting_the_slices_asked():
+    out = run("map", "--config", "original", "--fz-min", "100000", "--fz-max", "400000", "--resolution", "3",
+              "--n-v", "20", "--json")
+    assert out.returncode == 0, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) >= 4 and all(line.startswith("[") and " %] " in line for line in lines)
+    assert lines[-1].startswith("[100.0 %]") and "\r" not in out.stderr
+    assert "1/3 slices" in out.stderr  # counted in the slices asked for (more follow through regions they miss)
+
+
+def test_help_is_complete_plain_text_and_shows_the_shared_limits():
+    top = run("--help")
+    assert top.returncode == 0 and "``" not in top.stdout and "Units are SI" in top.stdout
+    assert "map --config nes_pd --resolution 10" in top.stdout
+    for command in ("map", "simulate", "study", "bifurcation"):
+        text = run(command, "--help").stdout
+        assert "``" not in text and "--progress" in text or command == "simulate"
+    assert "(2 to 80)" in run("map", "--help").stdout  # the API's limits, from its schema
+    assert "(0.1 to 600 s)" in run("simulate", "--help").stdout
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["map", "--config", "nes", "--resolution", "81"],
+     "resolution=81.0 is out of range; allowed: an integer in [2, 80]"),
+    (["simulate", "--config", "nes", "--V", "30", "--Fz", "150000", "--t-end", "601"],
+     "t_end=601.0 is out of range; allowed: a number in [0.1, 600] s"),
+    (["bifurcation", "--config", "nes", "--Fz", "150000", "--ntst", "5"], "ntst"),
+])
+def test_cli_limits_are_the_apis(argv, needle):
+    from shimmy.service import schemas
+
+    assert schemas.SCHEMAS["map"].field("resolution").high == 80
+    out = run(*argv)
+    assert out.returncode == 2 and needle in out.stderr
 
 
 def test_hopf_curves_command(capsys):

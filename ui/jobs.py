@@ -74,16 +74,20 @@ def canonical(analysis: str, wanted: Any) -> list[dict[str, Any]]:
 def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[str, Any]]],
              render: Callable[[list[dict[str, Any]]], tuple], outputs: Sequence[Output], states: Sequence[State],
              download: Download, lock: Sequence[str] = (), store: str | None = None,
-             error: str | None = None, triggers: Sequence[Input] = (), initial: bool = False,
-             notice: Callable[[list[dict[str, Any]]], str] | None = None) -> None:
+             error: str | None = None, triggers: Sequence[Input] = (), initial: bool | str = "cached",
+             notice: Callable[[list[dict[str, Any]]], str] | None = None,
+             blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None) -> None:
     """Wire the job of one page.
 
     ``requests(*trigger values, *state values)`` -> the analysis requests (may raise
     InvalidParameterError); ``render(results)`` -> one value per entry of ``outputs``;
     ``lock`` are ids of controls disabled while the jobs run; ``error`` the id of the element
     that shows a refusal (PREFIX-error by default), ``notice(results)`` what it shows with a
-    result; ``triggers`` inputs that start a computation besides the run button; ``initial`` runs
-    it when the page loads.
+    result; ``triggers`` inputs that start a computation besides the run button. When the page
+    loads, ``initial="cached"`` shows the answer to the page's controls if the cache has it (and
+    computes nothing otherwise), ``True`` computes it, ``False`` does nothing. ``blank()`` -> the
+    outputs that replace a shown result when the controls are refused (the old result no longer
+    answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay).
     """
     store = store or f"{prefix}-requests"
     error = error or f"{prefix}-error"
@@ -95,7 +99,9 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
              Output(f"{prefix}-progress", "value"), Output(f"{prefix}-status", "children")]
     idle = (None, True, False, True, *(False for _ in lock))
 
-    def refused(message: str, status: str = "") -> tuple:
+    def refused(message: str, status: str = "", clear: bool = False) -> tuple:
+        if clear and blank is not None:
+            return (*blank(), message, None, True, True) + idle + ("0", status)
         return (no_update,) * n_out + (message, no_update, no_update, no_update) + idle + ("0", status)
 
     def shown(results: list[dict[str, Any]], wanted: list[dict[str, Any]]) -> tuple:
@@ -105,20 +111,26 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
                    prevent_initial_call=not initial)
     def dispatch(_n, *values):
         """Answer at once when every result is cached; otherwise submit jobs and start reading them."""
+        loading = dash.ctx.triggered_id is None  # the page's first call, not a user's action
         try:
             wanted = canonical(analysis, requests(*values))
         except InvalidParameterError as exc:
-            return refused(str(exc))
+            if loading:  # the layout already says what of the address could not be used
+                return (no_update,) * (n_out + len(tail) + len(state))
+            return refused(str(exc), clear=True)
         results = [cache.get(analysis, r) for r in wanted]
         if all(r is not None for r in results):
             return shown(results, wanted)
+        if loading and initial == "cached":
+            return (no_update,) * (n_out + len(tail) + len(state))
         try:
             ids = [jobs.submit_canonical(analysis, r)["id"] for r, done in zip(wanted, results, strict=True)
                    if done is None]
         except jobs.QueueFull as exc:
             return refused(f"The service is busy: {exc}.")
-        return ((no_update,) * (n_out + len(tail)) + ({"jobs": ids, "requests": wanted}, False, True, False)
-                + tuple(True for _ in lock) + ("0", "queued"))
+        busy = running() if running is not None else (no_update,) * n_out
+        return (tuple(busy) + (no_update,) * len(tail) + ({"jobs": ids, "requests": wanted}, False, True, False)
+                + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-poll", "n_intervals"),
                    State(f"{prefix}-go", "data"), prevent_initial_call=True)
@@ -145,17 +157,22 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         fraction = sum(job["progress"] if job["status"] == "running" else 0.0 for job in current) / len(current)
         first = next(job for job in current if job["status"] != "done")
         label = first["request"].get("config") or analysis
-        status = (f"{label}: {first['message']}" if first["status"] == "running"
-                  else f"{label}: queued ({jobs.counts()['running']} analyses running)")
+        done = sum(job["status"] == "done" for job in current)
+        of = f" [{done} of {len(current)} analyses done]" if len(current) > 1 else ""
+        status = (f"{label}: {first['message']}{of}" if first["status"] == "running"
+                  else f"{label}: queued ({jobs.counts()['running']} analyses running){of}")
         return (no_update,) * (n_out + len(tail) + len(state) - 2) + (str(int(100 * fraction)), status)
 
-    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-cancel", "n_clicks"),
-                   State(f"{prefix}-go", "data"), prevent_initial_call=True)
+    @dash.callback(Output(f"{prefix}-cancel", "disabled", allow_duplicate=True),
+                   Output(f"{prefix}-status", "children", allow_duplicate=True),
+                   Input(f"{prefix}-cancel", "n_clicks"), State(f"{prefix}-go", "data"), prevent_initial_call=True)
     def cancel(_n, go):
+        """Cancel the jobs; the poll, the one writer of the page's job state, then says "cancelled" (a
+        poll already on its way cannot overwrite it with a progress line)."""
         ids, _ = _waiting(go)
         for job_id in ids:
             jobs.cancel(job_id, remove=False)
-        return refused("", "cancelled")
+        return True, "cancelling…" if ids else "cancelled"
 
     @dash.callback(Output(f"{download.prefix}-download", "data"), Input(f"{download.prefix}-csv", "n_clicks"),
                    Input(f"{download.prefix}-json", "n_clicks"), State(store, "data"), prevent_initial_call=True)
@@ -174,6 +191,14 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
                     "filename": f"{name}.json"}
         columns, rows = download.rows(results)
         return {"content": components.csv_text(columns, rows), "filename": f"{name}.csv"}
+
+
+def _asked(wanted: list[dict[str, Any]]) -> str:
+    """What was asked, in the page's words: the configurations (and a map's slices as asked)."""
+    configs = [r.get("config") for r in wanted if r.get("config")]
+    slices = {r.get("resolution") for r in wanted if r.get("resolution") is not None}
+    what = ", ".join(configs) if configs else f"{len(wanted)} analysis" + ("" if len(wanted) == 1 else "es")
+    return what + (f", {slices.pop()} Fz slices each" if len(slices) == 1 else "")
 
 
 def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:

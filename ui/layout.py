@@ -7,7 +7,8 @@ import json
 import dash
 from dash import ALL, Input, Output, State, dcc, html
 
-from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS
+from shimmy.errors import InvalidParameterError
+from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
 
 from . import state
 
@@ -29,24 +30,56 @@ def _short(x: float) -> str:
     return f"{x:g}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
 
 
-def _slider(name: str, value: float) -> html.Div:
+def _field_error(name: str, problem: str | None) -> html.Div:
+    return html.Div(problem, id={"type": "param-error", "name": name}, className="error field-error", role="alert")
+
+
+def _box(name: str, value: float) -> dcc.Input:
+    spec = PARAMETER_SPECS[name]
+    return html.Div(dcc.Input(id={"type": "param-box", "name": name}, type="number", value=value, step="any",
+                              debounce=True, className="param-box"), title=f"{name}: {spec.allowed}",
+                    className="param-box-wrap")
+
+
+def _slider(name: str, value: float, problem: str | None = None) -> html.Div:
     spec = PARAMETER_SPECS[name]
     return html.Div([
         _label(name),
-        dcc.Slider(id={"type": "param", "name": name}, min=spec.low, max=spec.high,
-                   step=(spec.high - spec.low) / SLIDER_STEPS, value=value, updatemode="drag",
-                   marks={spec.low: _short(spec.low), spec.high: _short(spec.high)},
-                   tooltip={"placement": "bottom", "always_visible": False}),
+        html.Div([
+            html.Div(dcc.Slider(id={"type": "param", "name": name}, min=spec.low, max=spec.high,
+                                step=(spec.high - spec.low) / SLIDER_STEPS, value=value, updatemode="drag",
+                                marks={spec.low: _short(spec.low), spec.high: _short(spec.high)},
+                                tooltip={"placement": "bottom", "always_visible": False}), className="slider-track"),
+            _box(name, value),
+        ], className="slider-line"),
+        _field_error(name, problem),
     ], className="slider-row")
 
 
-def _number(name: str, value: float) -> html.Div:
-    spec = PARAMETER_SPECS[name]
+def _number(name: str, value: float, problem: str | None = None) -> html.Div:
     return html.Div([
-        _label(name),
-        dcc.Input(id={"type": "param", "name": name}, type="number", value=value, min=spec.low, max=spec.high,
-                  step="any", debounce=True, className="number-input"),
+        html.Div([_label(name),
+                  html.Div(dcc.Input(id={"type": "param", "name": name}, type="number", value=value, step="any",
+                                     debounce=True, className="number-input"), title=PARAMETER_SPECS[name].allowed)],
+                 className="number-line"),
+        _field_error(name, problem),
     ], className="number-row")
+
+
+def _url_problems(query: dict[str, str]) -> dict[str, str]:
+    """Why a design key of the address was not applied, by field (shown at the field)."""
+    out = {}
+    material = query.get("material")
+    if material is not None and material not in MATERIALS:
+        out["material"] = (f"The address gives material={material}, which is not one of {', '.join(MATERIALS)}; "
+                           f"showing {state.DEFAULT_MATERIAL}.")
+    for name, raw in query.items():
+        if name in PARAMETER_SPECS:
+            try:
+                Parameters().with_overrides({name: raw})
+            except InvalidParameterError as exc:
+                out[name] = f"The address gives {name}={raw}: {exc}; showing the default."
+    return out
 
 
 def design_id(page_id: str) -> dict[str, str]:
@@ -55,39 +88,50 @@ def design_id(page_id: str) -> dict[str, str]:
     return {"type": "design", "page": page_id}
 
 
-def design_panel(query: dict[str, str], page_id: str) -> html.Aside:
+def design_panel(query: dict[str, str], page_id: str, shown: bool = True) -> html.Aside:
     material, values, problems = state.design_from_query(query)
+    at_field = _url_problems(query)
+    advanced_problem = any(n in at_field for n in ADVANCED)
+    summary = "" if not at_field else ("Some values of the address were not applied: see the fields marked below."
+                                       if shown else "; ".join(problems))
     return html.Aside([
         dcc.Store(id=design_id(page_id), data=state.design_request(material, values)),
         dcc.Store(id="url-update"), html.Div(id="url-sink", hidden=True),
         html.H2("Design"),
+        html.Div(summary, id="design-error", className="error", role="alert"),
         html.Div([html.Label("PD material", htmlFor="material"),
                   dcc.Dropdown(id="material", options=[{"label": m, "value": m} for m in MATERIALS],
-                               value=material, clearable=False)], className="slider-row"),
-        *[_slider(n, values[n]) for n in DESIGN],
+                               value=material, clearable=False),
+                  html.Div(at_field.get("material"), className="error field-error", role="alert")],
+                 className="slider-row"),
+        *[_slider(n, values[n], at_field.get(n)) for n in DESIGN],
         html.Details([html.Summary("Advanced parameters"),
-                      html.Div([_number(n, values[n]) for n in ADVANCED], className="advanced-grid")],
-                     id="advanced"),
-        html.Div("; ".join(problems), id="design-error", className="error", role="alert"),
+                      html.Div([_number(n, values[n], at_field.get(n)) for n in ADVANCED], className="advanced-grid")],
+                     id="advanced", open=advanced_problem),
         html.Button("Reset design", id="reset-design", className="secondary"),
-    ], className="design-panel", id="design-panel")
+    ], className="design-panel", id="design-panel", hidden=not shown)
 
 
-def page(query: dict[str, str], page_id: str, *children) -> html.Div:
+def page(query: dict[str, str], page_id: str, *children, design: bool = True) -> html.Div:
     """A page: the design panel (always at hand, initialised from the URL) beside the content.
 
     Every page carries its own panel so that page callbacks reading the design never meet a
-    layout without their inputs (Dash reports such callbacks as errors in the browser).
+    layout without their inputs (Dash reports such callbacks as errors in the browser). A page
+    that does not use the design (``design=False``) keeps the panel in its layout, hidden, so the
+    design still travels with the links.
     """
-    return html.Div([design_panel(query, page_id), html.Main(list(children), className="page")], className="body")
+    return html.Div([design_panel(query, page_id, design), html.Main(list(children), className="page")],
+                    className="body" if design else "body no-design")
 
 
 def navigation() -> html.Nav:
     # Plain links: their href is kept carrying the design by the clientside URL updater below.
     links = [html.A(p["name"], href=p["relative_path"], className="nav-link")
              for p in dash.page_registry.values()]
-    return html.Nav([html.Span("shimmy", className="brand"), html.Span("workbench", className="brand-sub"), *links],
-                    className="navbar")
+    toggle = html.Button("Design", id="design-toggle", className="nav-toggle",
+                         title="Hide or show the design panel", **{"aria-pressed": "true"})
+    return html.Nav([toggle, html.Span("shimmy", className="brand"), html.Span("workbench", className="brand-sub"),
+                     *links], className="navbar")
 
 
 def shell() -> html.Div:
@@ -123,31 +167,69 @@ dash.clientside_callback(
 )
 
 
-# Controls -> the design store, the URL and the error line, in the browser (no server round trip
-# before the page's own callbacks run: a slider move reaches the figure one request sooner).
-# Ranges and presets come from the parameter definitions; the server validates again.
+# The navigation's "Design panel" button hides or shows the panel on every page (a class on <body>,
+# which survives page changes).
 dash.clientside_callback(
     """
-    function(values, material, reset, ids) {
+    function(n) {
+        if (!n) { return window.dash_clientside.no_update; }
+        const hidden = document.body.classList.toggle("design-hidden");
+        window.dispatchEvent(new Event("resize"));  // the figures take the freed width
+        return hidden ? "false" : "true";
+    }
+    """,
+    Output("design-toggle", "aria-pressed"),
+    Input("design-toggle", "n_clicks"),
+)
+
+
+# Controls -> the design store, the URL and the errors at the fields, in the browser (no server
+# round trip before the page's own callbacks run: a slider move reaches the figure one request
+# sooner). Each slider has a number box beside it: either one moves the other. A value that is
+# refused is named at its field, in its unit, and the design keeps the last accepted value (never
+# a default in its place). Ranges and presets come from the parameter definitions; the server
+# validates again.
+dash.clientside_callback(
+    """
+    function(values, boxes, material, reset, ids, boxIds, errorIds, stores) {
         const C = window.dash_clientside, trig = C.callback_context.triggered_id;
-        const SPEC = %(spec)s, PRESET = %(preset)s, BASE = %(base)s, DEFAULT = %(default)s;
-        const names = ids.map(i => i.name);
+        const SPEC = %(spec)s, PRESET = %(preset)s, BASE = %(base)s, DEFAULT = %(default)s, ADVANCED = %(advanced)s;
+        const names = ids.map(i => i.name), boxNames = boxIds.map(i => i.name);
+        const previous = Object.assign({}, BASE[DEFAULT], ((stores || [])[0] || {}).params || {});
         let cur = {};
         names.forEach((n, i) => { cur[n] = values[i]; });
-        let outValues = names.map(() => C.no_update), outMaterial = C.no_update;
+        const boxOf = {};
+        boxNames.forEach((n, i) => { boxOf[n] = boxes[i]; });
+        let outValues = names.map(() => C.no_update), outBoxes = boxNames.map(() => C.no_update);
+        let outMaterial = C.no_update;
+        const typed = trig && typeof trig === "object" && trig.type === "param-box" ? trig.name : null;
         if (trig === "reset-design") {
             material = DEFAULT; cur = Object.assign({}, BASE[DEFAULT]); outMaterial = DEFAULT;
-            outValues = names.map(n => cur[n]);
+            outValues = names.map(n => cur[n]); outBoxes = boxNames.map(n => cur[n]);
         } else if (trig === "material") {
             Object.assign(cur, PRESET[material]); outValues = names.map(n => cur[n]);
+            outBoxes = boxNames.map(n => cur[n]);
+        } else if (typed) {
+            cur[typed] = boxOf[typed];
+        } else if (trig && typeof trig === "object" && trig.type === "param") {
+            if (boxNames.includes(trig.name)) { outBoxes[boxNames.indexOf(trig.name)] = cur[trig.name]; }
         }
-        const base = BASE[material], full = Object.assign({}, base), problems = [];
+        const base = BASE[material], full = Object.assign({}, base), problems = {};
         for (const n of names) {
             const v = cur[n], s = SPEC[n];
-            const ok = typeof v === "number" && isFinite(v) && v >= s.low && v <= s.high
-                       && (!s.integer || Number.isInteger(v));
-            if (ok) { full[n] = v; } else {
-                problems.push(n + "=" + v + " is out of range; allowed: " + s.allowed + " (kept " + base[n] + ")");
+            const unit = s.unit ? " " + s.unit : "";
+            const kept = previous[n] !== undefined ? previous[n] : base[n];
+            if (v === null || v === undefined || v === "" || typeof v !== "number" || !isFinite(v)) {
+                problems[n] = n + " is empty or not a number; enter " + s.allowed + " (kept " + kept + unit + ")";
+            } else if (v < s.low || v > s.high) {
+                problems[n] = n + " = " + v + unit + " is outside " + s.range + " (kept " + kept + unit + ")";
+            } else if (s.integer && !Number.isInteger(v)) {
+                problems[n] = n + " = " + v + unit + " is not a whole number; enter " + s.allowed
+                              + " (kept " + kept + unit + ")";
+            }
+            if (problems[n]) { full[n] = kept; } else {
+                full[n] = v;
+                if (n === typed) { outValues[names.indexOf(n)] = v; }
             }
         }
         const params = {}, url = {};
@@ -158,21 +240,34 @@ dash.clientside_callback(
             }
         }
         url.material = material === DEFAULT ? null : material;
-        return [outValues, outMaterial, url, [{material: material, params: params}], problems.join("; ")];
+        const refused = Object.keys(problems);
+        const summary = refused.length ? "Not applied: " + refused.join(", ") + " (see the field" +
+                        (refused.length > 1 ? "s" : "") + ")" : "";
+        const openAdvanced = refused.some(n => ADVANCED.includes(n)) ? true : C.no_update;
+        return [outValues, outBoxes, outMaterial, url, stores.map(() => ({material: material, params: params})),
+                summary, errorIds.map(i => problems[i.name] || ""), openAdvanced];
     }
-    """ % {"spec": json.dumps({n: {"low": s.low, "high": s.high, "integer": s.integer, "allowed": s.allowed}
+    """ % {"spec": json.dumps({n: {"low": s.low, "high": s.high, "integer": s.integer, "allowed": s.allowed,
+                                   "unit": s.unit, "range": f"[{s.low:g}, {s.high:g}] {s.unit}".rstrip()}
                                for n, s in PARAMETER_SPECS.items()}),
            "preset": json.dumps(MATERIALS),
            "base": json.dumps({m: state.material_params(m) for m in MATERIALS}),
-           "default": json.dumps(state.DEFAULT_MATERIAL)},
+           "default": json.dumps(state.DEFAULT_MATERIAL), "advanced": json.dumps(list(ADVANCED))},
     Output({"type": "param", "name": ALL}, "value"),
+    Output({"type": "param-box", "name": ALL}, "value"),
     Output("material", "value"),
     Output("url-update", "data", allow_duplicate=True),
     Output({"type": "design", "page": ALL}, "data"),
     Output("design-error", "children"),
+    Output({"type": "param-error", "name": ALL}, "children"),
+    Output("advanced", "open"),
     Input({"type": "param", "name": ALL}, "value"),
+    Input({"type": "param-box", "name": ALL}, "value"),
     Input("material", "value"),
     Input("reset-design", "n_clicks"),
     State({"type": "param", "name": ALL}, "id"),
+    State({"type": "param-box", "name": ALL}, "id"),
+    State({"type": "param-error", "name": ALL}, "id"),
+    State({"type": "design", "page": ALL}, "data"),
     prevent_initial_call=True,
 )

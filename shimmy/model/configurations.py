@@ -45,6 +45,18 @@ class Configuration(str, Enum):
 
 ALL_CONFIGURATIONS = tuple(Configuration)
 
+
+def affects(parameter: str, config: "Configuration | str") -> bool:
+    """Whether ``parameter`` enters the model of ``config``: a device's parameters (group ``nes`` or
+    ``pd``) do not enter a gear without that device, so a study of them there is a flat line."""
+    from .parameters import PARAMETER_SPECS
+
+    spec = PARAMETER_SPECS.get(parameter)
+    if spec is None:
+        raise unknown_name_error(parameter, PARAMETER_SPECS)
+    config = Configuration.parse(config)
+    return {"gear": True, "nes": config.has_nes, "pd": config.has_pd}[spec.group]
+
 #: State names in order; an NES adds the last two.
 STATE_NAMES = ("psi", "dpsi", "delta", "ddelta", "lam", "psis", "dpsis")
 STATE_UNITS = ("rad", "rad/s", "rad", "rad/s", "m", "rad", "rad/s")

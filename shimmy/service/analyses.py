@@ -40,9 +40,13 @@ def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[
                                         f"at least {request['t_end'] / MAX_SERIES_POINTS:g} s for t_end = "
                                         f"{request['t_end']:g} s (at most {MAX_SERIES_POINTS} samples per series)",
                                         "gives too many samples")
-    result = run_simulation(request["config"], request["V"], request["Fz"], _params(request),
-                            t_end=request["t_end"], exact_nes=request["exact_nes"])
+    params = _params(request)
+    x0 = np.zeros(Configuration.parse(request["config"]).n_states)
+    x0[0], x0[2] = request["psi0"], request["lateral0"] / params.gear.l_g
+    result = run_simulation(request["config"], request["V"], request["Fz"], params,
+                            t_end=request["t_end"], exact_nes=request["exact_nes"], x0=x0)
     out = result.to_dict()
+    out["start"] = {"psi0": request["psi0"], "lateral0": request["lateral0"]}
     if request["include_series"]:
         out["series"] = {k: v[::stride] for k, v in result.series().items()}
         out["series_dt"] = stride * result.options.dt_out

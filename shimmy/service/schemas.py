@@ -154,6 +154,13 @@ class RequestSchema:
     summary: str
     fields: tuple[Field, ...]
 
+    def field(self, name: str) -> Field:
+        """The declaration of field ``name`` (its limits are the ones the API, the CLI and the pages use)."""
+        for f in self.fields:
+            if f.name == name:
+                return f
+        raise KeyError(name)
+
     def validate(self, body: Any, extra: tuple[str, ...] = ()) -> dict[str, Any]:
         """The canonical request for ``body`` (a JSON object); ``extra`` names keys to ignore."""
         if not isinstance(body, Mapping):
@@ -294,6 +301,10 @@ SCHEMAS: dict[str, RequestSchema] = {
         Field("series_dt", "number", "sampling interval of the returned series (a multiple of 1 ms)",
               default=0.002, low=0.001, high=0.1, unit="s"),
         Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
+        Field("psi0", "number", "initial torsion psi (REFERENCE.md's start: 0.001 rad; the rest of the state zero "
+              "unless lateral0 is given)", default=0.001, low=-0.5, high=0.5, unit="rad"),
+        Field("lateral0", "number", "initial lateral bending displacement l_g delta", default=0.0, low=-0.5,
+              high=0.5, unit="m"),
         PARAMS, MATERIAL)),
     "hopf": RequestSchema("hopf", "Hopf points of straight rolling in V at one load", (
         _config(), FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),
