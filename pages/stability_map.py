@@ -124,9 +124,16 @@ def figure(results):
         scale += [[k / n, style.SHIMMY_TYPE_COLOURS[t]], [(k + 1) / n, style.SHIMMY_TYPE_COLOURS[t]]]
     fig = style.figure(f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)",
                        "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
-    fig.add_heatmap(x=V, y=Fz, z=codes, zmin=0, zmax=n, colorscale=scale, showscale=False, opacity=0.6,
-                    customdata=grid["types"], name="shimmy type", showlegend=False,
+    regions = shaded.get("regions") or []
+    # the regions as polygons (their edges on the curves at every row); the grid stays underneath,
+    # transparent, for the hover text and the click that opens a time history
+    fig.add_heatmap(x=V, y=Fz, z=codes, zmin=0, zmax=n, colorscale=scale, showscale=False,
+                    opacity=0.0 if regions else 0.6, customdata=grid["types"], name="shimmy type", showlegend=False,
                     hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history</extra>")
+    for region in regions:
+        fig.add_scatter(x=region["V"], y=[f / 1e3 for f in region["Fz"]], mode="lines", fill="toself",
+                        fillcolor=style.SHIMMY_TYPE_COLOURS[region["type"]], opacity=0.6, line={"width": 0},
+                        hoverinfo="skip", showlegend=False, name=region["type"])
     for result in results:
         config = result["config"]
         colour, label = style.CONFIG_COLOURS[config], style.CONFIG_LABELS[config]

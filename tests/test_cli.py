@@ -159,15 +159,22 @@ def test_map_command_json_carries_the_curves_grid_and_minimum_load(tmp_path):
     for key in ("hopf_curves", "fold_curves", "torus_curves"):
         assert all(set(p) >= {"V", "Fz"} for c in data[key] for p in c), key
     assert data["hopf_curves"] and data["gh_points"] and data["torus_curves"]
-    assert len(data["Fz"]) == 4 and len(data["V"]) == 25 and len(data["types"]) == 4
+    # the 4 slices asked, and those the map adds through regions between the curves they miss
+    asked = [100000.0 + k * 350000.0 / 3 for k in range(4)]
+    assert all(min(abs(f - a) for f in data["Fz"]) < 1e-6 for a in asked)
+    assert len(data["types"]) == len(data["Fz"]) >= 4 and len(data["V"]) == 25
     assert all(len(row) == 25 for row in data["types"])
+    shading = data["shading"]
+    assert len(shading["Fz"]) >= 180 and all(len(row) == 25 for row in shading["types"])
+    types = {"Stable", "Torsion", "Lateral", "Bistable", "Both"}
+    assert data["regions"] and {r["type"] for r in data["regions"]} <= types
     assert data["min_shimmy_Fz"] == pytest.approx(100000.0)  # shimmy on the lowest slice already
     assert data["metrics"]["torsion_area"] > 0
     assert "two-parameter continuation" in data["methods"]["hopf_curves"]
     assert "two-parameter continuation" in data["methods"]["fold_curves"]
     assert "double_hopf_points" in data
     rows = list(csv.reader(path.open()))
-    assert rows[0] == ["Fz_N", "V_m_s", "shimmy_type"] and len(rows) == 1 + 4 * 25
+    assert rows[0] == ["Fz_N", "V_m_s", "shimmy_type"] and len(rows) == 1 + len(shading["Fz"]) * 25  # the shading
 
 
 def test_classify_command():
