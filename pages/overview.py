@@ -56,7 +56,7 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
                "(the same maps as on the Stability map page, shared through the cache).", className="hint"),
         html.Div(jobs.controls("ov-regions", "Compute maps"), className="controls"),
         html.Div(id="ov-regions-error", className="error", role="alert"),
-        ui.graph("ov-regions-graph", figure=style.message_figure("Press 'Compute maps' (about 10-20 s per "
+        ui.graph("ov-regions-graph", figure=style.message_figure("Press 'Compute maps' (about 15-25 s per "
                                                                   "configuration cold, instant when cached)")),
         html.Div([html.Button("Download regions CSV", id="ovr-csv", className="secondary", disabled=True),
                   html.Button("Download maps JSON", id="ovr-json", className="secondary", disabled=True),
