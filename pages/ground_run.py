@@ -9,7 +9,8 @@ from plotly.subplots import make_subplots
 from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
-from ui import jobs
+from ui import fields, jobs
+from ui.fields import Quantity
 from ui import style
 from ui.layout import design_id, page
 
@@ -24,9 +25,17 @@ TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overf
                "style_header": {"backgroundColor": "#eef2f8", "fontWeight": "600"}}
 
 
-def layout(preset: str = "takeoff", config: str = "original", psi_thr: str = "0.01", lat_thr: str = "1", **query):
-    preset = preset if preset in PRESET_LABELS else "takeoff"
-    config = config if config in CONFIGS else "original"
+PSI_THR = Quantity("ground_run", "psi_threshold", "the shimmy threshold |psi|", "rad")
+LAT_THR = Quantity("ground_run", "lateral_threshold", "the shimmy threshold |l_g delta|", "mm", 1e-3)
+
+
+def layout(preset: str | None = None, config: str | None = None, psi_thr: str | None = None,
+           lat_thr: str | None = None, **query):
+    preset, bad_preset = fields.choice("preset", preset, list(PRESET_LABELS), "takeoff", "a preset")
+    config, bad_config = fields.choice("config", config, list(CONFIGS), "original", "a configuration")
+    psi_value, bad_psi = PSI_THR.from_url("psi_thr", psi_thr, 0.01)
+    lat_value, bad_lat = LAT_THR.from_url("lat_thr", lat_thr, 1.0)
+    address = " ".join(m for m in (bad_preset, bad_config, bad_psi, bad_lat) if m)
     return page(
         query, "gr",
         ui.header("Ground run", "The gear through a take-off, a landing roll or a taxi: forward speed and nose-gear "
@@ -43,11 +52,8 @@ def layout(preset: str = "takeoff", config: str = "original", psi_thr: str = "0.
                                                        style={"width": "150px"},
                                                        options=[{"label": style.CONFIG_LABELS[c], "value": c}
                                                                 for c in CONFIGS])),
-            ui.field("Shimmy threshold |psi| (rad)", dcc.Input(id="gr-psi-thr", type="number", min=1e-6, max=1,
-                                                               step="any", value=ui.number(psi_thr, 0.01))),
-            ui.field("Shimmy threshold |l_g delta| (mm)", dcc.Input(id="gr-lat-thr", type="number", min=1e-4,
-                                                                    max=1000, step="any",
-                                                                    value=ui.number(lat_thr, 1))),
+            ui.field("Shimmy threshold |psi| (rad)", PSI_THR.box("gr-psi-thr", psi_value)),
+            ui.field("Shimmy threshold |l_g delta| (mm)", LAT_THR.box("gr-lat-thr", lat_value)),
             *jobs.controls("gr", "Run"),
         ], className="controls"),
         html.Div([
@@ -73,6 +79,7 @@ def layout(preset: str = "takeoff", config: str = "original", psi_thr: str = "0.
                 html.P(id="gr-source", className="hint"),
             ]),
         ], style={"display": "grid", "gridTemplateColumns": "minmax(0, 3fr) minmax(15em, 2fr)", "gap": "16px"}),
+        html.Div(address, id="gr-address", className="error", role="alert"),  # what of the address is unusable
         html.Div(id="gr-error", className="error", role="alert"),
         html.Div(id="gr-summary"),
         ui.graph("gr-plane", figure=style.message_figure("Computing the take-off for the four configurations…")),
@@ -145,9 +152,9 @@ def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, desig
         profile = {"profile": [[r.get("t"), r.get("V"), _newtons(r.get("Fz"))] for r in rows]}
     else:
         profile = {"preset": name, "preset_options": _settings(settings)}
-    lateral = None if lat_thr is None else float(lat_thr) / 1e3
+    psi, lateral = PSI_THR.read(psi_thr), LAT_THR.read(lat_thr)  # refused in the box's unit, never defaulted
     order = [config] + [c for c in CONFIGS if c != config]
-    return [{"config": c, **profile, "psi_threshold": psi_thr, "lateral_threshold": lateral, "series_dt": SERIES_DT,
+    return [{"config": c, **profile, "psi_threshold": psi, "lateral_threshold": lateral, "series_dt": SERIES_DT,
              "hopf_curves": True, **design} for c in order]
 
 

@@ -88,3 +88,14 @@ def test_ground_run_page_runs_the_presets_and_a_table(server, browser):  # noqa:
     browser.save_screenshot(str(SHOTS / "ground-run-1024.png"))
     assert _severe(browser) == []
     browser.set_window_size(1500, 1100)
+
+
+def test_ground_run_address_values_are_refused_not_replaced(server, browser):  # noqa: F811
+    """Values from the address that are not usable are named where the user looks, in the
+    field's unit; a threshold that is not a number leaves its box empty and nothing runs from it."""
+    browser.get(server.base + "/ground-run?preset=cruise&psi_thr=abc&lat_thr=5000")
+    error = _wait_for(lambda: "".join(e.text for e in browser.find_elements(By.ID, "gr-address")) or None,
+                      what="the refusal")
+    assert "preset=cruise" in error and "psi_thr=abc" in error and "not a number" in error
+    assert "lat_thr=5000" in error and "mm" in error
+    assert browser.find_element(By.ID, "gr-psi-thr").get_attribute("value") == ""

@@ -78,3 +78,15 @@ def test_simulate_takes_a_start_and_reports_it():
     assert result["start"] == {"psi0": 0.2, "lateral0": 0.0}
     with pytest.raises(InvalidParameterError, match=r"psi0=0.6 is out of range; allowed: a number in \[-0.5, 0.5\]"):
         schemas.validate("simulate", {"config": "original", "V": 50, "Fz": 850e3, "psi0": 0.6})
+
+
+def test_ground_run_thresholds_are_refused_in_the_boxes_unit_never_defaulted():
+    import app  # noqa: F401 - registers the pages
+    from pages import ground_run
+
+    for psi, lateral, text in ((None, 1.0, "threshold |psi| is empty"), (0.01, 5000.0, "5000 mm is outside")):
+        with pytest.raises(InvalidParameterError) as err:
+            ground_run._requests("original", "takeoff", [], [], [], psi, lateral, {})
+        assert text in str(err.value)
+    request = ground_run._requests("original", "takeoff", [], [], [], 0.02, 2.0, {})[0]
+    assert request["psi_threshold"] == 0.02 and request["lateral_threshold"] == pytest.approx(0.002)
