@@ -65,6 +65,7 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
                     {"name": "unit", "id": "unit", "editable": False},
                     {"name": "range", "id": "range", "editable": False},
                     {"name": "meaning", "id": "description", "editable": False}]),
+                html.Div(id="gr-settings-error", className="error", role="alert"),  # at the settings
                 html.P(id="gr-assumptions", className="hint"),
             ]),
             html.Div([
@@ -100,9 +101,8 @@ def preset_settings(name):
 
 
 @dash.callback(Output("gr-table", "data"), Output("gr-preset-rows", "data"), Output("gr-assumptions", "children"),
-               Output("gr-error", "children", allow_duplicate=True),
-               Input("gr-settings", "data"), Input("gr-reset", "n_clicks"), State("gr-preset", "value"),
-               prevent_initial_call="initial_duplicate")
+               Output("gr-settings-error", "children"),
+               Input("gr-settings", "data"), Input("gr-reset", "n_clicks"), State("gr-preset", "value"))
 def preset_table(settings, _reset, name):
     """The preset's table for its settings (shown in the profile table, which may then be edited)."""
     if not settings:

@@ -98,4 +98,12 @@ def test_ground_run_address_values_are_refused_not_replaced(server, browser):  #
                       what="the refusal")
     assert "preset=cruise" in error and "psi_thr=abc" in error and "not a number" in error
     assert "lat_thr=5000" in error and "mm" in error
+    # nothing is run on load from what the address could not give (the line above says why) ...
+    _idle(browser)
+    assert not browser.find_elements(By.CSS_SELECTOR, "#gr-summary tbody tr")
+    # ... and Run refuses it in the box's unit
+    browser.find_element(By.ID, "gr-run").click()
+    refusal = _wait_for(lambda: "".join(e.text for e in browser.find_elements(By.ID, "gr-error")) or None,
+                        what="the refused run")
+    assert "threshold |psi|" in refusal and "rad" in refusal
     assert browser.find_element(By.ID, "gr-psi-thr").get_attribute("value") == ""
