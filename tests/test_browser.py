@@ -40,23 +40,32 @@ def _ensure_chromium() -> None:
     subprocess.run(["apt-get", "install", "-y", "-qq", "chromium", "chromium-driver"], check=True, env=env)
 
 
-@pytest.fixture(scope="module")
-def browser():
+def chromium(profile: str, window: str, downloads: Path | None = None):
+    """Headless Chromium on a profile of its own (``profile`` under .pytest_cache), started once
+    for a module: a second browser on the same profile, started while the first is still closing,
+    would hand its pages to that one."""
     _ensure_chromium()
     opts = webdriver.ChromeOptions()
     opts.binary_location = CHROMIUM
     for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                "--disable-dev-shm-usage", "--window-size=1500,1100"):
+                "--disable-dev-shm-usage", f"--window-size={window}"):
         opts.add_argument(arg)
-    opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / 'chromium-profile'}")
+    opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / profile}")
     opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    DOWNLOADS.mkdir(parents=True, exist_ok=True)
-    opts.add_experimental_option("prefs", {"download.default_directory": str(DOWNLOADS),
-                                           "download.prompt_for_download": False})
+    if downloads is not None:
+        downloads.mkdir(parents=True, exist_ok=True)
+        opts.add_experimental_option("prefs", {"download.default_directory": str(downloads),
+                                               "download.prompt_for_download": False})
     driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
     driver.set_page_load_timeout(60)
     SHOTS.mkdir(exist_ok=True)
+    return driver
+
+
+@pytest.fixture(scope="module")
+def browser():
+    driver = chromium("chromium-profile", "1500,1100", DOWNLOADS)
     yield driver
     driver.quit()
 

@@ -14,28 +14,14 @@ import pytest
 pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
-from selenium import webdriver  # noqa: E402
-from selenium.webdriver.chrome.service import Service  # noqa: E402
-from test_browser import (CHROMEDRIVER, CHROMIUM, PAGES, ROOT, SHOTS, _ensure_chromium, _idle,  # noqa: E402
+from test_browser import (PAGES, SHOTS, _idle, chromium,  # noqa: E402
                           _severe, _trace_count, _wait_for)
 
 
 @pytest.fixture(scope="module")
 def browser():
-    """Headless Chromium as in test_browser.py, with a profile of its own: a second browser on the
-    same profile, started while the first is still closing, would hand its pages to that one."""
-    _ensure_chromium()
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = CHROMIUM
-    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                "--disable-dev-shm-usage", "--window-size=1440,900"):
-        opts.add_argument(arg)
-    opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / 'chromium-profile-workbench'}")
-    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
-    driver.set_page_load_timeout(60)
-    SHOTS.mkdir(exist_ok=True)
+    """Headless Chromium as in test_browser.py, with a profile of its own."""
+    driver = chromium("chromium-profile-workbench", "1440,900")
     yield driver
     driver.quit()
 
