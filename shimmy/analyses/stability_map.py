@@ -254,12 +254,13 @@ def _special_points(result: BifurcationResult) -> list[dict[str, Any]]:
 
 
 def map_slice(config: Configuration | str, Fz: float, v_min: float, v_max: float, n_v: int,
-              params: Parameters, options: BifurcationOptions | None = None) -> SliceResult:
-    """The map's computation on one load: diagram in V, types on the grid, special points."""
+              params: Parameters, options: BifurcationOptions | None = None, result=None) -> SliceResult:
+    """The map's computation on one load: diagram in V (``result`` if already computed, with the same
+    load, range and parameters), types on the grid, special points."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     options = options or BifurcationOptions(mesh_check=False)
-    result = bifurcation(config, Fz, v_min, v_max, params, options)
+    result = result or bifurcation(config, Fz, v_min, v_max, params, options)
     coarse, fine = _grids(v_min, v_max, n_v)
     types_fine, _, simulated = _slice_types(result, fine, FINE, config, params)
     hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value}
