@@ -476,6 +476,99 @@ def _cmd_metrics(args) -> int:
     return 0
 
 
+def _names(text: str | None) -> list[str] | None:
+    return None if text is None else [n.strip() for n in str(text).split(",") if n.strip()]
+
+
+def _cmd_sensitivity(args) -> int:
+    from .analyses.sensitivity import sensitivity
+
+    Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
+    result = sensitivity(args.config, Fz, _params(args), _names(args.params), amplitude=not args.no_amplitude)
+    payload = result.to_dict()
+    lines = [f"{result.config.value} at Fz = {Fz / 1e3:g} kN: change of each quantity per +1 % of the parameter "
+             f"(per half of its range in brackets); largest effects first, then the device parameters"]
+    for q in payload["quantities"]:
+        lines.append(f"\n{q['label']} = {q['value']:.6g} {q['unit']}")
+        active = [r for r in q["rows"] if r["reason"] is None]
+        shown = active[:args.top] + [r for r in active[args.top:] if r["device"]]
+        for r in shown:
+            lines.append(f"  {r['name']:<12}{r['per_percent']:>+12.4g} {q['unit']:<4}"
+                         f"({r['per_half_range']:+.4g} {q['unit']} per half range)")
+        silent = [r["name"] for r in q["rows"] if r["reason"] is not None]
+        if silent:
+            lines.append(f"  no effect: {', '.join(silent)}")
+    if result.max_psi is not None and result.max_psi.get("dA_dp") is None:
+        lines.append(f"\nlargest stable torsional amplitude: {result.max_psi['reason']}")
+    reasons = {}
+    for by_name in result.no_effect.values():
+        for name, reason in by_name.items():
+            reasons.setdefault(reason, set()).add(name)
+    lines += [f"  {', '.join(sorted(n))}: {r}" for r, n in reasons.items()]
+    _emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_optimise(args) -> int:
+    from .analyses.optimise import FIGURES, optimise
+
+    Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
+    bar = _bar(args)
+    try:
+        result = optimise(args.config, args.objective, _names(args.params), Fz, args.constraint or [], _params(args),
+                          method=args.method, starts=args.starts, local_runs=args.local_runs, seed=args.seed,
+                          progress=bar)
+    finally:
+        bar.close()
+    payload = result.to_dict()
+    f = FIGURES[result.objective]
+    lines = [f"{result.config.value}: {'maximise' if f.sense > 0 else 'minimise'} {f.label}"
+             + (f" at {Fz / 1e3:g} kN" if f.at_load else "") + f" over {', '.join(result.names)} "
+             f"({result.method}, {result.evaluations} evaluations, {result.elapsed_s:.1f} s)",
+             f"  optimum {result.objective_value:.6g} {f.unit} (nominal {result.nominal_objective:.6g} {f.unit})",
+             "  design: " + ", ".join(f"{n} = {v:.6g} {PARAMETER_SPECS[n].unit}".rstrip()
+                                      for n, v in result.design.items())]
+    for c in result.constraints:
+        lines.append(f"  constraint {c}")
+    for label, table in result.figures.items():
+        lines.append(f"  {label:<9}" + ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k}: {v}"
+                                                 for k, v in table.items()))
+    lines.append(f"  {result.message}")
+    lines += [f"  warning: {w}" for w in result.warnings]
+    _emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_robustness(args) -> int:
+    from .analyses.robustness import robustness
+
+    Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
+    bar = _bar(args)
+    try:
+        result = robustness(args.config, args.tolerance or [], args.samples, Fz, _params(args), seed=args.seed,
+                            progress=bar)
+    finally:
+        bar.close()
+    payload = result.to_dict()
+    if not args.with_samples:
+        for h in payload["hopf_points"] + ([payload["min_shimmy_Fz"]] if payload["min_shimmy_Fz"] else []):
+            h.pop("samples")
+    lines = [f"{result.config.value} at Fz = {Fz / 1e3:g} kN, {result.samples} samples (seed {result.seed}): "
+             + ", ".join(f"{t.name} {100 * t.relative:g} % {t.distribution}" for t in result.tolerances),
+             f"  {'':<22}{'nominal':>10}{'mean':>10}{'std':>9}{'p05':>10}{'p95':>10}{'linear std':>12}"]
+    rows = [(f"Hopf speed {k + 1} (m/s)", h, 1.0) for k, h in enumerate(result.hopf_points)]
+    if result.min_shimmy:
+        rows.append(("min shimmy Fz (kN)", result.min_shimmy, 1e-3))
+    for label, h, k in rows:
+        lines.append(f"  {label:<22}{h['nominal'] * k:>10.4g}{h['mean'] * k:>10.4g}{h['std'] * k:>9.3g}"
+                     f"{h['p05'] * k:>10.4g}{h['p95'] * k:>10.4g}{h['linear_std'] * k:>12.3g}")
+    lines.append("  P(shimmy) sampled / linear: " + ", ".join(
+        f"{p} {result.p_shimmy[p]:.3f}/{result.p_shimmy_linear[p]:.3f}" for p in result.p_shimmy))
+    lines += [f"  warning: {w}" for w in result.warnings]
+    _emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
 def _cmd_study(args) -> int:
     from .analyses.studies import study, study_grid
 
@@ -692,6 +785,50 @@ def build_parser() -> argparse.ArgumentParser:
     _add_common(p)
     _add_progress(p)
     p.set_defaults(func=_cmd_metrics)
+
+    p = sub.add_parser("sensitivity", help="derivatives of the Hopf speeds, the minimum shimmy load and the largest "
+                                           "torsional amplitude with respect to every parameter")
+    p.add_argument("--config", required=True, choices=configs, help="configuration")
+    p.add_argument("--Fz", default=150e3, help="vertical load (N)")
+    p.add_argument("--params", help="comma-separated parameter names (default: all)")
+    p.add_argument("--no-amplitude", action="store_true",
+                   help="skip the largest torsional amplitude (which needs one bifurcation diagram)")
+    p.add_argument("--top", type=int, default=8, help="rows per quantity in the table")
+    _add_common(p)
+    p.set_defaults(func=_cmd_sensitivity)
+
+    p = sub.add_parser("optimise", help="search device parameters for the best figure of merit under constraints")
+    p.add_argument("--config", required=True, choices=configs, help="configuration")
+    p.add_argument("--objective", default="min_shimmy_Fz", choices=("min_shimmy_Fz", "interval", "max_psi",
+                                                                    "torsion_area"),
+                   help="maximise min_shimmy_Fz; minimise the shimmy interval width or max_psi at --Fz, or the "
+                        "pure-torsion area")
+    p.add_argument("--Fz", default=150e3, help="load (N) of the figures at a load")
+    p.add_argument("--params", default="r2,e_p,k_s,r3", help="comma-separated parameters to search in their ranges")
+    p.add_argument("--constraint", action="append", metavar="FIGURE[@Fz]<=VALUE",
+                   help="constraint on a figure (repeatable), e.g. max_psi<=0.02 or min_shimmy_Fz>=80000")
+    p.add_argument("--method", default="auto", choices=("auto", "gradient", "global"),
+                   help="gradient: Sobol starts then SLSQP with analytic gradients; global: differential evolution")
+    p.add_argument("--starts", default=8, type=int, help="start designs (gradient method)")
+    p.add_argument("--local-runs", default=2, type=int, help="SLSQP runs from the best starts (gradient method)")
+    p.add_argument("--seed", default=0, type=int, help="seed of the start designs")
+    _add_common(p)
+    _add_progress(p)
+    p.set_defaults(func=_cmd_optimise)
+
+    p = sub.add_parser("robustness", help="Hopf speeds, minimum shimmy load and shimmy at the operating points "
+                                          "under parameter tolerances (quasi-Monte Carlo and linear propagation)")
+    p.add_argument("--config", required=True, choices=configs, help="configuration")
+    p.add_argument("--Fz", default=150e3, help="vertical load (N)")
+    p.add_argument("--tolerance", action="append", metavar="NAME=REL[:normal|uniform]",
+                   help="relative tolerance of a parameter (repeatable): standard deviation (normal, the default) "
+                        "or half-width (uniform), e.g. k_lam=0.05")
+    p.add_argument("--samples", default=128, type=int, help="quasi-Monte Carlo samples")
+    p.add_argument("--seed", default=0, type=int, help="seed of the scrambled Sobol sequence")
+    p.add_argument("--with-samples", action="store_true", help="include every sample's values in the JSON")
+    _add_common(p)
+    _add_progress(p)
+    p.set_defaults(func=_cmd_robustness)
 
     p = sub.add_parser("study", help="parametric study: Hopf speeds and max amplitude against parameters")
     p.add_argument("--param", required=True, help="parameter name (see 'params')")

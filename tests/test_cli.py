@@ -211,3 +211,40 @@ def test_bad_map_study_classify_input_exits_2_naming_the_field(args, needle):
     out = run(*args)
     assert out.returncode == 2, (out.returncode, out.stderr)
     assert needle in out.stderr
+
+
+def test_sensitivity_optimise_robustness_commands_give_the_documented_json():
+    out = run("sensitivity", "--config", "nes", "--Fz", "150000", "--no-amplitude", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert len(data["hopf_points"]) == 2 and set(data["hopf_points"][0]["dV_dp"]) == set(PARAMETER_SPECS)
+    assert {"Fz", "dFz_dp"} <= set(data["min_shimmy_Fz"])
+    assert "a_p" in data["no_effect"]["hopf"]
+    text = run("sensitivity", "--config", "pd", "--Fz", "150000", "--no-amplitude")
+    assert "zero at rest" in text.stdout and "per +1 %" in text.stdout
+    out = run("optimise", "--config", "nes", "--params", "e_p", "--starts", "2", "--local-runs", "1", "--json",
+              "--progress", "none")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert {"design", "objective", "nominal_objective", "evaluations"} <= set(data)
+    assert data["objective"] >= data["nominal_objective"] and set(data["design"]) == {"e_p"}
+    out = run("robustness", "--config", "nes_pd", "--tolerance", "k_lam=0.05", "--tolerance", "k_s=0.05",
+              "--samples", "16", "--json", "--progress", "none")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert {"mean", "std", "p05", "p95", "linear_std"} <= set(data["hopf_points"][0])
+    assert set(data["p_shimmy"]) == set("ABCDEFGHI")
+
+
+@pytest.mark.parametrize("args, needle", [
+    (("sensitivity", "--config", "nes", "--Fz", "1"), "Fz"),
+    (("sensitivity", "--config", "nes", "--params", "k_sx"), "k_sx"),
+    (("optimise", "--config", "nes", "--constraint", "max_psi<0.02"), "constraint"),
+    (("optimise", "--config", "original", "--params", "k_s"), "not fitted"),
+    (("robustness", "--config", "nes", "--tolerance", "k_s=2"), "tolerance k_s"),
+    (("robustness", "--config", "nes"), "tolerance"),
+])
+def test_bad_design_command_input_exits_2_naming_the_field(args, needle):
+    out = run(*args)
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert needle in out.stderr

@@ -68,7 +68,7 @@ def test_parameters_without_effect_are_exact_zeros_with_their_reason():
     rows = o.tornado("hopf_V2")
     with_effect = [r for r in rows if r["reason"] is None]
     assert [r["name"] for r in rows[:len(with_effect)]] == [r["name"] for r in with_effect]  # reasons last
-    sizes = [abs(r["per_half_range"]) for r in with_effect]
+    sizes = [abs(r["per_percent"]) for r in with_effect]
     assert sizes == sorted(sizes, reverse=True)
     for r in rows:
         spec = PARAMETER_SPECS[r["name"]]

@@ -195,6 +195,8 @@ class _Problem:
     objective: str
     Fz: float
     constraints: list[Constraint]
+    #: design task -> {"ok", "figures"} (a module-level function: it travels to the executor's workers)
+    evaluator: Callable[[tuple], dict[str, Any]] = _evaluate_unit
 
     @property
     def lows(self) -> np.ndarray:
@@ -257,7 +259,7 @@ def _local_unit(task: tuple) -> dict[str, Any]:
         z = np.clip(np.asarray(z, float), 0.0, 1.0)
         k = z.tobytes()
         if k not in memo:
-            memo[k] = _evaluate_unit(problem.task(z, True))
+            memo[k] = problem.evaluator(problem.task(z, True))
             log.append((z.tolist(), memo[k]))
         return memo[k]
 
@@ -332,10 +334,10 @@ class OptimisationResult:
 
     def to_dict(self) -> dict[str, Any]:
         f = FIGURES[self.objective]
-        return {"config": self.config.value, "objective": {"name": self.objective, "label": f.label, "unit": f.unit,
-                                                            "sense": "maximise" if f.sense > 0 else "minimise",
-                                                            "Fz": self.Fz if f.at_load else None,
-                                                            "value": self.objective_value},
+        return {"config": self.config.value, "objective": self.objective_value,
+                "objective_figure": {"name": self.objective, "label": f.label, "unit": f.unit,
+                                     "sense": "maximise" if f.sense > 0 else "minimise",
+                                     "Fz": self.Fz if f.at_load else None},
                 "nominal_objective": self.nominal_objective, "design": self.design, "parameters": self.names,
                 "constraints": [c.to_dict() for c in self.constraints], "method": self.method,
                 "figures": self.figures, "evaluations": self.evaluations, "history": self.history,
@@ -346,6 +348,52 @@ class OptimisationResult:
 
 def _figure_table(figures: dict, keys) -> dict[str, Any]:
     return {f"{k[0]}" + (f"@{k[1]:g}" if k[1] is not None else ""): figures[k]["value"] for k in keys}
+
+
+def search(problem: _Problem, method: str, z_start: np.ndarray, starts: int, local_runs: int, max_iterations: int,
+           generations: int, popsize: int, seed: int, executor, report) -> tuple[list[dict[str, Any]], str]:
+    """The evaluations (in order) and the method's message: ``gradient`` (Sobol starts with ``z_start``
+    first, then SLSQP runs from the best) or ``global`` (differential evolution from a Sobol population
+    holding ``z_start``)."""
+    history: list[dict[str, Any]] = []
+    names = problem.names
+    if method == "gradient":
+        m = max(0, math.ceil(math.log2(max(starts - 1, 1))))
+        sample = qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(m)[:starts - 1]
+        zs = [z_start] + list(sample)
+        report(0.02, f"evaluating {len(zs)} start designs")
+        results = run_units(problem.evaluator, [problem.task(z, False) for z in zs], executor,
+                            lambda f, m: report(0.02 + 0.3 * f, f"start designs: {m}"), lambda t: "design")
+        for z, e in zip(zs, results, strict=True):
+            _record(history, problem, z, e, "start")
+        ranked = sorted(range(len(zs)), key=lambda k: (problem.merit(results[k])[1], problem.merit(results[k])[0]))
+        runs = run_units(_local_unit, [(problem, zs[k], max_iterations) for k in ranked[:local_runs]], executor,
+                         lambda f, m: report(0.32 + 0.6 * f, f"local searches (SLSQP): {m}"), lambda t: "search")
+        messages = []
+        for run in runs:
+            for z, e in run["log"]:
+                _record(history, problem, z, e, "local")
+            messages.append(run["message"])
+        message = "SLSQP: " + "; ".join(dict.fromkeys(messages))
+    else:
+        def mapper(_func, population):
+            population = [np.asarray(z, float) for z in population]
+            out = run_units(problem.evaluator, [problem.task(z, False) for z in population], executor, None,
+                            lambda t: "design")
+            merits = []
+            for z, e in zip(population, out, strict=True):
+                _record(history, problem, z, e, "global")
+                obj, violation = problem.merit(e)
+                merits.append(1e6 if not math.isfinite(obj) else obj + 100.0 * violation)
+            report(min(0.95, len(history) / (popsize * len(names) * (generations + 1))),
+                   f"differential evolution: {len(history)} designs evaluated")
+            return merits
+
+        res = differential_evolution(lambda z: 0.0, [(0.0, 1.0)] * len(names), workers=mapper, updating="deferred",
+                                     maxiter=generations, popsize=popsize, seed=seed, polish=False, tol=1e-3,
+                                     init="sobol", x0=z_start)
+        message = f"differential evolution: {res.message}"
+    return history, message
 
 
 def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
@@ -386,49 +434,10 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
         with open_executor() as own:
             return optimise(config, objective, names, Fz, cons, params, chosen, starts, local_runs, max_iterations,
                             generations, popsize, seed, own, progress)
-    history: list[dict[str, Any]] = []
-    evaluations: dict[bytes, dict] = {}
     warnings: list[str] = []
     z_nominal = np.clip(problem.z_of(params), 0.0, 1.0)
-    if chosen == "gradient":
-        m = max(0, math.ceil(math.log2(max(starts - 1, 1))))
-        sample = qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(m)[:starts - 1]
-        zs = [z_nominal] + list(sample)
-        report(0.02, f"evaluating {len(zs)} start designs")
-        results = run_units(_evaluate_unit, [problem.task(z, False) for z in zs], executor,
-                            lambda f, m: report(0.02 + 0.3 * f, f"start designs: {m}"), lambda t: "design")
-        for z, e in zip(zs, results, strict=True):
-            _record(history, problem, z, e, "start")
-            evaluations[np.asarray(z).tobytes()] = e
-        ranked = sorted(range(len(zs)), key=lambda k: (problem.merit(results[k])[1], problem.merit(results[k])[0]))
-        runs = run_units(_local_unit, [(problem, zs[k], max_iterations) for k in ranked[:local_runs]], executor,
-                         lambda f, m: report(0.32 + 0.6 * f, f"local searches (SLSQP): {m}"), lambda t: "search")
-        messages = []
-        for run in runs:
-            for z, e in run["log"]:
-                _record(history, problem, z, e, "local")
-                evaluations[np.asarray(z).tobytes()] = e
-            messages.append(run["message"])
-        message = "SLSQP: " + "; ".join(dict.fromkeys(messages))
-    else:
-        def mapper(_func, population):
-            population = [np.asarray(z, float) for z in population]
-            out = run_units(_evaluate_unit, [problem.task(z, False) for z in population], executor, None,
-                            lambda t: "design")
-            merits = []
-            for z, e in zip(population, out, strict=True):
-                _record(history, problem, z, e, "global")
-                evaluations[z.tobytes()] = e
-                obj, violation = problem.merit(e)
-                merits.append(1e6 if not math.isfinite(obj) else obj + 100.0 * violation)
-            report(min(0.95, len(history) / (popsize * len(names) * (generations + 1))),
-                   f"differential evolution: {len(history)} designs evaluated")
-            return merits
-
-        res = differential_evolution(lambda z: 0.0, [(0.0, 1.0)] * len(names), workers=mapper, updating="deferred",
-                                     maxiter=generations, popsize=popsize, seed=seed, polish=False, tol=1e-3,
-                                     init="sobol", x0=z_nominal)
-        message = f"differential evolution: {res.message}"
+    history, message = search(problem, chosen, z_nominal, starts, local_runs, max_iterations, generations, popsize,
+                              seed, executor, report)
     feasible = [h for h in history if h["feasible"]]
     sense = FIGURES[objective].sense
     if feasible:

@@ -208,7 +208,7 @@ class SensitivityResult:
             out[name] = {"per_percent": d * 0.01 * value, "per_half_range": d * 0.5 * (spec.high - spec.low)}
         return out
 
-    def tornado(self, key: str, by: str = "per_half_range") -> list[dict[str, Any]]:
+    def tornado(self, key: str, by: str = "per_percent") -> list[dict[str, Any]]:
         """Rows {name, unit, value, low, high, derivative, per_percent, per_half_range, reason} of one
         quantity, largest effect first; parameters without effect last, with their reason."""
         q = next((q for q in self.quantities() if q["key"] == key), None)
@@ -222,7 +222,7 @@ class SensitivityResult:
             value = float(getattr(self.params, name))
             rows.append({"name": name, "unit": spec.unit, "group": spec.group, "value": value,
                          "low": spec.low, "high": spec.high, "derivative": q["derivatives"][name],
-                         **scaled[name], "reason": reasons.get(name)})
+                         **scaled[name], "reason": reasons.get(name), "device": name in DESIGN_PARAMETERS})
         rows.sort(key=lambda r: (r["reason"] is not None, -abs(r[by])))
         return rows
 
