@@ -128,6 +128,8 @@ def _stats(values: np.ndarray, nominal: float, linear_std: float | None) -> dict
     return {"nominal": nominal, "mean": float(values.mean()), "std": float(values.std(ddof=1)) if values.size > 1
             else 0.0, "p05": float(np.quantile(values, 0.05)), "p95": float(np.quantile(values, 0.95)),
             "min": float(values.min()), "max": float(values.max()), "linear_std": linear_std,
+            "linear_p05": None if linear_std is None else nominal - 1.6448536269514722 * linear_std,
+            "linear_p95": None if linear_std is None else nominal + 1.6448536269514722 * linear_std,
             "samples": values.tolist()}
 
 
