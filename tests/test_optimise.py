@@ -5,7 +5,7 @@ import pytest
 
 from shimmy.analyses.executors import open_executor
 from shimmy.analyses.hopf_curves import hopf_curves
-from shimmy.analyses.optimise import Constraint, _Problem, figures_of, optimise, search
+from shimmy.analyses.optimise import Constraint, SearchProblem, figures_of, optimise, search
 from shimmy.analyses.robustness import Tolerance, robustness
 from shimmy.errors import InvalidParameterError
 from shimmy.model.parameters import PARAMETER_SPECS, Parameters
@@ -43,7 +43,7 @@ def _best(history, sense=1):
 @pytest.mark.parametrize("method", ["gradient", "global"])
 def test_search_finds_the_known_constrained_optimum(method):
     # max -(z1-0.3)^2 - 2(z2-0.6)^2 subject to z1 + z2 <= 0.7: Lagrange gives z = (1/6, 8/15).
-    problem = _Problem("nes", Parameters().to_dict(), NAMES, "min_shimmy_Fz", 150e3,
+    problem = SearchProblem("nes", Parameters().to_dict(), NAMES, "min_shimmy_Fz", 150e3,
                        [Constraint("max_psi", "<=", 0.07, 150e3)], evaluator=quadratic)
     with open_executor(max_workers=1) as inline:
         history, message = search(problem, method, np.array([0.5, 0.5]), 8, 2, 50, 30, 10, 0, inline,

@@ -58,6 +58,7 @@ class Figure:
     scale: float  # a typical size, to make objectives and constraints O(1)
 
 
+#: The figures of merit by name: label, unit, sense as an objective, whether taken at a load, scale.
 FIGURES = {
     "min_shimmy_Fz": Figure("minimum shimmy load", "N", +1, False, 1e5),
     "interval": Figure("shimmy speed interval width", "m/s", -1, True, 100.0),
@@ -188,7 +189,10 @@ def _evaluate_unit(task: tuple) -> dict[str, Any]:
 
 
 @dataclass
-class _Problem:
+class SearchProblem:
+    """What :func:`search` optimises: the design parameters (scaled to [0, 1]), the objective and
+    constraints, and the function that evaluates a design (``evaluator``, run on the executor)."""
+
     config: str
     base: dict[str, float]
     names: list[str]
@@ -236,7 +240,7 @@ class _Problem:
         return obj, violation
 
 
-def _record(history: list, problem: _Problem, z, evaluation, stage: str) -> None:
+def _record(history: list, problem: SearchProblem, z, evaluation, stage: str) -> None:
     obj, violation = problem.merit(evaluation)
     design = dict(zip(problem.names, problem.values(z), strict=True))
     entry = {"evaluation": len(history) + 1, "stage": stage, "design": design,
@@ -350,7 +354,7 @@ def _figure_table(figures: dict, keys) -> dict[str, Any]:
     return {f"{k[0]}" + (f"@{k[1]:g}" if k[1] is not None else ""): figures[k]["value"] for k in keys}
 
 
-def search(problem: _Problem, method: str, z_start: np.ndarray, starts: int, local_runs: int, max_iterations: int,
+def search(problem: SearchProblem, method: str, z_start: np.ndarray, starts: int, local_runs: int, max_iterations: int,
            generations: int, popsize: int, seed: int, executor, report) -> tuple[list[dict[str, Any]], str]:
     """The evaluations (in order) and the method's message: ``gradient`` (Sobol starts with ``z_start``
     first, then SLSQP runs from the best) or ``global`` (differential evolution from a Sobol population
@@ -426,7 +430,7 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
         raise InvalidParameterError("method", method, "one of auto, gradient, global")
     starts = int(check_number("starts", starts, 1, 256, integer=True))
     local_runs = int(check_number("local_runs", local_runs, 1, starts, integer=True))
-    problem = _Problem(config.value, params.to_dict(), names, objective, Fz, cons)
+    problem = SearchProblem(config.value, params.to_dict(), names, objective, Fz, cons)
     smooth = all(k[0] in DIFFERENTIABLE for k in problem.wanted)
     chosen = ("gradient" if smooth else "global") if method == "auto" else method
     report = progress or (lambda fraction, message: None)
