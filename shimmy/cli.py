@@ -14,6 +14,7 @@ import json
 import math
 import sys
 from typing import Any, Sequence
+from urllib.parse import urlencode
 
 import numpy as np
 
@@ -534,6 +535,7 @@ def _cmd_optimise(args) -> int:
         lines.append(f"  {label:<9}" + ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k}: {v}"
                                                  for k, v in table.items()))
     lines.append(f"  {result.message}")
+    lines.append("  open in the workbench: /?" + urlencode(result.link_query))
     lines += [f"  warning: {w}" for w in result.warnings]
     _emit(payload, args.json, "\n".join(lines))
     return 0
