@@ -494,7 +494,8 @@ def _cmd_sensitivity(args) -> int:
         active = [r for r in q["rows"] if r["reason"] is None]
         shown = active[:args.top] + [r for r in active[args.top:] if r["device"]]
         for r in shown:
-            lines.append(f"  {r['name']:<12}{r['per_percent']:>+12.4g} {q['unit']:<4}"
+            percent = "(value 0)" if r["per_percent"] is None else f"{r['per_percent']:+.4g}"
+            lines.append(f"  {r['name']:<12}{percent:>12} {q['unit']:<4}"
                          f"({r['per_half_range']:+.4g} {q['unit']} per half range)")
         silent = [r["name"] for r in q["rows"] if r["reason"] is not None]
         if silent:
@@ -806,7 +807,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="maximise min_shimmy_Fz; minimise the shimmy interval width or max_psi at --Fz, or the "
                         "pure-torsion area")
     p.add_argument("--Fz", default=150e3, help="load (N) of the figures at a load")
-    p.add_argument("--params", default="r2,e_p,k_s,r3", help="comma-separated parameters to search in their ranges")
+    p.add_argument("--params", help="comma-separated parameters to search in their ranges (default: the "
+                                    "configuration's device parameters: r2,e_p,k_s,r3 with the NES, a_p,rho_p with "
+                                    "the PD)")
     p.add_argument("--constraint", action="append", metavar="FIGURE[@Fz]<=VALUE",
                    help="constraint on a figure (repeatable), e.g. max_psi<=0.02 or min_shimmy_Fz>=80000")
     p.add_argument("--method", default="auto", choices=("auto", "gradient", "global"),

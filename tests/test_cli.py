@@ -241,6 +241,7 @@ def test_sensitivity_optimise_robustness_commands_give_the_documented_json():
     (("sensitivity", "--config", "nes", "--params", "k_sx"), "k_sx"),
     (("optimise", "--config", "nes", "--constraint", "max_psi<0.02"), "constraint"),
     (("optimise", "--config", "original", "--params", "k_s"), "not fitted"),
+    (("optimise", "--config", "original"), "no device parameters"),
     (("robustness", "--config", "nes", "--tolerance", "k_s=2"), "tolerance k_s"),
     (("robustness", "--config", "nes"), "tolerance"),
 ])

@@ -81,3 +81,18 @@ def test_operating_point_ranges():
         check_operating_point(0.5, 150e3)
     with pytest.raises(InvalidParameterError, match=r"Fz=1000000.0 is out of range.*\[10000, 900000\] N"):
         check_operating_point(30, 1e6)
+
+
+def test_sampled_values_may_leave_the_design_range_but_not_physics():
+    from shimmy.model.parameters import Parameters as P
+
+    p = P().with_sampled({"k_s": 1.5e6, "k_lam": 0.0021})  # k_s's design range ends at 1.4e6 N/m
+    assert p.k_s == 1.5e6 and p.k_lam == 0.0021 and P().k_s == 1.2e6
+    with pytest.raises(InvalidParameterError, match="k_s"):
+        P().with_sampled({"k_s": -1.0})
+    with pytest.raises(InvalidParameterError, match="L"):
+        P().with_sampled({"L": 0.0})
+    with pytest.raises(InvalidParameterError, match="r3"):  # the roller leaves its track
+        P().with_sampled({"r2": 0.07, "r3": 0.002})
+    with pytest.raises(InvalidParameterError, match="k_sx"):
+        P().with_sampled({"k_sx": 1.0})

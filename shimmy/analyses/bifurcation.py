@@ -28,7 +28,8 @@ reports the change of the maximum torsional amplitude under mesh doubling
 (``mesh_check``), the figure that shows the result does not depend on the mesh.
 
 ``max_psi`` is the largest torsional amplitude of a *stable* limit cycle (what the
-gear would show), refined by a bounded 1-D search along the branch; ``max_psi_any``
+gear would show), refined by a bounded 1-D search along the branch, each orbit's maximum located on
+its collocation polynomial (:meth:`PeriodicProblem.peak`); ``max_psi_any``
 includes unstable cycles.
 """
 
@@ -592,8 +593,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
             if point is None:
                 cache[h] = (0.0, None)
                 return 0.0
-            _, x = problem.sample(point.u)
-            a = float(np.abs(x[:, 0]).max())
+            a = problem.peak(point.u, 0)[2]  # on the collocation polynomial, not the nearest sample
             cache[h] = (a, point)
             return -a
 
@@ -621,8 +621,8 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
         if fixed is None:
             warnings.append("mesh check: no convergence on the doubled mesh")
         else:
-            a_f = float(np.abs(fine.sample(fixed.u)[1][:, 0]).max())
-            a_c = float(np.abs(problem.sample(point.u)[1][:, 0]).max())
+            a_f = fine.peak(fixed.u, 0)[2]
+            a_c = problem.peak(point.u, 0)[2]
             mesh_check = {"V": float(point.u[-1]), "ntst": problem.mesh.ntst, "ntst_fine": fine.mesh.ntst,
                           "max_psi": a_c, "max_psi_fine": a_f, "change": abs(a_f - a_c)}
     return amp, V, max(max_any, amp), mesh_check

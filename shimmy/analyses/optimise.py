@@ -43,7 +43,7 @@ from ..model.configurations import Configuration, affects
 from ..model.equations import build_model
 from ..model.parameters import PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from .executors import open_executor, run_units
-from .sensitivity import (V_BAND, amplitude_sensitivity, coefficient_pairs, hopf_sensitivities,
+from .sensitivity import (DESIGN_PARAMETERS, V_BAND, amplitude_sensitivity, coefficient_pairs, hopf_sensitivities,
                           min_shimmy_sensitivity)
 
 FZ_BOX = (1.0e4, 9.0e5)  # N
@@ -65,7 +65,6 @@ FIGURES = {
     "max_psi": Figure("largest stable torsional amplitude", "rad", -1, True, 0.1),
     "torsion_area": Figure("pure-torsion area (Fz <= 250 kN)", "(m/s) kN", -1, False, 1e4),
 }
-DEFAULT_PARAMETERS = ("r2", "e_p", "k_s", "r3")
 #: Figures with derivatives (where the interval ends at Hopf points and the amplitude's maximum is
 #: inside the stable part; a local search that meets a point without one stops there).
 DIFFERENTIABLE = ("min_shimmy_Fz", "max_psi", "interval")
@@ -125,13 +124,17 @@ def _interval_of(result, Fz, params, config, names, gradient, pairs, model):
     if not s.intervals:
         return {"value": 0.0, "gradient": {n: 0.0 for n in names} if gradient else None}
     lo, hi = s.intervals[0]["V_start"], s.intervals[-1]["V_end"]
-    grad = None
     speeds = [h["V"] for h in s.hopf_points]
     step = (V_BAND[1] - V_BAND[0]) / (10 * 199)
-    if gradient and len(speeds) == 2 and abs(speeds[0] - lo) <= step and abs(speeds[1] - hi) <= step:
-        d = hopf_sensitivities(model, Fz, speeds, pairs)
+    at_lo = [x for x in speeds if abs(x - lo) <= step]
+    at_hi = [x for x in speeds if abs(x - hi) <= step]
+    if at_lo and at_hi and at_lo[0] != at_hi[-1]:  # both ends are Hopf points: the width moves with them
+        ends = [at_lo[0], at_hi[-1]]
+        if not gradient:
+            return {"value": ends[1] - ends[0], "gradient": None}
+        d = hopf_sensitivities(model, Fz, ends, pairs)
         grad = {n: d[1]["dV_dp"][n] - d[0]["dV_dp"][n] for n in names}
-        return {"value": speeds[1] - speeds[0], "gradient": grad}
+        return {"value": ends[1] - ends[0], "gradient": grad}
     return {"value": hi - lo, "gradient": None}
 
 
@@ -246,8 +249,11 @@ def _record(history: list, problem: SearchProblem, z, evaluation, stage: str) ->
     entry = {"evaluation": len(history) + 1, "stage": stage, "design": design,
              "feasible": bool(evaluation["ok"] and violation <= 1e-9)}
     if evaluation["ok"]:
-        entry["objective"] = evaluation["figures"][problem.objective_key]["value"]
+        figure = evaluation["figures"][problem.objective_key]
+        entry["objective"] = figure["value"]
         entry["violation"] = violation
+        if figure.get("gradient") is not None:
+            entry["objective_gradient"] = dict(figure["gradient"])
     else:
         entry["objective"], entry["violation"], entry["reason"] = None, None, evaluation["reason"]
     history.append(entry)
@@ -255,13 +261,13 @@ def _record(history: list, problem: SearchProblem, z, evaluation, stage: str) ->
 
 def _local_unit(task: tuple) -> dict[str, Any]:
     """One SLSQP run from z0 with analytic gradients; returns its evaluations in order."""
-    problem, z0, max_iterations = task
-    memo: dict[bytes, dict] = {}
+    problem, z0, max_iterations, start = task
+    memo: dict[tuple, dict] = {tuple(problem.values(z0)): start}  # the start is in the history already
     log: list[tuple[list[float], dict]] = []
 
     def evaluate(z):
         z = np.clip(np.asarray(z, float), 0.0, 1.0)
-        k = z.tobytes()
+        k = tuple(problem.values(z))  # the design evaluated (rounded where a parameter is an integer)
         if k not in memo:
             memo[k] = problem.evaluator(problem.task(z, True))
             log.append((z.tolist(), memo[k]))
@@ -317,7 +323,7 @@ class OptimisationResult:
     method: str
     design: dict[str, float]
     objective_value: float
-    nominal_objective: float
+    nominal_objective: float | None
     figures: dict[str, dict[str, Any]]  # "optimum" / "nominal" / "original": {figure label: value}
     history: list[dict[str, Any]]
     feasible: bool
@@ -366,13 +372,17 @@ def search(problem: SearchProblem, method: str, z_start: np.ndarray, starts: int
         sample = qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(m)[:starts - 1]
         zs = [z_start] + list(sample)
         report(0.02, f"evaluating {len(zs)} start designs")
-        results = run_units(problem.evaluator, [problem.task(z, False) for z in zs], executor,
+        results = run_units(problem.evaluator, [problem.task(z, True) for z in zs], executor,
                             lambda f, m: report(0.02 + 0.3 * f, f"start designs: {m}"), lambda t: "design")
         for z, e in zip(zs, results, strict=True):
             _record(history, problem, z, e, "start")
-        ranked = sorted(range(len(zs)), key=lambda k: (problem.merit(results[k])[1], problem.merit(results[k])[0]))
-        runs = run_units(_local_unit, [(problem, zs[k], max_iterations) for k in ranked[:local_runs]], executor,
-                         lambda f, m: report(0.32 + 0.6 * f, f"local searches (SLSQP): {m}"), lambda t: "search")
+        usable = [k for k in range(len(zs)) if results[k]["ok"]]
+        if not usable:
+            return history, "no start design could be evaluated: " + results[0]["reason"]
+        ranked = sorted(usable, key=lambda k: (problem.merit(results[k])[1], problem.merit(results[k])[0]))
+        runs = run_units(_local_unit, [(problem, zs[k], max_iterations, results[k]) for k in ranked[:local_runs]],
+                         executor, lambda f, m: report(0.32 + 0.6 * f, f"local searches (SLSQP): {m}"),
+                         lambda t: "search")
         messages = []
         for run in runs:
             for z, e in run["log"]:
@@ -380,8 +390,11 @@ def search(problem: SearchProblem, method: str, z_start: np.ndarray, starts: int
             messages.append(run["message"])
         message = "SLSQP: " + "; ".join(dict.fromkeys(messages))
     else:
+        calls = [0]
+
         def mapper(_func, population):
             population = [np.asarray(z, float) for z in population]
+            calls[0] += 1
             out = run_units(problem.evaluator, [problem.task(z, False) for z in population], executor, None,
                             lambda t: "design")
             merits = []
@@ -389,8 +402,8 @@ def search(problem: SearchProblem, method: str, z_start: np.ndarray, starts: int
                 _record(history, problem, z, e, "global")
                 obj, violation = problem.merit(e)
                 merits.append(1e6 if not math.isfinite(obj) else obj + 100.0 * violation)
-            report(min(0.95, len(history) / (popsize * len(names) * (generations + 1))),
-                   f"differential evolution: {len(history)} designs evaluated")
+            report(min(0.95, calls[0] / (generations + 1)),
+                   f"differential evolution: generation {calls[0] - 1}, {len(history)} designs evaluated")
             return merits
 
         res = differential_evolution(lambda z: 0.0, [(0.0, 1.0)] * len(names), workers=mapper, updating="deferred",
@@ -401,25 +414,35 @@ def search(problem: SearchProblem, method: str, z_start: np.ndarray, starts: int
 
 
 def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
-             parameters: Sequence[str] = DEFAULT_PARAMETERS, Fz: float = 150e3,
+             parameters: Sequence[str] | None = None, Fz: float = 150e3,
              constraints: Sequence[Constraint | str] = (), params: Parameters | None = None,
              method: str = "auto", starts: int = 8, local_runs: int = 2, max_iterations: int = 30,
              generations: int = 6, popsize: int = 5, seed: int = 0, executor=None,
              progress: Callable[[float, str], None] | None = None) -> OptimisationResult:
-    """The design of ``parameters`` (inside their ranges) with the best ``objective`` (see
-    :data:`FIGURES`) subject to ``constraints``; the other parameters as in ``params``."""
+    """The design of ``parameters`` (inside their ranges; default: the device parameters fitted in
+    ``config``) with the best ``objective`` (see :data:`FIGURES`) subject to ``constraints``; the other
+    parameters as in ``params``."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
     if objective not in FIGURES:
         raise unknown_name_error(objective, FIGURES, "objective")
     Fz = check_number("Fz", Fz, *FZ_BOX, "N")
+    fitted = [n for n in DESIGN_PARAMETERS if affects(n, config)]
+    if parameters is None:
+        if not fitted:
+            raise InvalidParameterError("params", None, "gear parameters to search (configuration original has no "
+                                        "device parameters), e.g. k_psi,c_psi")
+        parameters = fitted
     names = []
     for n in parameters:
         if n not in PARAMETER_SPECS:
             raise unknown_name_error(n, PARAMETER_SPECS)
         if not affects(n, config):
-            raise InvalidParameterError("params", n, f"a parameter of configuration {config.value}",
+            allowed = [m for m in PARAMETER_SPECS if affects(m, config)]
+            raise InvalidParameterError("params", n, f"a parameter of configuration {config.value} "
+                                        f"(device parameters: {', '.join(fitted) or 'none'}; or any of "
+                                        f"{', '.join(m for m in allowed if m not in fitted)})",
                                         f"is not fitted in configuration {config.value}")
         if n not in names:
             names.append(n)
@@ -432,7 +455,14 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
     local_runs = int(check_number("local_runs", local_runs, 1, starts, integer=True))
     problem = SearchProblem(config.value, params.to_dict(), names, objective, Fz, cons)
     smooth = all(k[0] in DIFFERENTIABLE for k in problem.wanted)
-    chosen = ("gradient" if smooth else "global") if method == "auto" else method
+    integers = [n for n in names if PARAMETER_SPECS[n].integer]
+    chosen = ("gradient" if smooth and not integers else "global") if method == "auto" else method
+    if chosen == "gradient" and not smooth:
+        raise InvalidParameterError("method", method, "auto or global for " + ", ".join(
+            k[0] for k in problem.wanted if k[0] not in DIFFERENTIABLE), "needs derivatives that figure has not")
+    if chosen == "gradient" and integers:
+        raise InvalidParameterError("method", method, f"auto or global with the integer parameter {integers[0]}",
+                                    "needs continuous parameters")
     report = progress or (lambda fraction, message: None)
     if executor is None:
         with open_executor() as own:
@@ -464,7 +494,13 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
     figures = {}
     for label, t in zip(("optimum", "nominal", "original"), tables, strict=True):
         figures[label] = _figure_table(t["figures"], keys) if t["ok"] else {"error": t["reason"]}
-    nominal = tables[1]["figures"][problem.objective_key]["value"]
+    nominal = tables[1]["figures"][problem.objective_key]["value"] if tables[1]["ok"] else None
+    if tables[1]["ok"] is False:
+        warnings.append(f"the nominal design could not be evaluated: {tables[1]['reason']}")
+    start_gradient = history[0].get("objective_gradient") if history else None
+    if start_gradient is not None and all(v == 0.0 for v in start_gradient.values()):
+        warnings.append(f"{', '.join(names)} do not move the {FIGURES[objective].label} at the nominal design "
+                        "(zero derivatives): the search cannot improve it")
     report(1.0, "done")
     return OptimisationResult(config, objective, Fz, names, cons, chosen, design, best["objective"], nominal, figures,
                               history, bool(feasible), message, params, time.perf_counter() - clock,

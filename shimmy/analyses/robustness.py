@@ -8,7 +8,8 @@ into chunks, each chunk one unit of the executor.
 
 Per sample: the Hopf speeds at the load Fz (eigenvalue scan, :func:`shimmy.analyses.stability.hopf_points`),
 the minimum shimmy load (the lowest point of the Hopf curves, Newton from the nominal design's point,
-:func:`shimmy.analyses.sensitivity.polish_lowest_point`), and at each of the nine operating points
+:func:`shimmy.analyses.sensitivity.polish_lowest_point`, or the continued curves where Newton does not
+converge from there), and at each of the nine operating points
 whether straight rolling is unstable there (an eigenvalue with positive real part). That is linear
 shimmy; a point in a bistable region (x = 0 stable beside a stable cycle) is not counted, so
 ``p_shimmy`` is the probability that shimmy starts from any disturbance.
@@ -64,9 +65,13 @@ class Tolerance:
     def make(cls, name: str, relative: Any, distribution: str = "normal") -> "Tolerance":
         if name not in PARAMETER_SPECS:
             raise unknown_name_error(name, PARAMETER_SPECS)
-        rel = check_number(f"tolerance {name}", relative, 0.0, 0.5)
         if distribution not in DISTRIBUTIONS:
             raise InvalidParameterError(f"tolerance {name} distribution", distribution, "normal or uniform")
+        if PARAMETER_SPECS[name].integer:
+            raise InvalidParameterError(f"tolerance {name}", relative, "a tolerance on a continuous parameter",
+                                        f"{name} is an integer (a count), it has no tolerance")
+        # A normal tolerance up to 20 % (5 standard deviations to zero), a uniform one up to 50 %.
+        rel = check_number(f"tolerance {name}", relative, 0.0, 0.2 if distribution == "normal" else 0.5)
         return cls(name, rel, distribution)
 
     @property
@@ -87,18 +92,21 @@ def _sample_unit(task: tuple) -> list[dict[str, Any]]:
     config, base, names, rows, Fz, low = task
     out = []
     for values in rows:
-        try:
-            params = Parameters.from_dict(base).with_overrides(dict(zip(names, values, strict=True)))
+        try:  # samples may reach past a design range (not past physics): the statistics are not truncated
+            params = Parameters.from_dict(base).with_sampled(dict(zip(names, values, strict=True)))
         except InvalidParameterError as exc:
             out.append({"ok": False, "reason": str(exc)})
             continue
         model = build_model(config, params)
         speeds = [h.V for h in hopf_points(config, Fz, params, v_min=V_BAND[0], v_max=V_BAND[1]).hopf_points]
         entry: dict[str, Any] = {"ok": True, "hopf": speeds}
-        try:
-            entry["min_shimmy_Fz"] = polish_lowest_point(model, low[0], low[1])[1] if low else None
-        except (ConvergenceError, np.linalg.LinAlgError):
-            entry["min_shimmy_Fz"] = None
+        entry["min_shimmy_Fz"] = None
+        if low:
+            try:
+                entry["min_shimmy_Fz"] = polish_lowest_point(model, low[0], low[1])[1]
+            except (ConvergenceError, np.linalg.LinAlgError):  # too far from the nominal point: the curves
+                found = min_shimmy_sensitivity(model, {}, (1.0e4, 9.0e5))
+                entry["min_shimmy_Fz"] = None if found is None else found["Fz"]
         entry["unstable"] = {p: _growth(model, V, F) > 0.0 for p, (V, F) in OPERATING_POINTS.items()}
         out.append(entry)
     return out
@@ -220,8 +228,7 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     refused = len(flat) - len(ok)
     if refused:
         first = next(e["reason"] for e in flat if not e["ok"])
-        warnings.append(f"{refused} of {len(flat)} samples fall outside a parameter's allowed range and are left out "
-                        f"(for example: {first})")
+        warnings.append(f"{refused} of {len(flat)} samples are not physical and are left out (for example: {first})")
     if not ok:
         raise ConvergenceError("no sample could be evaluated: " + flat[0]["reason"])
     hopf_out = []
@@ -234,7 +241,15 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
             stats = _stats(np.array([e["hopf"][k] for e in same]), V0, linear_std(hopf_sens[k]["dV_dp"]))
             hopf_out.append(stats)
     lows = np.array([e["min_shimmy_Fz"] for e in ok if e["min_shimmy_Fz"] is not None])
-    low_out = _stats(lows, low["Fz"], linear_std(low["dFz_dp"])) if low and lows.size else None
+    if start is not None and lows.size < len(ok):
+        warnings.append(f"the lowest point of the Hopf curves did not converge for {len(ok) - lows.size} of "
+                        f"{len(ok)} samples; they are left out of its statistics")
+    if not same:
+        warnings.append(f"no sample has the nominal design's {len(nominal_speeds)} Hopf points at {Fz / 1e3:g} kN: "
+                        "no Hopf-speed statistics")
+    low_out = None
+    if low and lows.size:
+        low_out = _stats(lows, low["Fz"], linear_std(low["dFz_dp"]) if low["dFz_dp"] is not None else None)
     p_sampled = {p: float(np.mean([e["unstable"][p] for e in ok])) for p in OPERATING_POINTS}
     p_linear = {p: _linear_probability(model, V, F, pairs, names, sigma) for p, (V, F) in OPERATING_POINTS.items()}
     report(1.0, "done")

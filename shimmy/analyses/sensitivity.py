@@ -22,16 +22,20 @@ The minimum shimmy load on the Hopf curves is the lowest point (V_m, Fz_m) of Re
     dFz_m/dtheta = -Re(d lambda/d theta) / Re(d lambda/dFz)   at (V_m, Fz_m).
 
 The point is taken from the continued Hopf curves (:func:`shimmy.analyses.hopf_curves.hopf_curves`)
-and polished by Newton's method on (Re lambda, d Re lambda/dV) = 0 (tolerance 1e-12 of the
-scales) so the formula is applied at a true minimum.
+and polished by Newton's method on (Re lambda, d Re lambda/dV) = 0 (to 1e-10 of the scales, or the
+rounding level of its finite-difference Jacobian) so the formula is applied at a true minimum.
+Where the lowest point is the end of a curve on a speed edge of the box, the corner moves along
+that edge: dFz/dtheta is the same formula at (V_edge, Fz); on the lowest load edge there is no
+derivative (the figure is the edge).
 
 The largest stable torsional amplitude at the load, A = max_t |psi(t)| of the stable cycle where
 it is largest along the branch (an interior maximum in V, or at the end of the speed range):
 with G(u; theta) = 0 the collocation equations of that orbit at fixed V (u = node values and
 period), du/dtheta = -G_u^-1 G_theta (one sparse factorisation; G_theta by central differences of
-the residual in the coefficients), and dA/dtheta = dpsi(t*)/dtheta at the instant of the maximum
-(envelope in V and in t). Where the largest stable amplitude sits where the stable part of the
-branch ends (a fold or torus point) the fixed-speed derivative does not apply and none is given.
+the residual in the coefficients), and dA/dtheta = sign(psi(t*)) dpsi(t*)/dtheta at the instant t*
+of the maximum, located on the collocation polynomial (envelope in V and in t). Where the largest
+stable amplitude sits where the stable part of the branch ends (a fold or torus point) the
+fixed-speed derivative does not apply and none is given.
 
 Parameters that cannot move a quantity are reported with the reason: not fitted in the
 configuration; not in the equations (a geometry record); or, for the particle damper's material
@@ -188,7 +192,7 @@ class SensitivityResult:
             out.append({"key": "hopf_interval", "label": f"Hopf interval width at {self.Fz / 1e3:g} kN",
                         "unit": "m/s", "value": self.hopf[1]["V"] - self.hopf[0]["V"], "derivatives": d,
                         "kind": "hopf"})
-        if self.min_shimmy is not None:
+        if self.min_shimmy is not None and self.min_shimmy["dFz_dp"] is not None:
             out.append({"key": "min_shimmy_Fz", "label": "minimum shimmy load (lowest point of the Hopf curves)",
                         "unit": "N", "value": self.min_shimmy["Fz"], "derivatives": self.min_shimmy["dFz_dp"],
                         "kind": "hopf"})
@@ -200,12 +204,13 @@ class SensitivityResult:
 
     def scaled(self, derivatives: dict[str, float]) -> dict[str, dict[str, float]]:
         """{name: {"per_percent", "per_half_range"}}: the change for +1 % of the parameter's value
-        and for half its design range (linear)."""
+        (None where the value is 0) and for half its design range (linear)."""
         out = {}
         for name, d in derivatives.items():
             spec = PARAMETER_SPECS[name]
             value = float(getattr(self.params, name))
-            out[name] = {"per_percent": d * 0.01 * value, "per_half_range": d * 0.5 * (spec.high - spec.low)}
+            out[name] = {"per_percent": d * 0.01 * value if value != 0.0 else None,  # no relative change of 0
+                         "per_half_range": d * 0.5 * (spec.high - spec.low)}
         return out
 
     def tornado(self, key: str, by: str = "per_percent") -> list[dict[str, Any]]:
@@ -223,7 +228,7 @@ class SensitivityResult:
             rows.append({"name": name, "unit": spec.unit, "group": spec.group, "value": value,
                          "low": spec.low, "high": spec.high, "derivative": q["derivatives"][name],
                          **scaled[name], "reason": reasons.get(name), "device": name in DESIGN_PARAMETERS})
-        rows.sort(key=lambda r: (r["reason"] is not None, -abs(r[by])))
+        rows.sort(key=lambda r: (r["reason"] is not None, -abs(r[by] or 0.0)))
         return rows
 
     def to_dict(self) -> dict[str, Any]:
@@ -281,9 +286,11 @@ def hopf_sensitivities(model: Model, Fz: float, hopf_V: Sequence[float], pairs: 
     return out
 
 
-def polish_lowest_point(model: Model, V: float, Fz: float, tol: float = 1e-12) -> tuple[float, float, float]:
+def polish_lowest_point(model: Model, V: float, Fz: float, tol: float = 1e-10) -> tuple[float, float, float]:
     """(V, Fz, omega) of the turning point Re lambda = d Re lambda/dV = 0 near (V, Fz), by Newton with
-    a finite-difference Jacobian (scales 10 m/s and 1e5 N)."""
+    a finite-difference Jacobian (scales 10 m/s and 1e5 N): converged when a step is below ``tol`` of
+    the scales, or when steps stop shrinking below 1e-8 of them (the rounding level of the
+    finite-difference Jacobian)."""
     omega = None
 
     def g(v, f):
@@ -295,6 +302,7 @@ def polish_lowest_point(model: Model, V: float, Fz: float, tol: float = 1e-12) -
 
     z = np.array([V, Fz], float)
     scale = np.array([V_SCALE, 1e5])
+    last = math.inf
     for _ in range(30):
         r = g(*z)
         D = np.empty((2, 2))
@@ -304,9 +312,11 @@ def polish_lowest_point(model: Model, V: float, Fz: float, tol: float = 1e-12) -
             D[:, k] = (g(*(z + e)) - g(*(z - e))) / (2 * e[k])
         dz = -np.linalg.solve(D, r)
         z = z + dz
-        if np.max(np.abs(dz) / scale) < tol:
+        size = float(np.max(np.abs(dz) / scale))
+        if size < tol or (size < 1e-8 and size >= 0.5 * last):
             g(*z)
             return float(z[0]), float(z[1]), float(omega)
+        last = size
     raise ConvergenceError(f"the lowest point of the Hopf curve near V = {V:.6g} m/s, Fz = {Fz:.6g} N did not "
                            "converge in 30 Newton steps")
 
@@ -320,17 +330,37 @@ def min_shimmy_sensitivity(model: Model, pairs: dict[str, tuple], fz_box: tuple[
     low = hopf.fz_minimum
     if low is None:
         return None
-    if not any(abs(e["p"][1] - low["Fz"]) <= 1e-9 * low["Fz"] for c in hopf.curves for e in c.extrema):
-        return {"Fz": low["Fz"], "V": low["V"], "dFz_dp": {n: 0.0 for n in pairs}, "source": "box edge",
-                "reason": "the lowest point of the Hopf curves is on the edge of the (V, Fz) box"}
-    V, Fz, omega = polish_lowest_point(model, low["V"], low["Fz"])
+    turning = any(abs(e["p"][1] - low["Fz"]) <= 1e-9 * low["Fz"] for c in hopf.curves for e in c.extrema)
+    if turning:
+        V, Fz, omega = polish_lowest_point(model, low["V"], low["Fz"])
+        source = "lowest point of the Hopf curves"
+    elif abs(low["Fz"] - hopf.fz_range[0]) <= 1e-9 * low["Fz"]:
+        return {"Fz": low["Fz"], "V": low["V"], "dFz_dp": None, "source": "load edge",
+                "reason": f"the Hopf curves reach the lowest load of the box ({hopf.fz_range[0]:g} N): the minimum "
+                          "shimmy load is that edge, not a point that moves with the parameters"}
+    else:  # an end of a curve on a speed edge: the corner moves along the edge
+        V = min(hopf.v_range, key=lambda edge: abs(edge - low["V"]))
+        Fz, omega = _hopf_load_at(model, V, low["Fz"], 2 * math.pi * low["frequency_hz"])
+        source = f"end of a Hopf curve on the speed edge V = {V:g} m/s"
     lin = Linearisation(model, Fz)
     eig = _critical(lin.at(V), omega)
     dlam_dFz = eig.derivative(_dJ_dFz(model, V, Fz))
     dJ = jacobian_derivatives(model, V, Fz, pairs)
     return {"Fz": Fz, "V": V, "frequency_hz": omega / (2 * math.pi),
-            "dFz_dp": {n: -eig.derivative(d).real / dlam_dFz.real for n, d in dJ.items()},
-            "source": "lowest point of the Hopf curves"}
+            "dFz_dp": {n: -eig.derivative(d).real / dlam_dFz.real for n, d in dJ.items()}, "source": source}
+
+
+def _hopf_load_at(model: Model, V: float, Fz: float, omega: float, tol: float = 1e-10) -> tuple[float, float]:
+    """(Fz, omega) with Re lambda(V, Fz) = 0 near Fz, by Newton with the exact d lambda/dFz."""
+    for _ in range(30):
+        eig = _critical(Linearisation(model, Fz).at(V), omega)
+        omega = eig.lam.imag
+        step = -eig.lam.real / eig.derivative(_dJ_dFz(model, V, Fz)).real
+        Fz += step
+        if abs(step) <= tol * Fz:
+            return Fz, _critical(Linearisation(model, Fz).at(V), omega).lam.imag
+    raise ConvergenceError(f"the Hopf load at V = {V:.6g} m/s near Fz = {Fz:.6g} N did not converge in 30 Newton "
+                           "steps")
 
 
 def _orbit_at(result, V: float, amplitude: float):
@@ -363,7 +393,10 @@ def amplitude_sensitivity(model: Model, Fz: float, pairs: dict[str, tuple], v_ra
     if found is None:
         return {"value": A, "V": V, "dA_dp": None, "reason": "the largest stable cycle was not found on a branch"}
     raw, i = found
-    interior = 0 < i < raw.p.size - 1 and raw.stable[i - 1] and raw.stable[i + 1]
+    # The branch points bracketing the maximum's speed: both stable for an interior maximum.
+    j = i - 1 if i > 0 and (i == raw.p.size - 1 or (raw.p[i - 1] - V) * (raw.p[i] - V) <= 0) else i
+    interior = 0 <= j < raw.p.size - 1 and bool(raw.stable[j]) and bool(raw.stable[j + 1]) \
+        and 0 < i < raw.p.size - 1
     at_edge = abs(V - v_range[0]) <= 1e-9 * V_SCALE or abs(V - v_range[1]) <= 1e-9 * V_SCALE
     if not (interior or at_edge):
         return {"value": A, "V": V, "dA_dp": None,
@@ -386,8 +419,7 @@ def amplitude_sensitivity(model: Model, Fz: float, pairs: dict[str, tuple], v_ra
                     "reason": f"the cycle at V = {V:.6g} m/s did not converge at fixed speed"}
         u = out[0]
         problem.accept(u)
-    _, x = problem.sample(u)
-    A_here = float(np.abs(x[:, 0]).max())
+    tau_peak, sign, A_here = problem.peak(u, 0)
     matrix = sp.vstack([problem.jacobian(u), sp.csr_matrix(e_V)]).tocsc()
     lu = spla.splu(matrix)
     derivatives = {}
@@ -400,10 +432,8 @@ def amplitude_sensitivity(model: Model, Fz: float, pairs: dict[str, tuple], v_ra
         G = (rp.residual(u) - rm.residual(u)) / (2.0 * h)
         exact_zero[name] = bool(np.all(G == 0.0))
         du = lu.solve(-np.append(G, 0.0))
-        eps = 1e-6 / max(float(np.max(np.abs(du[:problem.n_x].reshape(-1, model.n_states)) / scale)), 1e-300)
-        _, xp = problem.sample(u + eps * du)
-        _, xm = problem.sample(u - eps * du)
-        derivatives[name] = (float(np.abs(xp[:, 0]).max()) - float(np.abs(xm[:, 0]).max())) / (2.0 * eps)
+        dX = du[:problem.n_x].reshape(problem.mesh.n_nodes, model.n_states)
+        derivatives[name] = sign * float(problem.evaluate(dX, np.array([tau_peak]))[0, 0])  # envelope in t
     return {"value": A_here, "V": V, "dA_dp": derivatives, "exact_zero": exact_zero,
             "where": "interior maximum" if interior else "end of the speed range"}
 

@@ -12,6 +12,7 @@ engineering envelope around the nominal value (documented per field).
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 import hashlib
@@ -144,13 +145,17 @@ class NESParameters:
 
     def __post_init__(self):
         _validate_fields(self)
-        # The roller must stay on its track over the whole valid angle |a| < pi/6,
-        # i.e. (r2 + r3) > A sin(pi/6) with A = (sqrt(3)/2)(r1 + r2).
-        A = 0.5 * math.sqrt(3.0) * (self.r1 + self.r2)
-        if self.r2 + self.r3 <= 0.5 * A:
-            raise InvalidParameterError(
-                "r3", self.r3, f"r2 + r3 > (sqrt(3)/4)(r1 + r2) = {0.5 * A:.5g} m",
-                "makes the roller leave its track inside |a| < pi/6")
+        check_roller_track(self.r1, self.r2, self.r3)
+
+
+def check_roller_track(r1: float, r2: float, r3: float) -> None:
+    """The NES roller must stay on its track over the whole valid angle |a| < pi/6, i.e.
+    (r2 + r3) > A sin(pi/6) with A = (sqrt(3)/2)(r1 + r2); raises InvalidParameterError on r3."""
+    A = 0.5 * math.sqrt(3.0) * (r1 + r2)
+    if r2 + r3 <= 0.5 * A:
+        raise InvalidParameterError(
+            "r3", r3, f"r2 + r3 > (sqrt(3)/4)(r1 + r2) = {0.5 * A:.5g} m",
+            "makes the roller leave its track inside |a| < pi/6")
 
 
 @dataclass(frozen=True)
@@ -241,6 +246,32 @@ class Parameters:
         changes = {g: dataclasses.replace(getattr(self, g), **vals)
                    for g, vals in grouped.items() if vals}
         return dataclasses.replace(self, **changes)
+
+    def with_sampled(self, overrides: Mapping[str, float]) -> "Parameters":
+        """A copy with the named values replaced, allowed outside their design ranges (a tolerance
+        study's samples reach past them); the physical conditions still hold: finite, positive where
+        the range is positive (non-negative where it starts at 0), the NES roller on its track."""
+        grouped: dict[str, dict[str, float]] = {g: {} for g in GROUPS}
+        for name, value in overrides.items():
+            spec = PARAMETER_SPECS.get(name)
+            if spec is None:
+                raise unknown_name_error(name, PARAMETER_SPECS)
+            number = float(value)
+            sign = "positive" if spec.low > 0 else "non-negative"
+            if not math.isfinite(number) or number < 0 or (spec.low > 0 and number == 0):
+                raise InvalidParameterError(name, value, f"a finite {sign} number {spec.unit}".rstrip(),
+                                            "is not physical")
+            grouped[spec.group][name] = number
+        changes = {}
+        for g, values in grouped.items():
+            if values:
+                group = copy.copy(getattr(self, g))
+                for name, number in values.items():
+                    object.__setattr__(group, name, number)
+                changes[g] = group
+        out = dataclasses.replace(self, **changes)
+        check_roller_track(out.nes.r1, out.nes.r2, out.nes.r3)
+        return out
 
     def with_material(self, material: str) -> "Parameters":
         """Apply a PD material preset ('steel' or 'tungsten')."""
