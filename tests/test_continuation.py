@@ -529,3 +529,23 @@ def test_closed_loop_of_cycles_is_traversed_once():
     radius2 = np.array([node_radius(br, i).mean() ** 2 for i in range(br.p.size)])
     away = np.abs(radius2 - 2.0) > 0.05
     assert np.all(br.stable[away] == (radius2[away] > 2.0))
+
+
+@pytest.mark.parametrize("phase", [0.0, 0.3217, 0.999])
+def test_peak_of_an_orbit_is_located_on_the_collocation_polynomial(phase):
+    """x(tau) = -1.7 cos(2 pi s) + 0.3 cos(4 pi s), s = tau - phase, on an uneven mesh: the largest |x|
+    is 2 at tau = phase + 1/2 (mod 1), whatever sample is nearest (|x| = 1.4 at s = 0); sign +."""
+    system = ALL_SYSTEMS["hopf_supercritical"]()  # the field does not enter: only the node values
+    points = np.sort(np.concatenate([[0.0, 1.0], np.random.default_rng(1).uniform(0.02, 0.98, 29)]))
+    mesh = Mesh(points, 4)
+    problem = PeriodicProblem(system, mesh, np.ones(system.n), 1.0, 1.0)
+    X = np.zeros((mesh.n_nodes, system.n))
+    s = mesh.node_times - phase
+    X[:, 0] = -1.7 * np.cos(2 * np.pi * s) + 0.3 * np.cos(4 * np.pi * s)
+    tau, sign, amplitude = problem.peak(problem.pack(X, 1.0, 0.0), 0)
+    assert amplitude == pytest.approx(2.0, rel=1e-6)  # interpolation error of degree 4 on ~1/30 intervals
+    assert sign == 1.0
+    offset = (tau - phase - 0.5) % 1.0
+    assert min(offset, 1.0 - offset) == pytest.approx(0.0, abs=1e-4)
+    sampled = np.abs(problem.sample(problem.pack(X, 1.0, 0.0))[1][:, 0]).max()
+    assert amplitude >= sampled
