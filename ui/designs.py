@@ -449,7 +449,7 @@ def _zero(d: float, *values: float) -> bool:
 
 
 def _signed(x: float, digits: int = 3) -> str:
-    text = f"{x:+.{digits}g}"
+    text = f"{x:+.0f}" if 1e3 <= abs(x) < 1e9 else f"{x:+.{digits}g}"
     return "0" if float(text) == 0 else text
 
 

@@ -56,7 +56,7 @@ def _message(text: str, notes: list[str] | None = None) -> list:
 
 
 def _refusal(exc: designs.DesignError) -> html.Div:
-    return html.Div([html.Span(f"{exc.what[:1].upper()}{exc.what[1:]} is refused:"),
+    return html.Div([html.Span(f"Refused ({exc.what}):"),
                      html.Ul([html.Li(p) for p in exc.problems])], className="error", role="alert")
 
 
@@ -123,8 +123,8 @@ def act(ask, upload, _opens, _deletes, _names, saved, stores):
                 return no_update, no_update, no_update
             new, text = designs.rename(saved, entry_id, value)
             return new, no_update, _message(text)
-    except designs.DesignError as exc:
-        return no_update, no_update, _refusal(exc)
+    except designs.DesignError as exc:  # a refused rename: the list is drawn again with the saved name
+        return (saved if isinstance(trig, dict) else no_update), no_update, _refusal(exc)
     return no_update, no_update, no_update
 
 
@@ -236,14 +236,15 @@ dash.clientside_callback(
     prevent_initial_call=True,
 )
 
-# The link box shows the address (design and page state) whenever the address changes.
-dash.clientside_callback(
-    """
+# The link box shows the address (design and page state) when the page loads and whenever the
+# address changes (the loading call is its own: the address updater's first call changes nothing,
+# and Dash then skips what depends on it).
+LINK = """
     function(_s) { return window.location.href; }
-    """,
-    Output("design-link", "value"),
-    Input("url-sink", "children"),
-)
+"""
+dash.clientside_callback(LINK, Output("design-link", "value"), Input("design-link", "id"))
+dash.clientside_callback(LINK, Output("design-link", "value", allow_duplicate=True), Input("url-sink", "children"),
+                         prevent_initial_call=True)
 
 # After an open, the page that loaded says what was opened (and what the file left to the preset).
 dash.clientside_callback(
