@@ -183,7 +183,7 @@ def figure(results, series=None, what="configuration"):
     for k, (result, (label, colour)) in enumerate(zip(results, series, strict=True)):
         group = f"{what}-{k}"
         for branch in result["branches"]:
-            for seg_stable, seg in _segments(branch["points"]):
+            for seg_stable, seg in _segments(branch["points"], [sp["V"] for sp in branch["special_points"]]):
                 line = {"color": colour, "width": 2.5 if seg_stable else 1.5, "dash": "solid" if seg_stable else "dash"}
                 kind = "stable" if seg_stable else "unstable"
                 if branch["kind"] == "equilibrium":
@@ -239,13 +239,24 @@ def figure(results, series=None, what="configuration"):
     return fig
 
 
-def _segments(points):
-    """Runs of equal stability (each run shares its end point with the next, so lines join)."""
-    out, start = [], 0
+def _segments(points, boundaries=()):
+    """Runs of equal stability, each sharing its end point with the next so that lines join. Where
+    the last point of a run is a point where stability changes (``boundaries``: the branch's special
+    points, a Hopf point on x = 0), the next run starts there; elsewhere the run reaches on to the
+    next one's first point."""
+    at = {round(v, 9) for v in boundaries}
+    if not points:
+        return []
+    out, start, stable = [], 0, points[0]["stable"]
     for i in range(1, len(points) + 1):
-        if i == len(points) or points[i]["stable"] != points[start]["stable"]:
-            out.append((points[start]["stable"], points[start:min(i + 1, len(points))]))
-            start = i
+        if i == len(points) or points[i]["stable"] != stable:
+            if i < len(points) and i - 1 > start and round(points[i - 1]["V"], 9) in at:
+                out.append((stable, points[start:i]))
+                start = i - 1
+            else:
+                out.append((stable, points[start:min(i + 1, len(points))]))
+                start = i
+            stable = points[i]["stable"] if i < len(points) else stable
     return out
 
 

@@ -275,7 +275,7 @@ def test_the_page_figures_name_each_design_in_its_colour():
         return {"config": "nes", "Fz": 150e3, "hopf_points": [{"V": 6 + shift, "frequency_hz": 10.0,
                                                                "criticality": "supercritical"}],
                 "branches": [{"kind": "equilibrium", "points": points,
-                              "special_points": [{"kind": "H", "V": 6 + shift}]},
+                              "special_points": [{"kind": "H", "V": 6 + shift}, {"kind": "H", "V": 70.0}]},
                              {"kind": "periodic", "points": cycle, "special_points": []}]}
 
     names = ["A wide track", "B stiff"]
@@ -286,6 +286,9 @@ def test_the_page_figures_name_each_design_in_its_colour():
     assert keys == series
     assert fig["layout"]["legend"]["title"]["text"] == "design (colour):"
     assert fig["layout"]["yaxis3"]["categoryarray"] == names[::-1]  # one x = 0 strip per design
+    strip = [(t["x"][0], t["x"][-1], t["line"]["dash"]) for t in fig["data"] if t.get("y") and t["y"][0] == names[0]
+             and t.get("mode") == "lines"]
+    assert strip == [(1.0, 6.0, "solid"), (6.0, 70.0, "dash"), (70.0, 200.0, "solid")]  # changes at the Hopf points
     assert fig["layout"]["xaxis3"]["title"]["text"] == "forward speed V (m/s)"
 
     curve = [{"V": 10.0, "Fz": 100e3}, {"V": 50.0, "Fz": 300e3}]

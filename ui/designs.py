@@ -74,8 +74,9 @@ def check_values(material: str, values: Mapping[str, Any]) -> tuple[dict[str, fl
         if name not in PARAMETER_SPECS:
             try:
                 base.with_overrides({name: value})
-            except InvalidParameterError as exc:
-                problems.append(str(exc))
+            except InvalidParameterError as exc:  # with a close name, the list of all 38 is noise
+                text = str(exc)
+                problems.append(text.split("; allowed:")[0] if "(did you mean" in text else text)
             continue
         if isinstance(value, (str, bool)) or value is None:  # JSON: numbers are numbers
             problems.append(f"{_with_unit(name, value)} is not a number; allowed: {PARAMETER_SPECS[name].allowed}")
