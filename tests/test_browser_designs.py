@@ -141,6 +141,14 @@ def test_a_saved_design_reopens_to_the_same_figures(server, browser, tmp_path): 
     _row_button(browser, "B renamed", "Delete").click()
     _wait_for(lambda: [n for n, _ in _saved(browser)] == ["A wide track"], timeout=10, what="the deletion")
     assert _text(browser, "designs-message") == "Deleted 'B renamed'."
+
+    # the refused file, corrected and chosen again, is read again
+    del data["parameters"]["k_sx"]
+    data["parameters"]["r2"] = 0.0855
+    bad.write_text(json.dumps(data))
+    _upload(browser, bad)
+    _reopened(browser, "/", r2="0.0855")
+    assert "Replaced the saved design 'A wide track'" in _text(browser, "designs-message")
     assert _severe(browser) == []
 
 

@@ -200,6 +200,8 @@ dash.clientside_callback(
     function(contents, filename) {
         const C = window.dash_clientside;
         if (!contents) { return [C.no_update, C.no_update, C.no_update]; }
+        const input = document.querySelector("#design-upload input[type=file]");
+        if (input) { input.value = ""; }  // the same file chosen again (edited) is read again
         const bytes = Math.floor((contents.length - contents.indexOf(",") - 1) * 3 / 4);
         if (bytes > %d) {  // emptied again, so that choosing the same file once more is seen
             return [C.no_update, filename + " is refused: it is " + Math.round(bytes / 1024) +
