@@ -114,7 +114,7 @@ def _compare_names(*values):
 
 
 def _compare_render(results, names):
-    series = [(name, compare.colour(k)) for k, name in enumerate(names)]
+    series = compare.series(names)
     table = designs.comparison(names, results, designs.bifurcation_figures())
     return figure(results, series, what="design"), compare.table(table, "bifc-summary")
 

@@ -159,7 +159,8 @@ def compare_designs(selection, saved, current, fz_kn, v_max):
     except InvalidParameterError as exc:
         return compare.swatches(names), no_update, no_update, str(exc)
     table = designs.comparison(names, results, designs.hopf_figures(CONFIGS, style.CONFIG_LABELS))
-    return compare.swatches(names), intervals_figure(results, names), compare.table(table, "ov-cmp-summary"), ""
+    shown = [name for name, _ in compare.series(names)]
+    return compare.swatches(names), intervals_figure(results, shown), compare.table(table, "ov-cmp-summary"), ""
 
 
 def intervals_figure(results, names):

@@ -149,7 +149,7 @@ def _merits(results, names):
 
 
 def _compare_render(results, names):
-    series = [(name, compare.colour(k)) for k, name in enumerate(names)]
+    series = compare.series(names)
     return figure(results, series, what="design"), compare.table(_merits(results, names), "mapc-summary")
 
 

@@ -279,7 +279,9 @@ def test_the_page_figures_name_each_design_in_its_colour():
                              {"kind": "periodic", "points": cycle, "special_points": []}]}
 
     names = ["A wide track", "B stiff"]
-    series = [(n, compare.colour(k)) for k, n in enumerate(names)]
+    series = compare.series(names)
+    assert series == [("A wide track", "#1A1A1A"), ("B stiff", "#D55E00")]
+    assert compare.series(["<b>x</b> & y"])[0][0] == "&lt;b&gt;x&lt;/b&gt; &amp; y"  # shown as typed by Plotly
     fig = bifurcation.figure([diagram(0.0), diagram(1.0)], series, what="design").to_dict()
     keys = [(t["name"], t["line"]["color"]) for t in fig["data"] if t.get("legend", "legend") == "legend"
             and t.get("showlegend")]

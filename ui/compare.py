@@ -6,6 +6,7 @@ changes against the first. The logic is :mod:`ui.designs`; this is the Dash side
 
 from __future__ import annotations
 
+from html import escape
 from typing import Any
 
 import dash
@@ -32,6 +33,12 @@ def chosen(selection: Any, saved: Any, current: Any) -> list[designs.Design]:
 
 def colour(k: int) -> str:
     return style.DESIGN_COLOURS[k % len(style.DESIGN_COLOURS)]
+
+
+def series(names: list[str]) -> list[tuple[str, str]]:
+    """(name as a figure shows it, colour) per design: Plotly reads tags and entities in its texts,
+    so a name (from someone's file, say) is escaped to show as typed."""
+    return [(escape(name, quote=False), colour(k)) for k, name in enumerate(names)]
 
 
 def swatches(names: list[str]) -> list:
