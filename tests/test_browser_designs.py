@@ -38,12 +38,30 @@ def _saved(driver):
         [r.querySelector('input').value, r.querySelector('.saved-detail').innerText]);""")
 
 
-def _row_button(driver, name: str, label: str):
-    return driver.execute_script("""
+def _click_row(driver, name: str, label: str) -> None:
+    """Press a saved design's button, found and clicked in one script (the list is redrawn after
+    every change: an element found earlier may be gone)."""
+    _idle(driver)
+    _wait_for(lambda: driver.execute_script("""
         const row = [...document.querySelectorAll('#designs-list .saved-row')]
             .find(r => r.querySelector('input').value === arguments[0]);
-        return row ? [...row.querySelectorAll('button')].find(b => b.innerText === arguments[1]) : null;""",
-                                 name, label)
+        const button = row ? [...row.querySelectorAll('button')].find(b => b.innerText === arguments[1]) : null;
+        if (button) { button.click(); }
+        return !!button;""", name, label), timeout=10, what=f"the {label} button of {name!r}")
+
+
+def _tick(driver, *names: str) -> None:
+    """Tick designs under Compare (found and clicked in one script; done once each is ticked)."""
+    _idle(driver)
+    _wait_for(lambda: driver.execute_script("""
+        const labels = [...document.querySelectorAll('#design-compare label')];
+        let done = true;
+        for (const name of arguments[0]) {
+            const label = labels.find(l => l.innerText.trim() === name);
+            if (!label) { done = false; continue; }
+            if (!label.querySelector('input').checked) { label.click(); done = false; }
+        }
+        return done;""", list(names)), timeout=10, interval=0.3, what=f"{names} ticked")
 
 
 def _save(driver, server, name: str, path: str) -> None:
@@ -97,7 +115,7 @@ def test_a_saved_design_reopens_to_the_same_figures(server, browser, tmp_path): 
     browser.save_screenshot(str(SHOTS / "designs-panel-1440x900.png"))
 
     # from its saved entry
-    _row_button(browser, "A wide track", "Open").click()
+    _click_row(browser, "A wide track", "Open")
     _reopened(browser, "/", r2="0.085")
     assert _figures(browser) == shown_a
     assert _by_id(browser, "design-name").get_attribute("value") == "A wide track"
@@ -138,7 +156,7 @@ def test_a_saved_design_reopens_to_the_same_figures(server, browser, tmp_path): 
     _type(browser, _by_id(browser, '{"id":"d2","type":"saved-name"}'), "B renamed")
     _wait_for(lambda: [n for n, _ in _saved(browser)] == ["A wide track", "B renamed"], timeout=10,
               what="the rename")
-    _row_button(browser, "B renamed", "Delete").click()
+    _click_row(browser, "B renamed", "Delete")
     _wait_for(lambda: [n for n, _ in _saved(browser)] == ["A wide track"], timeout=10, what="the deletion")
     assert _text(browser, "designs-message") == "Deleted 'B renamed'."
 
@@ -176,9 +194,7 @@ def test_two_designs_compared_on_the_bifurcation_page_both_show(server, browser)
     page = "/bifurcation?configs=nes&compare_config=nes"
     _save(browser, server, A[0], page + "&r2=0.085")
     _save(browser, server, B[0], page + "&r2=0.075&k_s=1300000")
-    for label in browser.find_elements(By.CSS_SELECTOR, "#design-compare label"):
-        if label.text in (A[0], B[0]):
-            label.click()
+    _tick(browser, A[0], B[0])
     _wait_for(lambda: _text(browser, "bifc-designs").startswith("Comparing: ■ A wide track (reference) ■ B stiff"),
               timeout=10, what="the designs to compare")
     _by_id(browser, "bifc-run").click()
@@ -198,7 +214,7 @@ def test_two_designs_compared_on_the_bifurcation_page_both_show(server, browser)
 
     # Reopened, A shows its own diagram at once (the cache has it: the same request) and the comparison stays.
     compared_a = _cycles(browser, "bifc-graph", A[0])
-    _row_button(browser, A[0], "Open").click()
+    _click_row(browser, A[0], "Open")
     _reopened(browser, "/bifurcation", r2="0.085")
     _wait_for(lambda: _trace_count(browser, "bif-graph") > 4, timeout=20, what="A's cached diagram")
     assert _cycles(browser, "bif-graph", "NES") == compared_a
