@@ -7,11 +7,12 @@ from dash import Input, Output, State, dcc, html
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
+from ui import compare, designs, fields, jobs
 from ui import components as ui
-from ui import fields, jobs
 from ui import style
 from ui.fields import Quantity
 from ui.layout import design_id, page
+from ui.sessions import LOCAL
 
 dash.register_page(__name__, path="/bifurcation", name="Bifurcation", order=3)
 
@@ -27,8 +28,9 @@ WAITING = "Press Compute: about 1 s per configuration cold, instant from the cac
 
 
 def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = None, configs: str | None = None,
-           **query):
+           compare_config: str | None = None, **query):
     chosen, bad = fields.choices_list("configs", configs, CONFIGS, list(CONFIGS), "a configuration")
+    compared, bad_compared = fields.choice("compare_config", compare_config, CONFIGS, "nes_pd", "a configuration")
     fz, p_fz = FZ.from_url("Fz", Fz, 150)
     lo, p_lo = V_MIN.from_url("v_min", v_min, 1)
     hi, p_hi = V_MAX.from_url("v_max", v_max, 200)
@@ -53,6 +55,23 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
         html.Div(id="bif-table", className="table-wrap"),
         ui.downloads("bif"),
         *jobs.stores("bif"),
+        html.H2("Compare saved designs"),
+        html.P("The designs ticked under Compare in the design panel (2 to 4; the current one may be one of them) "
+               "at this page's load and speed range, for one configuration: one colour per design, the first the "
+               "reference of the changes in the table. The x = 0 strip shows each design's Hopf interval (dashed: "
+               "straight rolling unstable).", className="hint"),
+        html.Div([ui.field("Configuration", dcc.Dropdown(id="bifc-config", value=compared, clearable=False,
+                                                         style={"width": "150px"},
+                                                         options=[{"label": style.CONFIG_LABELS[c], "value": c}
+                                                                  for c in CONFIGS])),
+                  *jobs.controls("bifc", "Compare")], className="controls"),
+        html.Div(id="bifc-designs", className="compare-designs"),
+        html.Div(bad_compared, id="bifc-error", className="error", role="alert"),
+        ui.graph("bifc-graph", figure=style.message_figure(compare.waiting_text("about 2-5 s per design cold, "
+                                                                                "instant from the cache"), 360)),
+        html.Div(id="bifc-table", className="table-wrap"),
+        ui.downloads("bifc"),
+        *jobs.stores("bifc"),
     )
 
 
@@ -81,6 +100,41 @@ jobs.register(
             State("bif-configs", "value"), State(design_id("bif"), "data")],
     lock=["bif-fz", "bif-vmin", "bif-vmax"], download=jobs.Download("bif", "bifurcation", _csv_rows),
     blank=lambda: (style.message_figure("Refused: see the message above", 520), None))
+
+
+def _compare_requests(fz_kn, v_min, v_max, config, selection, saved, current):
+    """The page's request for one configuration, once per compared design (the requests a design's
+    own diagram makes: the cache serves a design already drawn)."""
+    common = _requests(fz_kn, v_min, v_max, [config], {})[0]
+    return [{**common, **d.request()} for d in compare.chosen(selection, saved, current)]
+
+
+def _compare_names(*values):
+    return [d.name for d in compare.chosen(*values[4:])]
+
+
+def _compare_render(results, names):
+    series = compare.series(names)
+    table = designs.comparison(names, results, designs.bifurcation_figures())
+    return figure(results, series, what="design"), compare.table(table, "bifc-summary")
+
+
+def _compare_csv(results, names):
+    columns, rows = _csv_rows(results)
+    by_result = [name for r, name in zip(results, names, strict=True)
+                 for b in r["branches"] for _ in b["points"]]
+    return ["design", *columns], [[name, *row] for name, row in zip(by_result, rows, strict=True)]
+
+
+jobs.register(
+    "bifc", "bifurcation", requests=_compare_requests, labels=_compare_names, render=_compare_render,
+    outputs=[Output("bifc-graph", "figure"), Output("bifc-table", "children")],
+    states=[State("bif-fz", "value"), State("bif-vmin", "value"), State("bif-vmax", "value"),
+            State("bifc-config", "value"), State("design-compare", "value"), State(LOCAL, "data"),
+            State(design_id("bif"), "data")],
+    lock=["bifc-config"], download=jobs.Download("bifc", "bifurcation_designs", _compare_csv),
+    blank=lambda: (style.message_figure("Refused: see the message above", 360), None))
+compare.register_selection("bifc", "bif")
 
 
 KIND_NAMES = {"H": "Hopf", "LPC": "fold of cycles", "NS": "torus", "PD": "period doubling",
@@ -118,45 +172,49 @@ def _hover(label: str, config_label: str, sp: dict, hopf: dict | None) -> str:
     return "<br>".join(lines)
 
 
-def figure(results):
+def figure(results, series=None, what="configuration"):
     """Amplitude of the periodic branches (rows 1-2) and the stability of straight rolling x = 0, one
-    strip per configuration (row 3, where every equilibrium branch would otherwise lie on the zero line).
-    Colour: configuration; line style: stability; marker: special-point kind, each with its own legend."""
+    strip per result (row 3, where every equilibrium branch would otherwise lie on the zero line).
+    Colour: the result's configuration, or ``series`` [(name, colour)] one per result (compared
+    designs); line style: stability; marker: special-point kind, each with its own legend."""
+    if series is None:
+        series = [(style.CONFIG_LABELS[r["config"]], style.CONFIG_COLOURS[r["config"]]) for r in results]
     fig = make_subplots(rows=3, cols=1, shared_xaxes=True, vertical_spacing=0.05, row_heights=[0.4, 0.4, 0.2])
-    for result in results:
-        config = result["config"]
-        colour, label = style.CONFIG_COLOURS[config], style.CONFIG_LABELS[config]
+    for k, (result, (label, colour)) in enumerate(zip(results, series, strict=True)):
+        group = f"{what}-{k}"
         for branch in result["branches"]:
-            for seg_stable, seg in _segments(branch["points"]):
+            for seg_stable, seg in _segments(branch["points"], [sp["V"] for sp in branch["special_points"]]):
                 line = {"color": colour, "width": 2.5 if seg_stable else 1.5, "dash": "solid" if seg_stable else "dash"}
-                what = "stable" if seg_stable else "unstable"
+                kind = "stable" if seg_stable else "unstable"
                 if branch["kind"] == "equilibrium":
                     fig.add_scatter(x=[p["V"] for p in seg], y=[label] * len(seg), mode="lines", line=line,
-                                    legendgroup=config, showlegend=False, row=3, col=1,
-                                    hovertemplate=f"{label}: straight rolling x = 0, {what}<br>V %{{x:.4g}} m/s"
+                                    legendgroup=group, showlegend=False, row=3, col=1,
+                                    hovertemplate=f"{label}: straight rolling x = 0, {kind}<br>V %{{x:.4g}} m/s"
                                                   "<extra></extra>")
                     continue
                 for row, key, unit in ((1, "max_psi", "rad"), (2, "max_lateral", "m")):
                     fig.add_scatter(x=[p["V"] for p in seg], y=[p[key] for p in seg], mode="lines", line=line,
-                                    legendgroup=config, showlegend=False, row=row, col=1,
-                                    hovertemplate=f"{label}: limit cycle, {what}<br>V %{{x:.4g}} m/s<br>"
+                                    legendgroup=group, showlegend=False, row=row, col=1,
+                                    hovertemplate=f"{label}: limit cycle, {kind}<br>V %{{x:.4g}} m/s<br>"
                                                   f"%{{y:.4g}} {unit}<extra></extra>")
-    hopf_of = {(r["config"], round(h["V"], 6)): h for r in results for h in r["hopf_points"]}
+    index = {id(r): k for k, r in enumerate(results)}
+    hopf_of = {(k, round(h["V"], 6)): h for k, r in enumerate(results) for h in r["hopf_points"]}
     for result, branch, sp, name in _labelled(results):
-        config = result["config"]
-        colour, label = style.CONFIG_COLOURS[config], style.CONFIG_LABELS[config]
-        hover = _hover(name, label, sp, hopf_of.get((config, round(sp["V"], 6))))
+        k = index[id(result)]
+        label, colour = series[k]
+        hover = _hover(name, label, sp, hopf_of.get((k, round(sp["V"], 6))))
         marker = {"symbol": SYMBOLS[sp["kind"]], "size": 10, "color": colour, "line": {"width": 1, "color": "#333"}}
         spots = ([(3, label)] if branch["kind"] == "equilibrium"
                  else [(1, sp.get("max_psi", 0.0)), (2, sp.get("max_lateral", 0.0))])
         for row, y in spots:
             fig.add_scatter(x=[sp["V"]], y=[y], mode="markers+text", text=[name], textposition="top center",
-                            textfont={"size": 10, "color": colour}, marker=marker, legendgroup=config,
+                            textfont={"size": 10, "color": colour}, marker=marker, legendgroup=f"{what}-{k}",
                             showlegend=False, hovertext=[hover], hoverinfo="text", row=row, col=1,
-                            meta={"special_point": name, "config": config})
-    for config in dict.fromkeys(r["config"] for r in results):
-        style.legend_key(fig, style.CONFIG_LABELS[config], "legend", group=config, mode="lines",
-                         line={"color": style.CONFIG_COLOURS[config], "width": 3})
+                            meta={"special_point": name, "config": result["config"], "series": label})
+    for k, (label, colour) in enumerate(series):
+        if (label, colour) not in series[:k]:
+            style.legend_key(fig, label, "legend", group=f"{what}-{k}", mode="lines",
+                             line={"color": colour, "width": 3})
     style.legend_key(fig, "stable", "legend2", mode="lines", line={"color": "#555", "width": 2.5})
     style.legend_key(fig, "unstable", "legend2", mode="lines", line={"color": "#555", "width": 1.5, "dash": "dash"})
     present = {sp["kind"] for _, _, sp, _ in _labelled(results)} or {"H"}
@@ -166,24 +224,39 @@ def figure(results):
         style.legend_key(fig, f"{kind}: {KIND_NAMES[kind]}", "legend3", mode="markers",
                          marker={"symbol": symbol, "size": 9, "color": "#777", "line": {"width": 1, "color": "#333"}})
     fz = results[0]["Fz"] / 1e3 if results else 0
-    fig.update_layout(title=style.title(f"Bifurcation diagram at Fz = {fz:g} kN"), height=HEIGHT,
+    head = ("Bifurcation diagram" if what == "configuration"
+            else f"Bifurcation diagrams of {style.CONFIG_LABELS[results[0]['config']]}, {len(results)} designs")
+    fig.update_layout(title=style.title(f"{head} at Fz = {fz:g} kN"), height=HEIGHT,
                       template="plotly_white", margin={**style.MARGIN, "l": 70, "b": BOTTOM}, hovermode="closest")
-    style.legends(fig, ["configuration (colour)", "stability (line)", "special points (marker)"], HEIGHT, BOTTOM)
+    style.legends(fig, [f"{what} (colour)", "stability (line)", "special points (marker)"], HEIGHT, BOTTOM)
     fig.update_xaxes(title_text="forward speed V (m/s)", row=3, col=1)
     fig.update_yaxes(title_text="max |psi| (rad)", row=1, col=1)
     fig.update_yaxes(title_text="max |l_g delta| (m)", row=2, col=1)
-    fig.update_yaxes(title_text="x = 0", type="category", row=3, col=1,
-                     categoryorder="array", categoryarray=[style.CONFIG_LABELS[r["config"]] for r in results][::-1])
+    names = list(dict.fromkeys(label for label, _ in series))[::-1]
+    fig.update_yaxes(title_text="x = 0", type="category", row=3, col=1, categoryorder="array", categoryarray=names,
+                     tickvals=names, ticktext=[n if len(n) <= 16 else n[:15] + "…" for n in names], automargin=True,
+                     range=[-0.5, len(names) - 0.15])  # room above the top strip for its points' labels
     return fig
 
 
-def _segments(points):
-    """Runs of equal stability (each run shares its end point with the next, so lines join)."""
-    out, start = [], 0
+def _segments(points, boundaries=()):
+    """Runs of equal stability, each sharing its end point with the next so that lines join. Where
+    the last point of a run is a point where stability changes (``boundaries``: the branch's special
+    points, a Hopf point on x = 0), the next run starts there; elsewhere the run reaches on to the
+    next one's first point."""
+    at = {round(v, 9) for v in boundaries}
+    if not points:
+        return []
+    out, start, stable = [], 0, points[0]["stable"]
     for i in range(1, len(points) + 1):
-        if i == len(points) or points[i]["stable"] != points[start]["stable"]:
-            out.append((points[start]["stable"], points[start:min(i + 1, len(points))]))
-            start = i
+        if i == len(points) or points[i]["stable"] != stable:
+            if i < len(points) and i - 1 > start and round(points[i - 1]["V"], 9) in at:
+                out.append((stable, points[start:i]))
+                start = i - 1
+            else:
+                out.append((stable, points[start:min(i + 1, len(points))]))
+                start = i
+            stable = points[i]["stable"] if i < len(points) else stable
     return out
 
 
@@ -206,6 +279,7 @@ def summary(results):
 
 @dash.callback(Output("url-update", "data", allow_duplicate=True),
                Input("bif-fz", "value"), Input("bif-vmin", "value"), Input("bif-vmax", "value"),
-               Input("bif-configs", "value"), prevent_initial_call=True)
-def remember(fz, v_min, v_max, configs):
-    return {"Fz": fz, "v_min": v_min, "v_max": v_max, "configs": ",".join(configs or [])}
+               Input("bif-configs", "value"), Input("bifc-config", "value"), prevent_initial_call=True)
+def remember(fz, v_min, v_max, configs, compared):
+    return {"Fz": fz, "v_min": v_min, "v_max": v_max, "configs": ",".join(configs or []),
+            "compare_config": None if compared == "nes_pd" else compared}

@@ -7,8 +7,10 @@ from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
+from plotly.subplots import make_subplots
+
+from ui import compare, designs, jobs
 from ui import components as ui
-from ui import jobs
 from ui.fields import Quantity
 from ui.layout import design_id, page
 from ui import style
@@ -39,6 +41,16 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
         html.Div(id="ov-table"),
         ui.downloads("ov"),
         dcc.Store(id="ov-data"),
+        html.H2("Hopf speed intervals of the compared designs"),
+        html.P("The designs ticked under Compare in the design panel (2 to 4; the current one may be one of them) "
+               "at this load: where straight rolling is unstable for each configuration, one colour per design, "
+               "with the change of the onset speed against the first design.", className="hint"),
+        html.Div(id="ov-cmp-designs", className="compare-designs"),
+        html.Div(id="ov-cmp-error", className="error", role="alert"),
+        ui.graph("ov-cmp-graph", figure=style.message_figure(
+            f"Tick {designs.COMPARE[0]} to {designs.COMPARE[1]} designs under Compare in the design panel "
+            "(instant: linear stability)", 200)),
+        html.Div(id="ov-cmp-table", className="table-wrap"),
         html.H2("Stability boundary in (V, Fz)"),
         html.P("Hopf curves of straight rolling: inside a closed curve, or above the lateral one, x = 0 is "
                "unstable. Computed by two-parameter continuation; runs in the background.", className="hint"),
@@ -127,6 +139,72 @@ def download(_csv, _json, data):
     if dash.ctx.triggered_id == "ov-csv":
         return {"content": ui.csv_text(data["columns"], data["rows"]), "filename": "overview_hopf.csv"}
     return {"content": ui.json_text(data["result"]), "filename": "overview_stability.json"}
+
+
+@dash.callback(Output("ov-cmp-designs", "children"), Output("ov-cmp-graph", "figure"),
+               Output("ov-cmp-table", "children"), Output("ov-cmp-error", "children"),
+               *compare.SELECTION, Input(design_id("ov"), "data"), Input("ov-fz", "value"), Input("ov-vmax", "value"))
+def compare_designs(selection, saved, current, fz_kn, v_max):
+    """Linear stability of each compared design (quick: asked of the service at once, the current
+    design's answer shared with the figure above through the cache)."""
+    try:
+        chosen = compare.chosen(selection, saved, current)
+    except InvalidParameterError as exc:
+        message = style.message_figure(str(exc), 200)
+        return html.Span(str(exc), className="hint"), message, None, ""
+    names = [d.name for d in chosen]
+    try:
+        body = {"Fz": FZ.read(fz_kn), "v_max": V_MAX.read(v_max), "n_points": 120}
+        results = [analyses.run("stability", {**body, **d.request()})[0] for d in chosen]
+    except InvalidParameterError as exc:
+        return compare.swatches(names), no_update, no_update, str(exc)
+    table = designs.comparison(names, results, designs.hopf_figures(CONFIGS, style.CONFIG_LABELS))
+    shown = [name for name, _ in compare.series(names)]
+    return compare.swatches(names), intervals_figure(results, shown), compare.table(table, "ov-cmp-summary"), ""
+
+
+def intervals_figure(results, names):
+    """Where x = 0 is unstable, per configuration (one strip each) and design (one row each, its colour)."""
+    n = len(names)
+    rows = len(CONFIGS)
+    fig = make_subplots(rows=rows, cols=1, shared_xaxes=True, vertical_spacing=0.09,
+                        subplot_titles=[style.CONFIG_LABELS[c] for c in CONFIGS])
+    v_lo, v_hi = results[0]["V"][0], results[0]["V"][-1]
+    shown = [nm if len(nm) <= 18 else nm[:17] + "…" for nm in names]
+    for row, config in enumerate(CONFIGS, start=1):
+        for k, (result, name) in enumerate(zip(results, names, strict=True)):
+            colour, data = compare.colour(k), result["configs"][config]
+            fig.add_scatter(x=[v_lo, v_hi], y=[name, name], mode="lines", line={"color": "#d5d9e0", "width": 2},
+                            hoverinfo="skip", showlegend=False, row=row, col=1)
+            for a, b in data["unstable_intervals"]:
+                fig.add_scatter(x=[a, b], y=[name, name], mode="lines", line={"color": colour, "width": 9},
+                                legendgroup=f"design-{k}", showlegend=False, row=row, col=1,
+                                hovertemplate=f"{name}, {style.CONFIG_LABELS[config]}: x = 0 unstable for V in "
+                                              f"{a:.4g} – {b:.4g} m/s<extra></extra>")
+            hv = [h["V"] for h in data["hopf_points"]]
+            if hv:
+                fig.add_scatter(x=hv, y=[name] * len(hv), mode="markers", legendgroup=f"design-{k}", showlegend=False,
+                                marker={"symbol": "diamond", "size": 10, "color": colour,
+                                        "line": {"width": 1, "color": "#fff"}}, row=row, col=1,
+                                hovertemplate=f"{name}, {style.CONFIG_LABELS[config]}: Hopf point V = %{{x:.4g}} m/s"
+                                              "<extra></extra>")
+        fig.update_yaxes(type="category", categoryorder="array", categoryarray=names[::-1], tickvals=names,
+                         ticktext=shown, automargin=True, row=row, col=1)
+    for k, name in enumerate(names):
+        style.legend_key(fig, name, group=f"design-{k}", mode="lines", line={"color": compare.colour(k), "width": 6})
+    style.legend_key(fig, "Hopf point", "legend2", mode="markers",
+                     marker={"symbol": "diamond", "size": 9, "color": "#666"})
+    height = 120 + rows * (34 + 24 * n) + 90
+    fz = results[0]["Fz"] / 1e3
+    title = {**style.title(f"Where straight rolling is unstable at Fz = {fz:g} kN (thick: between Hopf points)"),
+             "yref": "container", "y": 1 - 40 / height, "yanchor": "top"}  # above the first strip's title
+    fig.update_layout(title=title, height=height, template="plotly_white", margin={**style.MARGIN, "t": 100, "b": 110},
+                      hovermode="closest")
+    fig.update_annotations(x=0, xanchor="left", font={"size": 13})  # the strips' titles, at their left
+    style.legends(fig, ["design (colour)", "marker"], height, 110)
+    fig.update_xaxes(type="log", showline=True, linecolor="#888", mirror=True)
+    fig.update_xaxes(title_text="forward speed V (m/s)", row=rows, col=1)
+    return fig
 
 
 def _boundary_requests(design):

@@ -8,11 +8,12 @@ import dash
 from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.errors import InvalidParameterError
+from ui import compare, designs, fields, jobs
 from ui import components as ui
-from ui import fields, jobs
 from ui import style
 from ui.fields import Quantity
 from ui.layout import design_id, page
+from ui.sessions import LOCAL
 
 dash.register_page(__name__, path="/stability-map", name="Stability map", order=4)
 
@@ -27,14 +28,17 @@ FZ_MAX = Quantity("map", "fz_max", "Fz to", "kN", 1e3)
 V_MIN = Quantity("map", "v_min", "V from", "m/s")
 V_MAX = Quantity("map", "v_max", "V to", "m/s")
 SLICES = Quantity("map", "resolution", "Fz slices", "")
+METRICS_FZ = Quantity("map", "metrics_Fz", "figures at Fz", "kN", 1e3)
 WAITING = "Press Compute: tens of seconds per configuration cold on 2 cores, instant from the cache"
 HEIGHT, BOTTOM = 740, 176
 
 
 def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | None = None,
            fz_max: str | None = None, v_min: str | None = None, v_max: str | None = None,
-           resolution: str | None = None, **query):
+           resolution: str | None = None, compare_config: str | None = None, compare_fz: str | None = None, **query):
     shade, bad_shade = fields.choice("shade", shade, list(CONFIGS), "original", "a configuration")
+    compared, bad_compared = fields.choice("compare_config", compare_config, CONFIGS, "nes_pd", "a configuration")
+    merit_fz, bad_merit_fz = METRICS_FZ.from_url("compare_fz", compare_fz, 150)
     others, bad_overlay = fields.choices_list("overlay", overlay, CONFIGS, [], "a configuration")
     others = [c for c in others if c != shade]
     values, problems = {}, [bad_shade, bad_overlay]
@@ -70,6 +74,26 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
         ui.downloads("map"),
         *jobs.stores("map"),
         dcc.Location(id="map-nav", refresh="callback-nav"),
+        html.H2("Compare saved designs"),
+        html.P("The designs ticked under Compare in the design panel (2 to 4; the current one may be one of them) "
+               "over this page's Fz and V ranges and slices, for one configuration: the Hopf, fold and torus curves "
+               "of each design in its colour, the shading of the first; their figures of merit below, each with "
+               "its change against the first.", className="hint"),
+        html.Div([ui.field("Configuration", dcc.Dropdown(id="mapc-config", value=compared, clearable=False,
+                                                         style={"width": "150px"},
+                                                         options=[{"label": style.CONFIG_LABELS[c], "value": c}
+                                                                  for c in CONFIGS])),
+                  ui.field("Figures at Fz (kN)", METRICS_FZ.box("mapc-fz", merit_fz)),
+                  *jobs.controls("mapc", "Compare")], className="controls"),
+        html.Div(id="mapc-designs", className="compare-designs"),
+        html.Div(" ".join(p for p in (bad_compared, bad_merit_fz) if p), id="mapc-error", className="error",
+                 role="alert"),
+        ui.graph("mapc-graph", figure=style.message_figure(compare.waiting_text(
+            "tens of seconds per design cold on 2 cores, instant from the cache"), 360)),
+        html.H3("Figures of merit"),
+        html.Div(id="mapc-table", className="table-wrap"),
+        ui.downloads("mapc"),
+        *jobs.stores("mapc"),
     )
 
 
@@ -107,13 +131,53 @@ jobs.register(
     blank=lambda: (style.message_figure("Refused: see the message above", 600), None))
 
 
+def _compare_requests(fz_min, fz_max, v_min, v_max, resolution, config, merit_fz, selection, saved, current):
+    """The page's map request for one configuration, once per compared design (the figures of merit at
+    the load asked; at 150 kN it is the request of the page's own map: the cache serves it)."""
+    common = _requests(config, [], fz_min, fz_max, v_min, v_max, resolution, {})[0]
+    common["metrics_Fz"] = METRICS_FZ.read(merit_fz)
+    return [{**common, **d.request()} for d in compare.chosen(selection, saved, current)]
+
+
+def _compare_names(*values):
+    return [d.name for d in compare.chosen(*values[7:])]
+
+
+def _merits(results, names):
+    fz = results[0]["metrics"]["at_Fz"]["Fz"]
+    return designs.comparison(names, [r["metrics"] for r in results], designs.merit_figures(fz))
+
+
+def _compare_render(results, names):
+    series = compare.series(names)
+    return figure(results, series, what="design"), compare.table(_merits(results, names), "mapc-summary")
+
+
+jobs.register(
+    "mapc", "map", requests=_compare_requests, labels=_compare_names, render=_compare_render,
+    outputs=[Output("mapc-graph", "figure"), Output("mapc-table", "children")],
+    states=[State("map-fzmin", "value"), State("map-fzmax", "value"), State("map-vmin", "value"),
+            State("map-vmax", "value"), State("map-res", "value"), State("mapc-config", "value"),
+            State("mapc-fz", "value"), State("design-compare", "value"), State(LOCAL, "data"),
+            State(design_id("map"), "data")],
+    lock=["mapc-config", "mapc-fz"],
+    download=jobs.Download("mapc", "figures_of_merit", lambda results, names: designs.comparison_csv(
+        _merits(results, names))),
+    blank=lambda: (style.message_figure("Refused: see the message above", 360), None))
+compare.register_selection("mapc", "map")
+
+
 MARKERS = {"gh_points": ("GH", "diamond", 12), "double_hopf_points": ("double Hopf", "star", 13)}
 
 
-def figure(results):
-    """The first map shaded by type; the curves of every map in its configuration's colour; the
-    operating points A-I. Three legends: configuration (colour), curve and point kind (line style,
-    marker), shimmy type (shading)."""
+def figure(results, series=None, what="configuration"):
+    """The first map shaded by type; the curves of every map in its configuration's colour (or
+    ``series`` [(name, colour)], one per map: compared designs, each curve over a white halo to
+    read on the shading); the operating points A-I. Three legends: configuration or design
+    (colour), curve and point kind (line style, marker), shimmy type (shading)."""
+    if series is None:
+        series = [(style.CONFIG_LABELS[r["config"]], style.CONFIG_COLOURS[r["config"]]) for r in results]
+    halo = what != "configuration"
     shaded = results[0]
     grid = shaded.get("shading") or shaded  # read off the curves; a map without it: its slices
     V, Fz = grid["V"], [f / 1e3 for f in grid["Fz"]]
@@ -122,8 +186,10 @@ def figure(results):
     scale = []
     for k, t in enumerate(TYPES):  # a stepped scale: code k -> its type's colour
         scale += [[k / n, style.SHIMMY_TYPE_COLOURS[t]], [(k + 1) / n, style.SHIMMY_TYPE_COLOURS[t]]]
-    fig = style.figure(f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)",
-                       "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    head = (f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)" if not halo else
+            f"{style.CONFIG_LABELS[shaded['config']]}: curves of {len(results)} designs, shimmy type of "
+            f"{series[0][0]} (shaded)")
+    fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
     regions = shaded.get("regions") or []
     # the regions as polygons (their edges on the curves at every row); the grid stays underneath,
     # transparent, for the hover text and the click that opens a time history
@@ -134,20 +200,23 @@ def figure(results):
         fig.add_scatter(x=region["V"], y=[f / 1e3 for f in region["Fz"]], mode="lines", fill="toself",
                         fillcolor=style.SHIMMY_TYPE_COLOURS[region["type"]], opacity=0.6, line={"width": 0},
                         hoverinfo="skip", showlegend=False, name=region["type"])
-    for result in results:
-        config = result["config"]
-        colour, label = style.CONFIG_COLOURS[config], style.CONFIG_LABELS[config]
+    for k, (result, (label, colour)) in enumerate(zip(results, series, strict=True)):
+        group = f"{what}-{k}"
         for key, (kind, dash_style, width) in CURVE_STYLES.items():
             for curve in result[key]:
-                fig.add_scatter(x=[p["V"] for p in curve], y=[p["Fz"] / 1e3 for p in curve], mode="lines",
-                                name=f"{label}: {kind}", legendgroup=config, showlegend=False,
+                x, y = [p["V"] for p in curve], [p["Fz"] / 1e3 for p in curve]
+                if halo:
+                    fig.add_scatter(x=x, y=y, mode="lines", legendgroup=group, showlegend=False, hoverinfo="skip",
+                                    line={"color": "rgba(255,255,255,0.85)", "width": width + 3})
+                fig.add_scatter(x=x, y=y, mode="lines",
+                                name=f"{label}: {kind}", legendgroup=group, showlegend=False,
                                 line={"color": colour, "dash": dash_style, "width": width},
                                 hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
         for key, (kind, symbol, size) in MARKERS.items():
             points = result.get(key) or []
             if points:
                 fig.add_scatter(x=[g["V"] for g in points], y=[g["Fz"] / 1e3 for g in points], mode="markers",
-                                name=f"{label}: {kind}", legendgroup=config, showlegend=False,
+                                name=f"{label}: {kind}", legendgroup=group, showlegend=False,
                                 marker={"symbol": symbol, "size": size, "color": colour,
                                         "line": {"width": 1.5, "color": "#fff"}},
                                 hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
@@ -159,10 +228,8 @@ def figure(results):
                         textfont={"size": 13, "color": "#111"}, name="points A-I", legend="legend2",
                         marker={"symbol": "circle", "size": 9, "color": "#fff", "line": {"width": 2, "color": "#111"}},
                         hovertemplate="operating point %{text}<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN<extra></extra>")
-    for result in results:
-        config = result["config"]
-        style.legend_key(fig, style.CONFIG_LABELS[config], "legend", group=config, mode="lines",
-                         line={"color": style.CONFIG_COLOURS[config], "width": 3})
+    for k, (label, colour) in enumerate(series):
+        style.legend_key(fig, label, "legend", group=f"{what}-{k}", mode="lines", line={"color": colour, "width": 3})
     for kind, dash_style, width in CURVE_STYLES.values():
         style.legend_key(fig, kind, "legend2", mode="lines",
                          line={"color": "#444", "dash": dash_style, "width": width})
@@ -176,7 +243,7 @@ def figure(results):
     fig.update_xaxes(range=[min(V), max(V)])
     fig.update_yaxes(range=[min(Fz), max(Fz)])
     fig.update_layout(margin={**style.MARGIN, "b": BOTTOM})
-    style.legends(fig, ["configuration (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM)
+    style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM)
     return fig
 
 
@@ -227,7 +294,9 @@ def open_time_history(click, requests):
 @dash.callback(Output("url-update", "data", allow_duplicate=True),
                Input("map-shade", "value"), Input("map-overlay", "value"), Input("map-fzmin", "value"),
                Input("map-fzmax", "value"), Input("map-vmin", "value"), Input("map-vmax", "value"),
-               Input("map-res", "value"), prevent_initial_call=True)
-def remember(shade, overlay, fz_min, fz_max, v_min, v_max, resolution):
+               Input("map-res", "value"), Input("mapc-config", "value"), Input("mapc-fz", "value"),
+               prevent_initial_call=True)
+def remember(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, compared, merit_fz):
     return {"shade": shade, "overlay": ",".join(overlay or []), "fz_min": fz_min, "fz_max": fz_max, "v_min": v_min,
-            "v_max": v_max, "resolution": resolution}
+            "v_max": v_max, "resolution": resolution, "compare_config": None if compared == "nes_pd" else compared,
+            "compare_fz": None if merit_fz == 150 else merit_fz}

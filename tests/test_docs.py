@@ -45,7 +45,7 @@ def _text(page: Path) -> str:
 def test_docs_build_in_strict_mode_with_every_page(site):
     for page in ("index", "model", "numerics", "validation", "http-api", "openapi", "cli", "python-api",
                  "continuation", "tutorials/index", "tutorials/reproduce-study", "tutorials/new-nes-design",
-                 "tutorials/dask-map", "tutorials/ground-runs"):
+                 "tutorials/dask-map", "tutorials/ground-runs", "tutorials/design-sessions"):
         assert (site / f"{page}.html").is_file(), page
 
 

@@ -76,7 +76,8 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
              download: Download, lock: Sequence[str] = (), store: str | None = None,
              error: str | None = None, triggers: Sequence[Input] = (), initial: bool | str = "cached",
              notice: Callable[[list[dict[str, Any]]], str] | None = None,
-             blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None) -> None:
+             blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None,
+             labels: Callable[..., list[str]] | None = None) -> None:
     """Wire the job of one page.
 
     ``requests(*trigger values, *state values)`` -> the analysis requests (may raise
@@ -88,6 +89,9 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
     computes nothing otherwise), ``True`` computes it, ``False`` does nothing. ``blank()`` -> the
     outputs that replace a shown result when the controls are refused (the old result no longer
     answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay).
+    ``labels(*values)`` -> a name for each request (the designs of a comparison): the results are then
+    drawn by ``render(results, names)`` and tabulated by ``download.rows(results, names)``, and the
+    requests store holds {"requests", "labels"}.
     """
     store = store or f"{prefix}-requests"
     error = error or f"{prefix}-error"
@@ -104,8 +108,10 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
             return (*blank(), message, None, True, True) + idle + ("0", status)
         return (no_update,) * n_out + (message, no_update, no_update, no_update) + idle + ("0", status)
 
-    def shown(results: list[dict[str, Any]], wanted: list[dict[str, Any]]) -> tuple:
-        return (*render(results), notice(results) if notice else "", wanted, False, False) + idle + ("100", "")
+    def shown(results: list[dict[str, Any]], wanted: list[dict[str, Any]], names: list[str] | None) -> tuple:
+        drawn = render(results) if labels is None else render(results, names)
+        kept = wanted if labels is None else {"requests": wanted, "labels": names}
+        return (*drawn, notice(results) if notice else "", kept, False, False) + idle + ("100", "")
 
     @dash.callback(*outputs, *tail, *state, Input(f"{prefix}-run", "n_clicks"), *triggers, *states,
                    prevent_initial_call=not initial)
@@ -114,13 +120,14 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         loading = dash.ctx.triggered_id is None  # the page's first call, not a user's action
         try:
             wanted = canonical(analysis, requests(*values))
+            names = None if labels is None else _names(labels(*values), wanted)
         except InvalidParameterError as exc:
             if loading:  # the layout already says what of the address could not be used
                 return (no_update,) * (n_out + len(tail) + len(state))
             return refused(str(exc), clear=True)
         results = [cache.get(analysis, r) for r in wanted]
         if all(r is not None for r in results):
-            return shown(results, wanted)
+            return shown(results, wanted, names)
         if loading and initial == "cached":
             return (no_update,) * (n_out + len(tail) + len(state))
         try:
@@ -129,7 +136,8 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         except jobs.QueueFull as exc:
             return refused(f"The service is busy: {exc}.")
         busy = running() if running is not None else (no_update,) * n_out
-        return (tuple(busy) + (no_update,) * len(tail) + ({"jobs": ids, "requests": wanted}, False, True, False)
+        go = {"jobs": ids, "requests": wanted, **({} if names is None else {"labels": names})}
+        return (tuple(busy) + (no_update,) * len(tail) + (go, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-poll", "n_intervals"),
@@ -148,12 +156,13 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         if all(job["status"] == "done" for job in current):
             try:  # the requests came back through the browser's JSON (150000.0 as 150000): canonical again
                 wanted = canonical(analysis, wanted)
+                names = None if labels is None else _names(go.get("labels"), wanted)
             except InvalidParameterError as exc:
                 return refused(str(exc))
             results = [cache.get(analysis, r) for r in wanted]
             if any(r is None for r in results):
                 return refused("A result left the cache before it could be shown; press Compute again.")
-            return shown(results, wanted)
+            return shown(results, wanted, names)
         fraction = sum(job["progress"] if job["status"] == "running" else 0.0 for job in current) / len(current)
         first = next(job for job in current if job["status"] != "done")
         label = first["request"].get("config") or analysis
@@ -176,11 +185,14 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
 
     @dash.callback(Output(f"{download.prefix}-download", "data"), Input(f"{download.prefix}-csv", "n_clicks"),
                    Input(f"{download.prefix}-json", "n_clicks"), State(store, "data"), prevent_initial_call=True)
-    def save(_csv, _json, wanted):
+    def save(_csv, _json, kept):
+        wanted, names = (kept.get("requests"), kept.get("labels")) if isinstance(kept, dict) else (kept, None)
         if not wanted:
             return no_update
         try:
-            results = [cache.get(analysis, r) for r in canonical(analysis, wanted)]
+            wanted = canonical(analysis, wanted)
+            names = None if labels is None else _names(names, wanted)
+            results = [cache.get(analysis, r) for r in wanted]
         except InvalidParameterError:
             return no_update
         if any(r is None for r in results):  # evicted from the cache since it was drawn: compute again first
@@ -189,8 +201,18 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         if dash.ctx.triggered_id == f"{download.prefix}-json":
             return {"content": components.json_text(results[0] if download.single else results),
                     "filename": f"{name}.json"}
-        columns, rows = download.rows(results)
+        columns, rows = download.rows(results) if labels is None else download.rows(results, names)
         return {"content": components.csv_text(columns, rows), "filename": f"{name}.csv"}
+
+
+def _names(names: Any, wanted: list[dict[str, Any]]) -> list[str]:
+    """One short name per request (as the client sent them back: checked, never trusted)."""
+    if (not isinstance(names, list) or len(names) != len(wanted)
+            or not all(isinstance(n, str) and 0 < len(n) <= 120 for n in names)):
+        raise InvalidParameterError("labels", names, f"{len(wanted)} names, one per analysis",
+                                    message="two of the designs ask for the same analysis" if isinstance(names, list)
+                                    and len(names) > len(wanted) else "the names of the analyses are missing")
+    return names
 
 
 def _asked(wanted: list[dict[str, Any]]) -> str:

@@ -10,7 +10,7 @@ from dash import ALL, Input, Output, State, dcc, html
 from shimmy.errors import InvalidParameterError
 from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
 
-from . import state
+from . import sessions, state
 
 #: The design parameters with sliders (PRODUCT.md); every other one is in the advanced panel.
 DESIGN = ("r2", "e_p", "k_s", "r3", "a_p", "rho_p")
@@ -109,6 +109,7 @@ def design_panel(query: dict[str, str], page_id: str, shown: bool = True) -> htm
                       html.Div([_number(n, values[n], at_field.get(n)) for n in ADVANCED], className="advanced-grid")],
                      id="advanced", open=advanced_problem),
         html.Button("Reset design", id="reset-design", className="secondary"),
+        sessions.section(),
     ], className="design-panel", id="design-panel", hidden=not shown)
 
 

@@ -42,12 +42,19 @@ def design_query(material: str, values: dict[str, float]) -> dict[str, Any]:
     base = material_params(material)
     out: dict[str, Any] = {"material": None if material == DEFAULT_MATERIAL else material}
     for name, value in values.items():
-        if value is not None and name in base and abs(float(value) - base[name]) > 1e-12 * max(1.0, abs(base[name])):
+        if _differs(name, value, base):
             out[name] = f"{float(value):.10g}"
     return out
 
 
 def design_request(material: str, values: dict[str, float]) -> dict[str, Any]:
     """The {"material", "params"} part of a service request for this design."""
-    overrides = {k: v for k, v in design_query(material, values).items() if k != "material" and v is not None}
-    return {"material": material, "params": {k: float(v) for k, v in overrides.items()}}
+    base = material_params(material)
+    # the values themselves (not the address's 10 digits): a design reopened from its link or its file
+    # asks for exactly what it asked before, and the shared cache answers
+    params = {name: float(value) for name, value in values.items() if _differs(name, value, base)}
+    return {"material": material, "params": params}
+
+
+def _differs(name: str, value: Any, base: dict[str, float]) -> bool:
+    return value is not None and name in base and abs(float(value) - base[name]) > 1e-12 * max(1.0, abs(base[name]))

@@ -8,6 +8,9 @@ CONFIG_COLOURS = {"original": "#000000", "nes": "#E69F00", "pd": "#0072B2", "nes
 CONFIG_LABELS = {"original": "original", "nes": "NES", "pd": "PD", "nes_pd": "NES + PD"}
 SHIMMY_TYPE_COLOURS = {"Stable": "#FFFFFF", "Torsion": "#E69F00", "Lateral": "#56B4E9", "Bistable": "#CC79A7",
                        "Both": "#117733"}  # Both: a dark green, far from Torsion's orange
+#: One colour per compared design (dark and saturated: readable on white and over the map's shading,
+#: apart from the configurations' colours, which stay with the configurations).
+DESIGN_COLOURS = ("#1A1A1A", "#D55E00", "#0057B8", "#A0329A")
 ACCENT = "#0072B2"
 #: Room above the plot for the figure toolbar and, below it, the title (they never overlap).
 MARGIN = {"l": 64, "r": 16, "t": 76, "b": 52}

@@ -1,0 +1,84 @@
+"""The pages' comparisons of saved designs: the designs ticked under Compare in the design panel,
+one colour each, their analyses requested from the service like the page's own (same requests,
+so the shared cache serves a design already drawn), and their figures side by side with the
+changes against the first. The logic is :mod:`ui.designs`; this is the Dash side.
+"""
+
+from __future__ import annotations
+
+from html import escape
+from typing import Any
+
+import dash
+from dash import Input, Output, html
+
+from shimmy.errors import InvalidParameterError
+
+from . import designs, style
+from .layout import design_id
+from .sessions import LOCAL
+
+#: The inputs that say which designs are compared (the panel's, on every page).
+SELECTION = (Input("design-compare", "value"), Input(LOCAL, "data"))
+
+
+def chosen(selection: Any, saved: Any, current: Any) -> list[designs.Design]:
+    """The compared designs, or InvalidParameterError saying what to tick (the pages' refusal type)."""
+    try:
+        return designs.compared(selection, saved, current)
+    except designs.DesignError as exc:
+        raise InvalidParameterError("designs", selection, f"{designs.COMPARE[0]} to {designs.COMPARE[1]} "
+                                    "different, usable designs", message="; ".join(exc.problems)) from None
+
+
+def colour(k: int) -> str:
+    return style.DESIGN_COLOURS[k % len(style.DESIGN_COLOURS)]
+
+
+def series(names: list[str]) -> list[tuple[str, str]]:
+    """(name as a figure shows it, colour) per design: Plotly reads tags and entities in its texts,
+    so a name (from someone's file, say) is escaped to show as typed."""
+    return [(escape(name, quote=False), colour(k)) for k, name in enumerate(names)]
+
+
+def swatches(names: list[str]) -> list:
+    """'Comparing: ■ A  ■ B' with each design's colour."""
+    out: list = [html.Span("Comparing: ")]
+    for k, name in enumerate(names):
+        out += [html.Span("■ ", style={"color": colour(k)}), html.Span(name, className="design-tag"),
+                html.Span(" (reference)  " if k == 0 else "  ")]
+    return out
+
+
+def register_selection(prefix: str, page_id: str) -> None:
+    """The line that says which designs the page's comparison would show (or what to tick)."""
+
+    @dash.callback(Output(f"{prefix}-designs", "children"), *SELECTION, Input(design_id(page_id), "data"))
+    def _designs(selection, saved, current):
+        try:
+            return swatches([d.name for d in chosen(selection, saved, current)])
+        except InvalidParameterError as exc:
+            return html.Span(str(exc), className="hint")
+
+
+def table(comparison: dict[str, Any], table_id: str) -> html.Table:
+    """Figures as rows, designs as columns (each after the first with its change against the first)."""
+    names = comparison["columns"][1:]
+    head = [html.Th("figure")] + [html.Th([html.Span("■ ", style={"color": colour(k)}), name,
+                                           html.Small(" (reference)" if k == 0 else "")])
+                                  for k, name in enumerate(names)]
+    body = []
+    for label, *cells in comparison["rows"]:
+        tds = [html.Td(label, className="figure-name")]
+        for cell in cells:
+            parts: list = [cell.text]
+            if cell.change is not None:
+                parts += [html.Br(), html.Small(f"Δ {cell.change}", className="change")]
+            tds.append(html.Td(parts))
+        body.append(html.Tr(tds))
+    return html.Table([html.Thead(html.Tr(head)), html.Tbody(body)], id=table_id, className="data-table compare")
+
+
+def waiting_text(what: str) -> str:
+    return (f"Tick {designs.COMPARE[0]} to {designs.COMPARE[1]} designs under Compare in the design panel, then "
+            f"press Compare: {what}")

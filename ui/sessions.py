@@ -1,0 +1,264 @@
+"""Saved designs in the design panel: name and save the design in the browser, reopen, rename or
+delete a saved one, download it as a JSON file or open one, copy the link that reopens it, and
+tick the designs the pages compare. The logic is :mod:`ui.designs`; these callbacks only carry it.
+
+Opening a design (an entry, a file) goes through the address, like a shared link: its keys replace
+the design keys of the address (the page's own keys stay) and the page loads from it, so a design
+reopened any way shows what its link shows.
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+
+import dash
+from dash import ALL, Input, Output, State, dcc, html, no_update
+
+from . import designs
+
+LOCAL = "designs-saved"  # localStorage key of the saved designs (shared by every page and tab)
+
+
+def section() -> html.Details:
+    """The panel's block of saved designs (the ids are the same on every page: one panel at a time)."""
+    return html.Details([
+        html.Summary("Saved designs"),
+        dcc.Store(id=LOCAL, storage_type="local"),
+        dcc.Store(id="design-ask"), dcc.Store(id="design-upload-ask"), dcc.Store(id="design-open"),
+        html.Div(id="design-open-sink", hidden=True),
+        html.Div([dcc.Input(id="design-name", type="text", placeholder="name this design", maxLength=designs.MAX_NAME,
+                            className="design-name", debounce=False),
+                  html.Button("Save design", id="design-save", title="Save the design in this browser")],
+                 className="save-line"),
+        html.Div(id="designs-message", className="designs-message", role="status"),
+        html.Div(id="designs-list", className="saved-list"),
+        html.Div([html.Label("Compare (tick 2 to 4)", htmlFor="design-compare"),
+                  dcc.Checklist(id="design-compare", value=[], className="compare-list",
+                                options=[{"label": designs.CURRENT_NAME, "value": designs.CURRENT}],
+                                persistence=True, persistence_type="local"),
+                  html.Small("The Overview, Bifurcation and Stability map pages overlay the ticked designs "
+                             "(changes against the first).", className="hint")], className="compare-block"),
+        html.Div([html.Button("Download JSON", id="design-download-json", className="secondary",
+                              title="This design as a JSON file (name, material, every parameter value)"),
+                  dcc.Upload(html.Button("Open JSON…", className="secondary", title="Open a design file"),
+                             id="design-upload", accept=".json,application/json"),
+                  dcc.Download(id="design-download")], className="file-line"),
+        html.Label("Link to this design", htmlFor="design-link"),
+        html.Div([dcc.Input(id="design-link", type="text", readOnly=True, className="design-link"),
+                  dcc.Clipboard(target_id="design-link", title="Copy the link", className="copy-link")],
+                 className="link-line"),
+    ], open=True, id="designs", className="designs")
+
+
+def _message(text: str, notes: list[str] | None = None) -> list:
+    return [html.Span(text), *([html.Ul([html.Li(n) for n in notes])] if notes else [])]
+
+
+def _refusal(exc: designs.DesignError) -> html.Div:
+    return html.Div([html.Span(f"Refused ({exc.what}):"),
+                     html.Ul([html.Li(p) for p in exc.problems])], className="error", role="alert")
+
+
+def _decode(contents: str) -> bytes:
+    """The bytes of a dcc.Upload's data URL."""
+    head, _, body = contents.partition(",")
+    if not head.endswith(";base64"):
+        raise designs.DesignError("the file", ["did not arrive as a file (no base64 data)"])
+    try:
+        return base64.b64decode(body, validate=True)
+    except (binascii.Error, ValueError):
+        raise designs.DesignError("the file", ["did not arrive whole (its base64 data is damaged)"]) from None
+
+
+def _open(design: designs.Design, message: str) -> dict:
+    return {"query": design.query(), "message": message}
+
+
+def _current(stores) -> object:
+    return (stores or [None])[0]
+
+
+@dash.callback(Output(LOCAL, "data"), Output("design-open", "data"), Output("designs-message", "children"),
+               Input("design-ask", "data"), Input("design-upload-ask", "data"),
+               Input({"type": "saved-open", "id": ALL}, "n_clicks"),
+               Input({"type": "saved-delete", "id": ALL}, "n_clicks"),
+               Input({"type": "saved-name", "id": ALL}, "value"),
+               State(LOCAL, "data"), State({"type": "design", "page": ALL}, "data"), prevent_initial_call=True)
+def act(ask, upload, _opens, _deletes, _names, saved, stores):
+    """Save, open, rename, delete, open a file: the store, the design to open, what was done."""
+    trig = dash.ctx.triggered_id
+    value = dash.ctx.triggered[0]["value"] if dash.ctx.triggered else None
+    try:
+        if trig == "design-ask":
+            if not isinstance(ask, dict) or ask.get("action") != "save":
+                return no_update, no_update, no_update
+            design = designs.current_design(_current(stores), ask.get("name"))
+            design = designs.Design(design.name, design.material, design.params,
+                                    designs.config_from_search(ask.get("search")))
+            new, _, text = designs.save(saved, design)
+            return new, no_update, _message(text)
+        if trig == "design-upload-ask":
+            if not isinstance(upload, dict) or not isinstance(upload.get("contents"), str):
+                return no_update, no_update, no_update
+            design, notes = designs.from_file(_decode(upload["contents"]), str(upload.get("filename") or "the file"))
+            new, _, text = designs.save(saved, design)
+            said = f"Opened {design.name!r} from {upload.get('filename') or 'the file'}. {text}"
+            return new, _open(design, " ".join([said, *(f"Note: {n}." for n in notes)])), _message(said, notes)
+        if not isinstance(trig, dict):
+            return no_update, no_update, no_update
+        entry_id = str(trig.get("id"))
+        if trig.get("type") == "saved-open" and value:
+            entry = designs.find(saved, entry_id)
+            if entry is None:
+                return no_update, no_update, _message("That design is no longer saved.")
+            design = designs.from_entry(entry)
+            return no_update, _open(design, f"Opened {design.name!r}."), _message(f"Opening {design.name!r}…")
+        if trig.get("type") == "saved-delete" and value:
+            new, text = designs.delete(saved, entry_id)
+            return new, no_update, _message(text)
+        if trig.get("type") == "saved-name":
+            entry = designs.find(saved, entry_id)
+            if entry is None or value == entry.get("name"):  # a list drawn again, not a rename
+                return no_update, no_update, no_update
+            new, text = designs.rename(saved, entry_id, value)
+            return new, no_update, _message(text)
+    except designs.DesignError as exc:  # a refused rename: the list is drawn again with the saved name
+        return (saved if isinstance(trig, dict) else no_update), no_update, _refusal(exc)
+    return no_update, no_update, no_update
+
+
+@dash.callback(Output("design-download", "data"), Input("design-ask", "data"),
+               State({"type": "design", "page": ALL}, "data"), prevent_initial_call=True)
+def download(ask, stores):
+    """The design in the panel as a file, named by the name box (the page's configuration with it)."""
+    if not isinstance(ask, dict) or ask.get("action") != "download":
+        return no_update
+    name = ask.get("name") if isinstance(ask.get("name"), str) and ask.get("name").strip() else "design"
+    try:
+        design = designs.current_design(_current(stores), name)
+    except designs.DesignError:
+        return no_update
+    design = designs.Design(design.name, design.material, design.params, designs.config_from_search(ask.get("search")))
+    return {"content": design.text(), "filename": design.filename(), "type": "application/json"}
+
+
+@dash.callback(Output("designs-list", "children"), Output("design-compare", "options"),
+               Output("design-name", "value"),
+               Input(LOCAL, "data"), Input({"type": "design", "page": ALL}, "data"), State("design-name", "value"))
+def show(saved, stores, name):
+    """The saved designs (the current one marked, one that can no longer be used says why) and the
+    compare choices; an empty name box takes the name of the saved design shown."""
+    entries = designs.saved_list(saved)
+    try:
+        match = designs.matching(saved, designs.current_design(_current(stores)))
+    except designs.DesignError:
+        match = None
+    rows = []
+    for e in entries:
+        problem = designs.usable(e)
+        is_current = match is not None and e["id"] == match["id"]
+        detail = (f"not usable: {problem}" if problem else designs.from_entry(e).summary())
+        rows.append(html.Div([
+            html.Div([html.Div(dcc.Input(id={"type": "saved-name", "id": e["id"]}, type="text", value=e.get("name"),
+                                         debounce=True, maxLength=designs.MAX_NAME, className="saved-name"),
+                               title="Type a new name and press Enter to rename", className="saved-name-wrap"),
+                      html.Button("Open", id={"type": "saved-open", "id": e["id"]}, className="secondary small",
+                                  disabled=bool(problem), title=f"Open {e.get('name')!r} on this page"),
+                      html.Button("Delete", id={"type": "saved-delete", "id": e["id"]}, className="secondary small",
+                                  title=f"Delete {e.get('name')!r} from this browser")], className="saved-line"),
+            html.Div(("● shown now · " if is_current else "") + detail,
+                     className="saved-detail error" if problem else "saved-detail"),
+        ], className="saved-row current" if is_current else "saved-row"))
+    if not rows:
+        rows = [html.Div("No design saved in this browser yet.", className="hint")]
+    options = [{"label": designs.CURRENT_NAME, "value": designs.CURRENT}]
+    options += [{"label": e.get("name"), "value": e["id"], "disabled": designs.usable(e) is not None}
+                for e in entries]
+    fill = match.get("name") if match is not None and not (name or "").strip() else no_update
+    return rows, options, fill
+
+
+# Save and Download read the page's address (a configuration it names goes into the design).
+dash.clientside_callback(
+    """
+    function(save, down, name) {
+        const trig = window.dash_clientside.callback_context.triggered_id;
+        if (!trig) { return window.dash_clientside.no_update; }
+        return {action: trig === "design-save" ? "save" : "download", name: name || "",
+                search: window.location.search, t: Date.now()};
+    }
+    """,
+    Output("design-ask", "data"),
+    Input("design-save", "n_clicks"), Input("design-download-json", "n_clicks"), State("design-name", "value"),
+    prevent_initial_call=True,
+)
+
+# A file goes to the server only if it can be a design file (the callback's body is bounded).
+dash.clientside_callback(
+    """
+    function(contents, filename) {
+        const C = window.dash_clientside;
+        if (!contents) { return [C.no_update, C.no_update, C.no_update]; }
+        const input = document.querySelector("#design-upload input[type=file]");
+        if (input) { input.value = ""; }  // the same file chosen again (edited) is read again
+        const bytes = Math.floor((contents.length - contents.indexOf(",") - 1) * 3 / 4);
+        if (bytes > %d) {  // emptied again, so that choosing the same file once more is seen
+            return [C.no_update, filename + " is refused: it is " + Math.round(bytes / 1024) +
+                    " kB; a design file is a few kB (at most %d kB).", null];
+        }
+        return [{contents: contents, filename: filename, t: Date.now()}, C.no_update, null];
+    }
+    """ % (designs.MAX_FILE_BYTES, designs.MAX_FILE_BYTES // 1024),
+    Output("design-upload-ask", "data"), Output("designs-message", "children", allow_duplicate=True),
+    Output("design-upload", "contents"),
+    Input("design-upload", "contents"), State("design-upload", "filename"),
+    prevent_initial_call=True,
+)
+
+# Open: the design's keys replace those of the address (the page's own keys stay), then the page
+# loads from the address, as from a shared link (a moment first, for the saved list to reach storage).
+dash.clientside_callback(
+    """
+    function(open) {
+        if (!open || !open.query) { return window.dash_clientside.no_update; }
+        const params = new URLSearchParams(window.location.search);
+        for (const [k, v] of Object.entries(open.query)) {
+            if (v === null || v === undefined || v === "") { params.delete(k); } else { params.set(k, String(v)); }
+        }
+        const s = params.toString();
+        const url = window.location.pathname + (s ? "?" + s : "");
+        try { sessionStorage.setItem("shimmy-opened", JSON.stringify(open.message || "")); } catch (e) {}
+        setTimeout(() => window.location.assign(url), 150);
+        return url;
+    }
+    """,
+    Output("design-open-sink", "children"),
+    Input("design-open", "data"),
+    prevent_initial_call=True,
+)
+
+# The link box shows the address (design and page state) when the page loads and whenever the
+# address changes (the loading call is its own: the address updater's first call changes nothing,
+# and Dash then skips what depends on it).
+LINK = """
+    function(_s) { return window.location.href; }
+"""
+dash.clientside_callback(LINK, Output("design-link", "value"), Input("design-link", "id"))
+dash.clientside_callback(LINK, Output("design-link", "value", allow_duplicate=True), Input("url-sink", "children"),
+                         prevent_initial_call=True)
+
+# After an open, the page that loaded says what was opened (and what the file left to the preset).
+dash.clientside_callback(
+    """
+    function(_s) {
+        let text = "";
+        try { text = JSON.parse(sessionStorage.getItem("shimmy-opened") || '""');
+              sessionStorage.removeItem("shimmy-opened"); } catch (e) {}
+        return text || window.dash_clientside.no_update;
+    }
+    """,
+    Output("designs-message", "children", allow_duplicate=True),
+    Input("design-open-sink", "id"),
+    prevent_initial_call="initial_duplicate",
+)
