@@ -42,6 +42,7 @@ from .sensitivity import (V_BAND, coefficient_pairs, hopf_sensitivities, jacobia
 from .stability import Linearisation, hopf_points
 
 DISTRIBUTIONS = ("normal", "uniform")
+FZ_BOX = (1.0e4, 9.0e5)  # N: where the lowest point of the Hopf curves is looked for
 CHUNK = 16  # samples per executor unit
 
 
@@ -95,10 +96,20 @@ def _sample_unit(task: tuple) -> list[dict[str, Any]]:
         model = build_model(config, params)
         speeds = [h.V for h in hopf_points(config, Fz, params, v_min=V_BAND[0], v_max=V_BAND[1]).hopf_points]
         entry: dict[str, Any] = {"ok": True, "hopf": speeds}
-        try:
-            entry["min_shimmy_Fz"] = polish_lowest_point(model, low[0], low[1])[1] if low else None
-        except (ConvergenceError, np.linalg.LinAlgError):
-            entry["min_shimmy_Fz"] = None
+        entry["min_shimmy_Fz"] = None
+        if low:
+            try:
+                V_low, Fz_low, _ = polish_lowest_point(model, low[0], low[1])
+            except (ConvergenceError, np.linalg.LinAlgError):
+                V_low, Fz_low = math.nan, math.nan
+            if V_BAND[0] <= V_low <= V_BAND[1] and FZ_BOX[0] <= Fz_low <= FZ_BOX[1]:
+                entry["min_shimmy_Fz"] = Fz_low
+            else:  # Newton from the nominal point went elsewhere (a turning point at Fz < 0): continue the curves
+                from .hopf_curves import hopf_curves
+
+                found = hopf_curves(config, params, V_BAND, FZ_BOX).fz_minimum
+                entry["min_shimmy_Fz"] = None if found is None else found["Fz"]
+                entry["min_recomputed"] = True
         entry["unstable"] = {p: _growth(model, V, F) > 0.0 for p, (V, F) in OPERATING_POINTS.items()}
         out.append(entry)
     return out
@@ -195,7 +206,7 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     pairs = coefficient_pairs(config, params, names)
     nominal_speeds = [h.V for h in hopf_points(config, Fz, params, v_min=V_BAND[0], v_max=V_BAND[1]).hopf_points]
     hopf_sens = hopf_sensitivities(model, Fz, nominal_speeds, pairs)
-    low = min_shimmy_sensitivity(model, pairs, (1.0e4, 9.0e5))
+    low = min_shimmy_sensitivity(model, pairs, FZ_BOX)
     sigma = np.array([float(getattr(params, t.name)) * t.std_factor for t in tols])
 
     def linear_std(derivatives: dict[str, float]) -> float:
@@ -224,6 +235,10 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
                         f"(for example: {first})")
     if not ok:
         raise ConvergenceError("no sample could be evaluated: " + flat[0]["reason"])
+    recomputed = sum(bool(e.get("min_recomputed")) for e in ok)
+    if recomputed:
+        warnings.append(f"{recomputed} of {len(ok)} samples: Newton from the nominal lowest point of the Hopf curves "
+                        "left the (V, Fz) box; their minimum shimmy load was found by continuing the curves")
     hopf_out = []
     same = [e for e in ok if len(e["hopf"]) == len(nominal_speeds)]
     if len(same) < len(ok):
