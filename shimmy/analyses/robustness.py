@@ -83,8 +83,18 @@ def _growth(model, V: float, Fz: float) -> float:
     return float(np.max(np.linalg.eigvals(Linearisation(model, Fz).at(V)).real))
 
 
+def _same_turning_point(found: tuple[float, float, float], nominal: tuple[float, float, float]) -> bool:
+    """Whether Newton from the nominal lowest point (V, Fz, omega) found that point of the sample's curves
+    (in the box, the same mode, near it) and not another turning point of Re lambda = d Re lambda/dV = 0."""
+    V, Fz, omega = found
+    V0, Fz0, omega0 = nominal
+    return (V_BAND[0] <= V <= V_BAND[1] and FZ_BOX[0] <= Fz <= FZ_BOX[1] and abs(omega / omega0 - 1.0) < 0.1
+            and abs(V / V0 - 1.0) < 0.5 and abs(Fz / Fz0 - 1.0) < 0.5)
+
+
 def _sample_unit(task: tuple) -> list[dict[str, Any]]:
-    """Figures of a chunk of samples: (config, base params, names, rows of values, Fz, start of min)."""
+    """Figures of a chunk of samples: (config, base params, names, rows of values, Fz, nominal lowest point of
+    the Hopf curves (V, Fz, omega) or None)."""
     config, base, names, rows, Fz, low = task
     out = []
     for values in rows:
@@ -99,12 +109,13 @@ def _sample_unit(task: tuple) -> list[dict[str, Any]]:
         entry["min_shimmy_Fz"] = None
         if low:
             try:
-                V_low, Fz_low, _ = polish_lowest_point(model, low[0], low[1])
+                V_low, Fz_low, omega_low = polish_lowest_point(model, low[0], low[1])
             except (ConvergenceError, np.linalg.LinAlgError):
-                V_low, Fz_low = math.nan, math.nan
-            if V_BAND[0] <= V_low <= V_BAND[1] and FZ_BOX[0] <= Fz_low <= FZ_BOX[1]:
+                V_low, Fz_low, omega_low = math.nan, math.nan, math.nan
+            if _same_turning_point((V_low, Fz_low, omega_low), low):
                 entry["min_shimmy_Fz"] = Fz_low
-            else:  # Newton from the nominal point went elsewhere (a turning point at Fz < 0): continue the curves
+            else:  # Newton from the nominal point went to another turning point (another mode, Fz < 0): continue
+                # this sample's curves
                 from .hopf_curves import hopf_curves
 
                 found = hopf_curves(config, params, V_BAND, FZ_BOX).fz_minimum
@@ -220,7 +231,8 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
                           for k, t in enumerate(tols)])
     nominal = np.array([float(getattr(params, n)) for n in names])
     rows = (nominal * (1.0 + xi * np.array([t.relative for t in tols]))).tolist()
-    start = (low["V"], low["Fz"]) if low and low.get("source") != "box edge" else None
+    start = ((low["V"], low["Fz"], 2 * math.pi * low["frequency_hz"]) if low and low.get("source") != "box edge"
+             else None)
     chunks = [rows[k:k + CHUNK] for k in range(0, len(rows), CHUNK)]
     report(0.02, f"{samples} samples in {len(chunks)} units")
     results = run_units(_sample_unit, [(config.value, params.to_dict(), names, c, Fz, start) for c in chunks],
@@ -238,7 +250,8 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     recomputed = sum(bool(e.get("min_recomputed")) for e in ok)
     if recomputed:
         warnings.append(f"{recomputed} of {len(ok)} samples: Newton from the nominal lowest point of the Hopf curves "
-                        "left the (V, Fz) box; their minimum shimmy load was found by continuing the curves")
+                        "reached another turning point; their minimum shimmy load was found by continuing their "
+                        "curves")
     hopf_out = []
     same = [e for e in ok if len(e["hopf"]) == len(nominal_speeds)]
     if len(same) < len(ok):
