@@ -8,7 +8,7 @@ import dash
 from dash import html
 
 from shimmy.service import schemas, settings
-from shimmy.service.api import PREFIX, openapi_document
+from shimmy.service.api import PREFIX, SYNC_ANALYSES, openapi_document
 from ui import components as ui
 from ui.layout import page
 
@@ -19,7 +19,12 @@ EXAMPLES = {
     "hopf": {"config": "nes", "Fz": 150000, "v_min": 1, "v_max": 200},
     "stability": {"Fz": 150000, "v_max": 200, "material": "tungsten"},
     "devices": {"params": {"e_p": 0.002}},
+    "sensitivity": {"config": "nes", "Fz": 150000, "names": ["r2", "e_p", "k_s", "r3"]},
     "jobs": {"analysis": "bifurcation", "config": "original", "Fz": 150000, "v_min": 1, "v_max": 200},
+    "optimise": {"analysis": "optimise", "config": "nes", "objective": "min_shimmy_Fz", "parameters": ["e_p", "k_s"],
+                 "constraints": ["max_psi<=0.2"]},
+    "robustness": {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05", "k_s=0.05:uniform"],
+                   "samples": 128},
 }
 
 
@@ -47,7 +52,7 @@ def layout(**query):
                         f"{settings.MAX_BODY_BYTES} bytes, t_end at most {settings.MAX_T_END:g} s, ntst at most "
                         f"{settings.MAX_NTST}, at most "
                         f"{settings.MAX_RUNNING_JOBS} jobs running at once (others queue)."], className="hint")]
-    for name in ("simulate", "hopf", "stability", "devices"):
+    for name in SYNC_ANALYSES:
         sections += [html.H2(f"POST {PREFIX}/{name}"), html.P(schemas.SCHEMAS[name].summary), _fields(name),
                      _curl(f"/{name}", EXAMPLES[name])]
     sections += [html.H2(f"POST {PREFIX}/jobs"),
@@ -57,8 +62,10 @@ def layout(**query):
                         "cancels. A finished result is cached: the same request is done at once."),
                  _curl("/jobs", EXAMPLES["jobs"])]
     for name in schemas.JOB_ANALYSES:
-        if name not in ("simulate",):
+        if name not in SYNC_ANALYSES:
             sections += [html.H2(f"job analysis \"{name}\""), html.P(schemas.SCHEMAS[name].summary), _fields(name)]
+            if name in EXAMPLES:
+                sections.append(_curl("/jobs", EXAMPLES[name]))
     sections += [html.H2("Errors"),
                  html.Pre(json.dumps({"error": "V=600 is out of range; allowed: a number in [1, 500] m/s",
                                       "field": "V", "allowed": "a number in [1, 500] m/s"}, indent=1)),

@@ -109,6 +109,37 @@ BAD = [
      "values2"),
     ("/api/v1/jobs", {"analysis": "study", "parameter": "e_p", "values": [0.001] * 20, "parameter2": "k_s",
                       "values2": [1.2e6] * 20}, 422, "values"),
+    # Sensitivities, optimiser, robustness (issue 16): refused before any job is queued.
+    ("/api/v1/sensitivity", {"config": "nes", "names": ["r2", "zeta"]}, 422, "names[1]"),
+    ("/api/v1/sensitivity", {"config": "nes", "Fz": 5}, 422, "Fz"),
+    ("/api/v1/jobs", {"analysis": "sensitivity", "config": "nes", "amplitude": "yes"}, 422, "amplitude"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "objective": "speed"}, 422, "objective"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "parameters": ["e_p", "zeta"]}, 422, "parameters[1]"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "parameters": ["a_p"]}, 422, "parameters[0]"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "pd"}, 422, "parameters"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "constraints": ["max_psi=0.02"]}, 422,
+     "constraints[0]"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "constraints": ["max_psy<=0.02"]}, 422,
+     "constraints[0].figure"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "constraints": ["max_psi<=0.02", "max_psi<=7"]}, 422,
+     "constraints[1].value"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes",
+                      "constraints": [{"figure": "max_psi", "op": "<", "value": 0.1}]}, 422, "constraints[0].op"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "constraints": "max_psi<=0.02"}, 422, "constraints"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "starts": 2, "local_runs": 3}, 422, "local_runs"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "objective": "torsion_area", "method": "gradient"},
+     422, "method"),
+    ("/api/v1/jobs", {"analysis": "robustness", "config": "nes"}, 422, "tolerances"),
+    ("/api/v1/jobs", {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.8"]}, 422,
+     "tolerances[0].relative"),
+    ("/api/v1/jobs", {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05", "zeta=0.1"]}, 422,
+     "tolerances[1].name"),
+    ("/api/v1/jobs", {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam"]}, 422, "tolerances[0]"),
+    ("/api/v1/jobs", {"analysis": "robustness", "config": "nes",
+                      "tolerances": [{"name": "k_s", "relative": 0.05, "distribution": "gauss"}]}, 422,
+     "tolerances[0].distribution"),
+    ("/api/v1/jobs", {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05"], "samples": 10 ** 6},
+     422, "samples"),
 ]
 
 
@@ -138,7 +169,14 @@ def test_unknown_paths_methods_and_jobs(server):
 def test_openapi_document_lists_every_endpoint_and_field(server):
     status, _, doc = server.request("GET", "/api/v1/openapi.json")
     assert status == 200 and doc["openapi"].startswith("3.")
-    assert {"/health", "/parameters", "/simulate", "/hopf", "/jobs", "/jobs/{id}"} <= set(doc["paths"])
+    assert {"/health", "/parameters", "/simulate", "/hopf", "/sensitivity", "/jobs", "/jobs/{id}"} <= set(doc["paths"])
+    schemas = doc["components"]["schemas"]
+    assert {"job_sensitivity", "job_optimise", "job_robustness"} <= set(schemas)
+    assert {"sensitivity", "optimise", "robustness"} <= set(schemas["Job"]["properties"]["analysis"]["enum"])
+    tolerances = schemas["job_robustness"]["properties"]["tolerances"]
+    assert tolerances["type"] == "array" and tolerances["minItems"] == 1 and "oneOf" in tolerances["items"]
+    assert schemas["job_optimise"]["properties"]["objective"]["enum"][:-1] == ["min_shimmy_Fz", "interval", "max_psi",
+                                                                              "torsion_area"]
     sim = doc["components"]["schemas"]["simulate_request"]
     assert sim["properties"]["V"]["minimum"] == 1 and sim["properties"]["V"]["maximum"] == 500
     assert set(sim["required"]) == {"config", "V", "Fz"}
@@ -264,3 +302,52 @@ def test_job_whose_worker_is_killed_is_failed_and_its_group_ends(server):
     failed, _ = _wait(server, job["id"], until=("failed", "done"), timeout=60)
     assert failed["status"] == "failed" and "ended without a result" in failed["error"]
     assert _group_gone(holder["pid"])
+
+
+def test_sensitivity_answers_in_the_request_and_as_a_job_from_one_cache_entry(server):
+    body = {"config": "pd", "Fz": 150000, "names": ["k_lam", "a_p", "rho_p", "e_p"]}
+    status, headers, first = server.request("POST", "/api/v1/sensitivity", body)
+    assert status == 200 and headers["X-Shimmy-Cache"] == "miss"
+    assert {"hopf_points", "min_shimmy_Fz", "max_psi", "no_effect", "quantities", "methods"} <= set(first)
+    assert [h["V"] for h in first["hopf_points"]] == sorted(h["V"] for h in first["hopf_points"])
+    assert {"dV_dp", "domega_dp", "destabilising", "criticality"} <= set(first["hopf_points"][0])
+    keys = [q["key"] for q in first["quantities"]]
+    assert keys[:2] == ["hopf_V1", "hopf_V2"] and "min_shimmy_Fz" in keys
+    row = first["quantities"][0]["rows"][0]
+    assert row["name"] == "k_lam" and {"per_percent", "per_half_range", "unit", "reason"} <= set(row)
+    # The damper's packing and density leave straight rolling's linearisation unchanged; e_p is not fitted.
+    assert "slope is zero at rest" in first["no_effect"]["hopf"]["a_p"]
+    assert "slope is zero at rest" in first["no_effect"]["hopf"]["rho_p"]
+    assert first["no_effect"]["hopf"]["e_p"] == "not fitted in this configuration"
+    status, _, job = server.request("POST", "/api/v1/jobs", {"analysis": "sensitivity", **body,
+                                                             "names": ["rho_p", "e_p", "a_p", "k_lam"]})
+    assert status == 202 and job["status"] == "done"  # the same question (names in another order): cached
+    _, _, done = server.request("GET", f"/api/v1/jobs/{job['id']}")
+    assert done["result"] == first
+
+
+def test_optimise_and_robustness_jobs_complete_with_their_results(server):
+    body = {"analysis": "optimise", "config": "nes", "parameters": ["e_p"], "starts": 2, "local_runs": 1,
+            "constraints": ["max_psi<=0.5"], "params": {"k_s": 1.3e6}}
+    _, _, opt = server.request("POST", "/api/v1/jobs", body)
+    body = {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05", "k_s=0.05:uniform"],
+            "samples": 16}
+    _, _, rob = server.request("POST", "/api/v1/jobs", body)
+    done, _ = _wait(server, rob["id"])
+    assert done["status"] == "done", done
+    result = done["result"]
+    assert [t["name"] for t in result["tolerances"]] == ["k_lam", "k_s"]
+    assert len(result["hopf_points"]) == 2 and len(result["hopf_points"][0]["samples"]) == 16
+    assert {"mean", "std", "p05", "p95", "linear_std"} <= set(result["min_shimmy_Fz"])
+    assert set(result["p_shimmy"]) == set(result["p_shimmy_linear"]) == set("ABCDEFGHI")
+    done, seen = _wait(server, opt["id"], timeout=180)
+    assert done["status"] == "done", done
+    result = done["result"]
+    assert result["parameters"] == ["e_p"] and set(result["design"]) == {"e_p"}
+    assert result["objective"] >= result["nominal_objective"] and result["evaluations"] == len(result["history"])
+    assert set(result["figures"]) == {"optimum", "nominal", "original"}
+    assert result["constraints"] == [{"figure": "max_psi", "op": "<=", "value": 0.5, "Fz": 150000.0, "unit": "rad"}]
+    # The workbench link carries the whole design: the searched value and the rest of the base design.
+    assert result["link_query"]["config"] == "nes" and float(result["link_query"]["k_s"]) == 1.3e6
+    assert float(result["link_query"]["e_p"]) == pytest.approx(result["design"]["e_p"])
+    assert any(0 < p < 1 for s, p in seen if s == "running")  # progress while it ran

@@ -27,7 +27,8 @@ SHOTS = ROOT / "screenshots"
 DOWNLOADS = ROOT / ".pytest_cache" / "downloads"
 CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 PAGES = {"overview": "/", "devices": "/devices", "time-history": "/time-history", "bifurcation": "/bifurcation",
-         "stability-map": "/stability-map", "study": "/study", "validation": "/validation", "api": "/api"}
+         "stability-map": "/stability-map", "study": "/study", "design": "/design", "validation": "/validation",
+         "api": "/api"}
 
 
 def _ensure_chromium() -> None:

@@ -41,7 +41,9 @@ def test_openapi_fields_match_the_schemas():
     from shimmy.service.api import openapi_document
 
     doc = openapi_document()
-    for name in ("simulate", "hopf", "stability", "devices"):
+    from shimmy.service.api import SYNC_ANALYSES
+
+    for name in SYNC_ANALYSES:
         props = doc["components"]["schemas"][f"{name}_request"]["properties"]
         assert set(props) == {f.name for f in schemas.SCHEMAS[name].fields}
     for name in schemas.JOB_ANALYSES:
@@ -127,3 +129,29 @@ def test_non_json_posts_are_refused_and_responses_carry_security_headers(tmp_pat
         assert headers["X-Frame-Options"] == "DENY" and headers["Referrer-Policy"] == "no-referrer", path
     page = client.get("/").get_data(as_text=True)
     assert "Python/" not in page and "Werkzeug/" not in page
+
+
+def test_design_schemas_name_what_the_analyses_take():
+    """The optimiser's and robustness's names in the request schemas are the analyses' own (the schemas do
+    not import the numerics: the web server stays light)."""
+    from shimmy.analyses import optimise, robustness
+
+    assert list(schemas.FIGURE_LIMITS) == list(optimise.FIGURES)
+    for name, (unit, at_load, _, _) in schemas.FIGURE_LIMITS.items():
+        assert (unit, at_load) == (optimise.FIGURES[name].unit, optimise.FIGURES[name].at_load), name
+    assert schemas.DIFFERENTIABLE == optimise.DIFFERENTIABLE
+    assert schemas.DEFAULT_SEARCH == optimise.DEFAULT_PARAMETERS
+    assert schemas.DISTRIBUTIONS == robustness.DISTRIBUTIONS
+    request = schemas.validate("optimise", {"config": "nes", "constraints": ["interval@200000<=40",
+                                                                             "min_shimmy_Fz>=8e4"]})
+    assert request["constraints"] == [{"figure": "interval", "op": "<=", "value": 40.0, "Fz": 200000.0},
+                                      {"figure": "min_shimmy_Fz", "op": ">=", "value": 80000.0, "Fz": None}]
+    assert request["parameters"] == ["r2", "e_p", "k_s", "r3"]
+    same = schemas.validate("optimise", {"config": "nes", "constraints": [
+        {"figure": "interval", "op": "<=", "value": 40, "Fz": 200000}, {"figure": "min_shimmy_Fz", "op": ">=",
+                                                                         "value": 80000}]})
+    assert same == request
+    a = schemas.validate("robustness", {"config": "nes", "tolerances": ["k_s=0.05:uniform"]})
+    b = schemas.validate("robustness", {"config": "nes", "tolerances": [{"name": "k_s", "relative": 0.05,
+                                                                         "distribution": "uniform"}]})
+    assert a == b and a["tolerances"] == [{"name": "k_s", "relative": 0.05, "distribution": "uniform"}]

@@ -339,8 +339,12 @@ class OptimisationResult:
 
     @property
     def link_query(self) -> dict[str, str]:
-        """URL keys that open the optimum in the workbench (?config=...&r2=...)."""
-        return {"config": self.config.value, **{n: f"{v:.10g}" for n, v in self.design.items()}}
+        """URL keys that open the optimum in the workbench (?config=...&r2=...): the searched values and
+        every other value of the design that differs from the defaults (the workbench starts from them)."""
+        default = Parameters().to_dict()
+        base = {n: v for n, v in self.params.to_dict().items()
+                if n not in self.design and abs(v - default[n]) > 1e-12 * max(1.0, abs(default[n]))}
+        return {"config": self.config.value, **{n: f"{v:.10g}" for n, v in {**base, **self.design}.items()}}
 
     def to_dict(self) -> dict[str, Any]:
         f = FIGURES[self.objective]

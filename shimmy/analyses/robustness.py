@@ -43,6 +43,7 @@ from .sensitivity import (V_BAND, coefficient_pairs, hopf_sensitivities, jacobia
 from .stability import Linearisation, hopf_points
 
 DISTRIBUTIONS = ("normal", "uniform")
+FZ_BOX = (1.0e4, 9.0e5)  # N: where the lowest point of the Hopf curves is looked for
 CHUNK = 16  # samples per executor unit
 
 
@@ -87,8 +88,18 @@ def _growth(model, V: float, Fz: float) -> float:
     return float(np.max(np.linalg.eigvals(Linearisation(model, Fz).at(V)).real))
 
 
+def _same_turning_point(found: tuple[float, float, float], nominal: tuple[float, float, float]) -> bool:
+    """Whether Newton from the nominal lowest point (V, Fz, omega) found that point of the sample's curves
+    (in the box, the same mode, near it) and not another turning point of Re lambda = d Re lambda/dV = 0."""
+    V, Fz, omega = found
+    V0, Fz0, omega0 = nominal
+    return (V_BAND[0] <= V <= V_BAND[1] and FZ_BOX[0] <= Fz <= FZ_BOX[1] and abs(omega / omega0 - 1.0) < 0.1
+            and abs(V / V0 - 1.0) < 0.5 and abs(Fz / Fz0 - 1.0) < 0.5)
+
+
 def _sample_unit(task: tuple) -> list[dict[str, Any]]:
-    """Figures of a chunk of samples: (config, base params, names, rows of values, Fz, start of min)."""
+    """Figures of a chunk of samples: (config, base params, names, rows of values, Fz, nominal lowest point of
+    the Hopf curves (V, Fz, omega) or None)."""
     config, base, names, rows, Fz, low = task
     out = []
     for values in rows:
@@ -101,12 +112,25 @@ def _sample_unit(task: tuple) -> list[dict[str, Any]]:
         speeds = [h.V for h in hopf_points(config, Fz, params, v_min=V_BAND[0], v_max=V_BAND[1]).hopf_points]
         entry: dict[str, Any] = {"ok": True, "hopf": speeds}
         entry["min_shimmy_Fz"] = None
-        if low:
+        if low == "curves":  # the nominal lowest point is on an edge of the box: each sample's own curves
+            from .hopf_curves import hopf_curves
+
+            found = hopf_curves(config, params, V_BAND, FZ_BOX).fz_minimum
+            entry["min_shimmy_Fz"] = None if found is None else found["Fz"]
+        elif low:
             try:
-                entry["min_shimmy_Fz"] = polish_lowest_point(model, low[0], low[1])[1]
-            except (ConvergenceError, np.linalg.LinAlgError):  # too far from the nominal point: the curves
-                found = min_shimmy_sensitivity(model, {}, (1.0e4, 9.0e5))
+                V_low, Fz_low, omega_low = polish_lowest_point(model, low[0], low[1])
+            except (ConvergenceError, np.linalg.LinAlgError):
+                V_low, Fz_low, omega_low = math.nan, math.nan, math.nan
+            if _same_turning_point((V_low, Fz_low, omega_low), low):
+                entry["min_shimmy_Fz"] = Fz_low
+            else:  # Newton from the nominal point went to another turning point (another mode, Fz < 0): continue
+                # this sample's curves
+                from .hopf_curves import hopf_curves
+
+                found = hopf_curves(config, params, V_BAND, FZ_BOX).fz_minimum
                 entry["min_shimmy_Fz"] = None if found is None else found["Fz"]
+                entry["min_recomputed"] = True
         entry["unstable"] = {p: _growth(model, V, F) > 0.0 for p, (V, F) in OPERATING_POINTS.items()}
         out.append(entry)
     return out
@@ -203,7 +227,7 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     pairs = coefficient_pairs(config, params, names)
     nominal_speeds = [h.V for h in hopf_points(config, Fz, params, v_min=V_BAND[0], v_max=V_BAND[1]).hopf_points]
     hopf_sens = hopf_sensitivities(model, Fz, nominal_speeds, pairs)
-    low = min_shimmy_sensitivity(model, pairs, (1.0e4, 9.0e5))
+    low = min_shimmy_sensitivity(model, pairs, FZ_BOX)
     sigma = np.array([float(getattr(params, t.name)) * t.std_factor for t in tols])
 
     def linear_std(derivatives: dict[str, float]) -> float:
@@ -217,7 +241,10 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
                           for k, t in enumerate(tols)])
     nominal = np.array([float(getattr(params, n)) for n in names])
     rows = (nominal * (1.0 + xi * np.array([t.relative for t in tols]))).tolist()
-    start = (low["V"], low["Fz"]) if low and low.get("source") != "box edge" else None
+    start: Any = None  # no Hopf curve in the box at the nominal design: no minimum shimmy load to sample
+    if low is not None:
+        start = ((low["V"], low["Fz"], 2 * math.pi * low["frequency_hz"])
+                 if low["source"] == "lowest point of the Hopf curves" else "curves")
     chunks = [rows[k:k + CHUNK] for k in range(0, len(rows), CHUNK)]
     report(0.02, f"{samples} samples in {len(chunks)} units")
     results = run_units(_sample_unit, [(config.value, params.to_dict(), names, c, Fz, start) for c in chunks],
@@ -231,6 +258,11 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
         warnings.append(f"{refused} of {len(flat)} samples are not physical and are left out (for example: {first})")
     if not ok:
         raise ConvergenceError("no sample could be evaluated: " + flat[0]["reason"])
+    recomputed = sum(bool(e.get("min_recomputed")) for e in ok)
+    if recomputed:
+        warnings.append(f"{recomputed} of {len(ok)} samples: Newton from the nominal lowest point of the Hopf curves "
+                        "reached another turning point; their minimum shimmy load was found by continuing their "
+                        "curves")
     hopf_out = []
     same = [e for e in ok if len(e["hopf"]) == len(nominal_speeds)]
     if len(same) < len(ok):
@@ -242,8 +274,8 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
             hopf_out.append(stats)
     lows = np.array([e["min_shimmy_Fz"] for e in ok if e["min_shimmy_Fz"] is not None])
     if start is not None and lows.size < len(ok):
-        warnings.append(f"the lowest point of the Hopf curves did not converge for {len(ok) - lows.size} of "
-                        f"{len(ok)} samples; they are left out of its statistics")
+        warnings.append(f"{len(ok) - lows.size} of {len(ok)} samples have no Hopf curve in the box; they are left "
+                        "out of the minimum shimmy load's statistics")
     if not same:
         warnings.append(f"no sample has the nominal design's {len(nominal_speeds)} Hopf points at {Fz / 1e3:g} kN: "
                         "no Hopf-speed statistics")

@@ -170,6 +170,39 @@ def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dic
     return out
 
 
+def sensitivity(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """Derivatives of the boundaries at one load to the chosen parameters, with the tornado rows."""
+    from ..analyses.sensitivity import sensitivity as run_sensitivity
+
+    report = progress or (lambda fraction, message: None)
+    report(0.0, f"sensitivities of {request['config']} at {request['Fz'] / 1e3:g} kN")
+    out = run_sensitivity(request["config"], request["Fz"], _params(request), request["names"],
+                          amplitude=request["amplitude"], min_shimmy=request["min_shimmy"]).to_dict()
+    report(1.0, "done")
+    return out
+
+
+def optimise(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """The optimiser; its design evaluations and local searches go through the executor of this environment."""
+    from ..analyses.optimise import Constraint, optimise as run_optimise
+
+    constraints = [Constraint(c["figure"], c["op"], c["value"], c["Fz"]) for c in request["constraints"]]
+    return run_optimise(request["config"], request["objective"], request["parameters"], request["Fz"], constraints,
+                        _params(request), method=request["method"], starts=request["starts"],
+                        local_runs=request["local_runs"], max_iterations=request["max_iterations"],
+                        generations=request["generations"], popsize=request["popsize"], seed=request["seed"],
+                        progress=progress).to_dict()
+
+
+def robustness(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """Quasi-Monte Carlo and linear propagation of the tolerances; chunks of samples through the executor."""
+    from ..analyses.robustness import Tolerance, robustness as run_robustness
+
+    tolerances = [Tolerance(t["name"], t["relative"], t["distribution"]) for t in request["tolerances"]]
+    return run_robustness(request["config"], tolerances, request["samples"], request["Fz"], _params(request),
+                          seed=request["seed"], progress=progress).to_dict()
+
+
 def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
     """A ground-run preset's table rows [t, V, Fz], its complete settings, each setting's range and
     its assumptions, for a profile editor (a table of a few hundred points: nothing to cache)."""
@@ -183,7 +216,7 @@ def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str
 RUNNERS: dict[str, Callable[[dict[str, Any], Progress | None], dict[str, Any]]] = {
     "simulate": simulate, "hopf": hopf, "stability": stability, "devices": devices,
     "bifurcation": bifurcation, "hopf_curves": hopf_curves, "map": stability_map, "study": study,
-    "ground_run": ground_run}
+    "ground_run": ground_run, "sensitivity": sensitivity, "optimise": optimise, "robustness": robustness}
 assert set(RUNNERS) == set(schemas.SCHEMAS)
 
 

@@ -22,6 +22,8 @@ from ..model.parameters import PARAMETER_SPECS
 from . import analyses, cache, jobs, schemas, settings
 
 PREFIX = "/api/v1"
+#: Analyses answered in the request (POST /api/v1/NAME); the long ones run as jobs (schemas.JOB_ANALYSES).
+SYNC_ANALYSES = ("simulate", "hopf", "stability", "devices", "sensitivity")
 api = Blueprint("api", __name__, url_prefix=PREFIX)
 
 
@@ -219,6 +221,11 @@ def devices():
     return _sync("devices")
 
 
+@api.post("/sensitivity")
+def sensitivity():
+    return _sync("sensitivity")
+
+
 @api.post("/jobs")
 def submit_job():
     body = _body()
@@ -260,9 +267,8 @@ def cancel_job(job_id: str):
     return _json(jobs.public(jobs.cancel(job_id), with_result=False))
 
 
-_METHODS = {"/health": ("GET",), "/parameters": ("GET",), "/simulate": ("POST",), "/hopf": ("POST",),
-            "/stability": ("POST",), "/devices": ("POST",), "/jobs": ("POST",), "/jobs/{id}": ("GET", "DELETE"),
-            "/openapi.json": ("GET",)}
+_METHODS = {"/health": ("GET",), "/parameters": ("GET",), **{f"/{name}": ("POST",) for name in SYNC_ANALYSES},
+            "/jobs": ("POST",), "/jobs/{id}": ("GET", "DELETE"), "/openapi.json": ("GET",)}
 
 
 @api.get("/openapi.json")
@@ -286,7 +292,7 @@ def openapi_document() -> dict[str, Any]:
         "/parameters": {"get": {"summary": "every parameter with unit, default, range and provenance",
                                 "responses": {"200": {"description": "the parameter table"}}}},
     }
-    for name in ("simulate", "hopf", "stability", "devices"):
+    for name in SYNC_ANALYSES:
         s = schemas.SCHEMAS[name]
         comps[f"{name}_request"] = s.openapi()
         paths[f"/{name}"] = {"post": {
@@ -321,7 +327,9 @@ def openapi_document() -> dict[str, Any]:
             "info": {"title": "shimmy API", "version": __version__,
                      "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Limits: "
                                     f"body <= {settings.MAX_BODY_BYTES} bytes, t_end <= {settings.MAX_T_END:g} s, "
-                                    f"ntst <= {settings.MAX_NTST}; at most {settings.MAX_RUNNING_JOBS} jobs run and "
+                                    f"ntst <= {settings.MAX_NTST}, robustness samples <= "
+                                    f"{settings.MAX_ROBUSTNESS_SAMPLES}; at most {settings.MAX_RUNNING_JOBS} jobs "
+                                    "run and "
                                     f"{settings.MAX_QUEUED_JOBS} wait queued (then 429 with Retry-After); an identical "
                                     "request already queued or running is that job. POST bodies: application/json."},
             "servers": [{"url": PREFIX}], "paths": paths, "components": {"schemas": comps}}

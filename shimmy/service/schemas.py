@@ -9,10 +9,11 @@ keys. Every refusal is an :class:`~shimmy.errors.InvalidParameterError` naming t
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from ..model.configurations import Configuration
+from ..model.configurations import Configuration, affects
 from ..errors import InvalidParameterError
 from . import settings
 from ..analyses.ground_profiles import MAX_PROFILE_POINTS, PRESETS
@@ -39,6 +40,7 @@ def _huge(value: Any) -> Any:
 class Field:
     name: str
     kind: str  # number | integer | string | boolean | object | numbers | strings (arrays) | table (rows of numbers)
+    #   | list (items checked by the schema's own rule; ``item`` says what one is, ``items`` is its JSON Schema)
     description: str
     required: bool = False
     default: Any = None
@@ -46,6 +48,8 @@ class Field:
     high: float | None = None
     unit: str = ""
     choices: tuple[str, ...] | None = None
+    item: str = ""
+    items: Any = None
 
     @property
     def allowed(self) -> str:
@@ -64,6 +68,8 @@ class Field:
             return f"a non-empty list of {', '.join(self.choices or ())}"
         if self.kind == "table":
             return f"a list of 2 to {self.high:g} rows [t (s), V (m/s), Fz (N)]"
+        if self.kind == "list":
+            return f"a list of {self.low:g} to {self.high:g} {self.item}"
         return "a string"
 
     def check(self, value: Any) -> Any:
@@ -94,10 +100,26 @@ class Field:
         if self.kind == "strings":
             if not isinstance(value, list) or not value:
                 raise InvalidParameterError(self.name, value, self.allowed)
+            choices = list(self.choices or ())
             for k, v in enumerate(value):
-                if not isinstance(v, str) or v not in (self.choices or ()):
-                    raise InvalidParameterError(f"{self.name}[{k}]", v, "one of " + ", ".join(self.choices or ()))
+                if not isinstance(v, str):
+                    raise InvalidParameterError(f"{self.name}[{k}]", v, "one of " + ", ".join(choices),
+                                                "is not a string")
+                if v not in choices:
+                    close = difflib.get_close_matches(v, choices, n=3)
+                    hint = f" (did you mean {', '.join(close)}?)" if close else ""
+                    allowed = "one of " + ", ".join(choices)
+                    raise InvalidParameterError(f"{self.name}[{k}]", v, allowed,
+                                                message=f"{self.name}[{k}]={v!r} is not a known name{hint}; "
+                                                        f"allowed: {allowed}")
             return list(dict.fromkeys(value))
+        if self.kind == "list":  # the items are checked by the schema's rule, by position
+            if not isinstance(value, list):
+                raise InvalidParameterError(self.name, value, self.allowed, "is not a list")
+            if not self.low <= len(value) <= self.high:
+                raise InvalidParameterError(self.name, f"{len(value)} items", self.allowed,
+                                            message=f"{self.name} has {len(value)} items; allowed: {self.allowed}")
+            return list(value)
         if self.kind == "table":  # the rows themselves are checked by the analysis's profile check, by row
             if not isinstance(value, list) or not 2 <= len(value) <= self.high:
                 size = f"{len(value)} rows" if isinstance(value, list) else type(value).__name__
@@ -134,6 +156,10 @@ class Field:
         if self.kind == "table":
             out.update(type="array", minItems=2, maxItems=int(self.high),
                        items={"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3})
+            out.pop("minimum", None)
+            out.pop("maximum", None)
+        if self.kind == "list":
+            out.update(type="array", minItems=int(self.low), maxItems=int(self.high), items=self.items or {})
             out.pop("minimum", None)
             out.pop("maximum", None)
         if self.kind in ("numbers", "strings"):
@@ -185,6 +211,8 @@ class RequestSchema:
             _check_study(out)
         if self.name == "ground_run":
             _check_ground_run(out)
+        if self.name in _CHECKS:
+            _CHECKS[self.name](out)
         for low, high in (("v_min", "v_max"), ("fz_min", "fz_max")):
             if low in out and high in out and not out[high] > out[low]:
                 raise InvalidParameterError(high, out[high], f"a number above {low} = {out[low]:g}",
@@ -201,6 +229,8 @@ class RequestSchema:
                                    f"ranges, a run of at most {settings.MAX_T_END:g} s (refusals name profile[i].t, "
                                    ".V or .Fz); without a profile, the preset with preset_options (its settings: "
                                    "python -m shimmy ground-run --help, shimmy.analyses.ground_profiles).")
+        if self.name in _RULES:
+            out["description"] += " " + _RULES[self.name]
         if self.name == "study":
             out["dependentRequired"] = {"parameter2": ["values2"], "values2": ["parameter2"]}
             out["description"] += (f" Study: each value within its parameter's range; at most "
@@ -256,6 +286,198 @@ def _check_ground_run(out: dict[str, Any]) -> None:
         raise InvalidParameterError("series_dt", out["series_dt"],
                                     f"at least {profile.duration / settings.MAX_SERIES_POINTS:g} s for a "
                                     f"{profile.duration:g} s run", "gives too many samples")
+
+
+# -- sensitivities, optimiser, robustness -------------------------------------------------------
+# The names below are those of shimmy.analyses.optimise.FIGURES and shimmy.analyses.robustness
+# (imported there only when an analysis runs; tests/test_api.py checks that they agree).
+
+#: The optimiser's figures of merit: unit, whether taken at a load, the range a constraint value may take.
+FIGURE_LIMITS: dict[str, tuple[str, bool, float, float]] = {
+    "min_shimmy_Fz": ("N", False, FZ_RANGE[0], FZ_RANGE[1]),
+    "interval": ("m/s", True, 0.0, 199.0),  # a width within the map's speeds 1-200 m/s
+    "max_psi": ("rad", True, 0.0, 1.0),
+    "torsion_area": ("(m/s) kN", False, 0.0, 199.0 * 240.0),  # within 1-200 m/s x 10-250 kN
+}
+#: Figures with derivatives (the gradient method needs the objective and every constraint among them).
+DIFFERENTIABLE = ("min_shimmy_Fz", "max_psi", "interval")
+#: The optimiser's default search parameters (those of them the configuration has).
+DEFAULT_SEARCH = ("r2", "e_p", "k_s", "r3")
+DISTRIBUTIONS = ("normal", "uniform")
+MAX_CONSTRAINTS = 8
+TOLERANCE_RANGE = (0.0, 0.5)  # relative: a fraction of the parameter's value
+OPS = ("<=", ">=")
+
+CONSTRAINT_TEXT = ("FIGURE<=VALUE or FIGURE>=VALUE (FIGURE@Fz for a figure at another load, Fz in N), or an object "
+                   "{figure, op, value, Fz}")
+TOLERANCE_TEXT = "NAME=REL or NAME=REL:normal|uniform (REL a fraction, 0.05 = 5 %), or an object " \
+                 "{name, relative, distribution}"
+
+
+def _item_keys(field: str, item: Mapping[str, Any], known: tuple[str, ...]) -> None:
+    for key in item:
+        if key not in known:
+            hint = unknown_name_error(str(key), known, f"{field} key")
+            raise InvalidParameterError(f"{field}.{_key(key)}", item[key], hint.allowed, message=str(hint))
+
+
+def _number_of(field: str, value: Any, low: float, high: float, unit: str = "") -> float:
+    if isinstance(value, str) or isinstance(value, bool) or value is None:
+        allowed = f"a number in [{low:g}, {high:g}] {unit}".rstrip()
+        raise InvalidParameterError(field, value, allowed, "is not a number")
+    return check_number(field, _huge(value), low, high, unit)
+
+
+def constraint(field: str, item: Any, default_Fz: float) -> dict[str, Any]:
+    """One optimiser constraint as {figure, op, value, Fz} (Fz None for a figure not taken at a load)."""
+    if isinstance(item, str):
+        raw = item.replace(" ", "")
+        op = next((o for o in OPS if o in raw), None)
+        if op is None:
+            raise InvalidParameterError(field, item, CONSTRAINT_TEXT, "has no <= or >=")
+        left, right = raw.split(op, 1)
+        figure, at, fz = left.partition("@")
+        try:
+            value: Any = float(right)
+        except ValueError:
+            value = right  # refused below, by name, as not a number
+        try:
+            given_fz: Any = float(fz) if at else None
+        except ValueError:
+            given_fz = fz
+        item = {"figure": figure, "op": op, "value": value, **({"Fz": given_fz} if at else {})}
+    elif isinstance(item, Mapping):
+        _item_keys(field, item, ("figure", "op", "value", "Fz"))
+        for key in ("figure", "op", "value"):
+            if key not in item:
+                raise InvalidParameterError(f"{field}.{key}", None, CONSTRAINT_TEXT,
+                                            message=f"{field}.{key} is required; allowed: {CONSTRAINT_TEXT}")
+    else:
+        raise InvalidParameterError(field, item, CONSTRAINT_TEXT, "is not a string or an object")
+    figure = item["figure"]
+    if not isinstance(figure, str) or figure not in FIGURE_LIMITS:
+        err = unknown_name_error(str(figure), FIGURE_LIMITS, f"{field}.figure")
+        raise InvalidParameterError(f"{field}.figure", figure, err.allowed, message=str(err))
+    unit, at_load, low, high = FIGURE_LIMITS[figure]
+    if item["op"] not in OPS:
+        raise InvalidParameterError(f"{field}.op", item["op"], "<= or >=", "is not <= or >=")
+    value = _number_of(f"{field}.value", item["value"], low, high, unit)
+    Fz = item.get("Fz")
+    if Fz is not None and not at_load:
+        raise InvalidParameterError(f"{field}.Fz", Fz, "none: " + figure + " is not taken at a load",
+                                    f"is given for {figure}, which is not taken at a load")
+    if at_load:
+        Fz = default_Fz if Fz is None else _number_of(f"{field}.Fz", Fz, FZ_RANGE[0], FZ_RANGE[1], "N")
+    return {"figure": figure, "op": item["op"], "value": value, "Fz": Fz}
+
+
+def tolerance(field: str, item: Any) -> dict[str, Any]:
+    """One toleranced parameter as {name, relative, distribution}."""
+    if isinstance(item, str):
+        name, sep, rest = item.replace(" ", "").partition("=")
+        if not sep:
+            raise InvalidParameterError(field, item, TOLERANCE_TEXT, "has no =")
+        text, _, dist = rest.partition(":")
+        try:
+            relative: Any = float(text)
+        except ValueError:
+            relative = text
+        item = {"name": name, "relative": relative, "distribution": dist or "normal"}
+    elif isinstance(item, Mapping):
+        _item_keys(field, item, ("name", "relative", "distribution"))
+        for key in ("name", "relative"):
+            if key not in item:
+                raise InvalidParameterError(f"{field}.{key}", None, TOLERANCE_TEXT,
+                                            message=f"{field}.{key} is required; allowed: {TOLERANCE_TEXT}")
+    else:
+        raise InvalidParameterError(field, item, TOLERANCE_TEXT, "is not a string or an object")
+    name = item["name"]
+    if not isinstance(name, str) or name not in PARAMETER_SPECS:
+        err = unknown_name_error(str(name), PARAMETER_SPECS, f"{field}.name")
+        raise InvalidParameterError(f"{field}.name", name, err.allowed, message=str(err))
+    if PARAMETER_SPECS[name].integer:
+        raise InvalidParameterError(f"{field}.name", name, "a parameter that is not a whole number",
+                                    "is a whole number: a relative tolerance does not apply")
+    relative = _number_of(f"{field}.relative", item["relative"], *TOLERANCE_RANGE,
+                          "(a fraction of the value)")
+    dist = item.get("distribution") or "normal"
+    if dist not in DISTRIBUTIONS:
+        raise InvalidParameterError(f"{field}.distribution", dist, "normal or uniform", "is not a distribution")
+    return {"name": name, "relative": relative, "distribution": dist}
+
+
+def _check_sensitivity(out: dict[str, Any]) -> None:
+    """The parameter names in the parameter table's order (equal sets, equal cache keys); all when absent."""
+    chosen = set(out["names"] or PARAMETER_SPECS)
+    out["names"] = [n for n in PARAMETER_SPECS if n in chosen]
+
+
+def _check_optimise(out: dict[str, Any]) -> None:
+    """Search parameters of the configuration, constraints as objects, the method fit for the figures."""
+    config = out["config"]
+    if out["parameters"] is None:
+        out["parameters"] = [n for n in DEFAULT_SEARCH if affects(n, config)]
+        if not out["parameters"]:
+            raise InvalidParameterError("parameters", None, f"parameters of configuration {config}",
+                                        message=f"parameters is required for configuration {config}: the default "
+                                                f"({', '.join(DEFAULT_SEARCH)}) are NES parameters, which it does "
+                                                "not have")
+    for k, name in enumerate(out["parameters"]):
+        if not affects(name, config):
+            raise InvalidParameterError(f"parameters[{k}]", name, f"a parameter of configuration {config}",
+                                        f"is not a parameter of configuration {config} (it has no "
+                                        f"{'NES' if PARAMETER_SPECS[name].group == 'nes' else 'particle damper'})")
+    out["constraints"] = [constraint(f"constraints[{k}]", c, out["Fz"]) for k, c in enumerate(out["constraints"])]
+    if out["local_runs"] > out["starts"]:
+        raise InvalidParameterError("local_runs", out["local_runs"], f"at most starts = {out['starts']}",
+                                    "exceeds the number of start designs")
+    figures = [out["objective"]] + [c["figure"] for c in out["constraints"]]
+    rough = [f for f in figures if f not in DIFFERENTIABLE]
+    if out["method"] == "gradient" and rough:
+        raise InvalidParameterError("method", "gradient", "auto or global (" + ", ".join(dict.fromkeys(rough))
+                                    + " has no derivative)", f"needs derivatives, which {rough[0]} does not have")
+
+
+def _check_robustness(out: dict[str, Any]) -> None:
+    tols = [tolerance(f"tolerances[{k}]", t) for k, t in enumerate(out["tolerances"])]
+    seen: dict[str, int] = {}
+    for k, t in enumerate(tols):
+        if t["name"] in seen:
+            raise InvalidParameterError(f"tolerances[{k}].name", t["name"], "each parameter at most once",
+                                        f"repeats tolerances[{seen[t['name']]}]")
+        seen[t["name"]] = k
+    out["tolerances"] = tols
+
+
+_CHECKS = {"sensitivity": _check_sensitivity, "optimise": _check_optimise, "robustness": _check_robustness}
+_RULES = {
+    "optimise": "Optimise: the search parameters are parameters of the configuration (default: those of r2, e_p, "
+                "k_s, r3 it has); local_runs at most starts; method gradient only for figures with derivatives ("
+                + ", ".join(DIFFERENTIABLE) + "); constraints as 'FIGURE<=VALUE', 'FIGURE@Fz>=VALUE' or "
+                "{figure, op, value, Fz}, each value in the figure's unit and range: "
+                + "; ".join(f"{f} [{lo:g}, {hi:g}] {u}" + (" at a load (default: Fz)" if at else "")
+                            for f, (u, at, lo, hi) in FIGURE_LIMITS.items()) + ".",
+    "robustness": "Robustness: tolerances as 'NAME=REL', 'NAME=REL:uniform' or {name, relative, distribution}, "
+                  f"REL a fraction in [{TOLERANCE_RANGE[0]:g}, {TOLERANCE_RANGE[1]:g}] (normal: the standard "
+                  "deviation; uniform: the half-width), each parameter at most once, not a whole-number one.",
+}
+
+_CONSTRAINT_ITEM = {"oneOf": [
+    {"type": "string", "pattern": r"^\s*[a-zA-Z_]+(@[0-9.eE+-]+)?\s*(<=|>=)\s*[-0-9.eE+]+\s*$",
+     "examples": ["max_psi<=0.02", "min_shimmy_Fz>=80000", "interval@200000<=40"]},
+    {"type": "object", "additionalProperties": False, "required": ["figure", "op", "value"], "properties": {
+        "figure": {"type": "string", "enum": list(FIGURE_LIMITS)}, "op": {"type": "string", "enum": list(OPS)},
+        "value": {"type": "number", "description": "in the figure's unit"},
+        "Fz": {"type": ["number", "null"], "minimum": FZ_RANGE[0], "maximum": FZ_RANGE[1],
+               "description": "load of a figure at a load (N); default: the request's Fz"}}}]}
+_TOLERANCE_ITEM = {"oneOf": [
+    {"type": "string", "pattern": r"^\s*[a-zA-Z_0-9]+\s*=\s*[0-9.eE+-]+(:(normal|uniform))?\s*$",
+     "examples": ["k_lam=0.05", "k_s=0.05:uniform"]},
+    {"type": "object", "additionalProperties": False, "required": ["name", "relative"], "properties": {
+        "name": {"type": "string", "enum": [n for n, spec in PARAMETER_SPECS.items() if not spec.integer]},
+        "relative": {"type": "number", "minimum": TOLERANCE_RANGE[0], "maximum": TOLERANCE_RANGE[1],
+                     "description": "relative tolerance, a fraction of the value"},
+        "distribution": {"type": "string", "enum": list(DISTRIBUTIONS), "default": "normal"}}}]}
 
 
 def design(overrides: Mapping[str, Any], material: str | None) -> dict[str, float]:
@@ -374,10 +596,56 @@ SCHEMAS: dict[str, RequestSchema] = {
               default=False),
         Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
         PARAMS, MATERIAL)),
+    "sensitivity": RequestSchema("sensitivity", "sensitivities: derivatives of the Hopf speeds and the largest "
+                                 "stable torsional amplitude at a load and of the minimum shimmy load, to every "
+                                 "parameter (implicit differentiation), as tornado rows", (
+        _config(), Field("Fz", "number", "vertical load", default=150e3, low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
+        Field("names", "strings", "parameters to differentiate against (default: all)", choices=tuple(PARAMETER_SPECS)),
+        Field("amplitude", "boolean", "also the largest stable torsional amplitude (a bifurcation diagram, ~1 s)",
+              default=True),
+        Field("min_shimmy", "boolean", "also the minimum shimmy load (the Hopf curves, ~0.4 s)", default=True),
+        PARAMS, MATERIAL)),
+    "optimise": RequestSchema("optimise", "optimiser: the design of the chosen parameters (within their ranges) with "
+                              "the best figure of merit under constraints on the others", (
+        _config(),
+        Field("objective", "string", "figure of merit (maximised: min_shimmy_Fz; minimised: the others)",
+              default="min_shimmy_Fz", choices=tuple(FIGURE_LIMITS)),
+        Field("parameters", "strings", "parameters to search, each within its range (default: those of r2, e_p, "
+              "k_s, r3 the configuration has)", choices=tuple(PARAMETER_SPECS)),
+        Field("Fz", "number", "load of the figures taken at a load (interval, max_psi)", default=150e3,
+              low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
+        Field("constraints", "list", "constraints on figures of merit", default=[], low=0, high=MAX_CONSTRAINTS,
+              item="constraints: " + CONSTRAINT_TEXT, items=_CONSTRAINT_ITEM),
+        Field("method", "string", "gradient (Sobol starts, then SLSQP with analytic gradients), global "
+              "(differential evolution) or auto (gradient when every figure has derivatives)", default="auto",
+              choices=("auto", "gradient", "global")),
+        Field("starts", "integer", "start designs of the gradient method (the nominal one among them)", default=8,
+              low=1, high=64),
+        Field("local_runs", "integer", "SLSQP runs from the best start designs", default=2, low=1, high=8),
+        Field("max_iterations", "integer", "iterations per SLSQP run", default=30, low=1, high=100),
+        Field("generations", "integer", "generations of differential evolution", default=6, low=1, high=30),
+        Field("popsize", "integer", "differential evolution's population per searched parameter", default=5, low=2,
+              high=15),
+        Field("seed", "integer", "seed of the Sobol starts and of differential evolution", default=0, low=0,
+              high=2 ** 31 - 1),
+        PARAMS, MATERIAL)),
+    "robustness": RequestSchema("robustness", "robustness to tolerances: distributions of the Hopf speeds at a load, "
+                                "of the minimum shimmy load and of shimmy at the nine operating points, sampled "
+                                "(quasi-Monte Carlo) and by linear propagation", (
+        _config(),
+        Field("tolerances", "list", "toleranced parameters", required=True, low=1, high=len(PARAMETER_SPECS),
+              item="tolerances: " + TOLERANCE_TEXT, items=_TOLERANCE_ITEM),
+        Field("samples", "integer", "samples (a scrambled Sobol sequence)", default=128, low=2,
+              high=settings.MAX_ROBUSTNESS_SAMPLES),
+        Field("Fz", "number", "load of the Hopf speeds", default=150e3, low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
+        Field("seed", "integer", "seed of the samples (the same seed gives the same samples)", default=0, low=0,
+              high=2 ** 31 - 1),
+        PARAMS, MATERIAL)),
 }
 
 #: Analyses that run as background jobs (POST /api/v1/jobs).
-JOB_ANALYSES = ("simulate", "bifurcation", "hopf_curves", "map", "study", "ground_run")
+JOB_ANALYSES = ("simulate", "bifurcation", "hopf_curves", "map", "study", "ground_run", "sensitivity", "optimise",
+                "robustness")
 
 
 def validate(analysis: str, body: Any, extra: tuple[str, ...] = ()) -> dict[str, Any]:
