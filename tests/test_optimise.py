@@ -136,7 +136,7 @@ def test_sampled_and_linear_figures_agree_for_engineering_tolerances():
     intermediate probability of shimmy, predicted by linear propagation to a few per cent."""
     tols = [f"{n}=0.05" for n in ("k_lam", "c_lam", "L", "h", "k_a", "alpha_m", "k_s")]
     result = robustness("nes_pd", tols, samples=256)
-    assert result.refused == 0 and not result.warnings
+    assert result.refused == 0 and not any("not physical" in w for w in result.warnings)
     for h in result.hopf_points + [result.min_shimmy]:
         assert h["std"] == pytest.approx(h["linear_std"], rel=0.05)
         assert len(h["samples"]) == 256

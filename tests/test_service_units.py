@@ -140,7 +140,7 @@ def test_design_schemas_name_what_the_analyses_take():
     for name, (unit, at_load, _, _) in schemas.FIGURE_LIMITS.items():
         assert (unit, at_load) == (optimise.FIGURES[name].unit, optimise.FIGURES[name].at_load), name
     assert schemas.DIFFERENTIABLE == optimise.DIFFERENTIABLE
-    assert schemas.DEFAULT_SEARCH == optimise.DEFAULT_PARAMETERS
+    assert list(schemas.DEFAULT_SEARCH) == optimise.device_parameters("nes_pd")
     assert schemas.DISTRIBUTIONS == robustness.DISTRIBUTIONS
     request = schemas.validate("optimise", {"config": "nes", "constraints": ["interval@200000<=40",
                                                                              "min_shimmy_Fz>=8e4"]})

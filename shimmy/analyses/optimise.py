@@ -43,31 +43,13 @@ from ..model.configurations import Configuration, affects
 from ..model.equations import build_model
 from ..model.parameters import PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from .executors import open_executor, run_units
-from .sensitivity import (DESIGN_PARAMETERS, V_BAND, amplitude_sensitivity, coefficient_pairs, hopf_sensitivities,
+from .design_space import DIFFERENTIABLE, FIGURES, Figure, device_parameters  # noqa: F401 (Figure: re-exported)
+from .sensitivity import (V_BAND, amplitude_sensitivity, coefficient_pairs, hopf_sensitivities,
                           min_shimmy_sensitivity)
 
 FZ_BOX = (1.0e4, 9.0e5)  # N
 
 
-@dataclass(frozen=True)
-class Figure:
-    label: str
-    unit: str
-    sense: int  # +1 maximised, -1 minimised as an objective
-    at_load: bool
-    scale: float  # a typical size, to make objectives and constraints O(1)
-
-
-#: The figures of merit by name: label, unit, sense as an objective, whether taken at a load, scale.
-FIGURES = {
-    "min_shimmy_Fz": Figure("minimum shimmy load", "N", +1, False, 1e5),
-    "interval": Figure("shimmy speed interval width", "m/s", -1, True, 100.0),
-    "max_psi": Figure("largest stable torsional amplitude", "rad", -1, True, 0.1),
-    "torsion_area": Figure("pure-torsion area (Fz <= 250 kN)", "(m/s) kN", -1, False, 1e4),
-}
-#: Figures with derivatives (where the interval ends at Hopf points and the amplitude's maximum is
-#: inside the stable part; a local search that meets a point without one stops there).
-DIFFERENTIABLE = ("min_shimmy_Fz", "max_psi", "interval")
 
 
 class _NotDifferentiable(Exception):
@@ -432,7 +414,7 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
     if objective not in FIGURES:
         raise unknown_name_error(objective, FIGURES, "objective")
     Fz = check_number("Fz", Fz, *FZ_BOX, "N")
-    fitted = [n for n in DESIGN_PARAMETERS if affects(n, config)]
+    fitted = device_parameters(config)
     if parameters is None:
         if not fitted:
             raise InvalidParameterError("params", None, "gear parameters to search (configuration original has no "

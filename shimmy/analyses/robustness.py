@@ -37,12 +37,12 @@ from ..errors import ConvergenceError, InvalidParameterError
 from ..model.configurations import OPERATING_POINTS, Configuration, affects
 from ..model.equations import build_model
 from ..model.parameters import PARAMETER_SPECS, Parameters, check_number, unknown_name_error
+from .design_space import DISTRIBUTIONS, TOLERANCE_LIMITS
 from .executors import open_executor, run_units
 from .sensitivity import (V_BAND, coefficient_pairs, hopf_sensitivities, jacobian_derivatives, min_shimmy_sensitivity,
                           polish_lowest_point)
 from .stability import Linearisation, hopf_points
 
-DISTRIBUTIONS = ("normal", "uniform")
 FZ_BOX = (1.0e4, 9.0e5)  # N: where the lowest point of the Hopf curves is looked for
 CHUNK = 16  # samples per executor unit
 
@@ -71,8 +71,7 @@ class Tolerance:
         if PARAMETER_SPECS[name].integer:
             raise InvalidParameterError(f"tolerance {name}", relative, "a tolerance on a continuous parameter",
                                         f"{name} is an integer (a count), it has no tolerance")
-        # A normal tolerance up to 20 % (5 standard deviations to zero), a uniform one up to 50 %.
-        rel = check_number(f"tolerance {name}", relative, 0.0, 0.2 if distribution == "normal" else 0.5)
+        rel = check_number(f"tolerance {name}", relative, 0.0, TOLERANCE_LIMITS[distribution])
         return cls(name, rel, distribution)
 
     @property
@@ -261,8 +260,8 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     recomputed = sum(bool(e.get("min_recomputed")) for e in ok)
     if recomputed:
         warnings.append(f"{recomputed} of {len(ok)} samples: Newton from the nominal lowest point of the Hopf curves "
-                        "reached another turning point; their minimum shimmy load was found by continuing their "
-                        "curves")
+                        "did not converge or reached another turning point; their minimum shimmy load was found by "
+                        "continuing their curves")
     hopf_out = []
     same = [e for e in ok if len(e["hopf"]) == len(nominal_speeds)]
     if len(same) < len(ok):

@@ -66,10 +66,9 @@ from ..model.configurations import Configuration, affects
 from ..model.equations import Model, build_model, jacobian, model_coefficients
 from ..model.parameters import PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from .bifurcation import STATE_SCALE, T_SCALE, V_SCALE, BifurcationOptions, bifurcation, gear_field
+from .design_space import DESIGN_PARAMETERS
 from .stability import Linearisation, hopf_points
 
-#: The device parameters with sliders in the workbench (their design ranges are the study's).
-DESIGN_PARAMETERS = ("r2", "e_p", "k_s", "r3", "a_p", "rho_p")
 #: Relative step of the central differences in the parameters.
 REL_STEP = 1e-5
 V_BAND = (1.0, 200.0)  # m/s: the map's speed range

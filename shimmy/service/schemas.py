@@ -16,6 +16,7 @@ from typing import Any, Mapping
 from ..model.configurations import Configuration, affects
 from ..errors import InvalidParameterError
 from . import settings
+from ..analyses import design_space
 from ..analyses.ground_profiles import MAX_PROFILE_POINTS, PRESETS
 from ..model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters,
                                 check_number, unknown_name_error)
@@ -289,23 +290,19 @@ def _check_ground_run(out: dict[str, Any]) -> None:
 
 
 # -- sensitivities, optimiser, robustness -------------------------------------------------------
-# The names below are those of shimmy.analyses.optimise.FIGURES and shimmy.analyses.robustness
-# (imported there only when an analysis runs; tests/test_api.py checks that they agree).
+# The figures, device parameters and tolerance limits are the analyses' own definitions
+# (shimmy.analyses.design_space: constants only, the solvers are imported when an analysis runs).
 
 #: The optimiser's figures of merit: unit, whether taken at a load, the range a constraint value may take.
 FIGURE_LIMITS: dict[str, tuple[str, bool, float, float]] = {
-    "min_shimmy_Fz": ("N", False, FZ_RANGE[0], FZ_RANGE[1]),
-    "interval": ("m/s", True, 0.0, 199.0),  # a width within the map's speeds 1-200 m/s
-    "max_psi": ("rad", True, 0.0, 1.0),
-    "torsion_area": ("(m/s) kN", False, 0.0, 199.0 * 240.0),  # within 1-200 m/s x 10-250 kN
-}
+    name: (f.unit, f.at_load, f.low, f.high) for name, f in design_space.FIGURES.items()}
 #: Figures with derivatives (the gradient method needs the objective and every constraint among them).
-DIFFERENTIABLE = ("min_shimmy_Fz", "max_psi", "interval")
+DIFFERENTIABLE = design_space.DIFFERENTIABLE
 #: The optimiser's default search parameters (those of them the configuration has).
-DEFAULT_SEARCH = ("r2", "e_p", "k_s", "r3")
-DISTRIBUTIONS = ("normal", "uniform")
+DEFAULT_SEARCH = design_space.DESIGN_PARAMETERS
+DISTRIBUTIONS = design_space.DISTRIBUTIONS
+TOLERANCE_RANGE = (0.0, max(design_space.TOLERANCE_LIMITS.values()))  # relative: a fraction of the value
 MAX_CONSTRAINTS = 8
-TOLERANCE_RANGE = (0.0, 0.5)  # relative: a fraction of the parameter's value
 OPS = ("<=", ">=")
 
 CONSTRAINT_TEXT = ("FIGURE<=VALUE or FIGURE>=VALUE (FIGURE@Fz for a figure at another load, Fz in N), or an object "
@@ -398,11 +395,11 @@ def tolerance(field: str, item: Any) -> dict[str, Any]:
     if PARAMETER_SPECS[name].integer:
         raise InvalidParameterError(f"{field}.name", name, "a parameter that is not a whole number",
                                     "is a whole number: a relative tolerance does not apply")
-    relative = _number_of(f"{field}.relative", item["relative"], *TOLERANCE_RANGE,
-                          "(a fraction of the value)")
     dist = item.get("distribution") or "normal"
     if dist not in DISTRIBUTIONS:
         raise InvalidParameterError(f"{field}.distribution", dist, "normal or uniform", "is not a distribution")
+    relative = _number_of(f"{field}.relative", item["relative"], 0.0, design_space.TOLERANCE_LIMITS[dist],
+                          f"(a fraction of the value; {dist})")
     return {"name": name, "relative": relative, "distribution": dist}
 
 
@@ -416,12 +413,12 @@ def _check_optimise(out: dict[str, Any]) -> None:
     """Search parameters of the configuration, constraints as objects, the method fit for the figures."""
     config = out["config"]
     if out["parameters"] is None:
-        out["parameters"] = [n for n in DEFAULT_SEARCH if affects(n, config)]
+        out["parameters"] = design_space.device_parameters(config)
         if not out["parameters"]:
             raise InvalidParameterError("parameters", None, f"parameters of configuration {config}",
                                         message=f"parameters is required for configuration {config}: the default "
-                                                f"({', '.join(DEFAULT_SEARCH)}) are NES parameters, which it does "
-                                                "not have")
+                                                f"({', '.join(DEFAULT_SEARCH)}) are device parameters, and it has "
+                                                "no device")
     for k, name in enumerate(out["parameters"]):
         if not affects(name, config):
             raise InvalidParameterError(f"parameters[{k}]", name, f"a parameter of configuration {config}",
@@ -458,8 +455,10 @@ _RULES = {
                 + "; ".join(f"{f} [{lo:g}, {hi:g}] {u}" + (" at a load (default: Fz)" if at else "")
                             for f, (u, at, lo, hi) in FIGURE_LIMITS.items()) + ".",
     "robustness": "Robustness: tolerances as 'NAME=REL', 'NAME=REL:uniform' or {name, relative, distribution}, "
-                  f"REL a fraction in [{TOLERANCE_RANGE[0]:g}, {TOLERANCE_RANGE[1]:g}] (normal: the standard "
-                  "deviation; uniform: the half-width), each parameter at most once, not a whole-number one.",
+                  f"REL a fraction (normal: the standard deviation, at most "
+                  f"{design_space.TOLERANCE_LIMITS['normal']:g}; uniform: the half-width, at most "
+                  f"{design_space.TOLERANCE_LIMITS['uniform']:g}), each parameter at most once, not a whole-number "
+                  "one.",
 }
 
 _CONSTRAINT_ITEM = {"oneOf": [
