@@ -1,6 +1,6 @@
 """Search the device parameters for the best figure of merit, under constraints on the others.
 
-Figures (:data:`FIGURES`), each a function of the design:
+Figures (:data:`~shimmy.analyses.design_space.FIGURES`), each a function of the design:
 
 * ``min_shimmy_Fz`` (N, maximised): the lowest point of the Hopf curves of straight rolling (below
   it x = 0 is stable at every speed; for the four nominal configurations this is also the map's
@@ -406,8 +406,8 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
              generations: int = 6, popsize: int = 5, seed: int = 0, executor=None,
              progress: Callable[[float, str], None] | None = None) -> OptimisationResult:
     """The design of ``parameters`` (inside their ranges; default: the device parameters fitted in
-    ``config``) with the best ``objective`` (see :data:`FIGURES`) subject to ``constraints``; the other
-    parameters as in ``params``."""
+    ``config``) with the best ``objective`` (see :data:`~shimmy.analyses.design_space.FIGURES`) subject
+    to ``constraints``; the other parameters as in ``params``."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
