@@ -116,7 +116,7 @@ BAD = [
     ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "objective": "speed"}, 422, "objective"),
     ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "parameters": ["e_p", "zeta"]}, 422, "parameters[1]"),
     ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "parameters": ["a_p"]}, 422, "parameters[0]"),
-    ("/api/v1/jobs", {"analysis": "optimise", "config": "pd"}, 422, "parameters"),
+    ("/api/v1/jobs", {"analysis": "optimise", "config": "original"}, 422, "parameters"),
     ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "constraints": ["max_psi=0.02"]}, 422,
      "constraints[0]"),
     ("/api/v1/jobs", {"analysis": "optimise", "config": "nes", "constraints": ["max_psy<=0.02"]}, 422,
