@@ -118,7 +118,10 @@ def test_a_small_robustness_run_shows_histograms_statistics_and_shimmy_probabili
 
 @pytest.mark.slow
 def test_a_small_optimiser_run_shows_the_optimum_and_opens_it_in_the_workbench(server, browser):
-    _open(browser, server, "/design?config=nes&search=e_p&starts=2&runs=1&k_s=1300000&cons=max_psi%3C%3D0.5")
+    # opt_seed=3: not the request tests/test_api.py computes on the same server (a cached answer is shown at
+    # once, with no progress to see)
+    _open(browser, server, "/design?config=nes&search=e_p&starts=2&runs=1&opt_seed=3&k_s=1300000"
+                           "&cons=max_psi%3C%3D0.5")
     _idle(browser)
     browser.find_element(By.ID, "opt-run").click()
     _wait_for(lambda: _text(browser, "opt-status"), timeout=30, interval=0.05, what="the optimiser's progress")
