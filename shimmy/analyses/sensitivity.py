@@ -337,10 +337,16 @@ def min_shimmy_sensitivity(model: Model, pairs: dict[str, tuple], fz_box: tuple[
         return {"Fz": low["Fz"], "V": low["V"], "dFz_dp": None, "source": "load edge",
                 "reason": f"the Hopf curves reach the lowest load of the box ({hopf.fz_range[0]:g} N): the minimum "
                           "shimmy load is that edge, not a point that moves with the parameters"}
-    else:  # an end of a curve on a speed edge: the corner moves along the edge
+    elif min(abs(low["V"] - edge) for edge in hopf.v_range) <= 1e-9 * max(hopf.v_range):
+        # an end of a curve on a speed edge: the corner moves along the edge
         V = min(hopf.v_range, key=lambda edge: abs(edge - low["V"]))
         Fz, omega = _hopf_load_at(model, V, low["Fz"], 2 * math.pi * low["frequency_hz"])
         source = f"end of a Hopf curve on the speed edge V = {V:g} m/s"
+    else:
+        reasons = "; ".join(r for c in hopf.curves for r in c.stop_reasons)
+        return {"Fz": low["Fz"], "V": low["V"], "dFz_dp": None, "source": "end of a Hopf curve inside the box",
+                "reason": f"the lowest point is where a Hopf curve stopped inside the box ({reasons}): not a turning "
+                          "point, no derivative"}
     lin = Linearisation(model, Fz)
     eig = _critical(lin.at(V), omega)
     dlam_dFz = eig.derivative(_dJ_dFz(model, V, Fz))

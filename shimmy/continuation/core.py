@@ -57,9 +57,13 @@ class ContinuationOptions:
     #: Curvature control: a step whose tangent turns by more than this (rad, in the weighted
     #: inner product) is refused and retried shorter; the step grows only below half of it.
     max_angle: float = math.inf
+    #: A corrected point farther from its predictor than this times the step (weighted norm) is
+    #: refused and the step retried shorter: Newton jumped to another branch, or the predictor was
+    #: too far off the curve for the step (a corrector on the curve moves ~ curvature h^2 / 2).
+    max_correction: float = 1.0
 
     def __post_init__(self):
-        for name in ("ds", "ds_min", "ds_max", "tol", "residual_tol", "locate_tol", "max_angle"):
+        for name in ("ds", "ds_min", "ds_max", "tol", "residual_tol", "locate_tol", "max_angle", "max_correction"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and (math.isfinite(value) or name == "max_angle") and value > 0):
                 raise InvalidInputError(name, value, "a positive finite number")
@@ -178,15 +182,19 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
 
 def step(problem: CurveProblem, point: CurvePoint, h: float, options: ContinuationOptions,
          with_tangent: bool = True) -> CurvePoint | None:
-    """One predictor-corrector step of length h from ``point`` (None if Newton fails).
+    """One predictor-corrector step of length h from ``point`` (None if Newton fails, or if the
+    corrected point lies farther than ``options.max_correction * h`` from the predictor).
 
     ``with_tangent=False`` skips the new tangent (one factorisation) for trial points whose
     tangent is not needed; the returned point then carries the old one.
     """
-    out = correct(problem, point.u + h * point.tangent, point.tangent, options)
+    predictor = point.u + h * point.tangent
+    out = correct(problem, predictor, point.tangent, options)
     if out is None:
         return None
     u, iterations = out
+    if weighted_norm(u - predictor, problem.weights) > options.max_correction * abs(h):
+        return None
     if not with_tangent:
         return CurvePoint(u, point.tangent, iterations)
     try:
