@@ -6,6 +6,7 @@ import pytest
 from shimmy.analyses.hopf_curves import hopf_curves
 from shimmy.analyses.stability import Criticality, Linearisation, hopf_points
 from shimmy.model.equations import build_model
+from shimmy.model.parameters import Parameters
 
 
 @pytest.fixture(scope="module")
@@ -112,3 +113,21 @@ def test_the_lateral_hopf_curve_and_its_located_lowest_load(original):
 
     assert len(near(low["Fz"] + 200.0)) == 2 and not near(low["Fz"] - 200.0)
     assert original.to_dict()["lateral_minimum"] == low
+
+
+def test_a_curve_is_not_cut_where_newton_jumps_to_another_branch():
+    """A corner NES design (found by the optimiser): the torsional Hopf curve is a closed loop with its
+    lowest point at ~82 kN. Newton once jumped from V = 22 to below 1 m/s in one step; the curve was cut
+    there and the cut end taken for its lowest point. A correction larger than the step is now refused."""
+    from shimmy.analyses.sensitivity import sensitivity
+
+    params = Parameters().with_overrides(r2=0.08145057809022613, e_p=0.005, k_s=1399769.10649413, r3=0.005)
+    result = hopf_curves("nes", params)
+    loop = next(c for c in result.curves if c.closed)
+    assert loop.stop_reasons == ["closed curve: returned to its start"]
+    assert np.max(np.abs(np.diff(loop.p[:, 0]))) < 12.0  # no jump across the plane (ds_max is 10 m/s in V)
+    low = result.fz_minimum
+    assert any(abs(e["p"][1] - low["Fz"]) < 1e-6 * low["Fz"] for e in loop.extrema)  # a located turning point
+    s = sensitivity("nes", 150e3, params, ["k_s", "e_p"], amplitude=False)
+    assert s.min_shimmy["source"] == "lowest point of the Hopf curves"
+    assert s.min_shimmy["Fz"] == pytest.approx(low["Fz"], rel=1e-6)
