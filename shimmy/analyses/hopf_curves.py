@@ -143,7 +143,8 @@ def hopf_curves(config: Configuration | str, params: Parameters | None = None,
     system = gear_two_parameter_field(config, params)
     n = system.n
     box = ((v_lo, v_hi), (f_lo, f_hi))
-    options = ContinuationOptions(ds=0.05, ds_max=1.0, max_steps=2000)
+    # max_correction: a Newton jump to another branch is refused (a loop of a corner NES design was cut).
+    options = ContinuationOptions(ds=0.05, ds_max=1.0, max_steps=2000, max_correction=1.0)
     curves: list[HopfCurve] = []
     warnings: list[str] = []
     slices = np.linspace(f_lo, f_hi, n_slices)

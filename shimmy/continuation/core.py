@@ -58,14 +58,15 @@ class ContinuationOptions:
     #: inner product) is refused and retried shorter; the step grows only below half of it.
     max_angle: float = math.inf
     #: A corrected point farther from its predictor than this times the step (weighted norm) is
-    #: refused and the step retried shorter: Newton jumped to another branch, or the predictor was
-    #: too far off the curve for the step (a corrector on the curve moves ~ curvature h^2 / 2).
-    max_correction: float = 1.0
+    #: refused and the step retried shorter: Newton jumped to another branch (a corrector on the
+    #: curve moves ~ curvature h^2 / 2). Off by default; the Hopf curves of the gear use 1.
+    max_correction: float = math.inf
 
     def __post_init__(self):
         for name in ("ds", "ds_min", "ds_max", "tol", "residual_tol", "locate_tol", "max_angle", "max_correction"):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and (math.isfinite(value) or name == "max_angle") and value > 0):
+            unbounded = name in ("max_angle", "max_correction")  # inf: no limit
+            if not (isinstance(value, (int, float)) and (math.isfinite(value) or unbounded) and value > 0):
                 raise InvalidInputError(name, value, "a positive finite number")
         if not self.ds_min <= self.ds <= self.ds_max:
             raise InvalidInputError("ds", self.ds, f"[{self.ds_min:g}, {self.ds_max:g}]",
@@ -193,7 +194,8 @@ def step(problem: CurveProblem, point: CurvePoint, h: float, options: Continuati
     if out is None:
         return None
     u, iterations = out
-    if weighted_norm(u - predictor, problem.weights) > options.max_correction * abs(h):
+    if math.isfinite(options.max_correction) and \
+            weighted_norm(u - predictor, problem.weights) > options.max_correction * abs(h):
         return None
     if not with_tangent:
         return CurvePoint(u, point.tangent, iterations)
