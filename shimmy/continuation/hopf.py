@@ -171,7 +171,7 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
         if is_closed:
             closed = True
             break
-    points = halves[0] if closed else halves[1][::-1] + halves[0][1:]
+    points = halves[-1] if closed else halves[1][::-1] + halves[0][1:]  # the half that closed is the loop
     U = np.array([q.u for q in points])
     n = system.n
     l1 = np.array([problem.lyapunov(u) if system.smooth else math.nan for u in U])
