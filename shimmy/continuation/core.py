@@ -26,6 +26,7 @@ converged point of the curve.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass, field, replace
@@ -281,6 +282,8 @@ def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[
     a, b, ga, gb = 0.0, h_end, g_start, g_end
     best = None
     side = 0
+    if math.isfinite(options.max_correction):  # bracketed by two accepted points: no branch to jump to
+        options = dataclasses.replace(options, max_correction=math.inf)
     for _ in range(options.max_locate):
         h = b - gb * (b - a) / (gb - ga) if gb != ga else 0.5 * (a + b)
         if not (min(a, b) < h < max(a, b)):
