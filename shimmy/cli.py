@@ -527,7 +527,9 @@ def _cmd_optimise(args) -> int:
     lines = [f"{result.config.value}: {'maximise' if f.sense > 0 else 'minimise'} {f.label}"
              + (f" at {Fz / 1e3:g} kN" if f.at_load else "") + f" over {', '.join(result.names)} "
              f"({result.method}, {result.evaluations} evaluations, {result.elapsed_s:.1f} s)",
-             f"  optimum {result.objective_value:.6g} {f.unit} (nominal {result.nominal_objective:.6g} {f.unit})",
+             f"  optimum {result.objective_value:.6g} {f.unit} (nominal "
+             + ("not evaluated" if result.nominal_objective is None else f"{result.nominal_objective:.6g} {f.unit}")
+             + ")",
              "  design: " + ", ".join(f"{n} = {v:.6g} {PARAMETER_SPECS[n].unit}".rstrip()
                                       for n, v in result.design.items())]
     for c in result.constraints:
