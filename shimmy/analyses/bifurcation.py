@@ -51,7 +51,7 @@ from ..continuation.collocation import Mesh, PeriodicProblem
 from ..model.configurations import Configuration
 from ..continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, SpecialPoint, VectorField,
                            equilibrium_branch, locate, step, tangent, weighted_norm)
-from ..model.equations import Model, build_model, jacobian, parameter_jacobian, rhs
+from ..model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ..errors import ConvergenceError, InvalidParameterError
 from ..model.nes import VALID_ANGLE
 from ..model.parameters import V_RANGE, Parameters, check_number, check_operating_point
@@ -109,7 +109,8 @@ def gear_field(model: Model, Fz: float) -> VectorField:
                        lambda x, V: rhs(model, x, V, Fz),
                        lambda x, V: jacobian(model, x, V, Fz),
                        lambda x, V: parameter_jacobian(model, x, V, Fz)[0],
-                       name=f"{model.config.value} at Fz = {Fz:g} N")
+                       name=f"{model.config.value} at Fz = {Fz:g} N",
+                       evaluate=lambda x, V: field_and_derivatives(model, x, V, Fz)[:3])
 
 
 @dataclass

@@ -35,7 +35,7 @@ from ..continuation import (ContinuationOptions, CycleCurve, CycleCurveOptions, 
 from ..continuation.errors import ContinuationError
 from ..errors import InvalidParameterError
 from ..model.configurations import Configuration
-from ..model.equations import build_model, jacobian, parameter_jacobian, rhs
+from ..model.equations import build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ..model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation
 from .hopf_curves import hopf_curves
@@ -56,10 +56,14 @@ SCAN_FRACTIONS = (0.3, 0.6, 0.9)  # loads of the one-parameter diagrams, as frac
 def gear_cycle_field(config: Configuration, params: Parameters) -> TwoParameterVectorField:
     """The gear's vector field in (V, Fz), vectorised over columns, analytic derivatives."""
     model = build_model(config, params)
+
+    def evaluate(x, p):
+        f, J, dV, dFz = field_and_derivatives(model, x, p[0], p[1])
+        return f, J, np.stack([dV, dFz])
     return TwoParameterVectorField(model.n_states, lambda x, p: rhs(model, x, p[0], p[1]),
                                    lambda x, p: jacobian(model, x, p[0], p[1]),
                                    lambda x, p: np.stack(parameter_jacobian(model, x, p[0], p[1])),
-                                   f"{config.value} in (V, Fz)")
+                                   f"{config.value} in (V, Fz)", evaluate)
 
 
 @dataclass(eq=False)  # compared by identity: list.remove takes the very start

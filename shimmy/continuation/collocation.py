@@ -54,7 +54,7 @@ class Mesh:
     def ntst(self) -> int:
         return self.points.size - 1
 
-    @property
+    @cached_property
     def h(self) -> np.ndarray:
         return np.diff(self.points)
 
@@ -146,7 +146,9 @@ class PeriodicProblem:
                                        indexing="ij")
         self._rows = ((j * m + k) * n + a).ravel()
         self._cols = ((j * m + node) * n + b).ravel()
-        self._eye = np.eye(n)[None, None, :, None, :]
+        eye = np.eye(n)[None, None, :, None, :]
+        self._D_eye = self.basis.D[None, :, None, :, None] * eye  # (1, m, n, m+1, n)
+        self._L_cols = self.basis.L[None, :, None, :, None]
         self.n_equations = N * m * n + n + 1
         self._structure()
 
@@ -178,9 +180,7 @@ class PeriodicProblem:
 
     def _at_collocation(self, X: np.ndarray):
         U = X[self.mesh.node_index]  # (ntst, m+1, n)
-        Xc = np.einsum("kl,jln->jkn", self.basis.L, U)
-        DXc = np.einsum("kl,jln->jkn", self.basis.D, U)  # derivative in local s; d/dtau = / h
-        return Xc, DXc
+        return self.basis.L @ U, self.basis.D @ U  # derivative in local s; d/dtau = / h
 
     # -- curve problem -------------------------------------------------------------------
     def accept(self, u: np.ndarray) -> None:
@@ -200,20 +200,26 @@ class PeriodicProblem:
         phase = np.einsum("j,k,jkn,jkn->", mesh.h, wq, Xc - self.reference_values, self.reference_derivative)
         return np.concatenate([coll.ravel(), X[0] - X[-1], [phase]])
 
+    def collocation_points(self, u: np.ndarray) -> np.ndarray:
+        """x at the collocation points of u as columns (n, ntst * m), interval-major."""
+        Xc, _ = self._at_collocation(self.unpack(u)[0])
+        return Xc.reshape(-1, self.n).T
+
+    def blocks_of(self, J: np.ndarray, T: float) -> np.ndarray:
+        """d(collocation)/d(nodes) (ntst, m, n, m+1, n) from the field's Jacobian at the
+        collocation points (ntst * m, n, n) and the period."""
+        mesh, n = self.mesh, self.n
+        J = J.reshape(mesh.ntst, mesh.ncol, n, 1, n)
+        hT = (mesh.h * T)[:, None, None, None, None]
+        return self._D_eye - hT * self._L_cols * J
+
     def collocation_blocks(self, u: np.ndarray):
         """Values of d(collocation)/d(nodes) as (ntst, m, n, m+1, n), and f, f_p at the points."""
-        X, T, p = self.unpack(u)
-        n = self.n
-        Xc, _ = self._at_collocation(X)
-        flat = Xc.reshape(-1, n).T
-        J = self.system.dfdx(flat, p).reshape(Xc.shape + (n,))  # (ntst, m, n, n)
-        L, D = self.basis.L, self.basis.D
-        hT = (self.mesh.h * T)[:, None, None, None, None]
-        blocks = (D[None, :, None, :, None] * self._eye
-                  - hT * L[None, :, None, :, None] * J[:, :, :, None, :])
-        F = self.system.f(flat, p).T.reshape(Xc.shape)
-        Fp = self.system.dfdp(flat, p).T.reshape(Xc.shape)
-        return blocks, F, Fp, T
+        _, T, p = self.unpack(u)
+        flat = self.collocation_points(u)
+        F, J, Fp = self.system.all_at(flat, p)
+        shape = (self.mesh.ntst, self.mesh.ncol, self.n)
+        return self.blocks_of(J, T), F.T.reshape(shape), Fp.T.reshape(shape), T
 
     def jacobian(self, u: np.ndarray):
         mesh, n = self.mesh, self.n

@@ -348,6 +348,15 @@ class VectorField:
     dfdx: Callable[[np.ndarray, float], np.ndarray]
     dfdp: Callable[[np.ndarray, float], np.ndarray]
     name: str = "system"
+    #: Optional ``evaluate(x, p) -> (f, dfdx, dfdp)`` in one pass (a compiled field's fast path);
+    #: must agree with the three functions.
+    evaluate: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None
+
+    def all_at(self, x: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(f, dfdx, dfdp) at columns x: one call of ``evaluate`` where the field has it."""
+        if self.evaluate is not None:
+            return self.evaluate(x, p)
+        return self.f(x, p), self.dfdx(x, p), self.dfdp(x, p)
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numba.extending import register_jitable
 
 from . import nes as nes_device
@@ -139,26 +140,9 @@ def vector_field(psi, dpsi, delta, ddelta, lam, psis, dpsis, V, Fz, c, has_nes, 
     return dpsi, psi_dd, ddelta, delta_dd, lam_d, dpsis, psis_dd
 
 
-def _columns(model: Model, x):
-    x = np.asarray(x)
-    if x.shape[0] != model.n_states:
-        raise ValueError(f"state has {x.shape[0]} rows; configuration {model.config.value} "
-                         f"has {model.n_states} states")
-    zero = np.zeros_like(x[0])
-    psis, dpsis = (x[5], x[6]) if model.config.has_nes else (zero, zero)
-    return x[0], x[1], x[2], x[3], x[4], psis, dpsis
-
-
-def rhs(model: Model, x, V, Fz):
-    """f(x; V, Fz), same shape as ``x``."""
-    cols = _columns(model, x)
-    out = vector_field(*cols, V, Fz, model.coefficients, *model.flags)
-    out = np.broadcast_arrays(*out, cols[0] + 0 * np.asarray(V) + 0 * np.asarray(Fz))[:-1]
-    return np.stack(out[:model.n_states])
-
-
-def _tyre_derivatives(lam, Fz, c):
-    """F_lam, dF_lam/dlam, M_ka and dM_ka/dlam (arrays, complex-safe)."""
+@register_jitable
+def tyre_derivatives(lam, Fz, c):
+    """F_lam, dF_lam/dlam, M_ka and dM_ka/dlam (scalars or arrays, complex-safe)."""
     L_ = c[L]
     force, aligning = tyre_forces(lam, Fz, c)
     u = 7.0 * lam / L_
@@ -166,12 +150,13 @@ def _tyre_derivatives(lam, Fz, c):
     dforce = c[K_LAM] * Fz * (7.0 / L_) * (np.cos(0.95 * w) - 0.95 * w * np.sin(0.95 * w)) / (1.0 + u * u)
     alpha = np.arctan(lam / L_)
     alpha_m = c[ALPHA_M]
-    inside = np.abs(np.real(alpha)) <= alpha_m
+    inside = np.abs(alpha.real) <= alpha_m
     dalpha = (1.0 / L_) / (1.0 + (lam / L_) ** 2)
     daligning = c[K_A] * np.cos(np.pi * alpha / alpha_m) * Fz * inside * dalpha
     return force, dforce, aligning, daligning
 
 
+@register_jitable
 def _pd_slope(dpsi, c):
     """d M_pd / d dpsi = n r^2 (3/2 s12 v^1/2 + 2 s1 v + 5/2 s32 v^3/2 + 3 s2 v^2 + 4 s3 v^3)."""
     v = c[PD_R] * np.abs(dpsi)
@@ -180,70 +165,130 @@ def _pd_slope(dpsi, c):
                          + 3.0 * c[PD_S2] * v * v + 4.0 * c[PD_S3] * v ** 3)
 
 
-def jacobian(model: Model, x, V, Fz):
-    """Analytic d f / d x: ``(n, n)`` for one state, ``(m, n, n)`` for columns."""
-    c = model.coefficients
-    psi, dpsi, delta, ddelta, lam, psis, dpsis = _columns(model, x)
-    shape = np.broadcast(psi, np.asarray(V), np.asarray(Fz)).shape
-    n = model.n_states
-    dtype = np.result_type(psi, V, Fz, float)
-    J = np.zeros(shape + (n, n), dtype=dtype)
+@register_jitable
+def derivatives_at(psi, dpsi, delta, ddelta, lam, psis, dpsis, V, Fz, c, has_nes, has_pd, exact_nes, J, dV, dFz):
+    """Analytic d f / d x into J (n, n) and d f / d V, d f / d Fz into dV, dFz (n,) at one state
+    (the arrays zeroed by the caller; entries outside the configuration's states untouched)."""
     cos_phi, e_eff = c[COS_PHI], c[E_EFF]
     theta = psi * cos_phi
     sin_theta, cos_theta = np.sin(theta), np.cos(theta)
-    force, dforce, _, daligning = _tyre_derivatives(lam, Fz, c)
+    force, dforce, aligning, daligning = tyre_derivatives(lam, Fz, c)
     i_psi, ix = c[I_PSI], c[IX]
 
-    J[..., 0, 1] = 1.0
-    J[..., 1, 0] = (-c[K_PSI] + Fz * c[SIN_PHI] * e_eff * cos_theta * cos_phi) / i_psi
-    J[..., 1, 1] = (-c[C_PSI] - c[C_LAM] * cos_phi / V) / i_psi
-    J[..., 1, 4] = (-daligning - e_eff * dforce) / i_psi
-    J[..., 2, 3] = 1.0
-    J[..., 3, 0] = (c[L_G] * force * sin_theta * cos_phi * cos_phi + Fz * e_eff * cos_theta * cos_phi) / ix
-    J[..., 3, 2] = -c[K_DELTA] / ix
-    J[..., 3, 3] = -c[C_DELTA] / ix
-    J[..., 3, 4] = -c[L_G] * dforce * cos_theta * cos_phi / ix
-    J[..., 4, 0] = V * cos_theta * cos_phi - (e_eff - c[H]) * sin_theta * cos_phi * dpsi * cos_phi
-    J[..., 4, 1] = (e_eff - c[H]) * cos_theta * cos_phi
-    J[..., 4, 2] = -c[L_G] * ddelta * np.sin(delta)
-    J[..., 4, 3] = c[L_G] * np.cos(delta)
-    J[..., 4, 4] = -V / c[L]
-    if model.config.has_pd:
-        J[..., 1, 1] -= _pd_slope(dpsi, c) / i_psi
-    if model.config.has_nes:
+    J[0, 1] = 1.0
+    J[1, 0] = (-c[K_PSI] + Fz * c[SIN_PHI] * e_eff * cos_theta * cos_phi) / i_psi
+    J[1, 1] = (-c[C_PSI] - c[C_LAM] * cos_phi / V) / i_psi
+    J[1, 4] = (-daligning - e_eff * dforce) / i_psi
+    J[2, 3] = 1.0
+    J[3, 0] = (c[L_G] * force * sin_theta * cos_phi * cos_phi + Fz * e_eff * cos_theta * cos_phi) / ix
+    J[3, 2] = -c[K_DELTA] / ix
+    J[3, 3] = -c[C_DELTA] / ix
+    J[3, 4] = -c[L_G] * dforce * cos_theta * cos_phi / ix
+    J[4, 0] = V * cos_theta * cos_phi - (e_eff - c[H]) * sin_theta * cos_phi * dpsi * cos_phi
+    J[4, 1] = (e_eff - c[H]) * cos_theta * cos_phi
+    J[4, 2] = -c[L_G] * ddelta * np.sin(delta)
+    J[4, 3] = c[L_G] * np.cos(delta)
+    J[4, 4] = -V / c[L]
+    if has_pd:
+        J[1, 1] -= _pd_slope(dpsi, c) / i_psi
+    if has_nes:
         u = psi - psis
-        if model.exact_nes:
+        if exact_nes:
             k_u = nes_device.stiffness_core(u, c[NES_A], c[NES_RHO], c[NES_DELTA0], c[K_S], c[E_P])
         else:
             k_u = c[K1] + 3.0 * c[K3] * u * u
         c_nes, i_nes = c[C_NES], c[I_NES]
-        J[..., 1, 0] -= k_u / i_psi
-        J[..., 1, 1] -= c_nes / i_psi
-        J[..., 1, 5] = k_u / i_psi
-        J[..., 1, 6] = c_nes / i_psi
-        J[..., 5, 6] = 1.0
-        J[..., 6, 0] = k_u / i_nes
-        J[..., 6, 1] = c_nes / i_nes
-        J[..., 6, 5] = -k_u / i_nes
-        J[..., 6, 6] = -c_nes / i_nes
-    return J
+        J[1, 0] -= k_u / i_psi
+        J[1, 1] -= c_nes / i_psi
+        J[1, 5] = k_u / i_psi
+        J[1, 6] = c_nes / i_psi
+        J[5, 6] = 1.0
+        J[6, 0] = k_u / i_nes
+        J[6, 1] = c_nes / i_nes
+        J[6, 5] = -k_u / i_nes
+        J[6, 6] = -c_nes / i_nes
+    dV[1] = c[C_LAM] * dpsi * cos_phi / (V * V) / i_psi
+    dV[4] = -lam / c[L] + sin_theta
+    dFz[1] = (-aligning / Fz - e_eff * force / Fz + c[SIN_PHI] * e_eff * sin_theta) / i_psi
+    dFz[3] = (-c[L_G] * (force / Fz) * cos_theta * cos_phi + e_eff * sin_theta) / ix
+
+
+@njit(cache=True)
+def _evaluate_columns(X, V, Fz, c, has_nes, has_pd, exact_nes, F, J, dV, dFz, want_f, want_derivatives):
+    """f, d f / d x, d f / d V and d f / d Fz at every column of X (n, m) (V, Fz per column)."""
+    n = X.shape[0]
+    for k in range(X.shape[1]):
+        zero = 0.0 * X[0, k]
+        psis = X[5, k] if has_nes else zero
+        dpsis = X[6, k] if has_nes else zero
+        if want_f:
+            d = vector_field(X[0, k], X[1, k], X[2, k], X[3, k], X[4, k], psis, dpsis, V[k], Fz[k], c,
+                             has_nes, has_pd, exact_nes)
+            for i in range(n):
+                F[i, k] = d[i]
+        if want_derivatives:
+            derivatives_at(X[0, k], X[1, k], X[2, k], X[3, k], X[4, k], psis, dpsis, V[k], Fz[k], c,
+                           has_nes, has_pd, exact_nes, J[k], dV[:, k], dFz[:, k])
+
+
+def _check_states(model: Model, x) -> np.ndarray:
+    x = np.asarray(x)
+    if x.shape[0] != model.n_states:
+        raise ValueError(f"state has {x.shape[0]} rows; configuration {model.config.value} "
+                         f"has {model.n_states} states")
+    return x
+
+
+def _evaluate(model: Model, x, V, Fz, want_f: bool, want_derivatives: bool):
+    """The compiled evaluation at states x (n,) or (n, ...), V and Fz broadcast against them:
+    (shape, f (n, m), J (m, n, n), dV (n, m), dFz (n, m)), m the number of broadcast columns."""
+    x = _check_states(model, x)
+    n = model.n_states
+    if x.ndim == 2 and np.ndim(V) == 0 and np.ndim(Fz) == 0 and x.dtype == float and \
+            not isinstance(V, complex) and not isinstance(Fz, complex):  # the engine's case
+        shape = x.shape[1:]
+        X = np.ascontiguousarray(x)
+        dtype = np.dtype(float)
+        Vs, Fzs = np.full(x.shape[1], float(V)), np.full(x.shape[1], float(Fz))
+    else:
+        V, Fz = np.asarray(V), np.asarray(Fz)
+        shape = np.broadcast(x[0], V, Fz).shape
+        dtype = np.result_type(x, V, Fz, float)
+        parts = np.broadcast_arrays(*x, V, Fz)
+        X = np.array(parts[:n], dtype=dtype).reshape(n, -1)
+        Vs, Fzs = (np.array(a, dtype=dtype).ravel() for a in parts[n:])
+    m = X.shape[1]
+    F = np.empty((n, m) if want_f else (n, 0), dtype)
+    J = np.zeros((m, n, n) if want_derivatives else (0, n, n), dtype)
+    dV = np.zeros((n, m) if want_derivatives else (n, 0), dtype)
+    dFz = np.zeros_like(dV)
+    _evaluate_columns(X, Vs, Fzs, model.coefficients, *model.flags, F, J, dV, dFz, want_f, want_derivatives)
+    return shape, F, J, dV, dFz
+
+
+def rhs(model: Model, x, V, Fz):
+    """f(x; V, Fz), shaped like x broadcast against V and Fz."""
+    shape, F, _, _, _ = _evaluate(model, x, V, Fz, True, False)
+    return F.reshape((model.n_states,) + shape)
+
+
+def jacobian(model: Model, x, V, Fz):
+    """Analytic d f / d x: ``(n, n)`` for one state, ``(m, n, n)`` for columns."""
+    shape, _, J, _, _ = _evaluate(model, x, V, Fz, False, True)
+    return J.reshape(shape + J.shape[1:])
 
 
 def parameter_jacobian(model: Model, x, V, Fz):
     """(d f / d V, d f / d Fz), each shaped like ``x``."""
-    c = model.coefficients
-    psi, dpsi, delta, ddelta, lam, psis, dpsis = _columns(model, x)
-    cos_phi, e_eff = c[COS_PHI], c[E_EFF]
-    theta = psi * cos_phi
-    sin_theta, cos_theta = np.sin(theta), np.cos(theta)
-    force, _, aligning, _ = _tyre_derivatives(lam, Fz, c)
-    shape = np.broadcast(psi, np.asarray(V), np.asarray(Fz)).shape
+    shape, _, _, dV, dFz = _evaluate(model, x, V, Fz, False, True)
     n = model.n_states
-    dtype = np.result_type(psi, V, Fz, float)
-    dV = np.zeros((n,) + shape, dtype=dtype)
-    dFz = np.zeros((n,) + shape, dtype=dtype)
-    dV[1] = c[C_LAM] * dpsi * cos_phi / (V * V) / c[I_PSI]
-    dV[4] = -lam / c[L] + sin_theta
-    dFz[1] = (-aligning / Fz - e_eff * force / Fz + c[SIN_PHI] * e_eff * sin_theta) / c[I_PSI]
-    dFz[3] = (-c[L_G] * (force / Fz) * cos_theta * cos_phi + e_eff * sin_theta) / c[IX]
-    return dV, dFz
+    return dV.reshape((n,) + shape), dFz.reshape((n,) + shape)
+
+
+def field_and_derivatives(model: Model, x, V, Fz):
+    """(f, d f / d x, d f / d V, d f / d Fz) in one compiled pass, shaped as :func:`rhs`,
+    :func:`jacobian` and :func:`parameter_jacobian` give them."""
+    shape, F, J, dV, dFz = _evaluate(model, x, V, Fz, True, True)
+    n = model.n_states
+    return (F.reshape((n,) + shape), J.reshape(shape + J.shape[1:]), dV.reshape((n,) + shape),
+            dFz.reshape((n,) + shape))

@@ -75,6 +75,7 @@ def stiffness_exact(a, r1: float, r2: float, r3: float, k_s: float, e_p: float):
     return stiffness_core(_check_angle(a), *geometry(r1, r2, r3), k_s, e_p)
 
 
+@register_jitable
 def stiffness_core(a, A, rho, delta0, k_s, e_p):
     """dM/da from precomputed geometry (accepts arrays, complex too)."""
     s, c = np.sin(a), np.cos(a)
