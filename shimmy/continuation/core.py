@@ -104,6 +104,7 @@ class _Bordered:
     """
 
     def __init__(self, jac, row: np.ndarray):
+        self.jac, self.row = jac, row
         if sp.issparse(jac):
             jac = jac.tocsr()
             size = row.size
@@ -133,20 +134,54 @@ def _unit_last(size: int) -> np.ndarray:
     return e
 
 
-def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray) -> np.ndarray:
-    """Unit tangent (w-norm) of the curve at u, oriented along ``previous``."""
+#: Refinement of a tangent on nearby factors: the residual of [F_u; (w t_prev)^T] t = e_last is
+#: driven below this (relative to |t|), else the matrix is factored afresh.
+TANGENT_REFINE_TOL = 1e-13
+
+
+def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray, near: _Bordered | None = None) -> np.ndarray:
+    """Unit tangent (w-norm) of the curve at u, oriented along ``previous``.
+
+    ``near``: factors of the same system at a nearby point with the same bordering row (the
+    corrector's last chord matrix): the tangent is found by iterative refinement on them (a
+    solve and a product per sweep, at most 4 sweeps, each required to shrink the residual 4x),
+    to ``TANGENT_REFINE_TOL``; only if that fails is the matrix factored here.
+    """
     w = problem.weights
-    t = _Bordered(problem.jacobian(u), w * previous).solve(_unit_last(u.size))
+    jac = problem.jacobian(u)
+    row = w * previous
+    e = _unit_last(u.size)
+    t = _refined(near, jac, row, e) if near is not None and np.array_equal(near.row, row) else None
+    if t is None:
+        t = _Bordered(jac, row).solve(e)
     return t / weighted_norm(t, w)
 
 
+def _refined(near: _Bordered, jac, row: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
+    """[jac; row]^-1 rhs by iterative refinement on ``near``'s factors; None if it does not converge."""
+    z = near.solve(rhs)
+    last = math.inf
+    for _ in range(5):
+        if not np.all(np.isfinite(z)):
+            return None
+        r = rhs - np.append(jac @ z, row @ z)
+        size = float(np.abs(r).max())
+        if size <= TANGENT_REFINE_TOL * float(np.abs(z).max()):
+            return z
+        if size > 0.25 * last:
+            return None
+        last = size
+        z = z + near.solve(r)
+    return None
+
+
 def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
-            options: ContinuationOptions) -> tuple[np.ndarray, int] | None:
+            options: ContinuationOptions) -> tuple[np.ndarray, int, _Bordered] | None:
     """Newton on [F(u); <t, u - u_pred>_w] = 0 from u_pred; None if it does not converge.
 
     Chord iterations: the bordered Jacobian is factored at the predictor and refreshed
-    only when a correction fails to shrink by half. Returns the solution and the number
-    of iterations.
+    only when a correction fails to shrink by half. Returns the solution, the number
+    of iterations and the last factors (a nearby matrix for the tangent's refinement).
     """
     w = problem.weights
     u = u_pred.copy()
@@ -178,7 +213,7 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
         u = u + du
         F = problem.residual(u)
         if size <= options.tol and np.all(np.isfinite(F)) and np.max(np.abs(F)) <= options.residual_tol:
-            return u, it
+            return u, it, lu
     return None
 
 
@@ -194,14 +229,14 @@ def step(problem: CurveProblem, point: CurvePoint, h: float, options: Continuati
     out = correct(problem, predictor, point.tangent, options)
     if out is None:
         return None
-    u, iterations = out
+    u, iterations, factors = out
     if math.isfinite(options.max_correction) and \
             weighted_norm(u - predictor, problem.weights) > options.max_correction * abs(h):
         return None
     if not with_tangent:
         return CurvePoint(u, point.tangent, iterations)
     try:
-        t = tangent(problem, u, point.tangent)
+        t = tangent(problem, u, point.tangent, factors)
     except (RuntimeError, ValueError, np.linalg.LinAlgError):
         return None
     if not np.all(np.isfinite(t)):
