@@ -244,12 +244,11 @@ def _evaluate(model: Model, x, V, Fz, want_f: bool, want_derivatives: bool):
     (shape, f (n, m), J (m, n, n), dV (n, m), dFz (n, m)), m the number of broadcast columns."""
     x = _check_states(model, x)
     n = model.n_states
-    if x.ndim == 2 and np.ndim(V) == 0 and np.ndim(Fz) == 0 and x.dtype == float and \
-            not isinstance(V, complex) and not isinstance(Fz, complex):  # the engine's case
-        shape = x.shape[1:]
-        X = np.ascontiguousarray(x)
+    if x.ndim <= 2 and x.dtype == float and isinstance(V, (float, int)) and isinstance(Fz, (float, int)):
+        shape = x.shape[1:]  # the engine's case: real states, one speed and load
+        X = np.ascontiguousarray(x.reshape(n, -1))
         dtype = np.dtype(float)
-        Vs, Fzs = np.full(x.shape[1], float(V)), np.full(x.shape[1], float(Fz))
+        Vs, Fzs = np.full(X.shape[1], float(V)), np.full(X.shape[1], float(Fz))
     else:
         V, Fz = np.asarray(V), np.asarray(Fz)
         shape = np.broadcast(x[0], V, Fz).shape
