@@ -133,7 +133,7 @@ def _amplitude_at_fixed_speed(model, Fz, problem, u, coefficients):
     options = ContinuationOptions(tol=1e-12, residual_tol=1e-11, max_newton=12)
     w = u
     for _ in range(4):
-        w, _ = correct(q, w, e_V / math.sqrt(q.weights[-1]), options)
+        w = correct(q, w, e_V / math.sqrt(q.weights[-1]), options)[0]
         q.accept(w)
     return _refined_peak(q, w)
 
