@@ -128,6 +128,35 @@ def test_collocation_jacobian_matches_finite_differences_of_the_residual():
     np.testing.assert_allclose(J, J_fd, atol=1e-7 * np.abs(J_fd).max())
 
 
+def test_tangent_refined_on_the_correctors_factors_equals_a_freshly_factored_one():
+    """A step's tangent comes from iterative refinement on the chord factors of its corrector;
+    it must equal the tangent of a fresh factorisation at the same point (to 1e-12) and, where
+    the nearby factors are of a different bordering row, a fresh factorisation is used."""
+    from shimmy.continuation.core import CurvePoint, _Bordered, correct, step, tangent, weighted_norm
+
+    system = hopf_supercritical(omega=2.0)  # cycles r^2 = mu: the orbit and its Jacobian change along the step
+    mesh = Mesh.uniform(12, 4)
+    problem = PeriodicProblem(system, mesh, np.ones(2), 1.0, 1.0)
+    theta = TWO_PI * mesh.node_times
+    X = 0.5 * np.column_stack([np.cos(theta), np.sin(theta)])
+    u0 = problem.pack(X, math.pi, 0.25)
+    problem.accept(u0)
+    e_p = np.zeros(u0.size)
+    e_p[-1] = 1.0
+    u0 = correct(problem, u0, e_p / weighted_norm(e_p, problem.weights), ContinuationOptions())[0]
+    problem.accept(u0)
+    t0 = tangent(problem, u0, e_p)
+    options = ContinuationOptions()
+    new = step(problem, CurvePoint(u0, t0), 0.3, options)
+    assert new is not None
+    fresh = tangent(problem, new.u, t0)
+    np.testing.assert_allclose(new.tangent, fresh, atol=1e-12)
+    assert abs(weighted_norm(new.tangent, problem.weights) - 1.0) < 1e-14
+    # factors with another bordering row are not used for refinement
+    other = _Bordered(problem.jacobian(u0), problem.weights * e_p)
+    np.testing.assert_allclose(tangent(problem, new.u, t0, other), fresh, atol=1e-14)
+
+
 # --------------------------------------------------------------------------- equilibria
 
 

@@ -3,7 +3,8 @@ import pytest
 
 from shimmy import Parameters
 from shimmy.model.configurations import ALL_CONFIGURATIONS
-from shimmy.model.equations import build_model, effective_caster, jacobian, parameter_jacobian, rhs
+from shimmy.model.equations import (build_model, effective_caster, field_and_derivatives, jacobian,
+                                    parameter_jacobian, rhs)
 from shimmy.model.integrator import N_FULL, _f
 from shimmy.model.reference_model import make_rhs
 
@@ -98,3 +99,33 @@ def test_pd_jacobian_at_rest_equals_the_bare_gear_with_added_inertia():
 def test_wrong_state_length_is_refused():
     with pytest.raises(ValueError, match="state has 5 rows; configuration nes has 7 states"):
         rhs(build_model("nes"), np.zeros(5), 30.0, 150e3)
+
+
+@pytest.mark.parametrize("exact_nes", [False, True])
+@pytest.mark.parametrize("config", ALL_CONFIGURATIONS, ids=lambda c: c.value)
+def test_one_pass_evaluation_equals_the_separate_functions(config, exact_nes):
+    """field_and_derivatives (the continuation engine's compiled pass) gives exactly what rhs,
+    jacobian and parameter_jacobian give, for columns, one state, and broadcast speeds."""
+    model = build_model(config, exact_nes=exact_nes)
+    x = random_states(model.n_states)
+    for V, Fz, states in ((52.0, 3.1e5, x), (52.0, 3.1e5, x[:, 1]), (np.linspace(5.0, 90.0, x.shape[1]), 2e5, x)):
+        f, J, dV, dFz = field_and_derivatives(model, states, V, Fz)
+        np.testing.assert_array_equal(f, rhs(model, states, V, Fz))
+        np.testing.assert_array_equal(J, jacobian(model, states, V, Fz))
+        ref_dV, ref_dFz = parameter_jacobian(model, states, V, Fz)
+        np.testing.assert_array_equal(dV, ref_dV)
+        np.testing.assert_array_equal(dFz, ref_dFz)
+
+
+@pytest.mark.parametrize("config", ALL_CONFIGURATIONS, ids=lambda c: c.value)
+def test_complex_step_in_v_of_the_field_gives_its_v_derivative(config):
+    """The compiled loop runs on complex states and speeds (the stability module's complex steps):
+    Im f(x, V + ih) / h equals the analytic d f / d V to rounding, away from the PD's |dpsi| kink."""
+    model = build_model(config)
+    x = random_states(model.n_states)
+    V, Fz, h = 41.0, 2.7e5, 1e-20
+    dV, _ = parameter_jacobian(model, x, V, Fz)
+    np.testing.assert_allclose(rhs(model, x, complex(V, h), Fz).imag / h, dV, rtol=1e-12, atol=1e-14)
+    J_c = jacobian(model, x.astype(complex), complex(V, h), Fz)
+    assert J_c.dtype == complex
+    np.testing.assert_allclose(J_c.real, jacobian(model, x, V, Fz), rtol=1e-14, atol=1e-14)

@@ -5,9 +5,11 @@ All functions are vectorised: ``x`` may be one state ``(n,)`` or many columns ``
 with ``V`` and ``Fz`` scalars or arrays broadcastable to ``(m,)``. Jacobians come back
 as ``(n, n)`` for one state and ``(m, n, n)`` for many (ready for batched ``eig``).
 
-:func:`vector_field` is plain arithmetic so that numba can compile it into the
-integrator (one source for the equations, compiled and vectorised) and numpy can
-evaluate it on arrays, including complex ones (the Jacobian is complex-analytic
+:func:`vector_field` and :func:`derivatives_at` (the analytic Jacobians in the state, V
+and Fz) are plain arithmetic on one state, the one source of the equations: numba inlines
+them into the integrator and into one compiled loop over columns of states, which
+:func:`rhs`, :func:`jacobian`, :func:`parameter_jacobian` and, all four in one pass,
+:func:`field_and_derivatives` run. States may be complex (the Jacobian is complex-analytic
 away from the PD's |dpsi|; the stability module uses complex steps on it).
 
 Model coefficients are packed once per (parameters, configuration) into a float
