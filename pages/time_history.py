@@ -13,6 +13,7 @@ from shimmy.service import settings
 from ui import components as ui
 from ui import fields, jobs
 from ui import style
+from ui.series import envelope
 from ui.fields import Quantity
 from ui.layout import design_id, page
 
@@ -148,14 +149,14 @@ def _figures(result):
     rows = 4 if has_nes else 3
     series = make_subplots(rows=rows, cols=1, shared_xaxes=True, vertical_spacing=0.05)
     colour = style.CONFIG_COLOURS[result["config"]]
-    series.add_scatter(x=t, y=s["psi"], name="torsion psi (rad)", line={"color": colour, "width": 1}, row=1, col=1)
-    series.add_scatter(x=t, y=s["lateral"], name="lateral l_g delta (m)", line={"color": "#56B4E9", "width": 1},
-                       row=2, col=1)
-    series.add_scatter(x=t, y=s["lam"], name="tyre deformation lam (m)", line={"color": "#CC79A7", "width": 1},
-                       row=3, col=1)
+    for row, values, name, c in ((1, s["psi"], "torsion psi (rad)", colour),
+                                 (2, s["lateral"], "lateral l_g delta (m)", "#56B4E9"),
+                                 (3, s["lam"], "tyre deformation lam (m)", "#CC79A7")):
+        x, y = envelope(t, values)
+        series.add_scatter(x=x, y=y, name=name, line={"color": c, "width": 1}, row=row, col=1)
     if has_nes:
-        relative = np.asarray(s["psi"]) - np.asarray(s["psis"])
-        series.add_scatter(x=t, y=relative, name="NES relative rotation psi - psis (rad)",
+        x, y = envelope(t, np.asarray(s["psi"]) - np.asarray(s["psis"]))
+        series.add_scatter(x=x, y=y, name="NES relative rotation psi - psis (rad)",
                            line={"color": "#D55E00", "width": 1}, row=4, col=1)
         series.update_yaxes(title_text="psi - psis (rad)", row=4, col=1)
     series.update_layout(title=style.title(title), height=180 * rows + 110, template="plotly_white",

@@ -139,11 +139,11 @@ def _unit_last(size: int) -> np.ndarray:
 TANGENT_REFINE_TOL = 1e-13
 
 
-def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray, near: _Bordered | None = None) -> np.ndarray:
+def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray, near: Any = None) -> np.ndarray:
     """Unit tangent (w-norm) of the curve at u, oriented along ``previous``.
 
-    ``near``: factors of the same system at a nearby point with the same bordering row (the
-    corrector's last chord matrix): the tangent is found by iterative refinement on them (a
+    ``near``: factors (as :func:`correct` returns them) of the same system at a nearby point
+    with the same bordering row (the corrector's last chord matrix): the tangent is found by iterative refinement on them (a
     solve and a product per sweep, at most 4 sweeps, each required to shrink the residual 4x),
     to ``TANGENT_REFINE_TOL``; only if that fails is the matrix factored here.
     """
@@ -157,7 +157,7 @@ def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray, near: _B
     return t / weighted_norm(t, w)
 
 
-def _refined(near: _Bordered, jac, row: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
+def _refined(near: Any, jac, row: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
     """[jac; row]^-1 rhs by iterative refinement on ``near``'s factors; None if it does not converge."""
     z = near.solve(rhs)
     last = math.inf
@@ -176,7 +176,7 @@ def _refined(near: _Bordered, jac, row: np.ndarray, rhs: np.ndarray) -> np.ndarr
 
 
 def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
-            options: ContinuationOptions) -> tuple[np.ndarray, int, _Bordered] | None:
+            options: ContinuationOptions) -> tuple[np.ndarray, int, Any] | None:
     """Newton on [F(u); <t, u - u_pred>_w] = 0 from u_pred; None if it does not converge.
 
     Chord iterations: the bordered Jacobian is factored at the predictor and refreshed
