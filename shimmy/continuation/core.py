@@ -139,7 +139,8 @@ def _unit_last(size: int) -> np.ndarray:
 TANGENT_REFINE_TOL = 1e-13
 
 
-def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray, near: Any = None) -> np.ndarray:
+def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray,
+            near: Any = None) -> np.ndarray:
     """Unit tangent (w-norm) of the curve at u, oriented along ``previous``.
 
     ``near``: factors (as :func:`correct` returns them) of the same system at a nearby point
