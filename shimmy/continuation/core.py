@@ -144,9 +144,10 @@ def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray,
     """Unit tangent (w-norm) of the curve at u, oriented along ``previous``.
 
     ``near``: factors (as :func:`correct` returns them) of the same system at a nearby point
-    with the same bordering row (the corrector's last chord matrix): the tangent is found by iterative refinement on them (a
-    solve and a product per sweep, at most 4 sweeps, each required to shrink the residual 4x),
-    to ``TANGENT_REFINE_TOL``; only if that fails is the matrix factored here.
+    with the same bordering row (the corrector's last chord matrix): the tangent is found by
+    iterative refinement on them (a solve and a product per sweep, at most 5 solves, each sweep
+    required to shrink the residual 4x) to ``TANGENT_REFINE_TOL``; only if that fails is the
+    matrix factored here.
     """
     w = problem.weights
     jac = problem.jacobian(u)
