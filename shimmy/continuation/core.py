@@ -104,7 +104,7 @@ class _Bordered:
     """
 
     def __init__(self, jac, row: np.ndarray):
-        self.jac, self.row = jac, row
+        self.row = row
         if sp.issparse(jac):
             jac = jac.tocsr()
             size = row.size
@@ -145,35 +145,43 @@ def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray,
 
     ``near``: factors (as :func:`correct` returns them) of the same system at a nearby point
     with the same bordering row (the corrector's last chord matrix): the tangent is found by
-    iterative refinement on them (a solve and a product per sweep, at most 5 solves, each sweep
-    required to shrink the residual 4x) to ``TANGENT_REFINE_TOL``; only if that fails is the
-    matrix factored here.
+    iterative refinement on them (``refine``: a solve and a product per sweep, at most 5
+    sweeps, each required to shrink the residual 4x) to ``TANGENT_REFINE_TOL``; only if that
+    fails is the matrix factored here.
     """
     w = problem.weights
     jac = problem.jacobian(u)
     row = w * previous
     e = _unit_last(u.size)
-    t = _refined(near, jac, row, e) if near is not None and np.array_equal(near.row, row) else None
+    t = None
+    if near is not None and np.array_equal(near.row, row):
+        t = refine(near.solve, lambda z: np.append(jac @ z, row @ z), e,
+                   lambda z: TANGENT_REFINE_TOL * float(np.abs(z).max()), 5)
     if t is None:
         t = _Bordered(jac, row).solve(e)
     return t / weighted_norm(t, w)
 
 
-def _refined(near: Any, jac, row: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
-    """[jac; row]^-1 rhs by iterative refinement on ``near``'s factors; None if it does not converge."""
-    z = near.solve(rhs)
+def refine(solve: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
+           rhs: np.ndarray, tolerance: Callable[[np.ndarray], float], sweeps: int) -> np.ndarray | None:
+    """A^-1 rhs by iterative refinement with ``solve`` (factors of a nearby matrix) and ``apply``
+    (A times a vector): the residual max |rhs - A z| is checked at most ``sweeps`` times, a
+    correction solved after each check it fails, until it is <= tolerance(z); None if that is not
+    reached, the residual is not finite, or a sweep shrinks it less than 4x (the factors are too
+    far off: better refactor)."""
+    z = solve(rhs)
     last = math.inf
-    for _ in range(5):
-        if not np.all(np.isfinite(z)):
-            return None
-        r = rhs - np.append(jac @ z, row @ z)
+    for sweep in range(sweeps):
+        r = rhs - apply(z)
         size = float(np.abs(r).max())
-        if size <= TANGENT_REFINE_TOL * float(np.abs(z).max()):
+        if not math.isfinite(size):
+            return None
+        if size <= tolerance(z):
             return z
-        if size > 0.25 * last:
+        if size > 0.25 * last or sweep == sweeps - 1:
             return None
         last = size
-        z = z + near.solve(r)
+        z = z + solve(r)
     return None
 
 

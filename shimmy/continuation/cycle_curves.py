@@ -53,8 +53,8 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
 from .collocation import Mesh, PeriodicProblem
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate_between, step,
-                   tangent, weighted_norm)
+from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate_between, refine,
+                   step, tangent, weighted_norm)
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
 from .lyapunov import hopf_eigenvectors
 from .periodic_orbits import PeriodicOptions, hopf_guess, multiplier_crossing_test, periodic_branch
@@ -319,19 +319,9 @@ class CycleCurveProblem:
             return None
         op = M.T if trans else M
         mode = "T" if trans else "N"
-        z = self._lu.solve(rhs, trans=mode)
         scale = max(float(np.abs(rhs).max()), 1e-300)
-        last = math.inf
-        for _ in range(6):
-            r = rhs - op @ z
-            size = float(np.abs(r).max())
-            if size <= 1e-13 * scale * max(1.0, float(np.abs(z).max())):
-                return z
-            if size > 0.25 * last:
-                return None
-            last = size
-            z = z + self._lu.solve(r, trans=mode)
-        return None
+        return refine(lambda b: self._lu.solve(b, trans=mode), lambda z: op @ z, rhs,
+                      lambda z: 1e-13 * scale * max(1.0, float(np.abs(z).max())), 6)
 
     def analyse(self, u: np.ndarray, left: bool = True) -> dict:
         """Kernel vectors V, the 2x2 (or 1x1) G and (``left``) the left vectors W of the bordered
