@@ -253,3 +253,25 @@ def test_results_download_as_csv_and_json(server, browser):
 
     data = json.loads((DOWNLOADS / "overview_stability.json").read_text())
     assert set(data["configs"]) == {"original", "nes", "pd", "nes_pd"}
+
+
+def test_a_result_slower_to_arrive_than_the_poll_interval_is_still_drawn(server, browser):
+    """A job's result that takes seconds to reach the page (a slow link here; a loaded machine or a
+    long run elsewhere) is drawn: Dash drops the answer of a callback whose input changed while it
+    was on its way, so a result drawn by the 400 ms poll itself never arrived (plotly/dash#1613)."""
+    browser.get(server.base + "/time-history?config=pd&V=61.3&Fz=187&t_end=10")  # a run no other test asks for
+    run = _wait_for(lambda: browser.find_elements(By.ID, "th-run"), what="the Run button")[0]
+    _idle(browser)
+    browser.set_network_conditions(offline=False, latency=0, download_throughput=100 * 1024,
+                                   upload_throughput=1024 * 1024)  # bytes/s: the result takes seconds
+    try:
+        run.click()
+        _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#th-metrics .metric"), timeout=120,
+                  what="the result over the slow link")
+        slowest = browser.execute_script("return Math.max(...performance.getEntriesByType('resource')"
+                                         ".filter(e => e.name.includes('_dash-update')).map(e => e.duration));")
+        assert slowest > 1000  # ms: the drawn answer did take longer than several poll intervals
+    finally:
+        browser.delete_network_conditions()
+    assert _trace_count(browser, "th-series") > 0
+    assert _severe(browser) == []

@@ -43,8 +43,8 @@ def test_ground_run_page_runs_the_presets_and_a_table(server, browser):  # noqa:
     browser.get_log("browser")
     browser.set_window_size(1440, 900)
     browser.get(server.base + "/ground-run")
-    # Four ground runs as background jobs, queued behind whatever earlier tests left on the shared
-    # server's two job slots: bounded generously, not timed (a loaded CI machine took over 120 s).
+    # Four ground runs as background jobs on the shared server's two job slots: bounded generously
+    # for a loaded machine, not timed.
     rows = _wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=JOB_WAIT,
                      what="the take-off of the four configurations")
     assert [r[0] for r in rows] == NAMES

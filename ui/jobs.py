@@ -9,7 +9,12 @@ results become CSV rows.
 Nothing is computed in the web worker and no process is started by Dash: a Compute submits
 one job per uncached request through :mod:`shimmy.service.jobs`, the admission control the
 API uses (bounded queue, identical requests shared, a full queue refused with a message), and
-an interval reads the jobs' progress until every result is in the cache. At most
+an interval reads the jobs' progress until every result is in the cache. The interval's
+callback only says so (a small answer that stops the interval); a second callback, triggered
+once by that, draws the results. Dash drops the answer of a callback whose input changed again
+while it ran (plotly/dash#1613), so a poll that drew a large figure more slowly than the
+interval (a loaded machine, a long time history) was dropped on every tick and the page never
+showed its result. At most
 ``MAX_PAGE_REQUESTS`` requests per action. The requests of the last answer are kept in a
 store so that the downloads serialise exactly what is drawn, from the cache (a download never
 computes).
@@ -38,8 +43,10 @@ def controls(prefix: str, label: str = "Compute", interval: int = 400) -> list:
 
 
 def stores(prefix: str, store: str | None = None) -> list:
-    """The store of the shown results' requests and the ids of the jobs being waited for."""
-    return [dcc.Store(id=store or f"{prefix}-requests"), dcc.Store(id=f"{prefix}-go")]
+    """The store of the shown results' requests, the ids of the jobs being waited for and the
+    jobs whose results are ready to be drawn."""
+    return [dcc.Store(id=store or f"{prefix}-requests"), dcc.Store(id=f"{prefix}-go"),
+            dcc.Store(id=f"{prefix}-ready")]
 
 
 @dataclass(frozen=True)
@@ -140,29 +147,23 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         return (tuple(busy) + (no_update,) * len(tail) + (go, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
-    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-poll", "n_intervals"),
-                   State(f"{prefix}-go", "data"), prevent_initial_call=True)
+    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Output(f"{prefix}-ready", "data"),
+                   Input(f"{prefix}-poll", "n_intervals"), State(f"{prefix}-go", "data"), prevent_initial_call=True)
     def poll(_n, go):
-        """Progress of the page's jobs; the figure once every result is in the cache."""
+        """Progress of the page's jobs; once every result is in the cache, the interval stops and
+        the ready store tells :func:`show` to draw them."""
         ids, wanted = _waiting(go)
         if not ids:
-            return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update)
+            return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update, no_update)
         current = [jobs.get(i) for i in ids]
         for job in current:
             if job is None or job["status"] == "cancelled":
-                return refused("", "cancelled")
+                return (*refused("", "cancelled"), no_update)
             if job["status"] == "failed":
-                return refused(f"{job['request'].get('config') or analysis}: {job['error']}")
-        if all(job["status"] == "done" for job in current):
-            try:  # the requests came back through the browser's JSON (150000.0 as 150000): canonical again
-                wanted = canonical(analysis, wanted)
-                names = None if labels is None else _names(go.get("labels"), wanted)
-            except InvalidParameterError as exc:
-                return refused(str(exc))
-            results = [cache.get(analysis, r) for r in wanted]
-            if any(r is None for r in results):
-                return refused("A result left the cache before it could be shown; press Compute again.")
-            return shown(results, wanted, names)
+                return (*refused(f"{job['request'].get('config') or analysis}: {job['error']}"), no_update)
+        if all(job["status"] == "done" for job in current):  # drawn by show(), not in this tick
+            return ((no_update,) * (n_out + len(tail)) + (no_update, True, no_update, True)
+                    + (no_update,) * len(lock) + ("100", "drawing the results…", {**go, "tick": _n}))
         fraction = sum(job["progress"] if job["status"] == "running" else 0.0 for job in current) / len(current)
         first = next(job for job in current if job["status"] != "done")
         label = first["request"].get("config") or analysis
@@ -170,7 +171,24 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         of = f" [{done} of {len(current)} analyses done]" if len(current) > 1 else ""
         status = (f"{label}: {first['message']}{of}" if first["status"] == "running"
                   else f"{label}: queued ({jobs.counts()['running']} analyses running){of}")
-        return (no_update,) * (n_out + len(tail) + len(state) - 2) + (str(int(100 * fraction)), status)
+        return (no_update,) * (n_out + len(tail) + len(state) - 2) + (str(int(100 * fraction)), status, no_update)
+
+    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-ready", "data"),
+                   prevent_initial_call=True)
+    def show(ready):
+        """The results of the jobs the poll found done, drawn (once per ready signal)."""
+        ids, wanted = _waiting(ready)
+        if not ids:
+            return (no_update,) * (n_out + len(tail) + len(state))
+        try:  # the requests came back through the browser's JSON (150000.0 as 150000): canonical again
+            wanted = canonical(analysis, wanted)
+            names = None if labels is None else _names(ready.get("labels"), wanted)
+        except InvalidParameterError as exc:
+            return refused(str(exc))
+        results = [cache.get(analysis, r) for r in wanted]
+        if any(r is None for r in results):
+            return refused("A result left the cache before it could be shown; press Compute again.")
+        return shown(results, wanted, names)
 
     @dash.callback(Output(f"{prefix}-cancel", "disabled", allow_duplicate=True),
                    Output(f"{prefix}-status", "children", allow_duplicate=True),
