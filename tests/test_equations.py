@@ -117,6 +117,28 @@ def test_one_pass_evaluation_equals_the_separate_functions(config, exact_nes):
         np.testing.assert_array_equal(dFz, ref_dFz)
 
 
+@pytest.mark.parametrize("exact_nes", [False, True])
+@pytest.mark.parametrize("config", ALL_CONFIGURATIONS, ids=lambda c: c.value)
+def test_one_state_path_equals_the_columns_path(config, exact_nes):
+    """One real state at one speed and load (a compiled path of its own, for speed) gives exactly
+    what the same state as a column gives; the other shapes (a complex state, an integer speed, a
+    state of the wrong length) still take the general path."""
+    model = build_model(config, exact_nes=exact_nes)
+    x = random_states(model.n_states)
+    for k in range(x.shape[1]):
+        one = np.ascontiguousarray(x[:, k])
+        f, J, dV, dFz = field_and_derivatives(model, one, 52.0, 3.1e5)
+        fc, Jc, dVc, dFzc = field_and_derivatives(model, x[:, k:k + 1], 52.0, 3.1e5)
+        assert f.shape == dV.shape == dFz.shape == (model.n_states,) and J.shape == (model.n_states,) * 2
+        np.testing.assert_array_equal(f, fc[:, 0])
+        np.testing.assert_array_equal(J, Jc[0])
+        np.testing.assert_array_equal(dV, dVc[:, 0])
+        np.testing.assert_array_equal(dFz, dFzc[:, 0])
+        np.testing.assert_array_equal(rhs(model, one, 52, 310000), fc[:, 0])
+        np.testing.assert_array_equal(jacobian(model, one, np.float64(52.0), 3.1e5), Jc[0])
+    assert jacobian(model, x[:, 0].astype(complex), 52.0, 3.1e5).dtype == complex
+
+
 @pytest.mark.parametrize("config", ALL_CONFIGURATIONS, ids=lambda c: c.value)
 def test_complex_step_in_v_of_the_field_gives_its_v_derivative(config):
     """The compiled loop runs on complex states and speeds (the stability module's complex steps):

@@ -18,6 +18,7 @@ vector by :func:`model_coefficients`, indexed by the module constants below.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -59,7 +60,7 @@ class Model:
     def n_states(self) -> int:
         return self.config.n_states
 
-    @property
+    @functools.cached_property
     def flags(self) -> tuple[bool, bool, bool]:
         return self.config.has_nes, self.config.has_pd, self.exact_nes
 
@@ -233,6 +234,32 @@ def _evaluate_columns(X, V, Fz, c, has_nes, has_pd, exact_nes, F, J, dV, dFz, wa
                            has_nes, has_pd, exact_nes, J[k], dV[:, k], dFz[:, k])
 
 
+@njit(cache=True)
+def _evaluate_one(x, V, Fz, c, has_nes, has_pd, exact_nes, want_f, want_derivatives):
+    """f (n,), d f / d x (n, n), d f / d V and d f / d Fz (n,) at one real state (empty when not wanted)."""
+    n = x.shape[0]
+    psis = x[5] if has_nes else 0.0
+    dpsis = x[6] if has_nes else 0.0
+    F = np.empty(n if want_f else 0)
+    J = np.zeros((n, n) if want_derivatives else (0, 0))
+    dV = np.zeros(n if want_derivatives else 0)
+    dFz = np.zeros(n if want_derivatives else 0)
+    if want_f:
+        d = vector_field(x[0], x[1], x[2], x[3], x[4], psis, dpsis, V, Fz, c, has_nes, has_pd, exact_nes)
+        for i in range(n):
+            F[i] = d[i]
+    if want_derivatives:
+        derivatives_at(x[0], x[1], x[2], x[3], x[4], psis, dpsis, V, Fz, c, has_nes, has_pd, exact_nes, J, dV, dFz)
+    return F, J, dV, dFz
+
+
+def _one_state(model: Model, x, V, Fz) -> bool:
+    """The engine's commonest call: one real state at one speed and load (the compiled single-state
+    path, without the columns' packing)."""
+    return (type(x) is np.ndarray and x.ndim == 1 and x.dtype == np.float64 and x.shape[0] == model.n_states
+            and isinstance(V, (float, int)) and isinstance(Fz, (float, int)))
+
+
 def _check_states(model: Model, x) -> np.ndarray:
     x = np.asarray(x)
     if x.shape[0] != model.n_states:
@@ -269,18 +296,24 @@ def _evaluate(model: Model, x, V, Fz, want_f: bool, want_derivatives: bool):
 
 def rhs(model: Model, x, V, Fz):
     """f(x; V, Fz), shaped like x broadcast against V and Fz."""
+    if _one_state(model, x, V, Fz):
+        return _evaluate_one(x, float(V), float(Fz), model.coefficients, *model.flags, True, False)[0]
     shape, F, _, _, _ = _evaluate(model, x, V, Fz, True, False)
     return F.reshape((model.n_states,) + shape)
 
 
 def jacobian(model: Model, x, V, Fz):
     """Analytic d f / d x: ``(n, n)`` for one state, ``(m, n, n)`` for columns."""
+    if _one_state(model, x, V, Fz):
+        return _evaluate_one(x, float(V), float(Fz), model.coefficients, *model.flags, False, True)[1]
     shape, _, J, _, _ = _evaluate(model, x, V, Fz, False, True)
     return J.reshape(shape + J.shape[1:])
 
 
 def parameter_jacobian(model: Model, x, V, Fz):
     """(d f / d V, d f / d Fz), each shaped like ``x``."""
+    if _one_state(model, x, V, Fz):
+        return _evaluate_one(x, float(V), float(Fz), model.coefficients, *model.flags, False, True)[2:]
     shape, _, _, dV, dFz = _evaluate(model, x, V, Fz, False, True)
     n = model.n_states
     return dV.reshape((n,) + shape), dFz.reshape((n,) + shape)
@@ -289,6 +322,8 @@ def parameter_jacobian(model: Model, x, V, Fz):
 def field_and_derivatives(model: Model, x, V, Fz):
     """(f, d f / d x, d f / d V, d f / d Fz) in one compiled pass, shaped as :func:`rhs`,
     :func:`jacobian` and :func:`parameter_jacobian` give them."""
+    if _one_state(model, x, V, Fz):
+        return _evaluate_one(x, float(V), float(Fz), model.coefficients, *model.flags, True, True)
     shape, F, J, dV, dFz = _evaluate(model, x, V, Fz, True, True)
     n = model.n_states
     return (F.reshape((n,) + shape), J.reshape(shape + J.shape[1:]), dV.reshape((n,) + shape),
