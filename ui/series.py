@@ -8,9 +8,8 @@ import numpy as np
 
 #: The time series are drawn as their envelope on this many time buckets (the lowest and highest
 #: sample of each, in time order): a 60 s run at 2 ms is 30 001 samples a trace, a figure of
-#: several MB that Chromium's Dash renderer does not apply (seen with 3.4 MB; 0.6 MB works),
-#: while 2000 buckets are more than the plot's width in pixels. The phase portrait and the
-#: downloads keep every sample.
+#: several MB to send and draw, while 2000 buckets are more than the plot's width in pixels.
+#: The phase portrait and the downloads keep every sample.
 ENVELOPE_BUCKETS = 2000
 
 

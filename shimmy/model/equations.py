@@ -236,21 +236,16 @@ def _evaluate_columns(X, V, Fz, c, has_nes, has_pd, exact_nes, F, J, dV, dFz, wa
 
 @njit(cache=True)
 def _evaluate_one(x, V, Fz, c, has_nes, has_pd, exact_nes, want_f, want_derivatives):
-    """f (n,), d f / d x (n, n), d f / d V and d f / d Fz (n,) at one real state (empty when not wanted)."""
+    """f (n,), d f / d x (n, n), d f / d V and d f / d Fz (n,) at one real state: the columns'
+    loop on one column, without the packing the Python side of :func:`_evaluate` does."""
     n = x.shape[0]
-    psis = x[5] if has_nes else 0.0
-    dpsis = x[6] if has_nes else 0.0
-    F = np.empty(n if want_f else 0)
-    J = np.zeros((n, n) if want_derivatives else (0, 0))
-    dV = np.zeros(n if want_derivatives else 0)
-    dFz = np.zeros(n if want_derivatives else 0)
-    if want_f:
-        d = vector_field(x[0], x[1], x[2], x[3], x[4], psis, dpsis, V, Fz, c, has_nes, has_pd, exact_nes)
-        for i in range(n):
-            F[i] = d[i]
-    if want_derivatives:
-        derivatives_at(x[0], x[1], x[2], x[3], x[4], psis, dpsis, V, Fz, c, has_nes, has_pd, exact_nes, J, dV, dFz)
-    return F, J, dV, dFz
+    F = np.empty((n, 1))
+    J = np.zeros((1, n, n))
+    dV = np.zeros((n, 1))
+    dFz = np.zeros((n, 1))
+    _evaluate_columns(np.ascontiguousarray(x).reshape((n, 1)), np.full(1, V), np.full(1, Fz), c, has_nes, has_pd,
+                      exact_nes, F, J, dV, dFz, want_f, want_derivatives)
+    return F[:, 0], J[0], dV[:, 0], dFz[:, 0]
 
 
 def _one_state(model: Model, x, V, Fz) -> bool:
