@@ -25,7 +25,8 @@ FZ = Quantity("simulate", "Fz", "Fz", "kN", 1e3)
 T_END = Quantity("simulate", "t_end", "simulated time", "s")
 PSI0 = Quantity("simulate", "psi0", "initial psi", "rad")
 LATERAL0 = Quantity("simulate", "lateral0", "initial l_g delta", "m")
-#: The starts offered: REFERENCE.md's, and one large enough to reach each attractor of a bistable point.
+#: The starts offered: the standard one (psi = 0.001 rad), and ones large enough to reach each
+#: attractor of a bistable point.
 STARTS = {"standard": ("standard: psi = 0.001 rad", 0.001, 0.0),
           "torsional": ("large torsional: psi = 0.2 rad", 0.2, 0.0),
           "lateral": ("large lateral: l_g delta = 0.1 m", 0.0, 0.1),
@@ -55,11 +56,11 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
     series, spectrum, phase, _ = _placeholders()
     return page(
         query, "th",
-        ui.header("Time history", "The gear at one operating point, from a start you choose (REFERENCE.md's is "
-                  "psi = 0.001 rad, the rest at rest): torsion and lateral bending against time, the spectrum of the "
-                  "steady window with its dominant frequency, and the torsional phase portrait. A bistable point "
-                  "settles on a different limit cycle from a large torsional or a large lateral start. Runs in the "
-                  "background; repeated questions come from the cache."),
+        ui.header("Time history", "The gear at one operating point, from a start you choose (the standard "
+                  "start is psi = 0.001 rad, the rest at rest): torsion and lateral bending against time, the "
+                  "spectrum of the steady window with its dominant frequency, and the torsional phase portrait. A "
+                  "bistable point settles on a different limit cycle from a large torsional or a large lateral "
+                  "start. Runs in the background; repeated questions come from the cache."),
         html.Div([
             ui.field("Configuration", dcc.Dropdown(id="th-config", options=CONFIG_OPTIONS, value=config,
                                                    clearable=False, style={"width": "160px"})),

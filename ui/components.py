@@ -16,7 +16,7 @@ def _whole(x: float) -> float | int:
     return int(x) if float(x).is_integer() else x
 
 
-#: REFERENCE.md's operating points: name -> (V m/s, Fz kN), from the package's definition in N.
+#: The study's nine operating points A-I: name -> (V m/s, Fz kN), from the package's definition in N.
 OPERATING_POINTS = {name: (_whole(v), _whole(fz / 1e3)) for name, (v, fz) in _OPERATING_POINTS_N.items()}
 
 GRAPH_CONFIG = {"displaylogo": False, "toImageButtonOptions": {"format": "png", "scale": 2}}

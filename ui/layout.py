@@ -12,7 +12,7 @@ from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
 
 from . import sessions, state
 
-#: The design parameters with sliders (PRODUCT.md); every other one is in the advanced panel.
+#: The design parameters with sliders (the six a device design moves); every other one is in the advanced panel.
 DESIGN = ("r2", "e_p", "k_s", "r3", "a_p", "rho_p")
 ADVANCED = tuple(n for n in PARAMETER_SPECS if n not in DESIGN)
 SLIDER_STEPS = 200

@@ -522,7 +522,7 @@ SCHEMAS: dict[str, RequestSchema] = {
         Field("series_dt", "number", "sampling interval of the returned series (a multiple of 1 ms)",
               default=0.002, low=0.001, high=0.1, unit="s"),
         Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
-        Field("psi0", "number", "initial torsion psi (REFERENCE.md's start: 0.001 rad; the rest of the state zero "
+        Field("psi0", "number", "initial torsion psi (the standard start: 0.001 rad; the rest of the state zero "
               "unless lateral0 is given)", default=0.001, low=-0.5, high=0.5, unit="rad"),
         Field("lateral0", "number", "initial lateral bending displacement l_g delta", default=0.0, low=-0.5,
               high=0.5, unit="m"),
