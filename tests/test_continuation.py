@@ -199,6 +199,31 @@ def test_curvature_predictor_estimates_the_circles_curvature_and_keeps_its_point
     tracer.point = CurvePoint(u.copy(), t.copy())
     assert tracer.curvature() is None
 
+def test_chord_control_bounds_how_far_each_drawn_step_strays_from_the_curve():
+    """With a chord check (the cubic's midpoint deviation h/8 |t_a - t_b| over a tolerance) every
+    accepted step of a circle of radius R has a sagitta R (1 - cos(angle / 2)) within the
+    tolerance (to the estimate's O(h^4)), and the steps still use most of it; without the check
+    the same options draw chords far off the circle."""
+    from shimmy.continuation.core import CurvePoint, Tracer
+
+    R, tol = 2.0, 1e-3
+    options = ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=100, tol=1e-12, residual_tol=1e-12)
+
+    def sagittas(chord):
+        tracer = Tracer(_Circle(R), CurvePoint(np.array([R, 0.0]), np.array([0.0, 1.0])), options, chord=chord)
+        points = [tracer.point.u]
+        for _ in range(30):
+            tracer.advance()
+            points.append(tracer.point.u)
+        angles = [math.atan2(a[0] * b[1] - a[1] * b[0], a @ b) for a, b in zip(points[:-1], points[1:], strict=True)]
+        return np.array([R * (1.0 - math.cos(0.5 * abs(a))) for a in angles])
+
+    controlled = sagittas(lambda problem, a, b, h: 0.125 * h * float(np.linalg.norm(a.tangent - b.tangent)) / tol)
+    assert controlled.max() <= 1.05 * tol
+    assert controlled.max() >= 0.3 * tol
+    assert sagittas(None).max() > 10 * tol
+
+
 # --------------------------------------------------------------------------- equilibria
 
 

@@ -292,3 +292,13 @@ def test_torus_curve_started_beside_the_double_hopf_point():
     np.testing.assert_allclose(curve.kappa, math.cos(2 * math.pi * 2.3), atol=1e-8)
     assert curve.p[:, 0].max() == pytest.approx(0.5) and curve.p[:, 0].min() < 1e-3
     assert any("amplitude shrank to zero" in r for r in curve.stop_reasons)  # ends at the double-Hopf point
+
+
+@pytest.mark.parametrize("name, value", [("chord_tol", 0.0), ("chord_tol", 2.0), ("chord_tol", math.nan),
+                                         ("amplitude_min", 1.0), ("adapt_every", -1)])
+def test_bad_curve_options_name_the_field(name, value):
+    from shimmy.continuation import CycleCurveOptions
+
+    with pytest.raises(InvalidInputError) as info:
+        CycleCurveOptions(**{name: value})
+    assert info.value.field == name

@@ -8,7 +8,8 @@ Generic: nothing here knows the landing gear. A *curve problem* supplies
 * ``accept(u)``: called once a point is accepted (the periodic-orbit problem moves its
   phase reference there).
 
-Each step: predictor u_pred = u + h t (t the unit tangent in the w-norm), corrector =
+Each step: predictor u_pred = u + h t + h^2/2 dt/ds (t the unit tangent in the w-norm; the
+curvature term from the last step, orthogonal to t: :meth:`Tracer.curvature`), corrector =
 Newton on [F(u); <t, u - u_pred>_w] = 0 with the bordered Jacobian [F_u; (w t)^T]
 (sparse LU when F_u is sparse). Converged when the w-norm of the Newton correction is
 below ``tol`` and |F|_inf below ``residual_tol``; chord iterations, the Jacobian refactored
@@ -261,10 +262,18 @@ def step(problem: CurveProblem, point: CurvePoint, h: float, options: Continuati
 
 
 class Tracer:
-    """Successive points of a curve with step-size control."""
+    """Successive points of a curve with step-size control.
 
-    def __init__(self, problem: CurveProblem, start: CurvePoint, options: ContinuationOptions):
+    ``chord(problem, a, b, h)``, optional: the error of drawing the step from point a to point b
+    (arclength h) as a straight segment, over what the caller allows (for example the deviation
+    of the cubic through both points and tangents from their chord, in the coordinates that are
+    drawn). A step with a ratio above 1 is refused and retried shorter (the error grows like
+    h^2); the step grows only while the ratio is at most 0.5."""
+
+    def __init__(self, problem: CurveProblem, start: CurvePoint, options: ContinuationOptions,
+                 chord: Callable[[Any, CurvePoint, CurvePoint, float], float] | None = None):
         self.problem, self.options = problem, options
+        self.chord = chord
         self.point = start
         self.h = options.ds
         self.failed: str | None = None
@@ -307,15 +316,20 @@ class Tracer:
             if new is None and bend is not None:
                 new = step(self.problem, self.point, self.h, opts)
             angle = self._turn(new) if new is not None else 0.0
-            if new is not None and (angle <= opts.max_angle or self.h * opts.shrink < opts.ds_min):
+            chord = self.chord(self.problem, self.point, new, self.h) if new is not None and self.chord else 0.0
+            last_chance = self.h * opts.shrink < opts.ds_min
+            if new is not None and ((angle <= opts.max_angle and chord <= 1.0) or last_chance):
                 taken = self.h
-                if new.iterations <= 4 and angle <= 0.5 * opts.max_angle:
+                if new.iterations <= 4 and angle <= 0.5 * opts.max_angle and chord <= 0.5:
                     self.h = min(self.h * opts.grow, opts.ds_max)
                 self.problem.accept(new.u)
                 self._last = (self.problem, new, self.point.tangent, taken)
                 self.point = new
                 return new, taken
-            self.h *= opts.shrink
+            if new is not None and angle <= opts.max_angle:  # refused for its chord: to ~0.8 of the limit
+                self.h *= min(opts.shrink, max(0.2, 0.9 / math.sqrt(chord)))
+            else:
+                self.h *= opts.shrink
             if self.h < opts.ds_min:
                 self.failed = (f"Newton did not converge with step {self.h / opts.shrink:.2g} "
                                f"(minimum {opts.ds_min:g})")

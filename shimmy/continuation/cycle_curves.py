@@ -131,6 +131,10 @@ class CycleCurveOptions:
     adapt_every: int = 10
     period_max: float = math.inf
     amplitude_min: float = 0.02  # end: amplitude below this fraction of the curve's largest
+    #: the drawn polyline in (p1, p2): each step's chord strays from the curve (the midpoint of
+    #: the cubic through both points with their tangents) by at most this fraction of each
+    #: parameter (at least a tenth of its scale)
+    chord_tol: float = 5e-3
     kappa_weight: float = 1.0
     continuation: ContinuationOptions = field(default_factory=lambda: ContinuationOptions(ds=0.05, ds_max=0.5,
                                                                                          max_steps=300))
@@ -138,6 +142,8 @@ class CycleCurveOptions:
     def __post_init__(self):
         if not (isinstance(self.adapt_every, int) and self.adapt_every >= 0):
             raise InvalidInputError("adapt_every", self.adapt_every, "an integer >= 0 (0: never)")
+        if not (isinstance(self.chord_tol, (int, float)) and 0.0 < self.chord_tol <= 1.0):
+            raise InvalidInputError("chord_tol", self.chord_tol, "a number in (0, 1]")
         if not 0.0 < self.amplitude_min < 1.0:
             raise InvalidInputError("amplitude_min", self.amplitude_min, "a number in (0, 1)")
 
@@ -624,7 +630,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
     rows: dict[str, list] = {k: [] for k in ("p", "T", "xmax", "xmin", "kappa", "mu", "solutions")}
     problem.accept(start.u)
     mu = _record(problem, rows, start)
-    tracer = Tracer(problem, start, copts)
+    tracer = Tracer(problem, start, copts, chord=lambda pr, a, b, h: _chord_ratio(pr, a, b, h, options.chord_tol))
     special: list[SpecialPoint] = []
 
     def p_direction(point):
@@ -700,6 +706,17 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         if options.adapt_every and steps % options.adapt_every == 0:
             problem = _remesh(problem, tracer, copts)
     return rows, special, reason, steps, closed
+
+
+def _chord_ratio(problem: CycleCurveProblem, a: CurvePoint, b: CurvePoint, h: float, tol: float) -> float:
+    """How far the step from a to b strays from its chord in the parameter plane, over the
+    allowed ``tol`` of each parameter (relative to its size, at least a tenth of its scale): the
+    cubic through both points with their tangents (d/ds, s the weighted arclength h) lies
+    h/8 (t_a - t_b) from the chord at the middle."""
+    i = problem.n_x + 1
+    p = np.abs(np.stack([a.u[i:i + 2], b.u[i:i + 2]])).max(axis=0)
+    allowed = tol * np.maximum(p, 0.1 * problem.p_scale)
+    return float(np.max(np.abs(0.125 * h * (a.tangent[i:i + 2] - b.tangent[i:i + 2])) / allowed))
 
 
 def _remesh(problem: CycleCurveProblem, tracer: Tracer, copts: ContinuationOptions) -> CycleCurveProblem:
