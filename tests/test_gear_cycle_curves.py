@@ -97,3 +97,20 @@ def test_bad_requests_name_the_field():
         cycle_curves("original", kinds=("LPC", "XX"))
     with pytest.raises(InvalidParameterError, match=r"loads\[0\]"):
         cycle_curves("original", loads=(5e6,))
+
+
+def test_a_torus_start_at_a_strong_resonance_gives_no_one_point_curve():
+    """`pd` at 243.7 kN: a diagram's NS point with its multipliers at -0.9994 (next to 1:2) leaves
+    kappa's range [-1, 1] in both directions at once. That is not a curve (one point bounds no
+    region): the search is told why, in a warning, and keeps no curve for it."""
+    from shimmy.analyses.cycle_curves import _continue, starts_of_diagram
+    from shimmy.model.configurations import Configuration
+    from shimmy.model.parameters import Parameters
+
+    Fz = 243687.15083798883  # a slice of the pd map
+    diagram = bifurcation("pd", Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    near_r2 = [s for s in starts_of_diagram(diagram, Fz) if s.kind == "NS" and s.point.data["torus_angle"] > 3.1]
+    assert near_r2
+    for start in near_r2:
+        curve, warning = _continue((Configuration.parse("pd"), Parameters(), start, ((1.0, 200.0), (1e4, 9e5)), ()))
+        assert curve is None and "gives no curve" in warning and "kappa = -1 left" in warning

@@ -414,6 +414,9 @@ def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
     except ContinuationError as exc:
         return None, (f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin}) "
                       f"not continued: {exc}")
+    if len(curve.p) < 2:  # stopped at its start both ways (a start at a strong resonance): no curve to draw
+        return None, (f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin}) "
+                      f"gives no curve: {'; '.join(curve.stop_reasons)}")
     return GearCycleCurve(start.kind, curve, start.origin), None
 
 
