@@ -408,15 +408,14 @@ def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
     kappa = math.cos(start.point.data["torus_angle"]) if start.kind == "NS" else None
     if kappa is not None and not -1.0 < kappa < 1.0:
         return None, None
+    about = f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin})"
     try:
         curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box, STATE_SCALE[:system.n],
                             (V_SCALE, FZ_SCALE), kappa=kappa, options=CURVE_OPTIONS, ncol=start.ncol, p2_marks=loads)
     except ContinuationError as exc:
-        return None, (f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin}) "
-                      f"not continued: {exc}")
+        return None, f"{about} not continued: {exc}"
     if len(curve.p) < 2:  # stopped at its start both ways (a start at a strong resonance): no curve to draw
-        return None, (f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin}) "
-                      f"gives no curve: {'; '.join(curve.stop_reasons)}")
+        return None, f"{about} gives no curve: {'; '.join(curve.stop_reasons)}"
     return GearCycleCurve(start.kind, curve, start.origin), None
 
 

@@ -289,8 +289,6 @@ class Tracer:
         if not self._current():
             return None
         _, point, before, h_last = self._last
-        if before.shape != point.tangent.shape:
-            return None
         w = self.problem.weights
         t = point.tangent
         c = (t - before) / h_last
