@@ -1,6 +1,7 @@
 """A continuation engine for any x' = f(x, p): equilibria, periodic orbits, Hopf curves.
 
-Generic: numpy and scipy only, nothing of the landing gear; tested on textbook systems.
+Generic: numpy and scipy only (numba compiles the condensed LU), nothing of the landing gear; tested on
+textbook systems.
 
 * :mod:`.core`: pseudo-arclength continuation of F(u) = 0 (predictor, bordered Newton
   corrector, step control, location of special points), the :class:`VectorField` every

@@ -34,6 +34,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
+from .condensed_lu import ChainLayout, collocation_layout
 from .core import VectorField
 
 
@@ -169,6 +170,15 @@ class PeriodicProblem:
         self._indices = (unique % (self.n_x + 2)).astype(np.int32)
         counts = np.bincount(unique // (self.n_x + 2), minlength=self.n_equations)
         self._indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+
+    @cached_property
+    def chain_layout(self) -> ChainLayout:
+        """Roles of the rows and columns of the bordered Jacobian [jacobian; row] for its condensed
+        LU (:mod:`.condensed_lu`): the mesh intervals are the links; T and p, the periodicity,
+        phase and bordering rows are the globals."""
+        n_coll = self.mesh.ntst * self.mesh.ncol * self.n
+        return collocation_layout(self.mesh.ntst, self.mesh.ncol, self.n, self.n_x + 2, [(0, 0)], [],
+                                  np.array([self.n_x, self.n_x + 1]), n_coll + np.arange(self.n + 2))
 
     # -- unknowns ------------------------------------------------------------------------
     def unpack(self, u: np.ndarray) -> tuple[np.ndarray, float, float]:

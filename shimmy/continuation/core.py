@@ -38,6 +38,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from .condensed_lu import CondensedLU
 from .errors import InvalidInputError
 
 
@@ -99,12 +100,15 @@ class CurvePoint:
 class _Bordered:
     """LU factors of the square matrix [jac; row] (jac dense, or scipy.sparse CSR).
 
-    Sparse: the CSR arrays of [jac; row] are the CSC arrays of its transpose, which SuperLU
-    factors (ordering MMD on A^T + A, the best of SuperLU's orderings on collocation
+    Sparse with a ``layout`` (:class:`~.condensed_lu.ChainLayout`, the problem's
+    ``chain_layout``: a collocation matrix): condensed LU of the mesh intervals; if that meets
+    a zero pivot (its pivoting is restricted to neighbouring intervals), SuperLU as below.
+    Sparse otherwise: the CSR arrays of [jac; row] are the CSC arrays of its transpose, which
+    SuperLU factors (ordering MMD on A^T + A, the best of SuperLU's orderings on collocation
     matrices) and solves with ``trans="T"``: no format conversion.
     """
 
-    def __init__(self, jac, row: np.ndarray):
+    def __init__(self, jac, row: np.ndarray, layout=None):
         self.row = row
         if sp.issparse(jac):
             jac = jac.tocsr()
@@ -112,6 +116,13 @@ class _Bordered:
             data = np.concatenate([jac.data, row])
             indices = np.concatenate([jac.indices, np.arange(size, dtype=jac.indices.dtype)])
             indptr = np.append(jac.indptr, jac.indptr[-1] + size)
+            if layout is not None:
+                try:
+                    condensed = CondensedLU(sp.csr_matrix((data, indices, indptr), shape=(size, size)), layout)
+                    self.solve = condensed.solve
+                    return
+                except np.linalg.LinAlgError:
+                    pass
             transpose = sp.csc_matrix((data, indices, indptr), shape=(size, size))
             lu = splu(transpose, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
             self.solve = lambda rhs: lu.solve(rhs, trans="T")
@@ -159,7 +170,7 @@ def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray,
         t = refine(near.solve, lambda z: np.append(jac @ z, row @ z), e,
                    lambda z: TANGENT_REFINE_TOL * float(np.abs(z).max()), 5)
     if t is None:
-        t = _Bordered(jac, row).solve(e)
+        t = _Bordered(jac, row, getattr(problem, "chain_layout", None)).solve(e)
     return t / weighted_norm(t, w)
 
 
@@ -207,7 +218,7 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
             if factorisations == options.max_newton:
                 return None
             try:
-                lu = _Bordered(problem.jacobian(u), row)
+                lu = _Bordered(problem.jacobian(u), row, getattr(problem, "chain_layout", None))
             except (RuntimeError, ValueError, np.linalg.LinAlgError):  # singular matrix
                 return None
             fresh, factorisations = True, factorisations + 1

@@ -46,6 +46,7 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import Any, Callable
 
 import numpy as np
@@ -53,6 +54,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
 from .collocation import Mesh, PeriodicProblem
+from .condensed_lu import ChainLayout, CondensedLU, collocation_layout
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate_between, refine,
                    step, tangent, weighted_norm)
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
@@ -176,6 +178,13 @@ class CycleCurve:
 # --------------------------------------------------------------------------- the defining systems
 
 
+#: Refinement sweeps of the test matrix's solves on the last factors before it is factored
+#: afresh (fewer: more factorisations; measured best at 6 on the gear's curves), and on
+#: fresh factors.
+REFINE_SWEEPS = 6
+FRESH_SWEEPS = 3
+
+
 class CycleCurveProblem:
     """The minimally augmented system of one curve type on one mesh, as a curve problem."""
 
@@ -210,6 +219,40 @@ class CycleCurveProblem:
 
     def kappa(self, u: np.ndarray) -> float:
         return float(u[self.n_x + 3]) if self.kind is CycleBifurcation.NS else math.nan
+
+    @cached_property
+    def chain_layout(self) -> ChainLayout:
+        """Roles of the rows and columns of the Newton matrix [jacobian; row] for its condensed LU:
+        the mesh intervals are the links; T, p1, p2 (and kappa) and the periodicity, phase, test
+        function and bordering rows are the globals."""
+        n_x, n_coll, n = self.n_x, self.n_coll, self.n
+        return collocation_layout(self.mesh.ntst, self.mesh.ncol, n, self.size, [(0, 0)], [],
+                                  np.arange(n_x, self.size), n_coll + np.arange(self.size - n_coll))
+
+    @cached_property
+    def test_layout(self) -> ChainLayout:
+        """Roles of the rows and columns of the bordered test matrix [[A, B], [C^T, 0]] (LPC: the
+        period column and the periodicity and phase rows are globals beside the borders; PD: the
+        anti-periodic rows; NS: the two periods are two copies of the mesh joined by the continuity
+        rows, the boundary condition rows are globals)."""
+        n_x, n_coll, n, m, k = self.n_x, self.n_coll, self.n, self.m, self.k
+        mesh = self.mesh
+        borders_c, borders_r = m + np.arange(k), m + np.arange(k)
+        if self.kind is CycleBifurcation.NS:
+            return collocation_layout(mesh.ntst, mesh.ncol, n, m + k, [(0, 0), (n_coll, n_x)],
+                                      [2 * n_coll + np.arange(n)], borders_c,
+                                      np.concatenate([2 * n_coll + n + np.arange(n), borders_r]))
+        extra = [n_x] if self.kind is CycleBifurcation.LPC else []  # the period's column
+        return collocation_layout(mesh.ntst, mesh.ncol, n, m + k, [(0, 0)], [], np.concatenate([extra, borders_c]),
+                                  np.concatenate([n_coll + np.arange(m - n_coll), borders_r]))
+
+    def _factor(self, M: sp.csc_matrix):
+        """LU factors of the bordered test matrix: condensed (:mod:`.condensed_lu`); SuperLU if
+        that meets a zero pivot."""
+        try:
+            return CondensedLU(M, self.test_layout)
+        except np.linalg.LinAlgError:
+            return splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
 
     # -- the cycle equations in (x, T, p1, p2[, kappa]) ------------------------------------------
     def cycle_jacobian(self, u: np.ndarray) -> sp.csr_matrix:
@@ -316,7 +359,7 @@ class CycleCurveProblem:
         size = self.m + self.k
         return sp.csc_matrix((data, self._indices, self._indptr), shape=(size, size))
 
-    def _solve(self, M: sp.csc_matrix, rhs: np.ndarray, trans: bool) -> np.ndarray | None:
+    def _solve(self, M: sp.csc_matrix, rhs: np.ndarray, trans: bool, sweeps: int | None = None) -> np.ndarray | None:
         """M^-1 rhs (or M^-T rhs) by iterative refinement on the last LU factors (those of a nearby
         point: a Newton iterate, the previous point); None if the residual does not reach 1e-13
         of the solution (a looser 1e-12 leaves the test functions noisy enough to slow Newton), or
@@ -326,8 +369,9 @@ class CycleCurveProblem:
         op = M.T if trans else M
         mode = "T" if trans else "N"
         scale = max(float(np.abs(rhs).max()), 1e-300)
+        sweeps = REFINE_SWEEPS if sweeps is None else sweeps
         return refine(lambda b: self._lu.solve(b, trans=mode), lambda z: op @ z, rhs,
-                      lambda z: 1e-13 * scale * max(1.0, float(np.abs(z).max())), 6)
+                      lambda z: 1e-13 * scale * max(1.0, float(np.abs(z).max())), sweeps)
 
     def analyse(self, u: np.ndarray, left: bool = True) -> dict:
         """Kernel vectors V, the 2x2 (or 1x1) G and (``left``) the left vectors W of the bordered
@@ -346,11 +390,13 @@ class CycleCurveProblem:
         if right is None:
             right = self._solve(M, rhs, False)
         solved = right is not None and (not left or (lhs := self._solve(M, rhs, True)) is not None)
-        if not solved:
-            self._lu = splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
-            right = self._lu.solve(rhs)
+        if not solved:  # refactor; the solves are refined on the new factors too
+            self._lu = self._factor(M)
+            right = self._solve(M, rhs, False, FRESH_SWEEPS)
+            right = self._lu.solve(rhs) if right is None else right
             if left:
-                lhs = self._lu.solve(rhs, trans="T")
+                lhs = self._solve(M, rhs, True, FRESH_SWEEPS)
+                lhs = self._lu.solve(rhs, trans="T") if lhs is None else lhs
         out = {"_right": right, "V": right[:m], "G": right[m:]}
         if left:
             out.update({"W": lhs[:m], "GT": lhs[m:]})
@@ -390,8 +436,11 @@ class CycleCurveProblem:
 
     def jacobian(self, u: np.ndarray):
         data = self.analyse(u)
-        rows = [self._gradient(u, i, j, data) for i, j in self.entries]
-        return sp.vstack([self.cycle_jacobian(u), sp.csr_matrix(np.array(rows))], format="csr")
+        rows = np.array([self._gradient(u, i, j, data) for i, j in self.entries])
+        full = np.tile(np.arange(self.size, dtype=np.int32), rows.shape[0])  # dense rows, zeros kept: a fixed pattern
+        dense = sp.csr_matrix((rows.ravel(), full, np.arange(rows.shape[0] + 1, dtype=np.int32) * self.size),
+                              shape=rows.shape)
+        return sp.vstack([self.cycle_jacobian(u), dense], format="csr")
 
     def accept(self, u: np.ndarray) -> None:
         self.cycle.accept(self.cycle_u(u))
