@@ -8,7 +8,7 @@ import scipy.sparse as sp
 from textbook_systems import bautin, flip_two_parameter, period_doubling, torus_two_parameter
 
 from shimmy.continuation import CycleCurveProblem, Mesh, PeriodicProblem
-from shimmy.continuation.condensed_lu import ChainLayout, CondensedLU, collocation_layout
+from shimmy.continuation.condensed_lu import ChainLayout, CondensedLU, collocation_layout, monodromy
 from shimmy.continuation.core import _Bordered
 
 
@@ -153,3 +153,16 @@ def test_collocation_layout_covers_every_row_and_column_once():
                            layout.global_cols])
     assert sorted(rows) == list(range(layout.size)) and sorted(cols) == list(range(layout.size))
     assert layout.links == 2 * mesh.ntst + 1 and math.isclose(layout.n_interior[mesh.ntst], 0)
+
+
+def test_monodromy_from_the_condensed_blocks_equals_the_product_of_dense_transfer_matrices():
+    problem, u = orbit_problem(Mesh(np.array([0.0, 0.2, 0.45, 0.7, 1.0]), 3))
+    blocks = problem.collocation_blocks(u)[0]
+    n, m, N = problem.n, problem.mesh.ncol, problem.mesh.ntst
+    B = np.ascontiguousarray(blocks.reshape(N, m * n, (m + 1) * n))
+    expected = np.eye(n)
+    for block in B:  # all nodes after the first from the first: x = -E^-1 F x_first
+        expected = np.linalg.solve(block[:, n:], -block[:, :n])[-n:] @ expected
+    np.testing.assert_allclose(monodromy(B, n), expected, atol=1e-13 * np.abs(expected).max())
+    B[1] = 0.0  # a singular interval: no monodromy matrix
+    assert np.isnan(monodromy(B, n)).all()

@@ -34,7 +34,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from .condensed_lu import ChainLayout, collocation_layout
+from .condensed_lu import ChainLayout, collocation_layout, monodromy
 from .core import VectorField
 
 
@@ -247,11 +247,9 @@ class PeriodicProblem:
         """Floquet multipliers (n,), the trivial one first, the others by decreasing modulus."""
         blocks, _, _, _ = self.collocation_blocks(u)
         n, m, N = self.n, self.mesh.ncol, self.mesh.ntst
-        B = blocks.reshape(N, m * n, (m + 1) * n)
-        transfer = np.linalg.solve(B[:, :, n:], -B[:, :, :n])[:, -n:, :]  # (N, n, n)
-        M = np.eye(n)
-        for P in transfer:
-            M = P @ M
+        M = monodromy(np.ascontiguousarray(blocks.reshape(N, m * n, (m + 1) * n)), n)
+        if not np.all(np.isfinite(M)):
+            raise np.linalg.LinAlgError("singular collocation block: no monodromy matrix")
         mu, vectors = np.linalg.eig(M)
         i = self._trivial(u, mu, vectors)
         rest = np.delete(mu, i)

@@ -572,3 +572,37 @@ def _solve(transposed, A, perm1, C1, M2, perm2, C2, F, permF, B, nint, n, nimax,
             out[:, j] = _solve_one(A, perm1, C1, M2, perm2, C2, F, permF, b, nint, n, nimax, g, link_rows, glob_rows,
                                    int_cols, node_cols, glob_cols)
     return out
+
+
+@njit(cache=True, error_model="numpy")
+def monodromy(blocks, n):
+    """The monodromy matrix P_(N-1) ... P_0 from the linearised collocation blocks (N, m n, (m + 1) n)
+    of the intervals (columns: the interval's nodes in order): P_j maps x at an interval's first node
+    to x at its last, found by eliminating the interior nodes (the first stage of the condensed LU)
+    and solving the n rows left over. NaN where an interval's block is singular."""
+    N, rows, width = blocks.shape
+    M = np.eye(n)
+    perm = np.zeros(max(rows - n, 1), np.int64)
+    for j in range(N):
+        B = blocks[j].copy()
+        ni = rows - n
+        if _lu_columns(B, rows, n, ni, perm):
+            return np.full((n, n), np.nan)
+        # rows ni .. rows-1: C x_first + D x_last = 0 -> P = -D^-1 C, by elimination on [D | C]
+        S = np.zeros((n, 2 * n))
+        for i in range(n):
+            for c in range(n):
+                S[i, c] = B[ni + i, width - n + c]
+                S[i, n + c] = -B[ni + i, c]
+        p2 = np.zeros(n, np.int64)
+        if _lu_columns(S, n, 0, n, p2):
+            return np.full((n, n), np.nan)
+        P = S[:, n:].copy()
+        for c in range(n - 1, -1, -1):
+            for k in range(c + 1, n):
+                for a in range(n):
+                    P[c, a] -= S[c, k] * P[k, a]
+            for a in range(n):
+                P[c, a] /= S[c, c]
+        M = P @ M
+    return M

@@ -307,10 +307,10 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
                           stop, steps, problem.mesh.ntst, problem.mesh.ncol, solutions, trivial)
 
 
-def _measures(problem: PeriodicProblem, rows, i: int) -> np.ndarray:
-    """Phase-free description of point i: p, T and every state's max and min, scaled."""
-    return np.concatenate([[rows["p"][i] / problem.p_scale, rows["T"][i] / problem.T_scale],
-                           np.asarray(rows["xmax"][i]) / problem.scale, np.asarray(rows["xmin"][i]) / problem.scale])
+def _measures(problem: PeriodicProblem, rows) -> np.ndarray:
+    """Phase-free description of every point (one row each): p, T and every state's max and min, scaled."""
+    return np.column_stack([np.asarray(rows["p"]) / problem.p_scale, np.asarray(rows["T"]) / problem.T_scale,
+                            np.asarray(rows["xmax"]) / problem.scale, np.asarray(rows["xmin"]) / problem.scale])
 
 
 def _closed(problem: PeriodicProblem, rows) -> bool:
@@ -323,12 +323,13 @@ def _closed(problem: PeriodicProblem, rows) -> bool:
     k = len(rows["p"])
     if k < 8:
         return False
-    first, prev, last = _measures(problem, rows, 0), _measures(problem, rows, k - 2), _measures(problem, rows, k - 1)
+    measures = _measures(problem, rows)
+    first, prev, last = measures[0], measures[-2], measures[-1]
     seg = last - prev
     length = float(np.linalg.norm(seg))
     if length == 0.0:
         return False
-    far = max(float(np.linalg.norm(_measures(problem, rows, i) - first)) for i in range(k))
+    far = float(np.linalg.norm(measures - first, axis=1).max())
     if far < 5.0 * length:
         return False
     s = float(np.clip(np.dot(first - prev, seg) / length ** 2, 0.0, 1.0))
