@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 import scipy.sparse as sp
@@ -127,6 +127,50 @@ def basis(ncol: int) -> _Basis:
     return _BASES[ncol]
 
 
+@dataclass(frozen=True)
+class _Pattern:
+    """What the Jacobian's structure depends on: ntst, ncol and n only (not the mesh points)."""
+
+    rows: np.ndarray  # collocation blocks' rows (j, k, a) and columns (node(j, l), b)
+    cols: np.ndarray
+    D_eye: np.ndarray
+    L_cols: np.ndarray
+    slot: np.ndarray  # CSR slot of every entry in the order jacobian() produces them
+    nnz: int
+    indices: np.ndarray
+    indptr: np.ndarray
+    chain_layout: ChainLayout
+
+
+@lru_cache(maxsize=32)
+def _pattern(N: int, m: int, n: int) -> _Pattern:
+    """The fixed CSR structure of the Jacobian of a mesh of N intervals of degree m for n states (built
+    once per shape: remeshing keeps it) and the chain layout of its bordered matrix."""
+    j, k, a, node, b = np.meshgrid(np.arange(N), np.arange(m), np.arange(n), np.arange(m + 1), np.arange(n),
+                                   indexing="ij")
+    block_rows = ((j * m + k) * n + a).ravel()
+    block_cols = ((j * m + node) * n + b).ravel()
+    base = basis(m)
+    D_eye = base.D[None, :, None, :, None] * np.eye(n)[None, None, :, None, :]  # (1, m, n, m+1, n)
+    L_cols = base.L[None, :, None, :, None]
+    n_coll, n_x = N * m * n, (N * m + 1) * n
+    idx = (np.arange(N)[:, None] * m + np.arange(m + 1)[None, :])[:, :, None] * n + np.arange(n)[None, None, :]
+    rows = np.concatenate([block_rows, np.arange(n_coll), np.arange(n_coll), n_coll + np.arange(n),
+                           n_coll + np.arange(n), np.full(idx.size, n_coll + n)])
+    cols = np.concatenate([block_cols, np.full(n_coll, n_x), np.full(n_coll, n_x + 1),
+                           np.arange(n), n_x - n + np.arange(n), idx.ravel()])
+    key = rows.astype(np.int64) * (n_x + 2) + cols
+    unique, slot = np.unique(key, return_inverse=True)
+    counts = np.bincount(unique // (n_x + 2), minlength=n_coll + n + 1)
+    indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+    layout = collocation_layout(N, m, n, n_x + 2, [(0, 0)], [], np.array([n_x, n_x + 1]),
+                                n_coll + np.arange(n + 2))
+    for array in (block_rows, block_cols, D_eye, L_cols, slot, indptr):
+        array.flags.writeable = False
+    return _Pattern(block_rows, block_cols, D_eye, L_cols, slot, unique.size,
+                    (unique % (n_x + 2)).astype(np.int32), indptr, layout)
+
+
 class PeriodicProblem:
     """The collocation equations of one mesh as a continuation curve problem in (x, T, p)."""
 
@@ -142,43 +186,15 @@ class PeriodicProblem:
         self.weights = np.concatenate([w_nodes.ravel(), [1.0 / self.T_scale ** 2, 1.0 / self.p_scale ** 2]])
         self.reference_derivative = np.zeros((N, m, n))
         self.reference_values = np.zeros((N, m, n))
-        # Sparsity pattern of the collocation blocks: rows (j, k, a), columns (node(j, l), b).
-        j, k, a, node, b = np.meshgrid(np.arange(N), np.arange(m), np.arange(n), np.arange(m + 1), np.arange(n),
-                                       indexing="ij")
-        self._rows = ((j * m + k) * n + a).ravel()
-        self._cols = ((j * m + node) * n + b).ravel()
-        eye = np.eye(n)[None, None, :, None, :]
-        self._D_eye = self.basis.D[None, :, None, :, None] * eye  # (1, m, n, m+1, n)
-        self._L_cols = self.basis.L[None, :, None, :, None]
         self.n_equations = N * m * n + n + 1
-        self._structure()
-
-    def _structure(self) -> None:
-        """The fixed CSR structure of the Jacobian and, for every (row, col, value) entry in the
-        order :meth:`jacobian` produces them, its slot in the CSR data (duplicates summed)."""
-        mesh, n = self.mesh, self.n
-        n_coll = mesh.ntst * mesh.ncol * n
-        idx = mesh.node_index[:, :, None] * n + np.arange(n)[None, None, :]
-        rows = np.concatenate([self._rows, np.arange(n_coll), np.arange(n_coll), n_coll + np.arange(n),
-                               n_coll + np.arange(n), np.full(idx.size, n_coll + n)])
-        cols = np.concatenate([self._cols, np.full(n_coll, self.n_x), np.full(n_coll, self.n_x + 1),
-                               np.arange(n), self.n_x - n + np.arange(n), idx.ravel()])
-        key = rows.astype(np.int64) * (self.n_x + 2) + cols
-        unique, slot = np.unique(key, return_inverse=True)
-        self._slot = slot
-        self._nnz = unique.size
-        self._indices = (unique % (self.n_x + 2)).astype(np.int32)
-        counts = np.bincount(unique // (self.n_x + 2), minlength=self.n_equations)
-        self._indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
-
-    @cached_property
-    def chain_layout(self) -> ChainLayout:
-        """Roles of the rows and columns of the bordered Jacobian [jacobian; row] for its condensed
-        LU (:mod:`.condensed_lu`): the mesh intervals are the links; T and p, the periodicity,
-        phase and bordering rows are the globals."""
-        n_coll = self.mesh.ntst * self.mesh.ncol * self.n
-        return collocation_layout(self.mesh.ntst, self.mesh.ncol, self.n, self.n_x + 2, [(0, 0)], [],
-                                  np.array([self.n_x, self.n_x + 1]), n_coll + np.arange(self.n + 2))
+        pattern = _pattern(N, m, n)
+        self._rows, self._cols = pattern.rows, pattern.cols
+        self._D_eye, self._L_cols = pattern.D_eye, pattern.L_cols
+        self._slot, self._nnz, self._indices, self._indptr = pattern.slot, pattern.nnz, pattern.indices, pattern.indptr
+        #: Roles of the rows and columns of the bordered Jacobian [jacobian; row] for its condensed LU
+        #: (:mod:`.condensed_lu`): the mesh intervals are the links; T and p, the periodicity, phase and
+        #: bordering rows are the globals.
+        self.chain_layout: ChainLayout = pattern.chain_layout
 
     # -- unknowns ------------------------------------------------------------------------
     def unpack(self, u: np.ndarray) -> tuple[np.ndarray, float, float]:
