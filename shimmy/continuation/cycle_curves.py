@@ -179,9 +179,11 @@ class CycleCurve:
 
 
 #: Refinement sweeps of the test matrix's solves on the last factors before it is factored
-#: afresh (fewer: more factorisations; measured best at 6 on the gear's curves), and on
-#: fresh factors.
-REFINE_SWEEPS = 6
+#: afresh (fewer: more factorisations), per curve type, and on fresh factors. Measured on the gear's
+#: curves with the condensed LU (a factorisation ~2.5 solves): NS (two periods, two right-hand
+#: sides) is fastest with 2 (nes curves 5.9 -> 5.4 s); LPC with 6 (with fewer, one of original's fold
+#: curves took shorter steps: 28 points with 2 or 3 sweeps, 42 with 1, 26 with 6).
+REFINE_SWEEPS = {CycleBifurcation.LPC: 6, CycleBifurcation.PD: 6, CycleBifurcation.NS: 2}
 FRESH_SWEEPS = 3
 
 
@@ -369,7 +371,7 @@ class CycleCurveProblem:
         op = M.T if trans else M
         mode = "T" if trans else "N"
         scale = max(float(np.abs(rhs).max()), 1e-300)
-        sweeps = REFINE_SWEEPS if sweeps is None else sweeps
+        sweeps = REFINE_SWEEPS[self.kind] if sweeps is None else sweeps
         return refine(lambda b: self._lu.solve(b, trans=mode), lambda z: op @ z, rhs,
                       lambda z: 1e-13 * scale * max(1.0, float(np.abs(z).max())), sweeps)
 
