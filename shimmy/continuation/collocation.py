@@ -33,6 +33,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from .condensed_lu import ChainLayout, collocation_layout, monodromy
 from .core import VectorField
@@ -127,14 +128,28 @@ def basis(ncol: int) -> _Basis:
     return _BASES[ncol]
 
 
+@njit(cache=True)
+def _blocks(J, hT, D, L):
+    """out[j, k, a, l, b] = D[k, l] delta_ab - hT[j] L[k, l] J[j, k, a, b]: d(collocation)/d(nodes)."""
+    N, m, n, _ = J.shape
+    out = np.zeros((N, m, n, m + 1, n))
+    for j in range(N):
+        for k in range(m):
+            for a in range(n):
+                for l_ in range(m + 1):
+                    c = hT[j] * L[k, l_]
+                    for b in range(n):
+                        out[j, k, a, l_, b] = -c * J[j, k, a, b]
+                    out[j, k, a, l_, a] += D[k, l_]
+    return out
+
+
 @dataclass(frozen=True)
 class _Pattern:
     """What the Jacobian's structure depends on: ntst, ncol and n only (not the mesh points)."""
 
     rows: np.ndarray  # collocation blocks' rows (j, k, a) and columns (node(j, l), b)
     cols: np.ndarray
-    D_eye: np.ndarray
-    L_cols: np.ndarray
     slot: np.ndarray  # CSR slot of every entry in the order jacobian() produces them
     nnz: int
     indices: np.ndarray
@@ -150,9 +165,6 @@ def _pattern(N: int, m: int, n: int) -> _Pattern:
                                    indexing="ij")
     block_rows = ((j * m + k) * n + a).ravel()
     block_cols = ((j * m + node) * n + b).ravel()
-    base = basis(m)
-    D_eye = base.D[None, :, None, :, None] * np.eye(n)[None, None, :, None, :]  # (1, m, n, m+1, n)
-    L_cols = base.L[None, :, None, :, None]
     n_coll, n_x = N * m * n, (N * m + 1) * n
     idx = (np.arange(N)[:, None] * m + np.arange(m + 1)[None, :])[:, :, None] * n + np.arange(n)[None, None, :]
     rows = np.concatenate([block_rows, np.arange(n_coll), np.arange(n_coll), n_coll + np.arange(n),
@@ -165,9 +177,9 @@ def _pattern(N: int, m: int, n: int) -> _Pattern:
     indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
     layout = collocation_layout(N, m, n, n_x + 2, [(0, 0)], [], np.array([n_x, n_x + 1]),
                                 n_coll + np.arange(n + 2))
-    for array in (block_rows, block_cols, D_eye, L_cols, slot, indptr):
+    for array in (block_rows, block_cols, slot, indptr):
         array.flags.writeable = False
-    return _Pattern(block_rows, block_cols, D_eye, L_cols, slot, unique.size,
+    return _Pattern(block_rows, block_cols, slot, unique.size,
                     (unique % (n_x + 2)).astype(np.int32), indptr, layout)
 
 
@@ -189,7 +201,6 @@ class PeriodicProblem:
         self.n_equations = N * m * n + n + 1
         pattern = _pattern(N, m, n)
         self._rows, self._cols = pattern.rows, pattern.cols
-        self._D_eye, self._L_cols = pattern.D_eye, pattern.L_cols
         self._slot, self._nnz, self._indices, self._indptr = pattern.slot, pattern.nnz, pattern.indices, pattern.indptr
         #: Roles of the rows and columns of the bordered Jacobian [jacobian; row] for its condensed LU
         #: (:mod:`.condensed_lu`): the mesh intervals are the links; T and p, the periodicity, phase and
@@ -235,9 +246,8 @@ class PeriodicProblem:
         """d(collocation)/d(nodes) (ntst, m, n, m+1, n) from the field's Jacobian at the
         collocation points (ntst * m, n, n) and the period."""
         mesh, n = self.mesh, self.n
-        J = J.reshape(mesh.ntst, mesh.ncol, n, 1, n)
-        hT = (mesh.h * T)[:, None, None, None, None]
-        return self._D_eye - hT * self._L_cols * J
+        return _blocks(np.ascontiguousarray(J).reshape(mesh.ntst, mesh.ncol, n, n), mesh.h * T, self.basis.D,
+                       self.basis.L)
 
     def collocation_blocks(self, u: np.ndarray):
         """Values of d(collocation)/d(nodes) as (ntst, m, n, m+1, n), and f, f_p at the points."""

@@ -277,11 +277,14 @@ class CycleCurveProblem:
         mesh, n = self.mesh, self.n
         _, T, p1 = self.cycle.unpack(cu)
         F, J, Fps = self.system.all_at(self.cycle.collocation_points(cu), np.array([p1, self.slice.p2]))
-        blocks = self.cycle.blocks_of(J, T)
         shape = (mesh.ntst, mesh.ncol, n)
         F, Fp, Fp2 = F.T.reshape(shape), Fps[0].T.reshape(shape), Fps[1].T.reshape(shape)
         W = w.reshape(shape)
-        nodes = np.einsum("jka,jkalb->jlb", W, blocks)
+        # w^T (D x - h T L f_x x) per interval, contracted without forming the blocks
+        WJ = np.einsum("jka,jkab->jkb", W, J.reshape(mesh.ntst, mesh.ncol, n, n))
+        basis = self.cycle.basis
+        nodes = (np.einsum("kl,jkb->jlb", basis.D, W)
+                 - (mesh.h * T)[:, None, None] * np.einsum("kl,jkb->jlb", basis.L, WJ))
         row = np.zeros(self.size)
         np.add.at(row[:self.n_x].reshape(mesh.n_nodes, n), mesh.node_index, nodes)
         weighted = W * mesh.h[:, None, None]
