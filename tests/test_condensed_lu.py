@@ -46,9 +46,13 @@ def test_bordered_collocation_jacobian_is_solved_like_a_dense_matrix(points, nco
     row = rng.standard_normal(u.size)
     matrix = sp.vstack([problem.jacobian(u), sp.csr_matrix(row[None, :])], format="csr")
     assert_solves(matrix, CondensedLU(matrix, problem.chain_layout), rng)
-    # and through the corrector's bordered factors, which use it
-    x = _Bordered(problem.jacobian(u), row, problem.chain_layout).solve(np.eye(u.size)[-1])
-    np.testing.assert_allclose(matrix @ x, np.eye(u.size)[-1], atol=1e-12 * np.abs(x).max())
+    # and through the corrector's bordered factors, which use it, and the factors condensed
+    # straight from the collocation blocks without assembling the matrix
+    b = rng.standard_normal(u.size)
+    for lu in (_Bordered(problem.jacobian(u), row, problem.chain_layout), problem.factor_bordered(u, row)):
+        x = lu.solve(b)
+        np.testing.assert_allclose(matrix @ x, b, atol=1e-12 * np.abs(x).max())
+        assert lu.row is row
 
 
 @pytest.mark.parametrize("kind,system,kappa", [("LPC", bautin, None), ("PD", flip_two_parameter, None),

@@ -35,8 +35,8 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .condensed_lu import ChainLayout, collocation_layout, monodromy
-from .core import VectorField
+from .condensed_lu import ChainLayout, CondensedLU, collocation_layout, monodromy
+from .core import VectorField, _Bordered
 
 
 @dataclass(frozen=True)
@@ -267,6 +267,34 @@ class PeriodicProblem:
                                  coeff.ravel()])
         data = np.bincount(self._slot, weights=values, minlength=self._nnz)
         return sp.csr_matrix((data, self._indices, self._indptr), shape=(self.n_equations, self.n_x + 2))
+
+    def factor_bordered(self, u: np.ndarray, row: np.ndarray):
+        """LU factors of the bordered Jacobian [jacobian(u); row] (``solve(b)``; ``row`` kept as an
+        attribute), condensed straight from the collocation blocks without assembling the sparse
+        matrix: the corrector's factorisation. A zero pivot of the condensation falls back to
+        SuperLU on the assembled matrix."""
+        mesh, n, m, N = self.mesh, self.n, self.mesh.ncol, self.mesh.ntst
+        lay = self.chain_layout
+        blocks, F, Fp, T = self.collocation_blocks(u)
+        width = (m + 1) * n
+        A = np.empty((N, m * n, lay.width))
+        A[:, :, :width] = blocks.reshape(N, m * n, width)
+        A[:, :, width] = (-mesh.h[:, None, None] * F).reshape(N, m * n)
+        A[:, :, width + 1] = (-(mesh.h * T)[:, None, None] * Fp).reshape(N, m * n)
+        Q = np.zeros((n + 2, self.n_x + 2))
+        Q[np.arange(n), np.arange(n)] = 1.0  # periodicity x(0) - x(1)
+        Q[np.arange(n), self.n_x - n + np.arange(n)] = -1.0
+        coeff = np.einsum("j,k,kl,jkn->jln", mesh.h, self.basis.gauss[1], self.basis.L, self.reference_derivative)
+        phase = Q[n, :self.n_x].reshape(mesh.n_nodes, n)
+        phase[:-1].reshape(N, m, n)[:] += coeff[:, :m]
+        phase[m::m] += coeff[:, m]
+        Q[n + 1] = row
+        try:
+            lu = CondensedLU(None, lay, parts=(A, Q))
+        except np.linalg.LinAlgError:
+            return _Bordered(self.jacobian(u), row)
+        lu.row = row
+        return lu
 
     # -- results -------------------------------------------------------------------------
     def multipliers(self, u: np.ndarray) -> np.ndarray:

@@ -154,14 +154,22 @@ class CondensedLU:
     """Factors of a square sparse matrix with a :class:`ChainLayout`; ``solve(b, trans)``
     like SuperLU's ("N": M x = b, "T": M^T x = b), b of shape (size,) or (size, k)."""
 
-    def __init__(self, matrix, layout: ChainLayout):
-        if matrix.shape != (layout.size, layout.size):
-            raise ValueError(f"matrix of shape {matrix.shape} for a chain layout of size {layout.size}")
+    def __init__(self, matrix, layout: ChainLayout, parts: tuple[np.ndarray, np.ndarray] | None = None):
+        """``parts``: instead of ``matrix`` (None then), the link blocks (L, r_max, width: columns
+        [left node | interior | right node | globals], rows in the layout's order) and the global
+        rows in full (q, size), for a caller that has them without assembling the matrix."""
         self.layout = lay = layout
-        buf = lay.buffer(matrix)
-        split = lay.links * lay.r_max * lay.width
-        self._A = buf[:split].reshape(lay.links, lay.r_max, lay.width)
-        self._Q = buf[split:].reshape(lay.q, lay.size)
+        if parts is None:
+            if matrix.shape != (layout.size, layout.size):
+                raise ValueError(f"matrix of shape {matrix.shape} for a chain layout of size {layout.size}")
+            buf = lay.buffer(matrix)
+            split = lay.links * lay.r_max * lay.width
+            self._A = buf[:split].reshape(lay.links, lay.r_max, lay.width)
+            self._Q = buf[split:].reshape(lay.q, lay.size)
+        else:
+            self._A, self._Q = parts
+            if self._A.shape != (lay.links, lay.r_max, lay.width) or self._Q.shape != (lay.q, lay.size):
+                raise ValueError("link blocks or global rows of the wrong shape for the chain layout")
         out = _factor(self._A, self._Q, lay.n_interior, lay.n, lay.ni_max, lay.g, lay.interior_cols,
                       lay.node_cols, lay.global_cols)
         status = out[-1]

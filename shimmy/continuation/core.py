@@ -6,7 +6,9 @@ Generic: nothing here knows the landing gear. A *curve problem* supplies
 * ``weights`` (N+1,): the diagonal of the inner product <a, b>_w = sum w a b used for the
   arclength, so that unknowns of very different size (states, period, speed) count alike;
 * ``accept(u)``: called once a point is accepted (the periodic-orbit problem moves its
-  phase reference there).
+  phase reference there);
+* optionally ``factor_bordered(u, row)``: factors of [F_u(u); row] (``solve``, ``row``) built
+  without assembling F_u (the periodic-orbit problem condenses its collocation blocks directly).
 
 Each step: predictor u_pred = u + h t + h^2/2 dt/ds (t the unit tangent in the w-norm; the
 curvature term from the last step, orthogonal to t: :meth:`Tracer.curvature`), corrector =
@@ -218,7 +220,9 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
             if factorisations == options.max_newton:
                 return None
             try:
-                lu = _Bordered(problem.jacobian(u), row, getattr(problem, "chain_layout", None))
+                factor = getattr(problem, "factor_bordered", None)
+                lu = factor(u, row) if factor is not None else \
+                    _Bordered(problem.jacobian(u), row, getattr(problem, "chain_layout", None))
             except (RuntimeError, ValueError, np.linalg.LinAlgError):  # singular matrix
                 return None
             fresh, factorisations = True, factorisations + 1
