@@ -302,3 +302,21 @@ def test_bad_curve_options_name_the_field(name, value):
     with pytest.raises(InvalidInputError) as info:
         CycleCurveOptions(**{name: value})
     assert info.value.field == name
+
+
+def test_remembered_collocation_blocks_follow_the_second_parameter():
+    """The cycle's blocks are remembered for the last (x, T, p1); a change of p2 alone changes the
+    field, so the curve problem's Jacobian at the new p2 equals a fresh problem's."""
+    system = bautin()
+    mesh = Mesh.uniform(6, 3)
+    u = np.concatenate([circle(mesh, 0.7, system.n).ravel(), [2 * np.pi, -0.25, 1.0]])
+    problem = CycleCurveProblem(system, "LPC", mesh, np.ones(system.n), 2 * np.pi, np.ones(2))
+    problem.cycle.accept(problem.cycle_u(u))
+    before = problem.cycle_jacobian(u).toarray()
+    moved = u.copy()
+    moved[-1] = 1.5
+    fresh = CycleCurveProblem(system, "LPC", mesh, np.ones(system.n), 2 * np.pi, np.ones(2))
+    fresh.cycle.accept(fresh.cycle_u(u))
+    after = problem.cycle_jacobian(moved).toarray()
+    np.testing.assert_array_equal(after, fresh.cycle_jacobian(moved).toarray())
+    assert np.abs(after - before).max() > 1e-3

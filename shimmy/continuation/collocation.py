@@ -199,6 +199,7 @@ class PeriodicProblem:
         self.reference_derivative = np.zeros((N, m, n))
         self.reference_values = np.zeros((N, m, n))
         self.n_equations = N * m * n + n + 1
+        self._blocks_memo: tuple[bytes, tuple] | None = None
         pattern = _pattern(N, m, n)
         self._rows, self._cols = pattern.rows, pattern.cols
         self._slot, self._nnz, self._indices, self._indptr = pattern.slot, pattern.nnz, pattern.indices, pattern.indptr
@@ -250,12 +251,19 @@ class PeriodicProblem:
                        self.basis.L)
 
     def collocation_blocks(self, u: np.ndarray):
-        """Values of d(collocation)/d(nodes) as (ntst, m, n, m+1, n), and f, f_p at the points."""
+        """Values of d(collocation)/d(nodes) as (ntst, m, n, m+1, n), and f, f_p at the points
+        (remembered for the last u: an accepted point's tangent and multipliers both need them;
+        callers must not modify them)."""
+        key = u.tobytes()
+        if self._blocks_memo is not None and self._blocks_memo[0] == key:
+            return self._blocks_memo[1]
         _, T, p = self.unpack(u)
         flat = self.collocation_points(u)
         F, J, Fp = self.system.all_at(flat, p)
         shape = (self.mesh.ntst, self.mesh.ncol, self.n)
-        return self.blocks_of(J, T), F.T.reshape(shape), Fp.T.reshape(shape), T
+        out = self.blocks_of(J, T), F.T.reshape(shape), Fp.T.reshape(shape), T
+        self._blocks_memo = (key, out)
+        return out
 
     def jacobian(self, u: np.ndarray):
         mesh, n = self.mesh, self.n

@@ -216,7 +216,10 @@ class CycleCurveProblem:
     # -- unknowns --------------------------------------------------------------------------
     def cycle_u(self, u: np.ndarray) -> np.ndarray:
         """(x, T, p1) with the slice moved to p2 = u[n_x + 2]."""
-        self.slice.p2 = float(u[self.n_x + 2])
+        p2 = float(u[self.n_x + 2])
+        if p2 != self.slice.p2:
+            self.slice.p2 = p2
+            self.cycle._blocks_memo = None  # the cycle's field changed under the same (x, T, p1)
         return u[:self.n_x + 2]
 
     def kappa(self, u: np.ndarray) -> float:
