@@ -647,3 +647,34 @@ def test_peak_of_an_orbit_is_located_on_the_collocation_polynomial(phase):
     assert min(offset, 1.0 - offset) == pytest.approx(0.0, abs=1e-4)
     sampled = np.abs(problem.sample(problem.pack(X, 1.0, 0.0))[1][:, 0]).max()
     assert amplitude >= sampled
+
+
+class _FlatWithNoise:
+    """One equation 1e-8 (u0 - 1) = 0 whose evaluation carries rounding-like noise of size
+    ``noise`` that flips sign at every call: Newton's corrections are noise / 1e-8."""
+
+    def __init__(self, noise: float):
+        self.noise, self.calls = noise, 0
+        self.weights = np.ones(2)
+
+    def residual(self, u):
+        self.calls += 1
+        return np.array([1e-8 * (u[0] - 1.0) + self.noise * (-1.0) ** self.calls])
+
+    def jacobian(self, u):
+        return np.array([[1e-8, 0.0]])
+
+    def accept(self, u):
+        pass
+
+
+def test_newton_at_the_noise_floor_is_converged_and_a_stalled_large_residual_is_not():
+    """A nearly flat equation turns rounding noise in F into corrections above ``tol`` that never
+    shrink (a fold-of-cycles test function near a Hopf point): with |F| already ~1e-16 the point
+    is converged. The same stall with |F| at 1e-9 (only 10x below residual_tol) is a failure."""
+    from shimmy.continuation.core import correct
+
+    options = ContinuationOptions()
+    out = correct(_FlatWithNoise(1e-16), np.array([1.0, 0.0]), np.array([0.0, 1.0]), options)
+    assert out is not None and abs(out[0][0] - 1.0) < 1e-8
+    assert correct(_FlatWithNoise(1e-9), np.array([1.0, 0.0]), np.array([0.0, 1.0]), options) is None
