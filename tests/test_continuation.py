@@ -147,10 +147,14 @@ def test_tangent_refined_on_the_correctors_factors_equals_a_freshly_factored_one
     problem.accept(u0)
     t0 = tangent(problem, u0, e_p)
     options = ContinuationOptions()
+    condensed = problem.factor_bordered
+    problem.factor_bordered = None  # the general path: the assembled Jacobian, refined on nearby factors
     new = step(problem, CurvePoint(u0, t0), 0.3, options)
     assert new is not None
     fresh = tangent(problem, new.u, t0)
     np.testing.assert_allclose(new.tangent, fresh, atol=1e-12)
+    problem.factor_bordered = condensed  # the collocation path: factored at the point without assembly
+    np.testing.assert_allclose(tangent(problem, new.u, t0), fresh, atol=1e-12)
     assert abs(weighted_norm(new.tangent, problem.weights) - 1.0) < 1e-14
     # factors with another bordering row are not used for refinement
     other = _Bordered(problem.jacobian(u0), problem.weights * e_p)

@@ -157,16 +157,22 @@ def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray,
             near: Any = None) -> np.ndarray:
     """Unit tangent (w-norm) of the curve at u, oriented along ``previous``.
 
-    ``near``: factors (as :func:`correct` returns them) of the same system at a nearby point
-    with the same bordering row (the corrector's last chord matrix): the tangent is found by
-    iterative refinement on them (``refine``: a solve and a product per sweep, at most 5
-    sweeps, each required to shrink the residual 4x) to ``TANGENT_REFINE_TOL``; only if that
-    fails is the matrix factored here.
+    A problem with ``factor_bordered`` (collocation: factored without assembling F_u, cheaper
+    than assembling it for a refinement) is factored afresh at u. Otherwise ``near``: factors
+    (as :func:`correct` returns them) of the same system at a nearby point with the same
+    bordering row (the corrector's last chord matrix): the tangent is found by iterative
+    refinement on them (``refine``: a solve and a product per sweep, at most 5 sweeps, each
+    required to shrink the residual 4x) to ``TANGENT_REFINE_TOL``; only if that fails is the
+    matrix factored here.
     """
     w = problem.weights
-    jac = problem.jacobian(u)
     row = w * previous
     e = _unit_last(u.size)
+    factor = getattr(problem, "factor_bordered", None)
+    if factor is not None:  # factoring without assembly costs less than assembling for refinement
+        t = factor(u, row).solve(e)
+        return t / weighted_norm(t, w)
+    jac = problem.jacobian(u)
     t = None
     if near is not None and np.array_equal(near.row, row):
         t = refine(near.solve, lambda z: np.append(jac @ z, row @ z), e,
