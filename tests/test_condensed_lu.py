@@ -72,8 +72,12 @@ def test_bordered_test_matrices_of_cycle_curves_are_solved_like_dense_matrices(k
     u = u + 1e-2 * rng.standard_normal(u.size)
     test_matrix = problem._bordered(u)
     assert_solves(test_matrix, CondensedLU(test_matrix, problem.test_layout), rng)
-    newton = sp.vstack([problem.jacobian(u), sp.csr_matrix(rng.standard_normal((1, u.size)))], format="csr")
+    row = rng.standard_normal(u.size)
+    newton = sp.vstack([problem.jacobian(u), sp.csr_matrix(row[None, :])], format="csr")
     assert_solves(newton, CondensedLU(newton, problem.chain_layout), rng)
+    b = rng.standard_normal(u.size)  # factored straight from the blocks and gradients, without assembly
+    x = problem.factor_bordered(u, row).solve(b)
+    np.testing.assert_allclose(newton @ x, b, atol=1e-11 * np.abs(x).max())
 
 
 def random_chain(rng, links=5, n=2, interior=(3, 0, 2, 4, 1), g=2):

@@ -100,19 +100,37 @@ def test_bad_requests_name_the_field():
 
 
 def test_a_torus_start_at_a_strong_resonance_gives_no_one_point_curve():
-    """`pd` at 243.7 kN: a diagram's NS point with its multipliers at -0.9994 (next to 1:2) leaves
-    kappa's range [-1, 1] in both directions at once. That is not a curve (one point bounds no
-    region): the search is told why, in a warning, and keeps no curve for it."""
+    """`pd` at 243.7 kN: near V = 4.0175 m/s the lateral cycles nearly shrink onto x = 0 and the
+    diagram locates torus points 4e-3 m/s apart whose reported angle depends on rounding (the one
+    at 4.0175 m/s had angle 3.11, next to 1:2, until tangents came from fresh factors; now ~0). A start there
+    on the pair next to 1:2 leaves kappa's range [-1, 1] in both directions at once. That is not a
+    curve (one point bounds no region): the search is told why, in a warning, and keeps no curve."""
+    import dataclasses
+
+    from shimmy.analyses.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
     from shimmy.analyses.cycle_curves import _continue, starts_of_diagram
+    from shimmy.continuation import Mesh, PeriodicProblem
     from shimmy.model.configurations import Configuration
+    from shimmy.model.equations import build_model
     from shimmy.model.parameters import Parameters
 
     Fz = 243687.15083798883  # a slice of the pd map
     diagram = bifurcation("pd", Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
-    near_r2 = [s for s in starts_of_diagram(diagram, Fz) if s.kind == "NS" and s.point.data["torus_angle"] > 3.1]
-    assert near_r2
-    for start in near_r2:
-        curve, warning = _continue((Configuration.parse("pd"), Parameters(), start, ((1.0, 200.0), (1e4, 9e5)), ()))
+    near = [s for s in starts_of_diagram(diagram, Fz) if s.kind == "NS" and abs(s.point.p - 4.0175) < 1e-3]
+    assert near
+    model = build_model("pd", Parameters())
+    for start in near:
+        mesh_points, u = start.point.solution
+        problem = PeriodicProblem(gear_field(model, Fz), Mesh(mesh_points, start.ncol), STATE_SCALE[:model.n_states],
+                                  T_SCALE, V_SCALE)
+        mu = problem.multipliers(u)[1:]
+        pair = mu[(np.abs(mu.imag) > 1e-7 * np.abs(mu)) & (mu.real < 0)]
+        angle = float(np.abs(np.angle(pair[np.argmin(np.abs(np.abs(pair) - 1.0))])))
+        assert angle > 3.1  # the pair next to 1:2
+        on_pair = dataclasses.replace(start, point=dataclasses.replace(
+            start.point, data={**start.point.data, "torus_angle": angle}))
+        curve, warning = _continue((Configuration.parse("pd"), Parameters(), on_pair, ((1.0, 200.0), (1e4, 9e5)),
+                                    ()))
         assert curve is None and "gives no curve" in warning and "kappa = -1 left" in warning
 
 

@@ -281,28 +281,42 @@ class PeriodicProblem:
         attribute), condensed straight from the collocation blocks without assembling the sparse
         matrix: the corrector's factorisation. A zero pivot of the condensation falls back to
         SuperLU on the assembled matrix."""
-        mesh, n, m, N = self.mesh, self.n, self.mesh.ncol, self.mesh.ntst
         lay = self.chain_layout
-        blocks, F, Fp, T = self.collocation_blocks(u)
-        width = (m + 1) * n
-        A = np.empty((N, m * n, lay.width))
-        A[:, :, :width] = blocks.reshape(N, m * n, width)
-        A[:, :, width] = (-mesh.h[:, None, None] * F).reshape(N, m * n)
-        A[:, :, width + 1] = (-(mesh.h * T)[:, None, None] * Fp).reshape(N, m * n)
-        Q = np.zeros((n + 2, self.n_x + 2))
-        Q[np.arange(n), np.arange(n)] = 1.0  # periodicity x(0) - x(1)
-        Q[np.arange(n), self.n_x - n + np.arange(n)] = -1.0
-        coeff = np.einsum("j,k,kl,jkn->jln", mesh.h, self.basis.gauss[1], self.basis.L, self.reference_derivative)
-        phase = Q[n, :self.n_x].reshape(mesh.n_nodes, n)
-        phase[:-1].reshape(N, m, n)[:] += coeff[:, :m]
-        phase[m::m] += coeff[:, m]
-        Q[n + 1] = row
+        A = self.link_blocks(u, lay.width)
+        Q = np.zeros((self.n + 2, self.n_x + 2))
+        Q[:self.n + 1] = self.periodicity_and_phase_rows()
+        Q[self.n + 1] = row
         try:
             lu = CondensedLU(None, lay, parts=(A, Q))
         except np.linalg.LinAlgError:
             return _Bordered(self.jacobian(u), row)
         lu.row = row
         return lu
+
+    def link_blocks(self, u: np.ndarray, width: int) -> np.ndarray:
+        """The collocation rows of the Jacobian per mesh interval, as the condensed LU's link blocks
+        (ntst, ncol n, ``width``): the interval's nodes in order, then d/dT and d/dp (further
+        columns, for unknowns beyond (x, T, p), zero)."""
+        mesh, n, m, N = self.mesh, self.n, self.mesh.ncol, self.mesh.ntst
+        blocks, F, Fp, T = self.collocation_blocks(u)
+        nodes = (m + 1) * n
+        A = np.zeros((N, m * n, width))
+        A[:, :, :nodes] = blocks.reshape(N, m * n, nodes)
+        A[:, :, nodes] = (-mesh.h[:, None, None] * F).reshape(N, m * n)
+        A[:, :, nodes + 1] = (-(mesh.h * T)[:, None, None] * Fp).reshape(N, m * n)
+        return A
+
+    def periodicity_and_phase_rows(self) -> np.ndarray:
+        """The Jacobian's last n + 1 rows (x(0) - x(1), the phase condition) in full, (n + 1, n_x + 2)."""
+        mesh, n, m, N = self.mesh, self.n, self.mesh.ncol, self.mesh.ntst
+        Q = np.zeros((n + 1, self.n_x + 2))
+        Q[np.arange(n), np.arange(n)] = 1.0
+        Q[np.arange(n), self.n_x - n + np.arange(n)] = -1.0
+        coeff = np.einsum("j,k,kl,jkn->jln", mesh.h, self.basis.gauss[1], self.basis.L, self.reference_derivative)
+        phase = Q[n, :self.n_x].reshape(mesh.n_nodes, n)
+        phase[:-1].reshape(N, m, n)[:] += coeff[:, :m]
+        phase[m::m] += coeff[:, m]
+        return Q
 
     # -- results -------------------------------------------------------------------------
     def multipliers(self, u: np.ndarray) -> np.ndarray:

@@ -55,8 +55,8 @@ from scipy.sparse.linalg import splu
 
 from .collocation import Mesh, PeriodicProblem
 from .condensed_lu import ChainLayout, CondensedLU, collocation_layout
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate_between, refine,
-                   step, tangent, weighted_norm)
+from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, _Bordered, locate_between,
+                   refine, step, tangent, weighted_norm)
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
 from .lyapunov import hopf_eigenvectors
 from .periodic_orbits import PeriodicOptions, hopf_guess, multiplier_crossing_test, periodic_branch
@@ -258,6 +258,30 @@ class CycleCurveProblem:
             return CondensedLU(M, self.test_layout)
         except np.linalg.LinAlgError:
             return splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+
+    def factor_bordered(self, u: np.ndarray, row: np.ndarray):
+        """LU factors of the Newton matrix [jacobian(u); row] (``solve(b)``, ``row``), condensed
+        straight from the cycle's collocation blocks, the test functions' gradients and the
+        bordering row, without assembling the sparse matrix; SuperLU on a zero pivot."""
+        data = self.analyse(u)
+        grads = [self._gradient(u, i, j, data) for i, j in self.entries]
+        cu = self.cycle_u(u)
+        lay = self.chain_layout
+        A = self.cycle.link_blocks(cu, lay.width)
+        N, m, n = self.mesh.ntst, self.mesh.ncol, self.n
+        X, T, p1 = self.cycle.unpack(cu)
+        Fp2 = self.slice.dfdp2(self.cycle.collocation_points(cu), p1).T.reshape(N, m, n)
+        A[:, :, (m + 1) * n + 2] = (-(self.mesh.h * T)[:, None, None] * Fp2).reshape(N, m * n)
+        Q = np.zeros((lay.q, self.size))
+        Q[:n + 1, :self.n_x + 2] = self.cycle.periodicity_and_phase_rows()
+        Q[n + 1:n + 1 + len(grads)] = grads
+        Q[-1] = row
+        try:
+            lu = CondensedLU(None, lay, parts=(A, Q))
+        except np.linalg.LinAlgError:
+            return _Bordered(self.jacobian(u), row)
+        lu.row = row
+        return lu
 
     # -- the cycle equations in (x, T, p1, p2[, kappa]) ------------------------------------------
     def cycle_jacobian(self, u: np.ndarray) -> sp.csr_matrix:
