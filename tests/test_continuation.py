@@ -674,11 +674,13 @@ class _FlatWithNoise:
 
 def test_newton_at_the_noise_floor_is_converged_and_a_stalled_large_residual_is_not():
     """A nearly flat equation turns rounding noise in F into corrections above ``tol`` that never
-    shrink (a fold-of-cycles test function near a Hopf point): with |F| already ~1e-16 the point
-    is converged. The same stall with |F| at 1e-9 (only 10x below residual_tol) is a failure."""
+    shrink (a fold-of-cycles test function near a Hopf point): with |F| already ~6e-17 and
+    corrections ~6e-9 the point is converged. The same stall with |F| at 1e-9 (only 10x below
+    residual_tol), or with corrections of 1e-5 (the point not known to better than that), fails."""
     from shimmy.continuation.core import correct
 
     options = ContinuationOptions()
-    out = correct(_FlatWithNoise(1e-16), np.array([1.0, 0.0]), np.array([0.0, 1.0]), options)
+    out = correct(_FlatWithNoise(3e-17), np.array([1.0, 0.0]), np.array([0.0, 1.0]), options)
     assert out is not None and abs(out[0][0] - 1.0) < 1e-8
     assert correct(_FlatWithNoise(1e-9), np.array([1.0, 0.0]), np.array([0.0, 1.0]), options) is None
+    assert correct(_FlatWithNoise(1e-13), np.array([1.0, 0.0]), np.array([0.0, 1.0]), options) is None

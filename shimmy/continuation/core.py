@@ -205,12 +205,15 @@ def refine(solve: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarra
     return None
 
 
-#: Newton has reached the noise floor when a correction with a fresh Jacobian fails to halve while
-#: |F|_inf is already below this times ``residual_tol``: the point is taken as converged. (A nearly
-#: flat equation turns rounding noise in F into corrections above ``tol``: a fold-of-cycles test
-#: function near a Hopf point, where the cycle's amplitude goes to zero, gave |F| ~ 2e-16 and
-#: corrections ~1.6e-9 that never shrank.)
+#: Newton has reached the noise floor when a correction with a fresh Jacobian fails to halve, is
+#: below NOISE_CORRECTION times ``tol``, and |F|_inf is already below NOISE_RESIDUAL times
+#: ``residual_tol``: the point is taken as converged. (A nearly flat equation turns rounding noise
+#: in F into corrections above ``tol``: a fold-of-cycles test function near a Hopf point, where the
+#: cycle's amplitude goes to zero, gave |F| ~ 2e-16 and corrections ~1.6e-9 that never shrank.
+#: Larger stalled corrections are not noise: accepting those up to 1e-4 left points too far off the
+#: curve for the secant location of special points, which then took all its trials.)
 NOISE_RESIDUAL = 1e-3
+NOISE_CORRECTION = 10.0
 
 
 def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
@@ -219,7 +222,8 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
 
     Chord iterations: the bordered Jacobian is factored at the predictor and refreshed
     only when a correction fails to shrink by half. Converged when the correction is below
-    ``tol`` and |F| below ``residual_tol``, or at the noise floor (``NOISE_RESIDUAL``). Returns
+    ``tol`` and |F| below ``residual_tol``, or at the noise floor (``NOISE_RESIDUAL``,
+    ``NOISE_CORRECTION``). Returns
     the solution, the number of iterations and the last factors (a nearby matrix for the
     tangent's refinement).
     """
@@ -249,7 +253,8 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
         if size > 0.5 * last and not fresh:  # the chord stalls: refactor here and redo
             lu = None
             continue
-        if size > 0.5 * last and np.max(np.abs(F)) <= NOISE_RESIDUAL * options.residual_tol:
+        if size > 0.5 * last and size <= NOISE_CORRECTION * options.tol \
+                and np.max(np.abs(F)) <= NOISE_RESIDUAL * options.residual_tol:
             return u, it, lu  # at the noise floor: the corrections are rounding noise, F is zero already
         if size > 2.0 * last:  # diverging even with a fresh Jacobian
             return None
