@@ -684,3 +684,19 @@ def test_newton_at_the_noise_floor_is_converged_and_a_stalled_large_residual_is_
     assert out is not None and abs(out[0][0] - 1.0) < 1e-8
     assert correct(_FlatWithNoise(1e-9), np.array([1.0, 0.0]), np.array([0.0, 1.0]), options) is None
     assert correct(_FlatWithNoise(1e-13), np.array([1.0, 0.0]), np.array([0.0, 1.0]), options) is None
+
+
+def test_a_seeded_branch_shrinking_to_the_equilibrium_ends_at_the_hopf_point():
+    """A branch started from an orbit (not at a Hopf point) at its largest amplitude, followed
+    towards the Hopf point: r^2 = mu shrinks to zero at mu = 0. It ends there with an H point; it
+    must not pass through x = 0 and go on along the constant 'orbits' x = 0 (any period), where
+    the equilibrium's eigenvalues would be reported as spurious folds and torus points."""
+    omega = 2.0
+    system = hopf_supercritical(omega)
+    mesh = Mesh.uniform(20, 4)
+    theta = 2 * np.pi * mesh.node_times
+    guess = OrbitGuess(mesh, 0.5 * np.column_stack([np.cos(theta), np.sin(theta)]), math.pi, 0.25)
+    br = periodic_branch(system, guess, -1.0, 1.0, np.ones(2), 1.0, PeriodicOptions(ntst=20), p_direction=-1)
+    assert "amplitude returned to zero" in br.stop_reason, br.stop_reason
+    assert kinds(br) == ["H"] and 0.0 <= br.p[-1] < 0.01
+    assert br.x_max[:, 0].min() > 1e-5 and br.p.min() > 0.0  # stopped just below 1e-3 of the peak, not at 0

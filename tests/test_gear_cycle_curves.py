@@ -100,38 +100,40 @@ def test_bad_requests_name_the_field():
 
 
 def test_a_torus_start_at_a_strong_resonance_gives_no_one_point_curve():
-    """`pd` at 243.7 kN: near V = 4.0175 m/s the lateral cycles nearly shrink onto x = 0 and the
-    diagram locates torus points 4e-3 m/s apart whose reported angle depends on rounding (the one
-    at 4.0175 m/s had angle 3.11, next to 1:2, until tangents came from fresh factors; now ~0). A start there
-    on the pair next to 1:2 leaves kappa's range [-1, 1] in both directions at once. That is not a
-    curve (one point bounds no region): the search is told why, in a warning, and keeps no curve."""
-    import dataclasses
-
+    """`pd` at 243.7 kN: the small cycles born at the Hopf point at 4.0175 m/s have a complex pair
+    next to 1:2 (|mu| 0.99, angle 3.12). A torus start on that pair converges where the pair is on
+    the circle and leaves kappa's range [-1, 1] in both directions at once. That is not a curve
+    (one point bounds no region): the search is told why, in a warning, and keeps no curve."""
     from shimmy.analyses.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
-    from shimmy.analyses.cycle_curves import _continue, starts_of_diagram
-    from shimmy.continuation import Mesh, PeriodicProblem
+    from shimmy.analyses.cycle_curves import Start, _continue
+    from shimmy.continuation import Mesh, PeriodicProblem, SpecialPoint
     from shimmy.model.configurations import Configuration
     from shimmy.model.equations import build_model
     from shimmy.model.parameters import Parameters
 
     Fz = 243687.15083798883  # a slice of the pd map
     diagram = bifurcation("pd", Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
-    near = [s for s in starts_of_diagram(diagram, Fz) if s.kind == "NS" and abs(s.point.p - 4.0175) < 1e-3]
-    assert near
+    born = [b for b in diagram.branches if b.kind == "periodic" and abs(b.V.min() - 4.0175) < 1e-3]
+    assert len(born) == 1
+    # Branches that shrink onto x = 0 end there: no fold or torus point of the constant 'orbit' x = 0
+    # (a seeded branch used to pass through it and report torus points there, at 4.0175 and 4.0215 m/s)
+    for b in diagram.branches:
+        if b.kind == "periodic":
+            assert all(p["max_psi"] > 1e-4 for p in b.to_dict()["special_points"] if p["kind"] in ("LPC", "NS")), \
+                b.origin
+    raw = born[0].raw
+    mesh_points, u = raw.solutions[0]
     model = build_model("pd", Parameters())
-    for start in near:
-        mesh_points, u = start.point.solution
-        problem = PeriodicProblem(gear_field(model, Fz), Mesh(mesh_points, start.ncol), STATE_SCALE[:model.n_states],
-                                  T_SCALE, V_SCALE)
-        mu = problem.multipliers(u)[1:]
-        pair = mu[(np.abs(mu.imag) > 1e-7 * np.abs(mu)) & (mu.real < 0)]
-        angle = float(np.abs(np.angle(pair[np.argmin(np.abs(np.abs(pair) - 1.0))])))
-        assert angle > 3.1  # the pair next to 1:2
-        on_pair = dataclasses.replace(start, point=dataclasses.replace(
-            start.point, data={**start.point.data, "torus_angle": angle}))
-        curve, warning = _continue((Configuration.parse("pd"), Parameters(), on_pair, ((1.0, 200.0), (1e4, 9e5)),
-                                    ()))
-        assert curve is None and "gives no curve" in warning and "kappa = -1 left" in warning
+    problem = PeriodicProblem(gear_field(model, Fz), Mesh(mesh_points, raw.ncol), STATE_SCALE[:model.n_states],
+                              T_SCALE, V_SCALE)
+    mu = problem.multipliers(u)[1:]
+    pair = mu[(np.abs(mu.imag) > 1e-7 * np.abs(mu)) & (mu.real < 0)]
+    angle = float(np.abs(np.angle(pair[0])))
+    assert angle > 3.1 and abs(abs(pair[0]) - 1.0) < 0.02
+    start = Start("NS", SpecialPoint("NS", float(raw.p[0]), 0, {"torus_angle": angle}, solution=(mesh_points, u)),
+                  Fz, raw.ncol, "the cycles born at the Hopf point at 4.0175 m/s")
+    curve, warning = _continue((Configuration.parse("pd"), Parameters(), start, ((1.0, 200.0), (1e4, 9e5)), ()))
+    assert curve is None and "gives no curve" in warning and "kappa = -1 left" in warning
 
 
 def test_a_fold_start_next_to_a_hopf_point_converges():

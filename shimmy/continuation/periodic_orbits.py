@@ -252,8 +252,9 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
             break
         _record(problem, rows, solutions, new)
         found = _detect(problem, rows, prev, new, copts)
-        ends = [s for s in found if s.kind == "LPC" and hopf_start
-                and _amplitude(problem, np.array(s.data["x_max"]), np.array(s.data["x_min"])) < amp_first]
+        zero = amp_first if hopf_start else 1e-3 * amp_peak  # below this a cycle's amplitude counts as zero
+        ends = [s for s in found if s.kind == "LPC"
+                and _amplitude(problem, np.array(s.data["x_max"]), np.array(s.data["x_min"])) < zero]
         if ends:  # a 'fold' at zero amplitude: the branch passed through the equilibrium
             for key in rows:
                 rows[key].pop()
@@ -278,7 +279,9 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
             if message:
                 stop = message
                 break
-        if amp < amp_last and amp_peak > 2.0 * amp_first:  # shrinking: approach x* with care
+        # Shrinking: approach x* with care (a Hopf start only once it has grown; a branch started
+        # from an orbit may start at its largest one)
+        if amp < amp_last and (amp_peak > 2.0 * amp_first or not hopf_start):
             if amp < amp_stop:
                 special.append(SpecialPoint("H", float(p_new), len(rows["p"]) - 1, {"amplitude": amp}))
                 stop = f"amplitude returned to zero near p = {p_new:.6g}: the branch ends at a Hopf point"
