@@ -49,7 +49,9 @@ def test_bordered_collocation_jacobian_is_solved_like_a_dense_matrix(points, nco
     # and through the corrector's bordered factors, which use it, and the factors condensed
     # straight from the collocation blocks without assembling the matrix
     b = rng.standard_normal(u.size)
-    for lu in (_Bordered(problem.jacobian(u), row, problem.chain_layout), problem.factor_bordered(u, row)):
+    direct = problem.factor_bordered(u, row)
+    assert isinstance(direct, CondensedLU)  # not the SuperLU fallback
+    for lu in (_Bordered(problem.jacobian(u), row, problem.chain_layout), direct):
         x = lu.solve(b)
         np.testing.assert_allclose(matrix @ x, b, atol=1e-12 * np.abs(x).max())
         assert lu.row is row
@@ -76,7 +78,9 @@ def test_bordered_test_matrices_of_cycle_curves_are_solved_like_dense_matrices(k
     newton = sp.vstack([problem.jacobian(u), sp.csr_matrix(row[None, :])], format="csr")
     assert_solves(newton, CondensedLU(newton, problem.chain_layout), rng)
     b = rng.standard_normal(u.size)  # factored straight from the blocks and gradients, without assembly
-    x = problem.factor_bordered(u, row).solve(b)
+    direct = problem.factor_bordered(u, row)
+    assert isinstance(direct, CondensedLU)  # not the SuperLU fallback
+    x = direct.solve(b)
     np.testing.assert_allclose(newton @ x, b, atol=1e-11 * np.abs(x).max())
 
 
@@ -120,14 +124,16 @@ def test_one_link_chain():
     assert_solves(sp.csr_matrix(M), CondensedLU(sp.csr_matrix(M), layout), rng)
 
 
-def test_a_zero_pivot_raises_and_the_corrector_falls_back_to_superlu():
-    """Pivoting is restricted to a link's rows: an interior unknown that no row of its link
-    touches (only a global row does) stops the condensation although the matrix is regular;
-    the corrector's factors then come from SuperLU and still solve it."""
+@pytest.mark.parametrize("tiny", [0.0, 1e-18, 1e-15])
+def test_a_zero_pivot_raises_and_the_corrector_falls_back_to_superlu(tiny):
+    """Pivoting is restricted to a link's rows: an interior unknown that its link's rows touch
+    only at rounding size (a global row carries it) stops the condensation although the matrix
+    is regular (eliminating on such a pivot gave errors of order 1 to 30); the corrector's
+    factors then come from SuperLU and still solve it."""
     rng = np.random.default_rng(13)
     M, layout = random_chain(rng)
     lonely = layout.interior_cols[0, 0]
-    M[layout.link_rows[0][layout.link_rows[0] >= 0], lonely] = 0.0
+    M[layout.link_rows[0][layout.link_rows[0] >= 0], lonely] = tiny
     assert np.linalg.cond(M) < 1e8
     with pytest.raises(np.linalg.LinAlgError, match="singular pivot"):
         CondensedLU(sp.csr_matrix(M), layout)
@@ -143,7 +149,7 @@ def test_a_matrix_outside_the_layout_is_refused():
     M[layout.link_rows[0, 0], layout.interior_cols[3, 0]] = 1.0  # link 0 touching link 3's unknowns
     with pytest.raises(ValueError, match="chain layout"):
         CondensedLU(sp.csr_matrix(M), layout)
-    with pytest.raises(ValueError, match="n rows more than interior unknowns"):
+    with pytest.raises(ValueError, match="chain layout: every row needs exactly one role"):
         ChainLayout(layout.size, layout.link_rows[:, :-1], layout.interior_cols, layout.node_cols,
                     layout.global_cols, layout.global_rows)
 
@@ -172,5 +178,31 @@ def test_monodromy_from_the_condensed_blocks_equals_the_product_of_dense_transfe
     for block in B:  # all nodes after the first from the first: x = -E^-1 F x_first
         expected = np.linalg.solve(block[:, n:], -block[:, :n])[-n:] @ expected
     np.testing.assert_allclose(monodromy(B, n), expected, atol=1e-13 * np.abs(expected).max())
+    B = B.copy()  # the problem's blocks are shared (read-only)
     B[1] = 0.0  # a singular interval: no monodromy matrix
     assert np.isnan(monodromy(B, n)).all()
+
+
+def test_layouts_with_roles_missing_doubled_or_padded_inside_are_refused():
+    rng = np.random.default_rng(15)
+    _, layout = random_chain(rng)
+    parts = dict(size=layout.size, link_rows=layout.link_rows, interior_cols=layout.interior_cols,
+                 node_cols=layout.node_cols, global_cols=layout.global_cols, global_rows=layout.global_rows)
+    doubled = dict(parts, global_rows=np.append(layout.global_rows[:-1], layout.link_rows[0, 0]))
+    with pytest.raises(ValueError, match="exactly one role"):
+        ChainLayout(**doubled)
+    inside = layout.interior_cols.copy()
+    inside[0, :2] = inside[0, [1, 0]]
+    inside[0, 0] = -1  # padding before an entry
+    with pytest.raises(ValueError, match="padding"):
+        ChainLayout(**dict(parts, interior_cols=inside))
+
+
+def test_solve_refuses_an_unknown_transposition_and_a_wrong_right_hand_side():
+    rng = np.random.default_rng(16)
+    M, layout = random_chain(rng)
+    lu = CondensedLU(sp.csr_matrix(M), layout)
+    with pytest.raises(ValueError, match="trans"):
+        lu.solve(np.ones(layout.size), trans="H")
+    with pytest.raises(ValueError, match="right-hand side"):
+        lu.solve(np.ones(2 * layout.size))

@@ -700,3 +700,25 @@ def test_a_seeded_branch_shrinking_to_the_equilibrium_ends_at_the_hopf_point():
     assert "amplitude returned to zero" in br.stop_reason, br.stop_reason
     assert kinds(br) == ["H"] and 0.0 <= br.p[-1] < 0.01
     assert br.x_max[:, 0].min() > 1e-5 and br.p.min() > 0.0  # stopped just below 1e-3 of the peak, not at 0
+
+
+class _DoubleRoot:
+    """1e-2 (u0 - 1)^2 = 0: Newton converges linearly, each correction half the last."""
+
+    weights = np.ones(2)
+
+    def residual(self, u):
+        return np.array([1e-2 * (u[0] - 1.0) ** 2])
+
+    def jacobian(self, u):
+        return np.array([[2e-2 * (u[0] - 1.0), 0.0]])
+
+    def accept(self, u):
+        pass
+
+
+def test_newton_converging_at_rate_one_half_is_not_taken_for_noise():
+    from shimmy.continuation.core import correct
+
+    out = correct(_DoubleRoot(), np.array([1.0 + 1e-6, 0.0]), np.array([0.0, 1.0]), ContinuationOptions())
+    assert out is not None and abs(out[0][0] - 1.0) < 5e-9  # the rule stopping it gave 2e-8

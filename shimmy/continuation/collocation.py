@@ -177,10 +177,10 @@ def _pattern(N: int, m: int, n: int) -> _Pattern:
     indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
     layout = collocation_layout(N, m, n, n_x + 2, [(0, 0)], [], np.array([n_x, n_x + 1]),
                                 n_coll + np.arange(n + 2))
-    for array in (block_rows, block_cols, slot, indptr):
+    indices = (unique % (n_x + 2)).astype(np.int32)
+    for array in (block_rows, block_cols, slot, indptr, indices):
         array.flags.writeable = False
-    return _Pattern(block_rows, block_cols, slot, unique.size,
-                    (unique % (n_x + 2)).astype(np.int32), indptr, layout)
+    return _Pattern(block_rows, block_cols, slot, unique.size, indices, indptr, layout)
 
 
 class PeriodicProblem:
@@ -255,13 +255,17 @@ class PeriodicProblem:
         (remembered for the last u: an accepted point's tangent and multipliers both need them;
         callers must not modify them)."""
         key = u.tobytes()
-        if self._blocks_memo is not None and self._blocks_memo[0] == key:
-            return self._blocks_memo[1]
+        memo = self._blocks_memo
+        if memo is not None and memo[0] == key:
+            return memo[1]
         _, T, p = self.unpack(u)
         flat = self.collocation_points(u)
         F, J, Fp = self.system.all_at(flat, p)
         shape = (self.mesh.ntst, self.mesh.ncol, self.n)
-        out = self.blocks_of(J, T), F.T.reshape(shape), Fp.T.reshape(shape), T
+        out = (self.blocks_of(J, T), np.ascontiguousarray(F.T).reshape(shape),
+               np.ascontiguousarray(Fp.T).reshape(shape), T)
+        for array in out[:3]:
+            array.flags.writeable = False  # shared with later calls at the same u
         self._blocks_memo = (key, out)
         return out
 
@@ -274,7 +278,9 @@ class PeriodicProblem:
                                  (-mesh.h[:, None, None] * T * Fp).ravel(), np.ones(n), -np.ones(n),
                                  coeff.ravel()])
         data = np.bincount(self._slot, weights=values, minlength=self._nnz)
-        return sp.csr_matrix((data, self._indices, self._indptr), shape=(self.n_equations, self.n_x + 2))
+        # the pattern is shared by every problem of this shape: the matrix gets its own copy
+        return sp.csr_matrix((data, self._indices.copy(), self._indptr.copy()),
+                             shape=(self.n_equations, self.n_x + 2))
 
     def factor_bordered(self, u: np.ndarray, row: np.ndarray):
         """LU factors of the bordered Jacobian [jacobian(u); row] (``solve(b)``; ``row`` kept as an

@@ -60,6 +60,16 @@ class ChainLayout:
         self.r_max = self.link_rows.shape[1]
         self.ni_max = self.interior_cols.shape[1]
         self.g, self.q = self.global_cols.size, self.global_rows.size
+        for name, table in (("link_rows", self.link_rows), ("interior_cols", self.interior_cols)):
+            used = table >= 0
+            if np.any(used[:, 1:] & ~used[:, :-1]):
+                raise ValueError(f"chain layout: {name} has -1 padding before an entry (pad at the end only)")
+        rows = np.concatenate([self.link_rows[self.link_rows >= 0], self.global_rows])
+        cols = np.concatenate([self.interior_cols[self.interior_cols >= 0], self.node_cols.ravel(), self.global_cols])
+        for name, roles in (("row", rows), ("column", cols)):
+            if roles.size != self.size or np.unique(roles).size != self.size or roles.min() < 0 \
+                    or roles.max() >= self.size:
+                raise ValueError(f"chain layout: every {name} needs exactly one role")
         rows_used = (self.link_rows >= 0).sum(axis=1)
         if np.any(rows_used != self.n_interior + self.n) or self.q != self.n + self.g:
             raise ValueError("chain layout: a link needs n rows more than interior unknowns, "
@@ -157,7 +167,8 @@ class CondensedLU:
     def __init__(self, matrix, layout: ChainLayout, parts: tuple[np.ndarray, np.ndarray] | None = None):
         """``parts``: instead of ``matrix`` (None then), the link blocks (L, r_max, width: columns
         [left node | interior | right node | globals], rows in the layout's order) and the global
-        rows in full (q, size), for a caller that has them without assembling the matrix."""
+        rows in full (q, size), for a caller that has them without assembling the matrix (both are
+        overwritten by the factors)."""
         self.layout = lay = layout
         if parts is None:
             if matrix.shape != (layout.size, layout.size):
@@ -179,7 +190,11 @@ class CondensedLU:
 
     def solve(self, b: np.ndarray, trans: str = "N") -> np.ndarray:
         lay = self.layout
+        if trans not in ("N", "T"):
+            raise ValueError(f"trans must be 'N' or 'T', got {trans!r}")
         b = np.asarray(b, float)
+        if b.shape[0] != lay.size or b.ndim > 2:
+            raise ValueError(f"right-hand side of shape {b.shape} for a matrix of size {lay.size}")
         flat = b.ndim == 1
         B = np.ascontiguousarray(b.reshape(lay.size, -1))
         X = _solve(trans == "T", self._A, *self._factors, B, lay.n_interior, lay.n, lay.ni_max, lay.g, lay.link_rows,
@@ -187,11 +202,18 @@ class CondensedLU:
         return X.ravel() if flat else X
 
 
+#: A pivot below this fraction of its column's size in the whole matrix is taken for zero (the
+#: pivoting is restricted to a link's rows, or two links', so a tiny one may be rounding where the
+#: whole matrix is regular): the factorisation stops and the caller falls back to SuperLU.
+PIVOT_TOL = 1e-13
+
 # ------------------------------------------------------------------ compiled kernels
 @njit(cache=True, error_model="numpy")
-def _lu_columns(M, rows, col0, ncols, perm):
+def _lu_columns(M, rows, col0, ncols, perm, colscale):
     """In place: partial-pivot elimination of columns col0 .. col0 + ncols - 1 of M[:rows]
-    (all other columns transformed alike; multipliers stored below the pivots). 1 if singular."""
+    (all other columns transformed alike; multipliers stored below the pivots). 1 if singular:
+    a pivot not above PIVOT_TOL times ``colscale[c]``, the size of that column in the whole
+    matrix (its entries in rows this elimination cannot pivot on included)."""
     width = M.shape[1]
     for c in range(ncols):
         col = col0 + c
@@ -201,7 +223,7 @@ def _lu_columns(M, rows, col0, ncols, perm):
             if abs(M[i, col]) > big:
                 big, p = abs(M[i, col]), i
         perm[c] = p
-        if big == 0.0 or not np.isfinite(big):
+        if not big > PIVOT_TOL * colscale[c] or not np.isfinite(big):
             return 1
         if p != c:  # the multipliers of earlier columns stay where they were made
             for j in range(width):
@@ -217,6 +239,21 @@ def _lu_columns(M, rows, col0, ncols, perm):
                 for j in range(col + 1, width):
                     M[i, j] -= f * M[c, j]
     return 0
+
+
+@njit(cache=True, error_model="numpy")
+def _column_sizes(M, rows, col0, ncols, G, gcols):
+    """max |entry| of columns col0 .. col0 + ncols - 1 over M[:rows] and, column c, over G[:, gcols[c]]
+    (the global rows' entries of that unknown; G may have no rows)."""
+    out = np.zeros(ncols)
+    for c in range(ncols):
+        big = 0.0
+        for i in range(rows):
+            big = max(big, abs(M[i, col0 + c]))
+        for a in range(G.shape[0]):
+            big = max(big, abs(G[a, gcols[c]]))
+        out[c] = big
+    return out
 
 
 @njit(cache=True, error_model="numpy")
@@ -259,7 +296,8 @@ def _factor(A, Q, nint, n, nimax, g, int_cols, node_cols, glob_cols):
         ni = nint[link]
         M = A[link]
         if ni > 0:
-            if _lu_columns(M, ni + n, n, ni, perm1[link]):
+            sizes = _column_sizes(M, ni + n, n, ni, Q, int_cols[link])
+            if _lu_columns(M, ni + n, n, ni, perm1[link], sizes):
                 return perm1, C1, M2, perm2, C2, F, permF, 1
             for a in range(q):
                 for c in range(ni):
@@ -297,7 +335,7 @@ def _factor(A, Q, nint, n, nimax, g, int_cols, node_cols, glob_cols):
             for c in range(g):
                 S[i, 3 * n + c] = run[i, 2 * n + c]
                 S[n + i, 3 * n + c] = Red[k, i, 2 * n + c]
-        if _lu_columns(S, 2 * n, 0, n, perm2[k]):
+        if _lu_columns(S, 2 * n, 0, n, perm2[k], _column_sizes(S, 2 * n, 0, n, Qn[:, k, :], np.arange(n))):
             return perm1, C1, M2, perm2, C2, F, permF, 1
         C = C2[k]
         _row_times_inverse_upper(Qn[:, k, :], S, 0, n, C)
@@ -326,7 +364,7 @@ def _factor(A, Q, nint, n, nimax, g, int_cols, node_cols, glob_cols):
             F[n + a, n + c] = Qn[a, L, c]
         for c in range(g):
             F[n + a, 2 * n + c] = Qg[a, c]
-    status = _lu_columns(F, size, 0, size, permF)
+    status = _lu_columns(F, size, 0, size, permF, _column_sizes(F, size, 0, size, F[:0], np.arange(size)))
     return perm1, C1, M2, perm2, C2, F, permF, status
 
 
@@ -594,7 +632,7 @@ def monodromy(blocks, n):
     for j in range(N):
         B = blocks[j].copy()
         ni = rows - n
-        if _lu_columns(B, rows, n, ni, perm):
+        if _lu_columns(B, rows, n, ni, perm, _column_sizes(B, rows, n, ni, B[:0], np.arange(ni))):
             return np.full((n, n), np.nan)
         # rows ni .. rows-1: C x_first + D x_last = 0 -> P = -D^-1 C, by elimination on [D | C]
         S = np.zeros((n, 2 * n))
@@ -603,7 +641,7 @@ def monodromy(blocks, n):
                 S[i, c] = B[ni + i, width - n + c]
                 S[i, n + c] = -B[ni + i, c]
         p2 = np.zeros(n, np.int64)
-        if _lu_columns(S, n, 0, n, p2):
+        if _lu_columns(S, n, 0, n, p2, _column_sizes(S, n, 0, n, S[:0], np.arange(n))):
             return np.full((n, n), np.nan)
         P = S[:, n:].copy()
         for c in range(n - 1, -1, -1):

@@ -205,15 +205,19 @@ def refine(solve: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarra
     return None
 
 
-#: Newton has reached the noise floor when a correction with a fresh Jacobian fails to halve, is
-#: below NOISE_CORRECTION times ``tol``, and |F|_inf is already below NOISE_RESIDUAL times
-#: ``residual_tol``: the point is taken as converged. (A nearly flat equation turns rounding noise
-#: in F into corrections above ``tol``: a fold-of-cycles test function near a Hopf point, where the
-#: cycle's amplitude goes to zero, gave |F| ~ 2e-16 and corrections ~1.6e-9 that never shrank.
-#: Larger stalled corrections are not noise: accepting those up to 1e-4 left points too far off the
-#: curve for the secant location of special points, which then took all its trials.)
+#: Newton has reached the noise floor when a correction with a fresh Jacobian does not shrink against
+#: the previous one with a fresh Jacobian, is below NOISE_CORRECTION times ``tol``, and |F|_inf is
+#: already below NOISE_RESIDUAL times ``residual_tol``: the point is taken as converged. (A nearly
+#: flat equation turns rounding noise in F into corrections above ``tol``: a fold-of-cycles test
+#: function near a Hopf point, where the cycle's amplitude goes to zero, gave |F| ~ 2e-16 and
+#: corrections ~1.6e-9 that never shrank. Larger stalled corrections are not noise: accepting those
+#: up to 1e-4 left points too far off the curve for the secant location of special points, which
+#: then took all its trials.)
 NOISE_RESIDUAL = 1e-3
 NOISE_CORRECTION = 10.0
+#: ... "does not shrink": by less than this factor. Fresh corrections shrinking at rate 1/2 are
+#: linear convergence at a double root (a fold of the augmented system), not noise.
+NOISE_STALL = 0.9
 
 
 def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
@@ -232,6 +236,7 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
     row = w * t
     F = problem.residual(u)
     lu, fresh, last, factorisations = None, False, np.inf, 0
+    last_fresh = np.inf
     for it in range(1, 3 * options.max_newton + 1):
         if not np.all(np.isfinite(F)):
             return None
@@ -253,11 +258,13 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
         if size > 0.5 * last and not fresh:  # the chord stalls: refactor here and redo
             lu = None
             continue
-        if size > 0.5 * last and size <= NOISE_CORRECTION * options.tol \
+        if fresh and size > NOISE_STALL * last_fresh and size <= NOISE_CORRECTION * options.tol \
                 and np.max(np.abs(F)) <= NOISE_RESIDUAL * options.residual_tol:
             return u, it, lu  # at the noise floor: the corrections are rounding noise, F is zero already
         if size > 2.0 * last:  # diverging even with a fresh Jacobian
             return None
+        if fresh:
+            last_fresh = size
         fresh, last = False, size
         u = u + du
         F = problem.residual(u)

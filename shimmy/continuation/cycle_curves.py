@@ -425,10 +425,14 @@ class CycleCurveProblem:
         if not solved:  # refactor; the solves are refined on the new factors too
             self._lu = self._factor(M)
             right = self._solve(M, rhs, False, FRESH_SWEEPS)
-            right = self._lu.solve(rhs) if right is None else right
-            if left:
-                lhs = self._solve(M, rhs, True, FRESH_SWEEPS)
-                lhs = self._lu.solve(rhs, trans="T") if lhs is None else lhs
+            lhs = self._solve(M, rhs, True, FRESH_SWEEPS) if left and right is not None else None
+            if right is None or (left and lhs is None):  # fresh condensed factors not accurate: SuperLU
+                self._lu = splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+                right = self._solve(M, rhs, False, FRESH_SWEEPS)
+                right = self._lu.solve(rhs) if right is None else right
+                if left:
+                    lhs = self._solve(M, rhs, True, FRESH_SWEEPS)
+                    lhs = self._lu.solve(rhs, trans="T") if lhs is None else lhs
         out = {"_right": right, "V": right[:m], "G": right[m:]}
         if left:
             out.update({"W": lhs[:m], "GT": lhs[m:]})
