@@ -35,8 +35,8 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .condensed_lu import ChainLayout, CondensedLU, collocation_layout, monodromy
-from .core import VectorField, _Bordered
+from .condensed_lu import ChainLayout, collocation_layout, monodromy
+from .core import VectorField, condensed_factors
 
 
 @dataclass(frozen=True)
@@ -292,12 +292,7 @@ class PeriodicProblem:
         Q = np.zeros((self.n + 2, self.n_x + 2))
         Q[:self.n + 1] = self.periodicity_and_phase_rows()
         Q[self.n + 1] = row
-        try:
-            lu = CondensedLU(None, lay, parts=(A, Q))
-        except np.linalg.LinAlgError:
-            return _Bordered(self.jacobian(u), row)
-        lu.row = row
-        return lu
+        return condensed_factors(lay, (A, Q), row, lambda: self.jacobian(u))
 
     def link_blocks(self, u: np.ndarray, width: int) -> np.ndarray:
         """The collocation rows of the Jacobian per mesh interval, as the condensed LU's link blocks

@@ -102,15 +102,12 @@ class CurvePoint:
 class _Bordered:
     """LU factors of the square matrix [jac; row] (jac dense, or scipy.sparse CSR).
 
-    Sparse with a ``layout`` (:class:`~.condensed_lu.ChainLayout`, the problem's
-    ``chain_layout``: a collocation matrix): condensed LU of the mesh intervals; if that meets
-    a zero pivot (its pivoting is restricted to neighbouring intervals), SuperLU as below.
-    Sparse otherwise: the CSR arrays of [jac; row] are the CSC arrays of its transpose, which
-    SuperLU factors (ordering MMD on A^T + A, the best of SuperLU's orderings on collocation
+    Sparse: the CSR arrays of [jac; row] are the CSC arrays of its transpose, which SuperLU
+    factors (ordering MMD on A^T + A, the best of SuperLU's orderings on collocation
     matrices) and solves with ``trans="T"``: no format conversion.
     """
 
-    def __init__(self, jac, row: np.ndarray, layout=None):
+    def __init__(self, jac, row: np.ndarray):
         self.row = row
         if sp.issparse(jac):
             jac = jac.tocsr()
@@ -118,13 +115,6 @@ class _Bordered:
             data = np.concatenate([jac.data, row])
             indices = np.concatenate([jac.indices, np.arange(size, dtype=jac.indices.dtype)])
             indptr = np.append(jac.indptr, jac.indptr[-1] + size)
-            if layout is not None:
-                try:
-                    condensed = CondensedLU(sp.csr_matrix((data, indices, indptr), shape=(size, size)), layout)
-                    self.solve = condensed.solve
-                    return
-                except np.linalg.LinAlgError:
-                    pass
             transpose = sp.csc_matrix((data, indices, indptr), shape=(size, size))
             lu = splu(transpose, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
             self.solve = lambda rhs: lu.solve(rhs, trans="T")
@@ -136,6 +126,19 @@ class _Bordered:
                 except la.LinAlgWarning as exc:
                     raise np.linalg.LinAlgError(str(exc)) from None
             self.solve = lambda rhs: la.lu_solve(factors, rhs, check_finite=False)
+
+
+def condensed_factors(layout, parts: tuple[np.ndarray, np.ndarray], row: np.ndarray,
+                      assembled: Callable[[], Any]):
+    """Factors of a bordered collocation matrix [jacobian; row] condensed from its ``parts`` (link
+    blocks and global rows, see :class:`~.condensed_lu.CondensedLU`), ``row`` kept as an attribute;
+    on a zero pivot of the condensation, SuperLU on ``assembled()`` (the sparse jacobian)."""
+    try:
+        lu = CondensedLU(None, layout, parts=parts)
+    except np.linalg.LinAlgError:
+        return _Bordered(assembled(), row)
+    lu.row = row
+    return lu
 
 
 def weighted_norm(v: np.ndarray, w: np.ndarray) -> float:
@@ -178,7 +181,7 @@ def tangent(problem: CurveProblem, u: np.ndarray, previous: np.ndarray,
         t = refine(near.solve, lambda z: np.append(jac @ z, row @ z), e,
                    lambda z: TANGENT_REFINE_TOL * float(np.abs(z).max()), 5)
     if t is None:
-        t = _Bordered(jac, row, getattr(problem, "chain_layout", None)).solve(e)
+        t = _Bordered(jac, row).solve(e)
     return t / weighted_norm(t, w)
 
 
@@ -227,9 +230,8 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
     Chord iterations: the bordered Jacobian is factored at the predictor and refreshed
     only when a correction fails to shrink by half. Converged when the correction is below
     ``tol`` and |F| below ``residual_tol``, or at the noise floor (``NOISE_RESIDUAL``,
-    ``NOISE_CORRECTION``). Returns
-    the solution, the number of iterations and the last factors (a nearby matrix for the
-    tangent's refinement).
+    ``NOISE_CORRECTION``, ``NOISE_STALL``). Returns the solution, the number of iterations and
+    the last factors (a nearby matrix for the tangent's refinement).
     """
     w = problem.weights
     u = u_pred.copy()
@@ -246,8 +248,7 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
                 return None
             try:
                 factor = getattr(problem, "factor_bordered", None)
-                lu = factor(u, row) if factor is not None else \
-                    _Bordered(problem.jacobian(u), row, getattr(problem, "chain_layout", None))
+                lu = factor(u, row) if factor is not None else _Bordered(problem.jacobian(u), row)
             except (RuntimeError, ValueError, np.linalg.LinAlgError):  # singular matrix
                 return None
             fresh, factorisations = True, factorisations + 1

@@ -55,8 +55,8 @@ from scipy.sparse.linalg import splu
 
 from .collocation import Mesh, PeriodicProblem
 from .condensed_lu import ChainLayout, CondensedLU, collocation_layout
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, _Bordered, locate_between,
-                   refine, step, tangent, weighted_norm)
+from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, condensed_factors,
+                   locate_between, refine, step, tangent, weighted_norm)
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
 from .lyapunov import hopf_eigenvectors
 from .periodic_orbits import PeriodicOptions, hopf_guess, multiplier_crossing_test, periodic_branch
@@ -276,12 +276,7 @@ class CycleCurveProblem:
         Q[:n + 1, :self.n_x + 2] = self.cycle.periodicity_and_phase_rows()
         Q[n + 1:n + 1 + len(grads)] = grads
         Q[-1] = row
-        try:
-            lu = CondensedLU(None, lay, parts=(A, Q))
-        except np.linalg.LinAlgError:
-            return _Bordered(self.jacobian(u), row)
-        lu.row = row
-        return lu
+        return condensed_factors(lay, (A, Q), row, lambda: self.jacobian(u))
 
     # -- the cycle equations in (x, T, p1, p2[, kappa]) ------------------------------------------
     def cycle_jacobian(self, u: np.ndarray) -> sp.csr_matrix:
