@@ -11,7 +11,9 @@
   the product had before its regions were read off the curves, whose cost is the slices'),
   in the same process; ``speed-up`` = slice map / map;
 * ``serial``: the map in the calling process (InlineExecutor); ``ratio`` = serial / pool;
-* ``four maps``: the four configurations one after the other on one pool (target <= 30 s);
+* ``four maps``: the four configurations on one pool, ``stability_maps`` (their units all
+  through the pool at once, as ``python -m shimmy metrics`` computes them; target <= 30 s), and
+  one after the other (``stability_map`` each) for the ratio;
 * ``dask``: one map on a loopback Dask cluster of 1 and of 2 single-threaded workers (separate
   processes, no nanny), and the speed-up 2 vs 1; the first run on a fresh cluster includes the
   workers' imports.
@@ -26,7 +28,7 @@ import time
 
 from shimmy.analyses.executors import InlineExecutor, describe, open_executor
 from shimmy.service.dask_cluster import loopback_cluster
-from shimmy.analyses.stability_map import stability_map
+from shimmy.analyses.stability_map import stability_map, stability_maps
 
 CONFIGS = ("original", "nes", "pd", "nes_pd")
 PLANE = dict(v_range=(1.0, 200.0), fz_range=(1.0e4, 9.0e5))
@@ -46,10 +48,15 @@ def main() -> None:
     parser.add_argument("--dask-resolution", type=int, default=10)
     parser.add_argument("--skip-dask", action="store_true")
     parser.add_argument("--only-dask", action="store_true")
+    parser.add_argument("--only-four", action="store_true", help="only the four maps (no one-map figures, no Dask)")
     args = parser.parse_args()
     print(f"machine: {os.cpu_count()} cores; default executor: {describe()}")
+    if args.only_four:
+        four(args)
+        return
     if not args.only_dask:
         local(args)
+        four(args)
     if not args.skip_dask:
         dask(args)
 
@@ -70,24 +77,35 @@ def local(args) -> None:
     print(f"  speed-up slice map / map {base / pool:.2f}")
     print(f"  serial     median {serial:6.1f} s  (runs {runs(serial_runs)});  ratio serial / pool {serial / pool:.2f}")
 
-    print(f"\nfour maps ({args.resolution} slices asked each), one after the other, medians of {args.repeats}:")
+
+
+def four(args) -> None:
+    runs = lambda r: ", ".join(f"{t:.1f}" for t in r)  # noqa: E731
+    print(f"\nfour maps ({args.resolution} slices asked each) on one pool, medians of {args.repeats}:")
     print(f"  {'config':<8}{'s':>7}{'min shimmy Fz (kN)':>20}{'slices':>8}{'curves H/LPC/NS':>17}{'regions':>9}")
-    totals = []
+    together, apart = [], []
     times: dict[str, list[float]] = {c: [] for c in CONFIGS}
     last = {}
     with open_executor() as pool_executor:
         for _ in range(args.repeats):
+            clock = time.perf_counter()
+            maps = stability_maps(CONFIGS, resolution=args.resolution, executor=pool_executor, **PLANE)
+            together.append(time.perf_counter() - clock)
             total = 0.0
             for c in CONFIGS:
                 t, last[c] = timed(c, args.resolution, pool_executor)
                 times[c].append(t)
                 total += t
-            totals.append(total)
+            apart.append(total)
     for c, smap in last.items():
         low = "-" if smap.min_shimmy_Fz is None else f"{smap.min_shimmy_Fz / 1e3:.2f}"
         print(f"  {c:<8}{statistics.median(times[c]):7.1f}{low:>20}{len(smap.Fz):>8}"
               f"{len(smap.hopf.curves):>9}/{len(smap.fold_curves)}/{len(smap.torus_curves)}{len(smap.regions):>9}")
-    print(f"  total median {statistics.median(totals):.1f} s (runs {runs(totals)})  target <= 30 s")
+    same = all(m.shading == last[c].shading for m, c in zip(maps, CONFIGS, strict=True))
+    print(f"  one after the other: total median {statistics.median(apart):.1f} s (runs {runs(apart)})")
+    print(f"  together (stability_maps): median {statistics.median(together):.1f} s (runs {runs(together)})"
+          f"  target <= 30 s;  ratio apart / together {statistics.median(apart) / statistics.median(together):.2f};"
+          f"  same shading as apart: {same}")
 
 
 def dask(args) -> None:

@@ -186,6 +186,39 @@ def test_monodromy_from_the_condensed_blocks_equals_the_product_of_dense_transfe
     assert np.isnan(monodromy(B, n)).all()
 
 
+@pytest.mark.parametrize("points,ncol", [(np.linspace(0, 1, 11), 4), (np.array([0.0, 0.2, 0.45, 0.7, 1.0]), 3)])
+def test_the_factors_give_the_same_monodromy_matrix_as_the_blocks(points, ncol):
+    """The Newton matrix's condensed factors hold each interval's interior elimination: the monodromy
+    matrix from them is the blocks' (bit for bit), and so are the multipliers at the point last
+    factored; elsewhere the multipliers come from the blocks."""
+    problem, u = orbit_problem(Mesh(points, ncol))
+    n, m, N = problem.n, problem.mesh.ncol, problem.mesh.ntst
+    blocks = np.ascontiguousarray(problem.collocation_blocks(u)[0].reshape(N, m * n, (m + 1) * n))
+    row = np.random.default_rng(4).standard_normal(u.size)
+    lu = problem.factor_bordered(u, row)
+    assert isinstance(lu, CondensedLU)
+    np.testing.assert_array_equal(lu.monodromy(), monodromy(blocks, n))
+    from_factors = problem.multipliers(u)
+    other = u + 0.01
+    problem.factor_bordered(other, row)  # the last factors are elsewhere now
+    np.testing.assert_array_equal(problem.multipliers(u), from_factors)
+    assert not np.array_equal(problem.multipliers(other), from_factors)
+
+
+def test_the_phase_row_follows_the_reference_orbit():
+    """The periodicity and phase rows are remembered, and recomputed when the reference changes
+    (accept, or a reference set from outside)."""
+    problem, u = orbit_problem(Mesh(np.linspace(0, 1, 6), 3))
+    first = problem.periodicity_and_phase_rows()
+    assert problem.periodicity_and_phase_rows() is first and not first.flags.writeable
+    problem.accept(u)
+    moved = problem.periodicity_and_phase_rows()
+    assert not np.array_equal(moved, first)
+    np.testing.assert_allclose(moved, problem.jacobian(u)[-(problem.n + 1):].toarray())
+    problem.reference_derivative = 2.0 * problem.reference_derivative
+    np.testing.assert_allclose(problem.periodicity_and_phase_rows()[-1], 2.0 * moved[-1])
+
+
 def test_layouts_with_roles_missing_doubled_or_padded_inside_are_refused():
     rng = np.random.default_rng(15)
     _, layout = random_chain(rng)

@@ -1,3 +1,5 @@
+import math
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -166,3 +168,12 @@ def test_spectral_frequency_agrees_with_the_zero_crossing_period(config, V, Fz):
     crossings = t[up] - signal[up] * (t[up + 1] - t[up]) / (signal[up + 1] - signal[up])
     period = (crossings[-1] - crossings[0]) / (crossings.size - 1)
     assert r.frequency_hz == pytest.approx(1.0 / period, abs=0.01)
+
+
+def test_the_spectrum_can_be_skipped_and_nothing_else_changes():
+    """frequency=False (a diagram's seeds need only the settled state) leaves every other measure as it is."""
+    full = simulate("original", 60.0, 150e3, t_end=6.0)
+    bare = simulate("original", 60.0, 150e3, t_end=6.0, frequency=False)
+    assert math.isfinite(full.frequency_hz) and math.isnan(bare.frequency_hz)
+    np.testing.assert_array_equal(full.states, bare.states)
+    assert (full.amplitude, full.steady, full.response_type) == (bare.amplitude, bare.steady, bare.response_type)

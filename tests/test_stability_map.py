@@ -18,7 +18,8 @@ from shimmy.analyses.executors import InlineExecutor
 from shimmy.analyses.simulation import simulate
 from shimmy.analyses.stability import hopf_points
 from shimmy.analyses import map_shading
-from shimmy.analyses.stability_map import SHIMMY_TYPES, attractors_at, classify, shimmy_type, stability_map
+from shimmy.analyses.stability_map import (SHIMMY_TYPES, attractors_at, classify, shimmy_type, stability_map,
+                                          stability_maps)
 
 RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"}
 
@@ -248,6 +249,31 @@ def test_bad_map_requests_name_the_field(kwargs, field):
     with pytest.raises(InvalidParameterError) as err:
         stability_map("original", **kwargs)
     assert err.value.field == field
+
+
+def test_bad_requests_for_several_maps_name_the_field():
+    with pytest.raises(InvalidParameterError) as err:
+        stability_maps([])
+    assert err.value.field == "configs"
+    with pytest.raises(InvalidParameterError) as err:
+        stability_maps(["original", "wing"])
+    assert err.value.field == "config"
+
+
+def test_maps_computed_together_are_the_maps_computed_one_by_one():
+    """stability_maps runs several maps' units through one pool at once: each map is the one
+    stability_map computes alone (its slices, curves and shading), and its elapsed time is its own."""
+    plane = dict(v_range=(1.0, 200.0), fz_range=(1.0e4, 3.0e5), resolution=3, n_v=30)
+    together = stability_maps(["original", "pd"], **plane)
+    for smap, config in zip(together, ("original", "pd"), strict=True):
+        alone = stability_map(config, executor=InlineExecutor(), **plane)
+        assert smap.config.value == config
+        assert smap.Fz.tolist() == alone.Fz.tolist()
+        assert smap.shading == alone.shading and smap.types == alone.types
+        assert len(smap.fold_curves) == len(alone.fold_curves) and len(smap.torus_curves) == len(alone.torus_curves)
+        assert smap.min_shimmy_Fz == alone.min_shimmy_Fz
+        assert 0.0 < smap.elapsed_s
+    assert together[0].elapsed_s != together[1].elapsed_s
 
 
 def test_classify_refuses_a_speed_outside_its_diagram():

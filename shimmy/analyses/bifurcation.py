@@ -412,12 +412,12 @@ def periodic_orbit_from_simulation(config: Configuration, Fz: float, V: float, p
     start state (default the standard start, psi = 0.001 rad)."""
     from .simulation import simulate  # analyses may use analyses; kept local to keep start-up light
 
-    run = simulate(config, V, Fz, params, t_end=t_end, exact_nes=exact_nes, x0=x0, rtol=SEED_RTOL)
+    run = simulate(config, V, Fz, params, t_end=t_end, exact_nes=exact_nes, x0=x0, rtol=SEED_RTOL, frequency=False)
     for _ in range(SEED_RETRIES):  # slow growth or decay: go on from where the run ended
         if not run.success or run.steady:
             break
         run = simulate(config, V, Fz, params, t_end=2 * t_end, x0=run.states[:, -1], exact_nes=exact_nes,
-                       rtol=SEED_RTOL)
+                       rtol=SEED_RTOL, frequency=False)
     if not run.success:
         return None, f"simulation failed: {run.message}"
     if run.response_type.value == "Stable":

@@ -26,7 +26,7 @@ from .bifurcation import BifurcationOptions
 from ..model.configurations import OPERATING_POINTS, Configuration
 from ..model.parameters import DEFAULT_MAP_SLICES, Parameters
 from .executors import run_units
-from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, classify, map_slice, stability_map
+from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, classify, map_slice, stability_maps
 
 BASELINE = "original"
 _trapezoid = getattr(np, "trapezoid", None) or np.trapz  # numpy 2 renamed it
@@ -125,12 +125,11 @@ def design_report(configs: Sequence[str] = ("original", "nes", "pd", "nes_pd"), 
     wanted = configs if BASELINE in configs else [BASELINE] + configs
     report = progress or (lambda fraction, message: None)
     results: dict[str, Any] = {}
-    maps: dict[str, StabilityMap] = {}
-    for k, c in enumerate(wanted):
-        def sub(fraction, message, k=k, c=c):
-            report((k + fraction) / len(wanted), f"{c}: {message}")
-
-        maps[c] = stability_map(c, BAND_V, (1.0e4, 9.0e5), resolution, params, executor=executor, progress=sub)
+    # all maps' units on the executor at once: no worker idles at the end of one map
+    computed = stability_maps(wanted, BAND_V, (1.0e4, 9.0e5), resolution, params, executor=executor,
+                              progress=lambda fraction, message: report(0.97 * fraction, message))
+    maps: dict[str, StabilityMap] = dict(zip(wanted, computed, strict=True))
+    for c in wanted:
         results[c] = metrics(maps[c], Fz)
     for c in configs:
         results[c]["against_original"] = against_baseline(results[c], results[BASELINE])

@@ -135,13 +135,15 @@ def _json_float(x: float):
 
 def simulate(config: Configuration | str, V: float, Fz: float, params: Parameters | None = None,
              t_end: float | None = None, x0=None, options: SimulationOptions | None = None,
-             **option_overrides) -> SimulationResult:
+             frequency: bool = True, **option_overrides) -> SimulationResult:
     """Integrate the model at forward speed V (m/s) and vertical load Fz (N).
 
     ``x0`` defaults to psi = 0.001 rad with all else zero (the study's start). Options may be
     given as a :class:`SimulationOptions` or as keyword overrides (``rtol=...``).
     Integration failures (divergence, step budget, NES out of range) do not raise:
     the result has ``success=False``, a ``message`` and the part that was computed.
+    ``frequency=False`` skips the spectrum (``frequency_hz`` is then NaN): for callers that need
+    only the settled state, such as the seeds of a bifurcation diagram.
     """
     config = Configuration.parse(config)
     V, Fz = check_operating_point(V, Fz)
@@ -166,7 +168,7 @@ def simulate(config: Configuration | str, V: float, Fz: float, params: Parameter
 
     t = np.arange(written) * options.dt_out
     states = np.ascontiguousarray(out[:written, :n].T)
-    measures = _steady_measures(states, start[:n], params, options)
+    measures = _steady_measures(states, start[:n], params, options, frequency)
     return SimulationResult(
         config=config, V=V, Fz=Fz, params=params, options=options, t=t, states=states,
         success=status == integrator.SUCCESS, status=int(status), message=_STATUS_MESSAGES[status],
@@ -191,7 +193,7 @@ def initial_state(x0, n: int) -> np.ndarray:
 
 
 def _steady_measures(states: np.ndarray, x0: np.ndarray, params: Parameters,
-                     options: SimulationOptions) -> dict[str, Any]:
+                     options: SimulationOptions, frequency: bool = True) -> dict[str, Any]:
     dt = options.dt_out
     k_psi, k_delta, l_g = params.gear.k_psi, params.gear.k_delta, params.gear.l_g
     span = max(2, int(round(options.steady_window / dt)))
@@ -215,13 +217,14 @@ def _steady_measures(states: np.ndarray, x0: np.ndarray, params: Parameters,
         amplitude["psis"] = peak_amplitude(final[5])
         amplitude["nes_relative"] = peak_amplitude(final[0] - final[5])
     total, total_prev = np.sqrt(e_t + e_l), np.sqrt(e_t_prev + e_l_prev)
+    hz = float("nan")
     if response is ResponseType.STABLE:
         # Settled when the motion has decayed to 1e-3 of its start.
         steady = bool(total <= DECAYED_FRACTION * np.sqrt(e_initial))
-        frequency = float("nan")
     else:
         # Settled when the amplitude changed by less than 1 % against the previous window.
         steady = bool(total_prev > 0 and abs(total / total_prev - 1.0) < 0.01)
-        frequency = dominant_frequency([np.sqrt(k_psi) * final[0], np.sqrt(k_delta) * final[2]], dt)
-    return {"amplitude": amplitude, "frequency_hz": frequency, "response_type": response,
+        if frequency:
+            hz = dominant_frequency([np.sqrt(k_psi) * final[0], np.sqrt(k_delta) * final[2]], dt)
+    return {"amplitude": amplitude, "frequency_hz": hz, "response_type": response,
             "steady": steady}

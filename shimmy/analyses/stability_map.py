@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -407,6 +407,142 @@ def _describe(task: tuple) -> str:
     return describe_search_unit(task)
 
 
+class _MapBuild:
+    """One map's units and what their results add (see :func:`stability_maps`)."""
+
+    def __init__(self, config: Configuration | str, v_range: tuple[float, float], fz_range: tuple[float, float],
+                 resolution: int, params: Parameters | None, n_v: int, options: BifurcationOptions | None):
+        self.config = Configuration.parse(config)
+        self.params = params if params is not None else Parameters()
+        self.v_range = check_range("v", v_range, V_RANGE, "m/s")
+        self.fz_range = check_range("fz", fz_range, FZ_RANGE, "N")
+        self.resolution = int(check_number("resolution", resolution, 2, 400, integer=True))
+        self.n_v = int(check_number("n_v", n_v, 2, 2000, integer=True))
+        self.options = options or BifurcationOptions(mesh_check=False)
+        (v_min, v_max), (f_min, f_max) = self.v_range, self.fz_range
+        self.loads = np.linspace(f_min, f_max, self.resolution)
+        self.search = CurveSearch(self.config, self.params, ((v_min, v_max), (f_min, f_max)), ("LPC", "NS"),
+                                  tuple(float(f) for f in self.loads))
+        self.rows = np.linspace(f_min, f_max, max(SHADING_ROWS, 4 * self.resolution))
+        self.hopf: HopfCurvesResult | None = None
+        self.slices: list[SliceResult] = []
+        self.slice_loads = [float(f) for f in self.loads]
+        self.rounds = 0
+        self.search.expect_sources(len(self.loads))
+        self.pending = 0  # units submitted or queued and not finished
+        self.finished_at = 0.0  # s after the start when its last unit finished
+
+    def _slice_unit(self, Fz: float) -> tuple:
+        v_min, v_max = self.v_range
+        return ("slice", self.config, float(Fz), v_min, v_max, self.n_v, self.params, self.options)
+
+    def _counted(self, units: list[tuple[int, tuple]]) -> list[tuple[int, tuple]]:
+        self.pending += len(units)
+        return units
+
+    def first_units(self) -> list[tuple[int, tuple]]:
+        units = [(0, ("hopf_curves", self.config, self.params, self.v_range, self.fz_range))]
+        return self._counted(units + [(2, self._slice_unit(Fz)) for Fz in self.loads])
+
+    def _coverage(self) -> list[tuple[int, tuple]]:
+        """Slices through the regions that no slice load (computed or under way) crosses: what
+        a region's boundaries are does not depend on the slices, only on the curves."""
+        if self.rounds == COVERAGE_ROUNDS:
+            return []
+        (v_min, v_max), (f_min, f_max) = self.v_range, self.fz_range
+        extra = map_shading.uncovered(self.slice_loads, _boundaries(self.hopf, self.search), self.rows,
+                                      (v_min, v_max), min_width=(v_max - v_min) / (self.n_v - 1),
+                                      min_area=COVERAGE_AREA * (v_max - v_min) * (f_max - f_min))
+        self.rounds += bool(extra)
+        self.slice_loads += extra
+        self.search.expect_sources(len(extra))
+        return [(2, self._slice_unit(Fz)) for Fz in extra]
+
+    def done(self, task: tuple, result: Any, elapsed: float) -> list[tuple[int, tuple]]:
+        """The units that a finished unit's result adds: curves from its starts, coverage slices
+        once the curves as they stand are all continued."""
+        self.pending -= 1
+        if task[0] == "hopf_curves":
+            self.hopf = result
+            more = [(0, u) for u in self.search.start_units(result)] + [(0, u) for u in self.search.continuations()]
+        elif task[0] == "slice":
+            self.slices.append(result)
+            self.search.add_source(result.starts)
+            more = [(0, u) for u in self.search.continuations()]
+        else:
+            more = [(0, u) for u in search_done(self.search, task, result)]
+        if self.search.idle() and self.hopf is not None:  # the curves as they stand
+            more += self._coverage()
+        if not more and self.pending == 0:
+            self.finished_at = elapsed
+        return self._counted(more)
+
+    def result(self, executor: str) -> StabilityMap:
+        """The map from the finished units; ``elapsed_s``: until its last unit finished, plus this."""
+        clock = time.perf_counter()
+        (v_min, v_max), rows = self.v_range, self.rows
+        hopf: HopfCurvesResult = self.hopf
+        slices = sorted(self.slices, key=lambda s: s.Fz)
+        cycles = self.search.result(self.finished_at).to_dict()
+        warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
+        for s in slices:
+            warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
+        segments, fallbacks = map_shading.row_segments(slices, _boundaries(hopf, self.search), rows, (v_min, v_max))
+        V = slices[0].V
+        return StabilityMap(self.config, self.params, self.v_range, self.fz_range, V,
+                            np.array([s.Fz for s in slices]), [s.types for s in slices], slices, hopf, cycles, rows,
+                            map_shading.grid(segments, V), [map_shading.measures(r) for r in segments], fallbacks,
+                            map_shading.polygons(segments, rows), _min_shimmy(hopf, cycles, slices), executor,
+                            self.finished_at + time.perf_counter() - clock, warnings)
+
+
+def _tagged_unit(tagged: tuple[int, tuple]) -> Any:
+    """A unit of map ``tagged[0]`` of :func:`stability_maps` (top level, for process pools and Dask)."""
+    return _unit(tagged[1])
+
+
+def stability_maps(configs: Sequence[Configuration | str], v_range: tuple[float, float] = DEFAULT_V_RANGE,
+                   fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = DEFAULT_MAP_SLICES,
+                   params: Parameters | None = None, n_v: int = 100, executor=None,
+                   progress: Callable[[float, str], None] | None = None,
+                   options: BifurcationOptions | None = None) -> list[StabilityMap]:
+    """The maps of several configurations (same plane, resolution and parameters), in the order
+    given: :func:`stability_map` of each, their units all through one ``executor`` at once.
+
+    The maps' units share the workers, most urgent first (every map's curve units ahead of any
+    slice), so that no worker idles while another map's units wait: one map's last curve or slice
+    no longer holds the workers back. Each map's ``elapsed_s`` is the time until its own last unit
+    finished."""
+    clock = time.perf_counter()
+    builds = [_MapBuild(c, v_range, fz_range, resolution, params, n_v, options) for c in configs]
+    if not builds:
+        raise InvalidParameterError("configs", list(configs), "one or more configurations")
+    if executor is None:
+        with open_executor() as own:
+            maps = stability_maps(configs, v_range, fz_range, resolution, params, n_v, own, progress, options)
+        for smap in maps:
+            smap.executor = name_of(None)
+        return maps
+    report = progress or (lambda fraction, message: None)
+    several = len(builds) > 1
+
+    def done(tagged: tuple[int, tuple], result: Any) -> list[tuple[int, tuple]]:
+        k, task = tagged
+        more = builds[k].done(task, result, time.perf_counter() - clock)
+        return [(priority, (k, unit)) for priority, unit in more]
+
+    def describe(tagged: tuple[int, tuple]) -> str:
+        k, task = tagged
+        return f"{builds[k].config.value}: {_describe(task)}" if several else _describe(task)
+
+    units = [(priority, (k, unit)) for k, b in enumerate(builds) for priority, unit in b.first_units()]
+    run_dynamic(_tagged_unit, units, executor, done, report, describe,
+                lambda tagged: "slices" if tagged[1][0] == "slice" else "curve units")
+    maps = [b.result(type(executor).__name__) for b in builds]
+    report(1.0, "done")
+    return maps
+
+
 def stability_map(config: Configuration | str, v_range: tuple[float, float] = DEFAULT_V_RANGE,
                   fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = DEFAULT_MAP_SLICES,
                   params: Parameters | None = None, n_v: int = 100, executor=None,
@@ -421,75 +557,7 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     branches beside their GH and double-Hopf points, and the slices' diagrams; each fold or torus
     curve is continued as soon as a start for it is known (a GH or double-Hopf point, or a
     slice's LPC / NS point), ahead of the remaining slices."""
-    clock = time.perf_counter()
-    config = Configuration.parse(config)
-    params = params if params is not None else Parameters()
-    v_min, v_max = check_range("v", v_range, V_RANGE, "m/s")
-    f_min, f_max = check_range("fz", fz_range, FZ_RANGE, "N")
-    resolution = int(check_number("resolution", resolution, 2, 400, integer=True))
-    n_v = int(check_number("n_v", n_v, 2, 2000, integer=True))
-    if executor is None:
-        with open_executor() as own:
-            smap = stability_map(config, v_range, fz_range, resolution, params, n_v, own, progress, options)
-        smap.executor = name_of(None)
-        return smap
-    options = options or BifurcationOptions(mesh_check=False)
-    report = progress or (lambda fraction, message: None)
-    loads = np.linspace(f_min, f_max, resolution)
-    search = CurveSearch(config, params, ((v_min, v_max), (f_min, f_max)), ("LPC", "NS"),
-                         tuple(float(f) for f in loads))
-    rows = np.linspace(f_min, f_max, max(SHADING_ROWS, 4 * resolution))
-    found: dict[str, Any] = {"hopf": None, "slices": [], "loads": list(loads), "rounds": 0}
-    search.expect_sources(len(loads))
-
-    def slice_unit(Fz: float) -> tuple:
-        return ("slice", config, float(Fz), v_min, v_max, n_v, params, options)
-
-    def coverage() -> list[tuple[int, tuple]]:
-        """Slices through the regions that no slice load (computed or under way) crosses: what
-        a region's boundaries are does not depend on the slices, only on the curves."""
-        if found["rounds"] == COVERAGE_ROUNDS:
-            return []
-        extra = map_shading.uncovered(found["loads"], _boundaries(found["hopf"], search), rows, (v_min, v_max),
-                                      min_width=(v_max - v_min) / (n_v - 1),
-                                      min_area=COVERAGE_AREA * (v_max - v_min) * (f_max - f_min))
-        found["rounds"] += bool(extra)
-        found["loads"] += extra
-        search.expect_sources(len(extra))
-        return [(2, slice_unit(Fz)) for Fz in extra]
-
-    def done(task: tuple, result: Any) -> list[tuple[int, tuple]]:
-        if task[0] == "hopf_curves":
-            found["hopf"] = result
-            more = [(0, u) for u in search.start_units(result)] + [(0, u) for u in search.continuations()]
-        elif task[0] == "slice":
-            found["slices"].append(result)
-            search.add_source(result.starts)
-            more = [(0, u) for u in search.continuations()]
-        else:
-            more = [(0, u) for u in search_done(search, task, result)]
-        if search.idle() and found["hopf"] is not None:  # the curves as they stand
-            more += coverage()
-        return more
-
-    units = [(0, ("hopf_curves", config, params, (v_min, v_max), (f_min, f_max)))]
-    units += [(2, slice_unit(Fz)) for Fz in loads]
-    run_dynamic(_unit, units, executor, done, report, _describe,
-                lambda task: "slices" if task[0] == "slice" else "curve units")
-    hopf: HopfCurvesResult = found["hopf"]
-    slices: list[SliceResult] = sorted(found["slices"], key=lambda s: s.Fz)
-    cycles = search.result(time.perf_counter() - clock).to_dict()
-    warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
-    for s in slices:
-        warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
-    segments, fallbacks = map_shading.row_segments(slices, _boundaries(hopf, search), rows, (v_min, v_max))
-    V = slices[0].V
-    report(1.0, "done")
-    return StabilityMap(config, params, (v_min, v_max), (f_min, f_max), V, np.array([s.Fz for s in slices]),
-                        [s.types for s in slices], slices, hopf, cycles, rows, map_shading.grid(segments, V),
-                        [map_shading.measures(r) for r in segments], fallbacks,
-                        map_shading.polygons(segments, rows), _min_shimmy(hopf, cycles, slices),
-                        type(executor).__name__, time.perf_counter() - clock, warnings)
+    return stability_maps([config], v_range, fz_range, resolution, params, n_v, executor, progress, options)[0]
 
 
 def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, np.ndarray]]:

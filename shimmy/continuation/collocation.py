@@ -35,7 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .condensed_lu import ChainLayout, collocation_layout, monodromy
+from .condensed_lu import ChainLayout, CondensedLU, collocation_layout, monodromy
 from .core import VectorField, condensed_factors
 
 
@@ -196,10 +196,12 @@ class PeriodicProblem:
         self.n_x = mesh.n_nodes * n
         w_nodes = mesh.node_weights[:, None] / self.scale[None, :] ** 2
         self.weights = np.concatenate([w_nodes.ravel(), [1.0 / self.T_scale ** 2, 1.0 / self.p_scale ** 2]])
+        self._rows_memo: np.ndarray | None = None  # periodicity and phase rows of the current reference
         self.reference_derivative = np.zeros((N, m, n))
         self.reference_values = np.zeros((N, m, n))
         self.n_equations = N * m * n + n + 1
         self._blocks_memo: tuple[bytes, tuple] | None = None
+        self._factors_memo: tuple[bytes, CondensedLU] | None = None  # the last condensed factors, at u
         pattern = _pattern(N, m, n)
         self._rows, self._cols = pattern.rows, pattern.cols
         self._slot, self._nnz, self._indices, self._indptr = pattern.slot, pattern.nnz, pattern.indices, pattern.indptr
@@ -219,6 +221,16 @@ class PeriodicProblem:
     def _at_collocation(self, X: np.ndarray):
         U = X[self.mesh.node_index]  # (ntst, m+1, n)
         return self.basis.L @ U, self.basis.D @ U  # derivative in local s; d/dtau = / h
+
+    @property
+    def reference_derivative(self) -> np.ndarray:
+        """d/dtau of the reference orbit at the collocation points (the phase condition's weights)."""
+        return self._reference_derivative
+
+    @reference_derivative.setter
+    def reference_derivative(self, value: np.ndarray) -> None:
+        self._reference_derivative = value
+        self._rows_memo = None  # the phase row changes with it
 
     # -- curve problem -------------------------------------------------------------------
     def accept(self, u: np.ndarray) -> None:
@@ -292,7 +304,10 @@ class PeriodicProblem:
         Q = np.zeros((self.n + 2, self.n_x + 2))
         Q[:self.n + 1] = self.periodicity_and_phase_rows()
         Q[self.n + 1] = row
-        return condensed_factors(lay, (A, Q), row, lambda: self.jacobian(u))
+        lu = condensed_factors(lay, (A, Q), row, lambda: self.jacobian(u))
+        if isinstance(lu, CondensedLU):  # its interval eliminations give the multipliers at u
+            self._factors_memo = (u.tobytes(), lu)
+        return lu
 
     def link_blocks(self, u: np.ndarray, width: int) -> np.ndarray:
         """The collocation rows of the Jacobian per mesh interval, as the condensed LU's link blocks
@@ -308,7 +323,14 @@ class PeriodicProblem:
         return A
 
     def periodicity_and_phase_rows(self) -> np.ndarray:
-        """The Jacobian's last n + 1 rows (x(0) - x(1), the phase condition) in full, (n + 1, n_x + 2)."""
+        """The Jacobian's last n + 1 rows (x(0) - x(1), the phase condition) in full, (n + 1, n_x + 2)
+        (remembered until the next :meth:`accept`; callers must not modify them)."""
+        if self._rows_memo is None:
+            self._rows_memo = self._periodicity_and_phase_rows()
+            self._rows_memo.flags.writeable = False
+        return self._rows_memo
+
+    def _periodicity_and_phase_rows(self) -> np.ndarray:
         mesh, n, m, N = self.mesh, self.n, self.mesh.ncol, self.mesh.ntst
         Q = np.zeros((n + 1, self.n_x + 2))
         Q[np.arange(n), np.arange(n)] = 1.0
@@ -321,10 +343,17 @@ class PeriodicProblem:
 
     # -- results -------------------------------------------------------------------------
     def multipliers(self, u: np.ndarray) -> np.ndarray:
-        """Floquet multipliers (n,), the trivial one first, the others by decreasing modulus."""
-        blocks, _, _, _ = self.collocation_blocks(u)
-        n, m, N = self.n, self.mesh.ncol, self.mesh.ntst
-        M = monodromy(np.ascontiguousarray(blocks.reshape(N, m * n, (m + 1) * n)), n)
+        """Floquet multipliers (n,), the trivial one first, the others by decreasing modulus.
+
+        The monodromy matrix comes from the condensed factors at u if the last factorisation was
+        there (an accepted point's tangent), else from the collocation blocks: the same numbers."""
+        memo = self._factors_memo
+        if memo is not None and memo[0] == u.tobytes():
+            M = memo[1].monodromy()
+        else:
+            blocks, _, _, _ = self.collocation_blocks(u)
+            n, m, N = self.n, self.mesh.ncol, self.mesh.ntst
+            M = monodromy(np.ascontiguousarray(blocks.reshape(N, m * n, (m + 1) * n)), n)
         if not np.all(np.isfinite(M)):
             raise np.linalg.LinAlgError("singular collocation block: no monodromy matrix")
         mu, vectors = np.linalg.eig(M)

@@ -201,6 +201,13 @@ class CondensedLU:
                    lay.global_rows, lay.interior_cols, lay.node_cols, lay.global_cols)
         return X.ravel() if flat else X
 
+    def monodromy(self) -> np.ndarray:
+        """P_(L-1) ... P_0, P_k mapping node k to node k + 1 through link k's rows with the global
+        columns left out: for a collocation matrix, the monodromy matrix of the orbit (the same
+        numbers as :func:`monodromy` on its blocks, whose interior elimination the factors hold)."""
+        lay = self.layout
+        return _transfer_product(_reduced_rows(self._A, lay.n_interior, lay.n, lay.ni_max), lay.n)
+
 
 #: A pivot below this fraction of its column's size in the whole matrix is taken for zero (the
 #: pivoting is restricted to a link's rows, or two links', so a tiny one may be rounding where the
@@ -621,26 +628,18 @@ def _solve(transposed, A, perm1, C1, M2, perm2, C2, F, permF, B, nint, n, nimax,
 
 
 @njit(cache=True, error_model="numpy")
-def monodromy(blocks, n):
-    """The monodromy matrix P_(N-1) ... P_0 from the linearised collocation blocks (N, m n, (m + 1) n)
-    of the intervals (columns: the interval's nodes in order): P_j maps x at an interval's first node
-    to x at its last, found by eliminating the interior nodes (the first stage of the condensed LU)
-    and solving the n rows left over. NaN where an interval's block is singular."""
-    N, rows, width = blocks.shape
+def _transfer_product(R, n):
+    """P_(N-1) ... P_0 with P_j = -D_j^-1 C_j from the rows R[j] = [C_j | D_j] (N, n, 2n) left after
+    eliminating interval j's interior nodes (C_j x_first + D_j x_last = 0); NaN if a D_j is singular."""
+    N = R.shape[0]
     M = np.eye(n)
-    perm = np.zeros(max(rows - n, 1), np.int64)
+    p2 = np.zeros(n, np.int64)
     for j in range(N):
-        B = blocks[j].copy()
-        ni = rows - n
-        if _lu_columns(B, rows, n, ni, perm, _column_sizes(B, rows, n, ni, B[:0], np.arange(ni))):
-            return np.full((n, n), np.nan)
-        # rows ni .. rows-1: C x_first + D x_last = 0 -> P = -D^-1 C, by elimination on [D | C]
-        S = np.zeros((n, 2 * n))
+        S = np.zeros((n, 2 * n))  # elimination on [D | -C]
         for i in range(n):
             for c in range(n):
-                S[i, c] = B[ni + i, width - n + c]
-                S[i, n + c] = -B[ni + i, c]
-        p2 = np.zeros(n, np.int64)
+                S[i, c] = R[j, i, n + c]
+                S[i, n + c] = -R[j, i, c]
         if _lu_columns(S, n, 0, n, p2, _column_sizes(S, n, 0, n, S[:0], np.arange(n))):
             return np.full((n, n), np.nan)
         P = S[:, n:].copy()
@@ -652,3 +651,40 @@ def monodromy(blocks, n):
                 P[c, a] /= S[c, c]
         M = P @ M
     return M
+
+
+@njit(cache=True, error_model="numpy")
+def monodromy(blocks, n):
+    """The monodromy matrix P_(N-1) ... P_0 from the linearised collocation blocks (N, m n, (m + 1) n)
+    of the intervals (columns: the interval's nodes in order): P_j maps x at an interval's first node
+    to x at its last, found by eliminating the interior nodes (the first stage of the condensed LU)
+    and solving the n rows left over. NaN where an interval's block is singular."""
+    N, rows, width = blocks.shape
+    ni = rows - n
+    perm = np.zeros(max(ni, 1), np.int64)
+    R = np.zeros((N, n, 2 * n))
+    for j in range(N):
+        B = blocks[j].copy()
+        if _lu_columns(B, rows, n, ni, perm, _column_sizes(B, rows, n, ni, B[:0], np.arange(ni))):
+            return np.full((n, n), np.nan)
+        for i in range(n):
+            for c in range(n):
+                R[j, i, c] = B[ni + i, c]
+                R[j, i, n + c] = B[ni + i, width - n + c]
+    return _transfer_product(R, n)
+
+
+@njit(cache=True, error_model="numpy")
+def _reduced_rows(A, nint, n, nimax):
+    """[left node | right node] of the rows each link keeps after its interior elimination (stage 1
+    of :func:`_factor`, left in A), (L, n, 2n)."""
+    L = A.shape[0]
+    right0 = n + nimax
+    R = np.zeros((L, n, 2 * n))
+    for link in range(L):
+        ni = nint[link]
+        for i in range(n):
+            for c in range(n):
+                R[link, i, c] = A[link, ni + i, c]
+                R[link, i, n + c] = A[link, ni + i, right0 + c]
+    return R
