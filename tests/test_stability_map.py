@@ -18,8 +18,8 @@ from shimmy.analyses.executors import InlineExecutor
 from shimmy.analyses.simulation import simulate
 from shimmy.analyses.stability import hopf_points
 from shimmy.analyses import map_shading
-from shimmy.analyses.stability_map import (SHIMMY_TYPES, attractors_at, classify, shimmy_type, stability_map,
-                                          stability_maps)
+from shimmy.analyses.stability_map import (SHIMMY_TYPES, TRIVIAL_LATERAL, TRIVIAL_PSI, attractors_at, attractors_on,
+                                          classify, shimmy_type, stability_map, stability_maps)
 
 RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"}
 
@@ -237,6 +237,49 @@ def test_attractors_ignore_a_branch_run_on_along_x_equal_0():
         found = attractors_at(result, V)
         assert [a["kind"] for a in found] == ["equilibrium"]
         assert simulate("nes_pd", V, 78461.5, t_end=60.0).response_type.value == "Stable"
+
+
+def attractors_one_by_one(result, V):
+    """The attractors at one speed, segment by segment in plain Python (the reference for the
+    vectorised read-off on a whole grid)."""
+    equilibrium = not any(a <= V <= b for a, b in result.hopf.unstable_intervals)
+    found = [{"kind": "equilibrium", "mode": None, "max_psi": 0.0, "max_lateral": 0.0, "period": None,
+              "branch": 0}] if equilibrium else []
+    tol = 1e-7 * max(1.0, abs(V))
+    for k, b in enumerate(result.branches):
+        if b.kind != "periodic" or b.V.size < 2:
+            continue
+        pairs = [(i, i + 1) for i in range(b.V.size - 1)]
+        if b.stop_reason.startswith("closed branch"):
+            pairs.append((b.V.size - 1, 0))
+        for i, j in pairs:
+            v0, v1 = float(b.V[i]), float(b.V[j])
+            if v0 == v1 or not min(v0, v1) - tol <= V <= max(v0, v1) + tol:
+                continue
+            f = min(max((V - v0) / (v1 - v0), 0.0), 1.0)
+            near = i if f <= 0.5 else j
+            stable = bool(b.stable[i]) if b.stable[i] == b.stable[j] else bool(b.stable[near])
+            mode = b.mode[near] or b.mode[i] or b.mode[j]
+            amp = float(b.max_psi[i] + f * (b.max_psi[j] - b.max_psi[i]))
+            lateral = float(b.max_lateral[i] + f * (b.max_lateral[j] - b.max_lateral[i]))
+            if not stable or mode is None or (amp <= 0.0 and lateral <= 0.0) \
+                    or (equilibrium and amp <= TRIVIAL_PSI and lateral <= TRIVIAL_LATERAL):
+                continue
+            found.append({"kind": "limit cycle", "mode": mode, "max_psi": amp, "max_lateral": lateral,
+                          "period": float(b.period[i] + f * (b.period[j] - b.period[i])), "branch": k})
+    return found
+
+
+@pytest.mark.parametrize("config, Fz", [("nes", 547e3), ("pd", 283e3), ("nes_pd", 78461.5)])
+def test_attractors_on_a_grid_are_those_at_each_speed(config, Fz):
+    """The read-off of a whole grid at once (closed loops, folds, Hopf ends, a branch run on along
+    x = 0 among them) gives, speed by speed, the attractors of the plain one-speed read-off."""
+    result = bifurcation(config, Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    ends = [float(v) for b in result.branches for v in b.V]
+    grid = np.concatenate([np.linspace(1.0, 200.0, 991), ends])
+    on_grid = attractors_on(result, grid)
+    assert [attractors_one_by_one(result, float(V)) for V in grid] == on_grid
+    assert sum(len(a) for a in on_grid) > grid.size  # cycles found, not only x = 0
 
 
 @pytest.mark.parametrize("kwargs, field", [

@@ -86,12 +86,23 @@ TRIVIAL_LATERAL = 1e-7
 
 def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
     """The stable equilibria and limit cycles of a bifurcation diagram at speed V."""
-    found: list[dict[str, Any]] = []
-    equilibrium_stable = not any(a <= V <= b for a, b in result.hopf.unstable_intervals)
-    if equilibrium_stable:
-        found.append({"kind": "equilibrium", "mode": None, "max_psi": 0.0, "max_lateral": 0.0,
-                      "period": None, "branch": 0})
-    tol = 1e-7 * max(1.0, abs(V))  # end points located on a range bound to rounding
+    return attractors_on(result, np.array([float(V)]))[0]
+
+
+def attractors_on(result: BifurcationResult, speeds: np.ndarray) -> list[list[dict[str, Any]]]:
+    """:func:`attractors_at` at each of ``speeds`` (one pass over each branch for all of them): x = 0
+    where no unstable interval holds V, then, branch by branch, every branch segment whose speeds
+    bracket V, interpolated linearly, if stable (the nearer end's flag where the ends differ) with
+    a mode."""
+    speeds = np.asarray(speeds, float)
+    found: list[list[dict[str, Any]]] = [[] for _ in speeds]
+    equilibrium_stable = np.ones(speeds.size, bool)
+    for a, b in result.hopf.unstable_intervals:
+        equilibrium_stable &= ~((a <= speeds) & (speeds <= b))
+    for g in np.nonzero(equilibrium_stable)[0]:
+        found[g].append({"kind": "equilibrium", "mode": None, "max_psi": 0.0, "max_lateral": 0.0,
+                         "period": None, "branch": 0})
+    tol = 1e-7 * np.maximum(1.0, np.abs(speeds))  # end points located on a range bound to rounding
     for k, b in enumerate(result.branches):
         if b.kind != "periodic" or b.V.size < 2:
             continue
@@ -100,24 +111,32 @@ def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
             first = np.append(first, b.V.size - 1)
         second = (first + 1) % b.V.size
         v0s, v1s = b.V[first], b.V[second]
-        hits = np.nonzero((np.minimum(v0s, v1s) - tol <= V) & (V <= np.maximum(v0s, v1s) + tol) & (v0s != v1s))[0]
-        for i, j in zip(first[hits].tolist(), second[hits].tolist(), strict=True):
-            v0, v1 = b.V[i], b.V[j]
-            f = min(max((V - v0) / (v1 - v0), 0.0), 1.0)
-            near = i if f <= 0.5 else j
-            stable = bool(b.stable[i]) if b.stable[i] == b.stable[j] else bool(b.stable[near])
-            mode = b.mode[near] or b.mode[i] or b.mode[j]
-            if not stable or mode is None:
+        lo, hi = np.minimum(v0s, v1s), np.maximum(v0s, v1s)
+        inside = (lo[None, :] - tol[:, None] <= speeds[:, None]) & (speeds[:, None] <= hi[None, :] + tol[:, None]) \
+            & (v0s != v1s)[None, :]
+        gs, segs = np.nonzero(inside)  # by speed, then along the branch
+        if gs.size == 0:
+            continue
+        i, j = first[segs], second[segs]
+        v0, v1 = b.V[i], b.V[j]
+        f = np.minimum(np.maximum((speeds[gs] - v0) / (v1 - v0), 0.0), 1.0)
+        near = np.where(f <= 0.5, i, j)
+        flags = np.asarray(b.stable, bool)
+        stable = np.where(flags[i] == flags[j], flags[i], flags[near])
+        amp = b.max_psi[i] + f * (b.max_psi[j] - b.max_psi[i])
+        lateral = b.max_lateral[i] + f * (b.max_lateral[j] - b.max_lateral[i])
+        period = b.period[i] + f * (b.period[j] - b.period[i])
+        for h in np.nonzero(stable)[0]:
+            mode = b.mode[near[h]] or b.mode[i[h]] or b.mode[j[h]]
+            if mode is None:
                 continue
-            amp = float(b.max_psi[i] + f * (b.max_psi[j] - b.max_psi[i]))
-            lateral = float(b.max_lateral[i] + f * (b.max_lateral[j] - b.max_lateral[i]))
-            if equilibrium_stable and amp <= TRIVIAL_PSI and lateral <= TRIVIAL_LATERAL:
+            g = gs[h]
+            if equilibrium_stable[g] and amp[h] <= TRIVIAL_PSI and lateral[h] <= TRIVIAL_LATERAL:
                 continue  # a zero-amplitude end point, or a branch run on along a stable x = 0
-            if amp <= 0.0 and lateral <= 0.0:
+            if amp[h] <= 0.0 and lateral[h] <= 0.0:
                 continue  # the zero-amplitude end point at a Hopf point
-            found.append({"kind": "limit cycle", "mode": mode, "max_psi": amp,
-                          "max_lateral": lateral,
-                          "period": float(b.period[i] + f * (b.period[j] - b.period[i])), "branch": k})
+            found[g].append({"kind": "limit cycle", "mode": mode, "max_psi": float(amp[h]),
+                             "max_lateral": float(lateral[h]), "period": float(period[h]), "branch": k})
     return found
 
 
@@ -192,7 +211,7 @@ def _slice_types(result: BifurcationResult, fine: np.ndarray, coarse_step: int, 
                  params: Parameters) -> tuple[list[str], list[list[dict]], list[float]]:
     """Types on the fine grid; stretches with no stable equilibrium or cycle are simulated at
     their output-grid points (at most MAX_SIMULATIONS_PER_SLICE, spread evenly)."""
-    attractors = [attractors_at(result, float(v)) for v in fine]
+    attractors = attractors_on(result, fine)
     empty = [i for i, a in enumerate(attractors) if not a]
     simulated: list[float] = []
     if empty:
