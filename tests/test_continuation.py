@@ -203,6 +203,29 @@ def test_curvature_predictor_estimates_the_circles_curvature_and_keeps_its_point
     tracer.point = CurvePoint(u.copy(), t.copy())
     assert tracer.curvature() is None
 
+def test_point_at_a_level_of_one_unknown_is_the_circles_point_there():
+    """point_at: between two points of a circle of radius R, the point where x = c is (c, sqrt(R^2 - c^2))
+    (one Newton solve with x held), and where y = 0 across the turning point of x it is (R, 0); the
+    tangent, when asked, is the circle's; a level not crossed between the two points is refused."""
+    from shimmy.continuation.core import CurvePoint, point_at
+
+    R = 2.0
+    options = ContinuationOptions(tol=1e-12, residual_tol=1e-12)
+    circle = _Circle(R)
+    a = CurvePoint(np.array([R * np.cos(0.3), R * np.sin(0.3)]), np.array([-np.sin(0.3), np.cos(0.3)]))
+    b = CurvePoint(np.array([R * np.cos(0.9), R * np.sin(0.9)]), np.array([-np.sin(0.9), np.cos(0.9)]))
+    c = 1.5
+    at = point_at(circle, a, b, 0, c, options)
+    np.testing.assert_allclose(at.u, [c, np.sqrt(R * R - c * c)], rtol=0.0, atol=1e-12)
+    assert at.tangent is a.tangent
+    turned = point_at(circle, a, b, 0, c, options, with_tangent=True)
+    np.testing.assert_allclose(turned.tangent, [-at.u[1] / R, at.u[0] / R], atol=1e-12)
+    with pytest.raises(ValueError):
+        point_at(circle, a, b, 0, 0.5, options)  # not crossed between a and b
+    below = CurvePoint(np.array([R * np.cos(-0.3), R * np.sin(-0.3)]), np.array([np.sin(0.3), np.cos(0.3)]))
+    np.testing.assert_allclose(point_at(circle, below, a, 1, 0.0, options).u, [R, 0.0], atol=1e-12)
+
+
 def test_chord_control_bounds_how_far_each_drawn_step_strays_from_the_curve():
     """With a chord check (the cubic's midpoint deviation h/8 |t_a - t_b| over a tolerance) every
     accepted step of a circle of radius R has a sagitta R (1 - cos(angle / 2)) within the

@@ -404,9 +404,13 @@ class Tracer:
         if low <= value <= high:
             return prev, new, h, None
         bound = high if value > high else low
-        hit = locate(self.problem, prev, h, lambda q: q.u[index] - bound, prev.u[index] - bound, value - bound,
-                     self.options)
-        return prev, (hit[0] if hit is not None else None), h, bound
+        at = point_at(self.problem, prev, new, index, bound, self.options, with_tangent=True) \
+            if prev.u[index] != bound else None
+        if at is None:
+            hit = locate(self.problem, prev, h, lambda q: q.u[index] - bound, prev.u[index] - bound, value - bound,
+                         self.options)
+            at = None if hit is None else hit[0]
+        return prev, at, h, bound
 
     def limit_step(self, h_max: float) -> None:
         self.h = max(min(self.h, h_max), self.options.ds_min)
@@ -448,6 +452,38 @@ def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[
             side = 1
         b, gb = h, gh
     return best
+
+
+def point_at(problem: CurveProblem, a: CurvePoint, b: CurvePoint, index: int, value: float,
+             options: ContinuationOptions, with_tangent: bool = False) -> CurvePoint | None:
+    """The point of the curve between two of its points a and b where unknown ``index`` equals
+    ``value`` (which it crosses between them): one Newton solve with that unknown held at the value
+    (the corrector with the bordering row e_index), from the chord between a and b. Cheaper than a
+    secant search (:func:`locate`), which corrects a whole trial step per iteration. None if Newton
+    does not converge, or converges farther from the chord than the distance from a to b (another
+    part of the curve, or one where it is tangent to the level): callers then :func:`locate`.
+    The point carries its own tangent (oriented along a's) with ``with_tangent``, else a's."""
+    ga, gb = a.u[index] - value, b.u[index] - value
+    if not ga * gb < 0:
+        raise ValueError(f"unknown {index} does not cross {value} between the two points")
+    guess = a.u + (ga / (ga - gb)) * (b.u - a.u)
+    guess[index] = value
+    hold = np.zeros_like(guess)
+    hold[index] = 1.0 / problem.weights[index]  # bordering row w * hold = e_index: u[index] = value
+    out = correct(problem, guess, hold, options)
+    if out is None:
+        return None
+    u, iterations, _ = out
+    w = problem.weights
+    if weighted_norm(u - guess, w) > weighted_norm(b.u - a.u, w):
+        return None
+    if not with_tangent:
+        return CurvePoint(u, a.tangent, iterations)
+    try:
+        t = tangent(problem, u, a.tangent)
+    except (RuntimeError, ValueError, np.linalg.LinAlgError):
+        return None
+    return CurvePoint(u, t, iterations) if np.all(np.isfinite(t)) else None
 
 
 def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Callable[[CurvePoint], float],

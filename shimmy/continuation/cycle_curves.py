@@ -56,7 +56,7 @@ from scipy.sparse.linalg import splu
 from .collocation import Mesh, PeriodicProblem
 from .condensed_lu import ChainLayout, CondensedLU, collocation_layout
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, condensed_factors,
-                   locate_between, refine, step, tangent, weighted_norm)
+                   locate_between, point_at, refine, step, tangent, weighted_norm)
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
 from .lyapunov import hopf_eigenvectors
 from .periodic_orbits import PeriodicOptions, hopf_guess, multiplier_crossing_test, periodic_branch
@@ -849,10 +849,13 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
         if abs(b) <= 1e-9 * problem.p_scale[1]:  # the step ends on the mark (a box edge)
             found.append(_located(problem, "P2_MARK", new, rows))
         elif a * b < 0:
-            hit = locate_between(problem, prev, new, lambda q, m=mark: q.u[i2] - m, a, b, copts,
-                                 1e-9 * problem.p_scale[1], with_tangent=False)
-            if hit is not None:
-                found.append(_located(problem, "P2_MARK", hit[0], rows))
+            at = point_at(problem, prev, new, i2, mark, copts)  # p2 held at the mark: one Newton solve
+            if at is None:
+                hit = locate_between(problem, prev, new, lambda q, m=mark: q.u[i2] - m, a, b, copts,
+                                     1e-9 * problem.p_scale[1], with_tangent=False)
+                at = None if hit is None else hit[0]
+            if at is not None:
+                found.append(_located(problem, "P2_MARK", at, rows))
     problem.cycle_u(new.u)
     return found
 
