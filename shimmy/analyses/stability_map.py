@@ -31,7 +31,9 @@ type is set by the curves (a mode change inside a region is interpolated by the 
 
 All units of a map (the Hopf curves, branches beside codimension-2 points, curve continuations,
 slices) go through :mod:`shimmy.analyses.executors` (a local process pool, or a Dask cluster),
-most urgent first (:func:`~shimmy.analyses.executors.run_dynamic`).
+most urgent first (:func:`~shimmy.analyses.executors.run_dynamic`). :func:`stability_maps` runs
+several maps' units through one executor at once (no worker waits for one map's last unit while
+another map has units left); each map is the one :func:`stability_map` computes alone.
 """
 
 from __future__ import annotations

@@ -57,7 +57,7 @@ from .collocation import Mesh, PeriodicProblem
 from .cycle_curves import (CODIM2_KINDS, CycleBifurcation, CycleCurve, CycleCurveOptions, CycleCurveProblem,
                            TwoParameterVectorField, cycle_curve, start_beside)
 from .core import (ContinuationOptions, CurvePoint, CurveProblem, SpecialPoint, Tracer, VectorField, correct,
-                   locate, step, tangent, weighted_norm)
+                   locate, point_at, step, tangent, weighted_norm)
 from .equilibria import EquilibriumBranch, equilibrium_branch
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
 from .hopf import HopfCurve, HopfCurveProblem, TwoParameterField, hopf_curve, hopf_start
@@ -73,5 +73,5 @@ __all__ = [
     "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "SpecialPoint", "Tracer", "TwoParameterField",
     "VectorField", "correct", "equilibrium_branch", "first_lyapunov_coefficient", "hopf_curve",
     "hopf_eigenvectors", "hopf_guess", "hopf_start", "locate", "orbit_from_samples", "periodic_branch",
-    "step", "tangent", "weighted_norm",
+    "point_at", "step", "tangent", "weighted_norm",
 ]
