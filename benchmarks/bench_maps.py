@@ -50,6 +50,8 @@ def main() -> None:
     parser.add_argument("--only-dask", action="store_true")
     parser.add_argument("--only-four", action="store_true", help="only the four maps (no one-map figures, no Dask)")
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error("--repeats must be at least 1")
     print(f"machine: {os.cpu_count()} cores; default executor: {describe()}")
     if args.only_four:
         four(args)

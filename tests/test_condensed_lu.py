@@ -198,7 +198,9 @@ def test_the_factors_give_the_same_monodromy_matrix_as_the_blocks(points, ncol):
     lu = problem.factor_bordered(u, row)
     assert isinstance(lu, CondensedLU)
     np.testing.assert_array_equal(lu.monodromy(), monodromy(blocks, n))
+    problem._blocks_memo = None  # the multipliers at u must come from the factors, not the blocks
     from_factors = problem.multipliers(u)
+    assert problem._blocks_memo is None
     other = u + 0.01
     problem.factor_bordered(other, row)  # the last factors are elsewhere now
     np.testing.assert_array_equal(problem.multipliers(u), from_factors)

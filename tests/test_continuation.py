@@ -226,6 +226,22 @@ def test_point_at_a_level_of_one_unknown_is_the_circles_point_there():
     np.testing.assert_allclose(point_at(circle, below, a, 1, 0.0, options).u, [R, 0.0], atol=1e-12)
 
 
+def test_a_step_leaving_the_range_ends_on_its_bound_and_one_starting_outside_does_not_fail():
+    """advance_within: a step across the bound ends on the circle's point there (found with x held);
+    a tracer already outside the range (a start moved past it) still gets an answer, not an error."""
+    from shimmy.continuation.core import CurvePoint, Tracer
+
+    R = 2.0
+    options = ContinuationOptions(ds=0.3, ds_max=0.3, tol=1e-12, residual_tol=1e-12)
+    start = CurvePoint(np.array([R * np.cos(0.3), R * np.sin(0.3)]), np.array([-np.sin(0.3), np.cos(0.3)]))
+    prev, new, _, bound = Tracer(_Circle(R), start, options).advance_within(1.85, 2.5, 0)  # x: 1.91 -> 1.80
+    assert bound == 1.85 and prev is start
+    np.testing.assert_allclose(new.u, [1.85, np.sqrt(R * R - 1.85 ** 2)], atol=1e-12)
+    np.testing.assert_allclose(new.tangent, [-new.u[1] / R, new.u[0] / R], atol=1e-12)
+    outside = Tracer(_Circle(R), start, options).advance_within(1.0, 1.5, 0)  # x = 1.91 already above 1.5
+    assert outside is not None and outside[3] == 1.5
+
+
 def test_chord_control_bounds_how_far_each_drawn_step_strays_from_the_curve():
     """With a chord check (the cubic's midpoint deviation h/8 |t_a - t_b| over a tolerance) every
     accepted step of a circle of radius R has a sagitta R (1 - cos(angle / 2)) within the

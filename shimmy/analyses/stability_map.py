@@ -535,6 +535,7 @@ def stability_maps(configs: Sequence[Configuration | str], v_range: tuple[float,
     no longer holds the workers back. Each map's ``elapsed_s`` is the time until its own last unit
     finished."""
     clock = time.perf_counter()
+    configs = list(configs)
     builds = [_MapBuild(c, v_range, fz_range, resolution, params, n_v, options) for c in configs]
     if not builds:
         raise InvalidParameterError("configs", list(configs), "one or more configurations")

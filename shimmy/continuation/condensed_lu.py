@@ -203,8 +203,10 @@ class CondensedLU:
 
     def monodromy(self) -> np.ndarray:
         """P_(L-1) ... P_0, P_k mapping node k to node k + 1 through link k's rows with the global
-        columns left out: for a collocation matrix, the monodromy matrix of the orbit (the same
-        numbers as :func:`monodromy` on its blocks, whose interior elimination the factors hold)."""
+        columns left out: for the Newton matrix of one periodic orbit (links = its mesh intervals,
+        in order), the monodromy matrix of the orbit (the same numbers as :func:`monodromy` on its
+        blocks, whose interior elimination the factors hold). Meaningless for other chains (the two
+        periods of a torus test matrix)."""
         lay = self.layout
         return _transfer_product(_reduced_rows(self._A, lay.n_interior, lay.n, lay.ni_max), lay.n)
 

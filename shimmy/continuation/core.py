@@ -404,8 +404,8 @@ class Tracer:
         if low <= value <= high:
             return prev, new, h, None
         bound = high if value > high else low
-        at = point_at(self.problem, prev, new, index, bound, self.options, with_tangent=True) \
-            if prev.u[index] != bound else None
+        crossed = (prev.u[index] - bound) * (value - bound) < 0  # not when the step started outside
+        at = point_at(self.problem, prev, new, index, bound, self.options, with_tangent=True) if crossed else None
         if at is None:
             hit = locate(self.problem, prev, h, lambda q: q.u[index] - bound, prev.u[index] - bound, value - bound,
                          self.options)

@@ -219,7 +219,8 @@ class CycleCurveProblem:
         p2 = float(u[self.n_x + 2])
         if p2 != self.slice.p2:
             self.slice.p2 = p2
-            self.cycle._blocks_memo = None  # the cycle's field changed under the same (x, T, p1)
+            self.cycle._blocks_memo = None  # the cycle's field changed under the same (x, T, p1):
+            self.cycle._factors_memo = None  # nothing computed from it at another p2 is reused
         return u[:self.n_x + 2]
 
     def kappa(self, u: np.ndarray) -> float:
