@@ -83,6 +83,8 @@ def local(args) -> None:
 
 def four(args) -> None:
     runs = lambda r: ", ".join(f"{t:.1f}" for t in r)  # noqa: E731
+    if args.only_four:  # the pool's workers fork from this process: load the compiled kernels here once
+        stability_map("original", resolution=2, executor=InlineExecutor(), **PLANE)
     print(f"\nfour maps ({args.resolution} slices asked each) on one pool, medians of {args.repeats}:")
     print(f"  {'config':<8}{'s':>7}{'min shimmy Fz (kN)':>20}{'slices':>8}{'curves H/LPC/NS':>17}{'regions':>9}")
     together, apart = [], []
