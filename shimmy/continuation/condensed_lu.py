@@ -664,16 +664,11 @@ def monodromy(blocks, n):
     N, rows, width = blocks.shape
     ni = rows - n
     perm = np.zeros(max(ni, 1), np.int64)
-    R = np.zeros((N, n, 2 * n))
+    B = blocks.copy()
     for j in range(N):
-        B = blocks[j].copy()
-        if _lu_columns(B, rows, n, ni, perm, _column_sizes(B, rows, n, ni, B[:0], np.arange(ni))):
+        if _lu_columns(B[j], rows, n, ni, perm, _column_sizes(B[j], rows, n, ni, B[j][:0], np.arange(ni))):
             return np.full((n, n), np.nan)
-        for i in range(n):
-            for c in range(n):
-                R[j, i, c] = B[ni + i, c]
-                R[j, i, n + c] = B[ni + i, width - n + c]
-    return _transfer_product(R, n)
+    return _transfer_product(_reduced_rows(B, np.full(N, ni), n, ni), n)
 
 
 @njit(cache=True, error_model="numpy")

@@ -465,7 +465,8 @@ def point_at(problem: CurveProblem, a: CurvePoint, b: CurvePoint, index: int, va
     The point carries its own tangent (oriented along a's) with ``with_tangent``, else a's."""
     ga, gb = a.u[index] - value, b.u[index] - value
     if not ga * gb < 0:
-        raise ValueError(f"unknown {index} does not cross {value} between the two points")
+        raise InvalidInputError("value", value, f"a value of unknown {index} crossed between the two points "
+                                f"({a.u[index]:g} and {b.u[index]:g})")
     guess = a.u + (ga / (ga - gb)) * (b.u - a.u)
     guess[index] = value
     hold = np.zeros_like(guess)
