@@ -28,9 +28,9 @@ import time
 
 import numpy as np
 
-from shimmy.analyses.bifurcation import bifurcation
-from shimmy.analyses.hopf_curves import hopf_curves
-from shimmy.analyses.simulation import simulate
+from shimmy.analyses.diagrams.bifurcation import bifurcation
+from shimmy.analyses.diagrams.hopf_curves import hopf_curves
+from shimmy.analyses.core.simulation import simulate
 
 CONFIGS = ("original", "nes", "pd", "nes_pd")
 FZ = 150e3

@@ -33,8 +33,8 @@ from shimmy import simulate
 from shimmy.model.configurations import ALL_CONFIGURATIONS
 from shimmy.model.equations import build_model, jacobian, rhs
 from shimmy.model.reference_model import make_rhs
-from shimmy.analyses.response import peak_amplitude
-from shimmy.analyses.stability import hopf_points
+from shimmy.analyses.core.response import peak_amplitude
+from shimmy.analyses.core.stability import hopf_points
 
 V_A, FZ_A, T_END, WINDOW = 30.0, 150_000.0, 60.0, 20.0
 N_COLUMNS = 10_000

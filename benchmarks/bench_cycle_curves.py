@@ -22,9 +22,9 @@ import argparse
 import statistics
 import time
 
-from shimmy.analyses.bifurcation import bifurcation
-from shimmy.analyses.cycle_curves import cycle_curves
-from shimmy.analyses.hopf_curves import hopf_curves
+from shimmy.analyses.diagrams.bifurcation import bifurcation
+from shimmy.analyses.diagrams.cycle_curves import cycle_curves
+from shimmy.analyses.diagrams.hopf_curves import hopf_curves
 
 
 def timed(fn, *args, **kwargs):

@@ -22,12 +22,12 @@ import os
 import statistics
 import time
 
-from shimmy.analyses.bifurcation import BifurcationOptions, bifurcation
-from shimmy.analyses.executors import InlineExecutor, describe, open_executor
-from shimmy.analyses.optimise import optimise
-from shimmy.analyses.robustness import robustness
-from shimmy.analyses.sensitivity import sensitivity
-from shimmy.analyses.stability import hopf_points
+from shimmy.analyses.diagrams.bifurcation import BifurcationOptions, bifurcation
+from shimmy.analyses.core.executors import InlineExecutor, describe, open_executor
+from shimmy.analyses.decisions.optimise import optimise
+from shimmy.analyses.decisions.robustness import robustness
+from shimmy.analyses.decisions.sensitivity import sensitivity
+from shimmy.analyses.core.stability import hopf_points
 from shimmy.model.parameters import PARAMETER_SPECS, Parameters
 from shimmy.service.dask_cluster import loopback_cluster
 

@@ -17,8 +17,8 @@ import argparse
 import statistics
 import time
 
-from shimmy.analyses.ground_profiles import preset
-from shimmy.analyses.ground_run import ground_run, ground_runs
+from shimmy.analyses.ground.ground_profiles import preset
+from shimmy.analyses.ground.ground_run import ground_run, ground_runs
 from shimmy.model.configurations import ALL_CONFIGURATIONS
 
 PROFILES = {"taxi (60 s)": preset("taxi"),

@@ -26,9 +26,9 @@ import os
 import statistics
 import time
 
-from shimmy.analyses.executors import InlineExecutor, describe, open_executor
+from shimmy.analyses.core.executors import InlineExecutor, describe, open_executor
 from shimmy.service.dask_cluster import loopback_cluster
-from shimmy.analyses.stability_map import stability_map, stability_maps
+from shimmy.analyses.maps.stability_map import stability_map, stability_maps
 
 CONFIGS = ("original", "nes", "pd", "nes_pd")
 PLANE = dict(v_range=(1.0, 200.0), fz_range=(1.0e4, 9.0e5))

@@ -4,18 +4,17 @@ The model (docs/model.md) and its analyses: parameters, devices, equations with 
 Jacobians, time histories, ground runs (take-off, landing roll, taxi), linear stability with
 Hopf points, calibration, and a continuation engine (equilibria, periodic orbits with
 Floquet multipliers, LPC/NS/PD points, Hopf curves) with the gear's bifurcation diagrams
-(``shimmy.analyses.bifurcation``, ``shimmy.analyses.hopf_curves``, imported on demand).
+(``shimmy.analyses.diagrams.bifurcation``, ``shimmy.analyses.diagrams.hopf_curves``, imported on demand).
 """
 
-__version__ = "0.1.0"
-
-from .model.configurations import ALL_CONFIGURATIONS, Configuration  # noqa: E402
-from .errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError  # noqa: E402
-from .model.parameters import MATERIALS, PARAMETER_SPECS, Parameters  # noqa: E402
-from .analyses.simulation import SimulationOptions, SimulationResult, simulate  # noqa: E402
-from .analyses.stability import HopfPoint, HopfResult, eigenvalues, hopf_points  # noqa: E402
-from .analyses.ground_profiles import GroundProfile, preset, profile_from_table  # noqa: E402
-from .analyses.ground_run import GroundRunOptions, GroundRunResult, ground_run, ground_runs  # noqa: E402
+from .version import __version__
+from .model.configurations import ALL_CONFIGURATIONS, Configuration
+from .errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
+from .model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
+from .analyses.core.simulation import SimulationOptions, SimulationResult, simulate
+from .analyses.core.stability import HopfPoint, HopfResult, eigenvalues, hopf_points
+from .analyses.ground.ground_profiles import GroundProfile, preset, profile_from_table
+from .analyses.ground.ground_run import GroundRunOptions, GroundRunResult, ground_run, ground_runs
 
 __all__ = [
     "ALL_CONFIGURATIONS", "Configuration", "ConvergenceError", "GeometryError",

@@ -73,7 +73,7 @@ def _cmd_params(args) -> int:
 
 
 def _cmd_hopf(args) -> int:
-    from .analyses.stability import hopf_points
+    from .analyses.core.stability import hopf_points
 
     result = hopf_points(args.config, args.Fz, _params(args), v_min=args.v_min, v_max=args.v_max)
     payload = result.to_dict()
@@ -91,7 +91,7 @@ def _cmd_hopf(args) -> int:
 
 def _cmd_eigen(args) -> int:
     from .model.parameters import check_operating_point
-    from .analyses.stability import eigenvalues
+    from .analyses.core.stability import eigenvalues
 
     V, Fz = check_operating_point(args.V, args.Fz)
     params = _params(args)
@@ -111,7 +111,7 @@ def _cmd_eigen(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from .analyses.simulation import simulate
+    from .analyses.core.simulation import simulate
 
     result = simulate(args.config, args.V, args.Fz, _params(args), t_end=_limit("simulate", "t_end", args.t_end),
                       exact_nes=args.exact_nes)
@@ -161,7 +161,7 @@ def _read_profile_csv(path: str) -> tuple[list[list[Any]], list[int]]:
 
 
 def _profile(args):
-    from .analyses.ground_profiles import PRESETS, preset, profile_from_table
+    from .analyses.ground.ground_profiles import PRESETS, preset, profile_from_table
 
     settings = _parse_sets(args.profile_set)
     if args.profile in PRESETS:
@@ -181,7 +181,7 @@ def _profile(args):
 
 
 def _cmd_ground_run(args) -> int:
-    from .analyses.ground_run import GroundRunOptions, ground_runs
+    from .analyses.ground.ground_run import GroundRunOptions, ground_runs
     from .model.parameters import check_number
 
     profile = _profile(args)
@@ -221,7 +221,7 @@ def _cmd_ground_run(args) -> int:
 
 
 def _cmd_devices(args) -> int:
-    from .analyses.device_curves import nes_curve, pd_curves
+    from .analyses.core.device_curves import nes_curve, pd_curves
 
     params = _params(args)
     nes_c = nes_curve(params)
@@ -277,7 +277,7 @@ def _bar(args) -> _ProgressBar:
 
 
 def _cmd_bifurcation(args) -> int:
-    from .analyses.bifurcation import BifurcationOptions, bifurcation
+    from .analyses.diagrams.bifurcation import BifurcationOptions, bifurcation
 
     ntst = _limit("bifurcation", "ntst", args.ntst)
     ds_max = check_number("ds_max", args.ds_max, 1e-3, 10.0)
@@ -314,7 +314,7 @@ def _cmd_bifurcation(args) -> int:
 
 
 def _cmd_hopf_curves(args) -> int:
-    from .analyses.hopf_curves import hopf_curves
+    from .analyses.diagrams.hopf_curves import hopf_curves
 
     bar = _bar(args)
     try:
@@ -341,7 +341,7 @@ def _cmd_hopf_curves(args) -> int:
 
 
 def _cmd_curves(args) -> int:
-    from .analyses.cycle_curves import KEY_OF_KIND, KINDS, cycle_curves
+    from .analyses.diagrams.cycle_curves import KEY_OF_KIND, KINDS, cycle_curves
 
     kinds = tuple(k.strip().upper() for k in str(args.kinds).split(",") if k.strip())
     for k in kinds:
@@ -388,8 +388,8 @@ def _float_list(name: str, text: str) -> list[float]:
 
 
 def _cmd_map(args) -> int:
-    from .analyses.design_metrics import metrics
-    from .analyses.stability_map import stability_map
+    from .analyses.maps.design_metrics import metrics
+    from .analyses.maps.stability_map import stability_map
 
     resolution = _limit("map", "resolution", args.resolution)
     n_v = _limit("map", "n_v", args.n_v)
@@ -426,7 +426,7 @@ def _cmd_map(args) -> int:
 
 
 def _cmd_classify(args) -> int:
-    from .analyses.stability_map import classify
+    from .analyses.maps.stability_map import classify
 
     result = classify(args.config, args.V, args.Fz, _params(args), (args.v_min, args.v_max))
     lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {result['shimmy_type']}"]
@@ -441,7 +441,7 @@ def _cmd_classify(args) -> int:
 
 
 def _cmd_metrics(args) -> int:
-    from .analyses.design_metrics import design_report
+    from .analyses.maps.design_metrics import design_report
 
     resolution = _limit("map", "resolution", args.resolution)
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
@@ -482,7 +482,7 @@ def _names(text: str | None) -> list[str] | None:
 
 
 def _cmd_sensitivity(args) -> int:
-    from .analyses.sensitivity import sensitivity
+    from .analyses.decisions.sensitivity import sensitivity
 
     Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
     result = sensitivity(args.config, Fz, _params(args), _names(args.params), amplitude=not args.no_amplitude)
@@ -512,7 +512,7 @@ def _cmd_sensitivity(args) -> int:
 
 
 def _cmd_optimise(args) -> int:
-    from .analyses.optimise import FIGURES, optimise
+    from .analyses.decisions.optimise import FIGURES, optimise
 
     Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
     bar = _bar(args)
@@ -545,7 +545,7 @@ def _cmd_optimise(args) -> int:
 
 
 def _cmd_robustness(args) -> int:
-    from .analyses.robustness import robustness
+    from .analyses.decisions.robustness import robustness
 
     Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
     bar = _bar(args)
@@ -575,7 +575,7 @@ def _cmd_robustness(args) -> int:
 
 
 def _cmd_study(args) -> int:
-    from .analyses.studies import study, study_grid
+    from .analyses.decisions.studies import study, study_grid
 
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
     bar = _bar(args)
@@ -610,7 +610,7 @@ def _cmd_study(args) -> int:
 
 
 def _cmd_calibrate(args) -> int:
-    from .analyses.calibration import calibrate, format_report
+    from .analyses.core.calibration import calibrate, format_report
 
     result = calibrate(_params(args))
     _emit(result.to_dict(), args.json, format_report(result))

@@ -67,7 +67,7 @@ def test_generated_tables_come_from_the_code(site):
     for schema in schemas.SCHEMAS.values():
         for f in schema.fields:
             assert f.allowed in html.unescape(api), (schema.name, f.name)  # the page escapes <, >, @
-    from shimmy.analyses.ground_profiles import PRESETS, preset_fields
+    from shimmy.analyses.ground.ground_profiles import PRESETS, preset_fields
 
     numerics = _text(site / "numerics.html")
     for name in PRESETS:
@@ -167,7 +167,7 @@ def test_tutorial_examples_print_what_the_page_shows(page, code, output):
 def test_the_tests_and_files_the_docs_cite_exist():
     pages = "\n".join(page.read_text() for page in DOCS.rglob("*.md"))
     cited_tests = set(re.findall(r"`(?:tests/\w+\.py::)?(test_\w+)`", pages))
-    defined = set(re.findall(r"def (test_\w+)", "\n".join(p.read_text() for p in (ROOT / "tests").glob("*.py"))))
+    defined = set(re.findall(r"def (test_\w+)", "\n".join(p.read_text() for p in (ROOT / "tests").rglob("*.py"))))
     assert cited_tests and not cited_tests - defined, sorted(cited_tests - defined)
     cited_files = set(re.findall(r"`((?:tests|shimmy|scripts|benchmarks|docs)/[\w/.-]+\.(?:py|sh|md))", pages))
     assert cited_files and not [f for f in cited_files if not (ROOT / f).is_file()]

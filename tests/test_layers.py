@@ -1,7 +1,10 @@
 """The package's folders are its layers, and each imports only downward.
 
 continuation (generic engine) <- model (the gear) <- analyses <- service <- UI (app, pages, ui);
-``shimmy.errors`` is the package's exception root, importable from model upwards.
+``shimmy.errors`` is the package's exception root, importable from model upwards, and
+``shimmy.version`` the ground floor every layer may read. Nothing inside the package imports the
+package root (it imports the analyses). The analyses are families, each importing only those below
+it: core <- diagrams <- maps, ground <- decisions.
 """
 
 import ast
@@ -13,7 +16,7 @@ import shimmy
 PACKAGE = pathlib.Path(shimmy.__file__).parent
 ROOT = PACKAGE.parent
 LAYERS = ("continuation", "model", "analyses", "service")
-TOP_LEVEL = {"__init__", "__main__", "cli", "errors"}
+TOP_LEVEL = {"__init__", "__main__", "cli", "errors", "version"}
 UI_LIBRARIES = {"dash", "plotly", "flask", "gunicorn", "diskcache"}
 STDLIB = set(sys.stdlib_module_names)
 
@@ -41,9 +44,25 @@ def imports(path: pathlib.Path) -> set[str]:
 
 
 def files_of(layer: str) -> list[pathlib.Path]:
-    files = sorted((PACKAGE / layer).glob("*.py"))
+    files = sorted((PACKAGE / layer).rglob("*.py"))
     assert files, layer
     return files
+
+
+def imported_modules(path: pathlib.Path) -> set[str]:
+    """The modules a file's import statements load (for ``from M import a``: M itself)."""
+    package = module_name(path) if path.name == "__init__.py" else module_name(path).rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                found.add(".".join(base + ([node.module] if node.module else [])))
+            else:
+                found.add(node.module)
+    return found
 
 
 def shimmy_imports(path: pathlib.Path) -> set[str]:
@@ -56,7 +75,7 @@ def within(name: str, *prefixes: str) -> bool:
 
 def test_resolver_reads_relative_imports():
     assert "shimmy.continuation.core" in imports(PACKAGE / "continuation" / "collocation.py")
-    assert "shimmy.model.parameters" in imports(PACKAGE / "analyses" / "simulation.py")
+    assert "shimmy.model.parameters" in imports(PACKAGE / "analyses" / "core" / "simulation.py")
     assert "shimmy.errors" in imports(PACKAGE / "model" / "parameters.py")
 
 
@@ -70,10 +89,40 @@ def test_continuation_is_generic_numpy_scipy_and_numba_only():
                 assert name.split(".")[0] in STDLIB | {"numpy", "scipy", "numba"}, (path.name, name)
 
 
+def test_nothing_in_the_package_imports_the_package_root():
+    """The root imports the analyses: a module below it that imports the root works only by line order."""
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if path.parent == PACKAGE and path.stem in ("__init__", "__main__"):
+            continue
+        assert "shimmy" not in imported_modules(path), path.relative_to(ROOT)
+
+
+def test_the_version_is_a_ground_floor_module():
+    assert imported_modules(PACKAGE / "version.py") == set()
+    assert shimmy.__version__ == __import__("shimmy.version").version.__version__
+
+
+#: Each family of the analyses and the families it may import.
+FAMILIES = {"core": set(), "diagrams": {"core"}, "maps": {"core", "diagrams"}, "ground": {"core", "diagrams"},
+            "decisions": {"core", "diagrams", "maps"}}
+
+
+def test_analyses_families_import_only_downward():
+    folders = {p.name for p in (PACKAGE / "analyses").iterdir() if p.is_dir() and p.name != "__pycache__"}
+    assert folders == set(FAMILIES)
+    assert {p.stem for p in (PACKAGE / "analyses").glob("*.py")} == {"__init__"}
+    for family, below in FAMILIES.items():
+        for path in files_of(f"analyses/{family}"):
+            for name in shimmy_imports(path):
+                if within(name, "shimmy.analyses"):
+                    other = name.split(".")[2]
+                    assert other == family or other in below, (family, path.name, name)
+
+
 def test_model_imports_only_the_model_and_the_errors():
     for path in files_of("model"):
         for name in shimmy_imports(path):
-            assert within(name, "shimmy.model", "shimmy.errors"), (path.name, name)
+            assert within(name, "shimmy.model", "shimmy.errors", "shimmy.version"), (path.name, name)
         assert not {n.split(".")[0] for n in imports(path)} & UI_LIBRARIES, path.name
 
 
@@ -99,7 +148,8 @@ def test_every_module_sits_in_a_layer():
 
 
 #: What the UI may import from the package: definitions and the service layer, never numerics.
-UI_MAY_IMPORT = ("shimmy.service", "shimmy.errors", "shimmy.model.parameters", "shimmy.model.configurations")
+UI_MAY_IMPORT = ("shimmy.service", "shimmy.errors", "shimmy.version", "shimmy.model.parameters",
+                 "shimmy.model.configurations")
 
 
 def test_ui_uses_only_the_service_layer_and_definitions():

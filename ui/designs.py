@@ -21,7 +21,7 @@ from urllib.parse import parse_qs
 from shimmy.errors import InvalidParameterError
 from shimmy.model.configurations import Configuration
 from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters, check_number
-from shimmy.service import __version__ as SHIMMY_VERSION
+from shimmy.version import __version__ as SHIMMY_VERSION
 
 from . import state
 

@@ -4,7 +4,7 @@
   :data:`shimmy.model.parameters.PARAMETER_SPECS` with unit, default, range and provenance.
 * ``shimmy-operating-points``: the nine operating points of :mod:`shimmy.model.configurations`.
 * ``shimmy-calibration-targets``: the published results the calibration fits
-  (:mod:`shimmy.analyses.calibration`).
+  (:mod:`shimmy.analyses.core.calibration`).
 * ``shimmy-endpoints``: method, path, summary and status codes of every path of the OpenAPI document
   (:func:`shimmy.service.api.openapi_document`).
 * ``shimmy-request NAME``: the fields of one request schema (:data:`shimmy.service.schemas.SCHEMAS`).
@@ -13,7 +13,7 @@
 * ``shimmy-openapi``: the whole OpenAPI document as JSON.
 * ``shimmy-cli``: every subcommand of :func:`shimmy.cli.build_parser` with its options.
 * ``shimmy-ground-presets``: every setting of the ground-run presets with default and range
-  (:func:`shimmy.analyses.ground_profiles.preset_fields`).
+  (:func:`shimmy.analyses.ground.ground_profiles.preset_fields`).
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ class CalibrationTargets(SphinxDirective):
              "nes_pd": "I_pd (about 4.9 kg m²)"}
 
     def run(self):
-        from shimmy.analyses import calibration as cal
+        from shimmy.analyses.core import calibration as cal
         rows = [[_literal(config), f"Hopf points of x = 0 in V at Fz = {cal.FZ_REFERENCE / 1e3:g} kN",
                  " and ".join(f"{v:g}" for v in targets) + " m/s", self.FIXES.get(config, "")]
                 for config, targets in cal.HOPF_TARGETS.items()]
@@ -178,7 +178,7 @@ class Limits(SphinxDirective):
 
 class GroundPresets(SphinxDirective):
     def run(self):
-        from shimmy.analyses.ground_profiles import PRESETS, preset_fields
+        from shimmy.analyses.ground.ground_profiles import PRESETS, preset_fields
         rows = [[_literal(name), _literal(f["name"]), f["unit"] or "–", _number(f["default"]),
                  f"{_number(f['low'])} to {_number(f['high'])}", f["description"]]
                 for name in PRESETS for f in preset_fields(name)]
@@ -275,7 +275,7 @@ def _identity(obj):
 
 def resolve_alias(app, env, node, contnode):
     """A Python reference to an object documented under another of its names (``shimmy.simulate`` is
-    documented, ``shimmy.analyses.simulation.simulate`` is referenced, or the reverse; a name relative
+    documented, ``shimmy.analyses.core.simulation.simulate`` is referenced, or the reverse; a name relative
     to the current module): resolved to the documented name of the same object. A reference to
     something that does not exist or is not documented under any name stays unresolved (and fails the
     nitpicky build)."""

@@ -23,7 +23,7 @@ from .equations import vector_field
 
 N_FULL = 7
 
-# Integration status codes, returned to :mod:`shimmy.analyses.simulation`.
+# Integration status codes, returned to :mod:`shimmy.analyses.core.simulation`.
 SUCCESS = 0
 MAX_STEPS = 1
 NES_OUT_OF_RANGE = 2

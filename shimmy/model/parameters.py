@@ -25,7 +25,7 @@ from ..errors import InvalidParameterError
 
 PUBLISHED = "published study"
 ENVELOPE = "published value; range is an engineering envelope around it"
-CALIBRATED = "calibrated by shimmy.analyses.calibration against the published study (docs/validation.md)"
+CALIBRATED = "calibrated by shimmy.analyses.core.calibration against the published study (docs/validation.md)"
 FIXED = "docs/model.md"
 
 

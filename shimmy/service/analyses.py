@@ -30,7 +30,7 @@ def _finite(x) -> float | None:
 
 
 def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..analyses.simulation import SimulationOptions, simulate as run_simulation
+    from ..analyses.core.simulation import SimulationOptions, simulate as run_simulation
 
     stride = max(1, int(round(request["series_dt"] / SimulationOptions.dt_out)))
     if request["include_series"]:  # refuse before computing, not after
@@ -70,7 +70,7 @@ def _spectrum(result) -> dict[str, Any]:
 
 
 def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..analyses.stability import hopf_points
+    from ..analyses.core.stability import hopf_points
 
     return hopf_points(request["config"], request["Fz"], _params(request), request["v_min"],
                        request["v_max"]).to_dict()
@@ -79,7 +79,7 @@ def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str,
 def stability(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """Largest real part of the eigenvalues of x = 0 against V, and the Hopf points, per configuration."""
     from ..model.equations import build_model
-    from ..analyses.stability import Linearisation, hopf_points
+    from ..analyses.core.stability import Linearisation, hopf_points
 
     params = _params(request)
     V = np.geomspace(request["v_min"], request["v_max"], request["n_points"])
@@ -90,7 +90,7 @@ def stability(request: dict[str, Any], progress: Progress | None = None) -> dict
         k = np.argmax(ev.real, axis=1)
         lead = ev[np.arange(V.size), k]
         # A coarse grid suffices: the near-axis extremum scan catches pairs between grid points
-        # (tests/test_stability.py: 12 points find what 20 000 do); 1e-7 m/s is far below display.
+        # (tests/analyses/core/test_stability.py: 12 points find what 20 000 do); 1e-7 m/s is far below display.
         h = hopf_points(config, request["Fz"], params, request["v_min"], request["v_max"], n_grid=80, v_tol=1e-7)
         out["configs"][config.value] = {
             "max_real": lead.real.tolist(), "frequency_hz": (np.abs(lead.imag) / (2 * np.pi)).tolist(),
@@ -100,7 +100,7 @@ def stability(request: dict[str, Any], progress: Progress | None = None) -> dict
 
 
 def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..analyses.device_curves import nes_curve, pd_curves
+    from ..analyses.core.device_curves import nes_curve, pd_curves
 
     params = _params(request)
     nes = nes_curve(params)
@@ -110,7 +110,7 @@ def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[s
 
 
 def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..analyses.bifurcation import BifurcationOptions, bifurcation as run_bifurcation
+    from ..analyses.diagrams.bifurcation import BifurcationOptions, bifurcation as run_bifurcation
 
     options = BifurcationOptions(ntst=request["ntst"], seeds=request["seeds"])
     return run_bifurcation(request["config"], request["Fz"], request["v_min"], request["v_max"], _params(request),
@@ -118,7 +118,7 @@ def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> di
 
 
 def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..analyses.hopf_curves import hopf_curves as run_hopf_curves
+    from ..analyses.diagrams.hopf_curves import hopf_curves as run_hopf_curves
 
     return run_hopf_curves(request["config"], _params(request), (request["v_min"], request["v_max"]),
                            (request["fz_min"], request["fz_max"]), progress=progress).to_dict()
@@ -126,8 +126,8 @@ def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> di
 
 def stability_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """The map with its design metrics; slices go through the executor of this environment."""
-    from ..analyses.design_metrics import metrics
-    from ..analyses.stability_map import stability_map as run_map
+    from ..analyses.maps.design_metrics import metrics
+    from ..analyses.maps.stability_map import stability_map as run_map
 
     smap = run_map(request["config"], (request["v_min"], request["v_max"]), (request["fz_min"], request["fz_max"]),
                    request["resolution"], _params(request), n_v=request["n_v"], progress=progress)
@@ -137,7 +137,7 @@ def stability_map(request: dict[str, Any], progress: Progress | None = None) -> 
 
 
 def study(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..analyses.studies import study as run_study, study_grid
+    from ..analyses.decisions.studies import study as run_study, study_grid
 
     common = dict(configs=request["configs"], Fz=request["Fz"], params=_params(request),
                   v_range=(request["v_min"], request["v_max"]), progress=progress)
@@ -149,7 +149,7 @@ def study(request: dict[str, Any], progress: Progress | None = None) -> dict[str
 
 def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """One configuration through the profile; with ``hopf_curves`` its Hopf curves (from the shared cache)."""
-    from ..analyses.ground_run import GroundRunOptions, ground_run as run_ground_run
+    from ..analyses.ground.ground_run import GroundRunOptions, ground_run as run_ground_run
 
     report = progress or (lambda fraction, message: None)
     profile = request["profile"] if request["profile"] is not None else request["preset"]
@@ -172,7 +172,7 @@ def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dic
 
 def sensitivity(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """Derivatives of the boundaries at one load to the chosen parameters, with the tornado rows."""
-    from ..analyses.sensitivity import sensitivity as run_sensitivity
+    from ..analyses.decisions.sensitivity import sensitivity as run_sensitivity
 
     report = progress or (lambda fraction, message: None)
     report(0.0, f"sensitivities of {request['config']} at {request['Fz'] / 1e3:g} kN")
@@ -184,7 +184,7 @@ def sensitivity(request: dict[str, Any], progress: Progress | None = None) -> di
 
 def optimise(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """The optimiser; its design evaluations and local searches go through the executor of this environment."""
-    from ..analyses.optimise import Constraint, optimise as run_optimise
+    from ..analyses.decisions.optimise import Constraint, optimise as run_optimise
 
     constraints = [Constraint(c["figure"], c["op"], c["value"], c["Fz"]) for c in request["constraints"]]
     return run_optimise(request["config"], request["objective"], request["parameters"], request["Fz"], constraints,
@@ -196,7 +196,7 @@ def optimise(request: dict[str, Any], progress: Progress | None = None) -> dict[
 
 def robustness(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """Quasi-Monte Carlo and linear propagation of the tolerances; chunks of samples through the executor."""
-    from ..analyses.robustness import Tolerance, robustness as run_robustness
+    from ..analyses.decisions.robustness import Tolerance, robustness as run_robustness
 
     tolerances = [Tolerance(t["name"], t["relative"], t["distribution"]) for t in request["tolerances"]]
     return run_robustness(request["config"], tolerances, request["samples"], request["Fz"], _params(request),
@@ -206,7 +206,7 @@ def robustness(request: dict[str, Any], progress: Progress | None = None) -> dic
 def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
     """A ground-run preset's table rows [t, V, Fz], its complete settings, each setting's range and
     its assumptions, for a profile editor (a table of a few hundred points: nothing to cache)."""
-    from ..analyses.ground_profiles import preset, preset_fields
+    from ..analyses.ground.ground_profiles import preset, preset_fields
 
     profile = preset(name, options)
     return {"name": name, "rows": profile.rows(), "settings": profile.settings, "fields": preset_fields(name),

@@ -24,7 +24,7 @@ from typing import Any, Callable
 
 import diskcache
 
-from .. import __version__
+from ..version import __version__
 from ..model.parameters import canonical_digest
 from . import settings
 

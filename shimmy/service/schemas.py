@@ -16,8 +16,8 @@ from typing import Any, Mapping
 from ..model.configurations import Configuration, affects
 from ..errors import InvalidParameterError
 from . import settings
-from ..analyses import design_space
-from ..analyses.ground_profiles import MAX_PROFILE_POINTS, PRESETS
+from ..analyses.decisions import design_space
+from ..analyses.ground.ground_profiles import MAX_PROFILE_POINTS, PRESETS
 from ..model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters,
                                 check_number, unknown_name_error)
 
@@ -229,7 +229,7 @@ class RequestSchema:
             out["description"] += (f" Ground run: profile rows [t, V, Fz] with t increasing, V and Fz within their "
                                    f"ranges, a run of at most {settings.MAX_T_END:g} s (refusals name profile[i].t, "
                                    ".V or .Fz); without a profile, the preset with preset_options (its settings: "
-                                   "python -m shimmy ground-run --help, shimmy.analyses.ground_profiles).")
+                                   "python -m shimmy ground-run --help, shimmy.analyses.ground.ground_profiles).")
         if self.name in _RULES:
             out["description"] += " " + _RULES[self.name]
         if self.name == "study":
@@ -265,7 +265,7 @@ def _check_study(out: dict[str, Any]) -> None:
 def _check_ground_run(out: dict[str, Any]) -> None:
     """The profile as checked rows (a table) or as the preset's complete settings; the run and its series
     within the service's limits."""
-    from ..analyses.ground_profiles import preset, profile_from_table
+    from ..analyses.ground.ground_profiles import preset, profile_from_table
 
     if out["profile"] is not None:
         if out["preset_options"]:
@@ -291,7 +291,7 @@ def _check_ground_run(out: dict[str, Any]) -> None:
 
 # -- sensitivities, optimiser, robustness -------------------------------------------------------
 # The figures, device parameters and tolerance limits are the analyses' own definitions
-# (shimmy.analyses.design_space: constants only, the solvers are imported when an analysis runs).
+# (shimmy.analyses.decisions.design_space: constants only, the solvers are imported when an analysis runs).
 
 #: The optimiser's figures of merit: unit, whether taken at a load, the range a constraint value may take.
 FIGURE_LIMITS: dict[str, tuple[str, bool, float, float]] = {

@@ -1,0 +1,136 @@
+"""Parametric studies: how the Hopf speeds and the torsional amplitude move with design parameters.
+
+:func:`study` sweeps one parameter, :func:`study_grid` two on a grid. Each (design, config)
+pair is one unit of work (a bifurcation diagram in V at the study's load, through
+:mod:`shimmy.analyses.core.executors`), giving the row a design report carries: the first and last Hopf
+speed of x = 0 in the speed range (shimmy onset and end of the linear instability), every
+Hopf point, and the largest torsional amplitude of a stable limit cycle with its speed.
+"""
+
+from __future__ import annotations
+
+import csv
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+from ...version import __version__
+from ..diagrams.bifurcation import BifurcationOptions, bifurcation
+from ...model.configurations import Configuration
+from ...errors import InvalidParameterError
+from ..core.executors import name_of, run_units
+from ...model.parameters import PARAMETER_SPECS, V_RANGE, Parameters, check_operating_point, check_range
+
+MAX_VALUES = 200  # per parameter
+MAX_UNITS = 2000  # designs x configurations
+DEFAULT_CONFIGS = ("original", "nes", "pd", "nes_pd")
+
+
+@dataclass
+class StudyResult:
+    parameters: list[str]
+    values: list[list[float]]  # one list per parameter
+    configs: list[str]
+    Fz: float
+    v_range: tuple[float, float]
+    rows: list[dict[str, Any]]
+    executor: str
+    elapsed_s: float
+    warnings: list[str] = field(default_factory=list)
+
+    COLUMNS = ("config", "hopf_start", "hopf_end", "max_psi", "max_psi_V")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"parameters": self.parameters, "values": self.values, "configs": self.configs, "Fz": self.Fz,
+                "v_range": list(self.v_range), "rows": self.rows,
+                "units": {"hopf_start": "m/s", "hopf_end": "m/s", "max_psi": "rad", "max_psi_V": "m/s",
+                          "Fz": "N"},
+                "executor": self.executor, "warnings": self.warnings, "elapsed_s": self.elapsed_s,
+                "version": __version__}
+
+    def write_csv(self, stream) -> None:
+        w = csv.writer(stream)
+        units = {"hopf_start": "hopf_start_m_s", "hopf_end": "hopf_end_m_s", "max_psi": "max_psi_rad",
+                 "max_psi_V": "max_psi_V_m_s"}
+        w.writerow(self.parameters + [units.get(c, c) for c in self.COLUMNS] + ["hopf_points_m_s"])
+        for r in self.rows:
+            w.writerow([f"{r[p]:.10g}" for p in self.parameters]
+                       + [r["config"]] + ["" if r[c] is None else f"{r[c]:.10g}" for c in self.COLUMNS[1:]]
+                       + [" ".join(f"{v:.10g}" for v in r["hopf_points"])])
+
+
+def _check_values(name: str, values: Sequence[float], params: Parameters) -> list[float]:
+    if name not in PARAMETER_SPECS:
+        raise InvalidParameterError("parameter", name, "one of " + ", ".join(PARAMETER_SPECS))
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__len__") or not 1 <= len(values) <= MAX_VALUES:
+        raise InvalidParameterError("values", values, f"a list of 1 to {MAX_VALUES} numbers")
+    checked = []
+    for v in values:
+        params.with_overrides({name: v})  # names the parameter, its value and its range if out of range
+        checked.append(float(v))
+    return checked
+
+
+def _check_configs(configs: Sequence[str]) -> list[str]:
+    if isinstance(configs, str) or not configs:
+        raise InvalidParameterError("configs", configs, "a non-empty list of " + ", ".join(DEFAULT_CONFIGS))
+    return [Configuration.parse(c).value for c in configs]
+
+
+def _unit(task: tuple) -> dict[str, Any]:
+    config, overrides, Fz, v_min, v_max, params, options = task
+    design = params.with_overrides(overrides)
+    result = bifurcation(config, Fz, v_min, v_max, design, options)
+    speeds = sorted(h.V for h in result.hopf.hopf_points)
+    return {**overrides, "config": config, "hopf_start": speeds[0] if speeds else None,
+            "hopf_end": speeds[-1] if speeds else None, "max_psi": result.max_psi, "max_psi_V": result.max_psi_V,
+            "hopf_points": speeds, "unstable_intervals": [list(iv) for iv in result.hopf.unstable_intervals],
+            "warnings": list(result.warnings)}
+
+
+def _run(parameters: list[str], designs: list[dict[str, float]], configs, Fz, v_range, params, executor,
+         progress, options) -> StudyResult:
+    clock = time.perf_counter()
+    params = params if params is not None else Parameters()
+    configs = _check_configs(configs)
+    _, Fz = check_operating_point(V_RANGE[0], Fz)
+    v_min, v_max = check_range("v", v_range, V_RANGE, "m/s")
+    if len(designs) * len(configs) > MAX_UNITS:
+        raise InvalidParameterError("values", len(designs) * len(configs),
+                                    f"at most {MAX_UNITS} designs x configurations")
+    options = options or BifurcationOptions(mesh_check=False)
+    tasks = [(c, d, Fz, v_min, v_max, params, options) for d in designs for c in configs]
+    rows = run_units(_unit, tasks, executor, progress,
+                     lambda t: f"{t[0]} at " + ", ".join(f"{k} = {v:g}" for k, v in t[1].items()))
+    warnings = [f"{r['config']} at " + ", ".join(f"{p} = {r[p]:g}" for p in parameters) + f": {w}"
+                for r in rows for w in r["warnings"]]
+    values = [sorted({d[p] for d in designs}, key=[d[p] for d in designs].index) for p in parameters]
+    return StudyResult(parameters, values, configs, Fz, (v_min, v_max), rows,
+                       name_of(executor), time.perf_counter() - clock,
+                       warnings)
+
+
+def study(parameter: str, values: Sequence[float], configs: Sequence[str] = DEFAULT_CONFIGS, Fz: float = 150e3,
+          params: Parameters | None = None, v_range: tuple[float, float] = (1.0, 200.0), executor=None,
+          progress: Callable[[float, str], None] | None = None,
+          options: BifurcationOptions | None = None) -> StudyResult:
+    """One-parameter study: a row per (value, configuration)."""
+    base = params if params is not None else Parameters()
+    checked = _check_values(parameter, values, base)
+    return _run([parameter], [{parameter: v} for v in checked], configs, Fz, v_range, base, executor, progress,
+                options)
+
+
+def study_grid(parameters: tuple[str, str], values: tuple[Sequence[float], Sequence[float]],
+               configs: Sequence[str] = DEFAULT_CONFIGS, Fz: float = 150e3, params: Parameters | None = None,
+               v_range: tuple[float, float] = (1.0, 200.0), executor=None,
+               progress: Callable[[float, str], None] | None = None,
+               options: BifurcationOptions | None = None) -> StudyResult:
+    """Two-parameter study on the grid values[0] x values[1]: a row per (pair, configuration)."""
+    base = params if params is not None else Parameters()
+    if len(parameters) != 2 or len(values) != 2 or parameters[0] == parameters[1]:
+        raise InvalidParameterError("parameters", list(parameters), "two different parameter names")
+    first = _check_values(parameters[0], values[0], base)
+    second = _check_values(parameters[1], values[1], base)
+    designs = [{parameters[0]: a, parameters[1]: b} for a in first for b in second]
+    return _run(list(parameters), designs, configs, Fz, v_range, base, executor, progress, options)

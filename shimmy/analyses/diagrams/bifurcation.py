@@ -1,0 +1,633 @@
+"""One-parameter bifurcation diagrams of the landing gear in the forward speed V.
+
+``bifurcation(config, Fz, v_min, v_max, params)`` computes
+
+1. the straight-rolling equilibrium x = 0 continued in V by the generic engine
+   (:func:`shimmy.continuation.equilibrium_branch`), with its stability and Hopf points;
+   the Hopf points are cross-checked against the independent eigenvalue scan of
+   :func:`shimmy.analyses.core.stability.hopf_points` (which also gives their criticality);
+2. every periodic branch born at those Hopf points (orthogonal collocation,
+   :mod:`shimmy.continuation.periodic_orbits`), followed until it ends at another Hopf point, leaves
+   [v_min, v_max], or meets a stop rule; a branch that reaches another Hopf point
+   accounts for that one too;
+3. branches not born at a Hopf point inside the range (e.g. the lateral limit cycle at
+   high load, where x = 0 is unstable over the whole range): time simulations at the
+   ends and middle of every unstable interval of x = 0; a settled periodic motion not
+   lying on a branch already found seeds a new branch, continued both ways.
+
+Mode of each periodic point: the torsional share of elastic energy, k_psi psi_amp^2
+against k_delta delta_amp^2 (psi_amp, delta_amp = half the peak-to-peak of psi and
+delta over the orbit): torsional >= 0.8, lateral <= 0.2, both in between
+(:func:`shimmy.analyses.core.response.mode_of`, the thresholds of the simulation's response type).
+
+The particle damper's |dpsi|^(1/2) dpsi is used exactly: it is C^1 (its slope is zero
+at dpsi = 0), which is all Newton's method and the Floquet multipliers (first
+derivatives) need. No smoothing is applied. The collocation error is then limited by
+the reduced smoothness at the two instants per period where dpsi = 0; the diagram
+reports the change of the maximum torsional amplitude under mesh doubling
+(``mesh_check``), the figure that shows the result does not depend on the mesh.
+
+``max_psi`` is the largest torsional amplitude of a *stable* limit cycle (what the
+gear would show), refined by a bounded 1-D search along the branch, each orbit's maximum located on
+its collocation polynomial (:meth:`PeriodicProblem.peak`); ``max_psi_any``
+includes unstable cycles.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import time
+from dataclasses import dataclass, replace, field
+from typing import Any, Callable
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from ...version import __version__
+from ...continuation.errors import ConvergenceError as EngineConvergenceError
+from ...continuation.errors import InvalidInputError as EngineInvalidInputError
+from ...continuation.collocation import Mesh, PeriodicProblem
+from ...model.configurations import Configuration
+from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, SpecialPoint, VectorField,
+                           equilibrium_branch, locate, step, tangent, weighted_norm)
+from ...model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
+from ...errors import ConvergenceError, InvalidParameterError
+from ...model.nes import VALID_ANGLE
+from ...model.parameters import V_RANGE, Parameters, check_number, check_operating_point
+from ...continuation.periodic_orbits import (PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
+                              periodic_branch)
+from ..core.response import mode_of, torsional_share
+from ..core.stability import HopfResult, hopf_points
+
+# Size of a unit step in each unknown (the arclength metric): psi, dpsi, delta, ddelta, lam, psis, dpsis.
+STATE_SCALE = np.array([0.05, 5.0, 0.005, 0.5, 0.01, 0.05, 5.0])
+V_SCALE = 10.0  # m/s
+T_SCALE = 0.01  # s
+MAX_PSI = 1.0  # rad: beyond this a branch is stopped (far outside any physical shimmy)
+PERIOD_MAX = 2.0  # s: a period blow-up (homoclinic approach) stops a branch
+SEED_T_END = 30.0  # s of simulation per seed
+SEED_RETRIES = 2  # further runs of 2 * SEED_T_END from the last state while the motion has not settled
+#: A seed needs the attractor, not the trajectory: its orbit is then converged by collocation (to 1e-9).
+#: At rtol 1e-6 instead of the histories' 1e-7 a 30 s run costs ~30 % less; amplitudes agree to 1e-6.
+SEED_RTOL = 1e-6
+#: Large-amplitude seeds: cycles no Hopf point in range feeds and the standard start does not reach
+#: (the torsional isola between two folds above ~720 kN). (state, size): psi in rad, l_g delta in m.
+LARGE_STARTS = (("psi", 0.2), ("lateral", 0.1))
+LARGE_SEED_SPEEDS = (30.0, 80.0)  # m/s
+
+
+@dataclass(frozen=True)
+class BifurcationOptions:
+    ntst: int = 40
+    ncol: int = 4
+    ds: float = 0.05
+    ds_max: float = 0.5
+    max_steps: int = 300
+    seeds: bool = True
+    mesh_check: bool = True
+    exact_nes: bool = False
+    max_angle: float = 0.2  # rad: the tangent turns at most this much per step (curvature control)
+
+    def __post_init__(self):
+        try:  # the engine validates the mesh; the gear's callers see the gear's error class
+            PeriodicOptions(ntst=self.ntst, ncol=self.ncol)
+        except EngineInvalidInputError as exc:
+            raise InvalidParameterError(exc.field, exc.value, exc.allowed, message=str(exc)) from None
+        check_number("ds", self.ds, 1e-6, 1.0)
+        check_number("ds_max", self.ds_max, self.ds, 10.0)
+        check_number("max_steps", self.max_steps, 1, 100_000, integer=True)
+        check_number("max_angle", self.max_angle, 0.01, 3.2, "rad")
+
+    def periodic(self) -> PeriodicOptions:
+        return PeriodicOptions(ntst=self.ntst, ncol=self.ncol, period_max=PERIOD_MAX,
+                               continuation=ContinuationOptions(ds=self.ds, ds_max=self.ds_max,
+                                                                max_steps=int(self.max_steps),
+                                                                max_angle=self.max_angle))
+
+
+def gear_field(model: Model, Fz: float) -> VectorField:
+    """The gear's vector field with V as the continuation parameter at fixed Fz."""
+    return VectorField(model.n_states,
+                       lambda x, V: rhs(model, x, V, Fz),
+                       lambda x, V: jacobian(model, x, V, Fz),
+                       lambda x, V: parameter_jacobian(model, x, V, Fz)[0],
+                       name=f"{model.config.value} at Fz = {Fz:g} N",
+                       evaluate=lambda x, V: field_and_derivatives(model, x, V, Fz)[:3])
+
+
+@dataclass
+class Branch:
+    """A branch of the diagram in output form."""
+
+    kind: str  # "equilibrium" | "periodic"
+    V: np.ndarray
+    period: np.ndarray  # s (nan on the equilibrium)
+    max_psi: np.ndarray  # rad
+    max_lateral: np.ndarray  # m: l_g max |delta|
+    stable: np.ndarray
+    mode: list[str | None]
+    special_points: list[dict[str, Any]]
+    origin: str
+    stop_reason: str
+    steps: int
+    raw: PeriodicBranch | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        points = [{"V": float(v), "period": None if math.isnan(T) else float(T), "max_psi": float(a),
+                   "max_lateral": float(lat), "stable": bool(s), "mode": m}
+                  for v, T, a, lat, s, m in zip(self.V, self.period, self.max_psi, self.max_lateral, self.stable,
+                                                self.mode, strict=True)]
+        return {"kind": self.kind, "origin": self.origin, "stop_reason": self.stop_reason, "steps": self.steps,
+                "points": points, "special_points": self.special_points}
+
+
+@dataclass
+class BifurcationResult:
+    config: Configuration
+    Fz: float
+    v_min: float
+    v_max: float
+    params: Parameters
+    hopf: HopfResult
+    branches: list[Branch]
+    max_psi: float  # over stable cycles (0 if none)
+    max_psi_V: float | None
+    max_psi_any: float
+    mesh_check: dict[str, Any] | None
+    options: BifurcationOptions
+    elapsed_s: float
+    warnings: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"config": self.config.value, "Fz": self.Fz, "v_min": self.v_min, "v_max": self.v_max,
+                "params": self.params.to_dict(),
+                "hopf_points": [h.to_dict() for h in self.hopf.hopf_points],
+                "branches": [b.to_dict() for b in self.branches],
+                "max_psi": self.max_psi, "max_psi_V": self.max_psi_V, "max_psi_any": self.max_psi_any,
+                "mesh_check": self.mesh_check,
+                "numerics": {"ntst": self.options.ntst, "ncol": self.options.ncol,
+                             "steps": sum(b.steps for b in self.branches),
+                             "seeds": self.options.seeds, "exact_nes": self.options.exact_nes},
+                "warnings": list(self.warnings), "elapsed_s": self.elapsed_s, "version": __version__}
+
+    def write_csv(self, path) -> None:
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["branch", "kind", "V_m_s", "period_s", "max_psi_rad", "max_lateral_m", "stable", "mode"])
+            for i, b in enumerate(self.branches):
+                for v, T, a, lat, s, m in zip(b.V, b.period, b.max_psi, b.max_lateral, b.stable, b.mode,
+                                              strict=True):
+                    w.writerow([i, b.kind, f"{v:.10g}", "" if math.isnan(T) else f"{T:.10g}", f"{a:.10g}",
+                                f"{lat:.10g}", int(bool(s)), m or ""])
+
+
+def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0], v_max: float = 200.0,
+                params: Parameters | None = None, options: BifurcationOptions | None = None,
+                progress: Callable[[float, str], None] | None = None) -> BifurcationResult:
+    """The bifurcation diagram in V at load Fz (N) over [v_min, v_max] (m/s)."""
+    clock = time.perf_counter()
+    config = Configuration.parse(config)
+    params = params if params is not None else Parameters()
+    options = options or BifurcationOptions()
+    v_min, Fz = check_operating_point(v_min, Fz)
+    v_max = check_number("v_max", v_max, V_RANGE[0], V_RANGE[1], "m/s")
+    if not v_max > v_min:
+        raise InvalidParameterError("v_max", v_max, f"a number in ({v_min:g}, {V_RANGE[1]:g}] m/s",
+                                    "must exceed v_min")
+    report = progress or (lambda fraction, message: None)
+    model = build_model(config, params, exact_nes=options.exact_nes)
+    system = gear_field(model, Fz)
+    n = model.n_states
+    scale = STATE_SCALE[:n]
+    warnings: list[str] = []
+
+    report(0.0, "equilibrium branch")
+    hopf = hopf_points(config, Fz, params, v_min=v_min, v_max=v_max)
+    eq = equilibrium_branch(system, np.zeros(n), v_min, v_min, v_max,
+                            ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000), scale=scale,
+                            p_scale=V_SCALE)
+    engine_h = [s.p for s in eq.special_points if s.kind == "H"]
+    scan_h = [h.V for h in hopf.hopf_points]
+    starts = sorted(scan_h)
+    for v in scan_h:
+        if not any(abs(v - e) <= 1e-6 * max(v, 1.0) for e in engine_h):
+            warnings.append(f"Hopf point V = {v:.9g} m/s found by the eigenvalue scan but stepped over by the "
+                            "equilibrium continuation (two crossings within one step); used as a start")
+    for e in engine_h:
+        if not any(abs(v - e) <= 1e-6 * max(v, 1.0) for v in scan_h):
+            warnings.append(f"equilibrium continuation reports a Hopf point at V = {e:.9g} m/s "
+                            "that the eigenvalue scan does not confirm")
+    branches = [_equilibrium_output(eq, hopf)]
+
+    popts = options.periodic()
+    limits = _limits(model)
+    done: list[float] = []
+    large = [(V, what, size) for V in LARGE_SEED_SPEEDS if v_min < V < v_max for what, size in LARGE_STARTS]
+    units = max(1, len(starts)) + (len(_seed_speeds(hopf)) + len(large) if options.seeds else 0)
+    unit = 0
+    for v_h in starts:
+        unit += 1
+        if v_h in done:
+            continue  # reached by an earlier branch
+        report(unit / (units + 1), f"periodic branch from the Hopf point at V = {v_h:.4g} m/s")
+        A = jacobian(model, np.zeros(n), v_h, Fz)
+        ev, vecs = np.linalg.eig(A)
+        i = int(np.argmin(np.abs(ev.real) + np.where(ev.imag > 0, 0.0, np.inf)))
+        q = vecs[:, i] / vecs[np.argmax(np.abs(vecs[:, i] / scale)), i]
+        guess, shape = hopf_guess(np.zeros(n), v_h, ev[i].imag, q, Mesh.uniform(popts.ntst, popts.ncol), 0.0)
+        try:
+            raw = periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts, direction=shape,
+                                  limits=limits)
+        except EngineConvergenceError as exc:  # the engine's, or ours derived from it
+            warnings.append(f"no periodic branch from the Hopf point at V = {v_h:.6g} m/s: {exc}")
+            continue
+        done.append(v_h)
+        for s in raw.special_points:
+            if s.kind == "H":  # ended on another Hopf point: the located one it approaches
+                near = _hopf_reached(starts, raw)
+                if near is not None:
+                    done.append(near)
+                else:
+                    warnings.append(f"branch from V = {v_h:.6g} m/s returns to x = 0 near V = {s.p:.6g} m/s, "
+                                    "where no Hopf point was located")
+        branch = _periodic_output(raw, params, f"Hopf point at V = {v_h:.6g} m/s", starts)
+        omega = {h.V: h.omega for h in hopf.hopf_points}
+        branches.append(_with_hopf_ends(branch, v_h, omega))
+
+    if options.seeds:
+        for v_seed in _seed_speeds(hopf):
+            unit += 1
+            report(unit / (units + 1), f"simulation seed at V = {v_seed:.4g} m/s")
+            seeded = _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popts,
+                                    limits, branches, warnings)
+            if seeded is not None:
+                branches.append(seeded)
+        for v_seed, what, size in large:
+            unit += 1
+            report(unit / (units + 1), f"large {what} seed at V = {v_seed:.4g} m/s")
+            x0 = np.zeros(n)
+            x0[0 if what == "psi" else 2] = size if what == "psi" else size / params.gear.l_g
+            seeded = _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popts,
+                                    limits, branches, warnings, x0=x0, label=f"large {what} start")
+            if seeded is not None:
+                branches.append(seeded)
+
+    report(0.97, "maximum torsional amplitude")
+    max_psi, max_v, max_any, mesh_check = _maximum(system, branches, options, scale, warnings, params.gear.l_g)
+    report(1.0, "done")
+    return BifurcationResult(config, Fz, v_min, v_max, params, hopf, branches, max_psi, max_v, max_any,
+                             mesh_check, options, time.perf_counter() - clock, warnings)
+
+
+def _seed_speeds(hopf: HopfResult) -> list[float]:
+    """Where to look for periodic motions not born at a Hopf point in range: the middle of every
+    unstable interval of x = 0, and its ends where they are range bounds, not Hopf points."""
+    hopf_speeds = [h.V for h in hopf.hopf_points] + list(hopf.branch_points)
+    speeds = []
+    for a, b in hopf.unstable_intervals:
+        speeds.append(math.sqrt(a * b))
+        for end, inward in ((a, b), (b, a)):
+            if not any(abs(end - v) <= 1e-9 * max(end, 1.0) for v in hopf_speeds):
+                speeds.append(end + 1e-4 * (inward - end))
+    return sorted(speeds)
+
+
+def _limits(model: Model):
+    has_nes = model.config.has_nes
+
+    def check(x_max, x_min, T, V):
+        if max(abs(x_max[0]), abs(x_min[0])) > MAX_PSI:
+            return f"torsional amplitude above {MAX_PSI:g} rad at V = {V:.6g} m/s: branch stopped"
+        if has_nes and model.exact_nes:
+            # |psi - psis| is not available from the extremes alone; bound it conservatively
+            rel = max(abs(x_max[0] - x_min[5]), abs(x_min[0] - x_max[5]))
+            if rel >= VALID_ANGLE:
+                return f"NES relative rotation may exceed pi/6 at V = {V:.6g} m/s (roller leaves its track)"
+        return None
+    return check
+
+
+def _hopf_reached(hopf_speeds: list[float], raw: PeriodicBranch) -> float | None:
+    """The Hopf point a branch ending at zero amplitude runs into: among the Hopf points within
+    5 % (or ten last steps) of its last point, the nearest one ahead in its direction of travel,
+    else the nearest one (near a degenerate Hopf point the amplitude is tiny over a wide speed
+    range, so the branch can stop just past the point it is joining)."""
+    if raw.p.size < 2 or not hopf_speeds:
+        return None
+    last, before = raw.p[-1], raw.p[-2]
+    tolerance = 10.0 * abs(last - before)
+    close = [v for v in hopf_speeds if abs(v - last) <= 0.05 * v + tolerance]
+    if not close:
+        return None
+    ahead = [v for v in close if (v - last) * (last - before) >= -1e-9 * max(abs(last), 1.0)]
+    return min(ahead or close, key=lambda v: abs(v - last))
+
+
+def _equilibrium_output(eq: EquilibriumBranch, hopf: HopfResult) -> Branch:
+    """x = 0 with its stability from the engine, the exact Hopf points inserted (neutral there)."""
+    V = list(eq.p)
+    stable = [bool(s) for s in eq.stable]
+    for h in hopf.hopf_points:
+        k = int(np.searchsorted(V, h.V))
+        V.insert(k, h.V)
+        stable.insert(k, False)
+    V_arr = np.array(V)
+    zeros = np.zeros_like(V_arr)
+    special = [{"kind": "H", "V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value,
+                "lyapunov": h.lyapunov} for h in hopf.hopf_points]
+    special += [{"kind": "BP", "V": v} for v in hopf.branch_points]
+    return Branch("equilibrium", V_arr, np.full_like(V_arr, np.nan), zeros, zeros.copy(), np.array(stable),
+                  [None] * V_arr.size, special, "x = 0", eq.stop_reason, eq.steps)
+
+
+def _periodic_output(raw: PeriodicBranch, params: Parameters, origin: str, hopf_speeds: list[float]) -> Branch:
+    l_g = params.gear.l_g
+    psi_amp = np.maximum(np.abs(raw.x_max[:, 0]), np.abs(raw.x_min[:, 0]))
+    delta_amp = np.maximum(np.abs(raw.x_max[:, 2]), np.abs(raw.x_min[:, 2]))
+    half_psi = 0.5 * (raw.x_max[:, 0] - raw.x_min[:, 0])
+    half_delta = 0.5 * (raw.x_max[:, 2] - raw.x_min[:, 2])
+    share = torsional_share(half_psi, half_delta, params.gear.k_psi, params.gear.k_delta)
+    modes = [mode_of(s).value if np.isfinite(s) else None for s in share]
+    special = []
+    for s in raw.special_points:
+        d = {"kind": s.kind, "V": s.p}
+        if s.kind == "H" and hopf_speeds:
+            near = _hopf_reached(hopf_speeds, raw)
+            if near is not None:
+                d.update({"V": near, "V_last_point": s.p})
+        if "period" in s.data:
+            xmax, xmin = np.array(s.data["x_max"]), np.array(s.data["x_min"])
+            d.update({"period": s.data["period"], "max_psi": float(max(abs(xmax[0]), abs(xmin[0]))),
+                      "max_lateral": float(l_g * max(abs(xmax[2]), abs(xmin[2]))),
+                      "multipliers_abs": s.data["multipliers_abs"]})
+        if "torus_angle" in s.data:
+            d["torus_angle"] = s.data["torus_angle"]
+        special.append(d)
+    return Branch("periodic", raw.p, raw.period, psi_amp, l_g * delta_amp, raw.stable, modes, special, origin,
+                  raw.stop_reason, raw.steps, raw)
+
+
+def _with_hopf_ends(branch: Branch, v_start: float, omega: dict[float, float]) -> Branch:
+    """The branch with its zero-amplitude end points at the Hopf points it joins (for plots and
+    tables: the cycles shrink to x = 0 there; with the particle damper the amplitude grows like
+    (V - V_H)^2, so the first computed orbit can lie well away from V_H)."""
+    def point(V):
+        return V, 2.0 * math.pi / omega[V]
+
+    head = [point(v_start)]
+    tail = [point(s["V"]) for s in branch.special_points if s["kind"] == "H" and s["V"] in omega]
+    V = np.concatenate([[v for v, _ in head], branch.V, [v for v, _ in tail]])
+    T = np.concatenate([[t for _, t in head], branch.period, [t for _, t in tail]])
+    zeros_h, zeros_t = np.zeros(len(head)), np.zeros(len(tail))
+    stable = np.concatenate([branch.stable[:1], branch.stable, branch.stable[-1:][:len(tail)]])
+    mode = branch.mode[:1] + branch.mode + branch.mode[-1:][:len(tail)]
+    return Branch(branch.kind, V, T, np.concatenate([zeros_h, branch.max_psi, zeros_t]),
+                  np.concatenate([zeros_h, branch.max_lateral, zeros_t]), stable, mode, branch.special_points,
+                  branch.origin, branch.stop_reason, branch.steps, branch.raw)
+
+
+def _on_branch(branches: list[Branch], V: float, period: float, psi_amp: float, lat_amp: float) -> bool:
+    """Whether a periodic motion (V, period, amplitudes) lies on a computed periodic branch (2 %)."""
+    for b in branches:
+        if b.kind != "periodic":
+            continue
+        for i in range(b.V.size - 1):
+            lo, hi = sorted((b.V[i], b.V[i + 1]))
+            if not lo <= V <= hi:
+                continue
+            f = 0.0 if hi == lo else (V - b.V[i]) / (b.V[i + 1] - b.V[i])
+            T = b.period[i] + f * (b.period[i + 1] - b.period[i])
+            a = b.max_psi[i] + f * (b.max_psi[i + 1] - b.max_psi[i])
+            lat = b.max_lateral[i] + f * (b.max_lateral[i + 1] - b.max_lateral[i])
+            if abs(T - period) <= 0.02 * period and abs(a - psi_amp) <= 0.02 * max(psi_amp, 1e-6) + 1e-5 \
+                    and abs(lat - lat_amp) <= 0.02 * max(lat_amp, 1e-6) + 1e-5:
+                return True
+    return False
+
+
+def periodic_orbit_from_simulation(config: Configuration, Fz: float, V: float, params: Parameters,
+                                   mesh: Mesh, t_end: float = SEED_T_END, exact_nes: bool = False, x0=None):
+    """(guess, None) from a simulated settled periodic motion, or (None, reason). ``x0``: the
+    start state (default the standard start, psi = 0.001 rad)."""
+    from ..core.simulation import simulate  # analyses may use analyses; kept local to keep start-up light
+
+    run = simulate(config, V, Fz, params, t_end=t_end, exact_nes=exact_nes, x0=x0, rtol=SEED_RTOL, frequency=False)
+    for _ in range(SEED_RETRIES):  # slow growth or decay: go on from where the run ended
+        if not run.success or run.steady:
+            break
+        run = simulate(config, V, Fz, params, t_end=2 * t_end, x0=run.states[:, -1], exact_nes=exact_nes,
+                       rtol=SEED_RTOL, frequency=False)
+    if not run.success:
+        return None, f"simulation failed: {run.message}"
+    if run.response_type.value == "Stable":
+        return None, "the simulation decays to x = 0"
+    if not run.steady:
+        return None, f"the simulated motion did not settle within {t_end * (1 + 2 * SEED_RETRIES):g} s"
+    k_psi, k_delta = params.gear.k_psi, params.gear.k_delta
+    states = run.states
+    window = states[:, states.shape[1] // 2:]
+    t = run.t[states.shape[1] // 2:]
+    signal = (np.sqrt(k_psi) * window[0] if run.amplitude["psi"] ** 2 * k_psi
+              >= (run.amplitude["lateral"] / params.gear.l_g) ** 2 * k_delta else np.sqrt(k_delta) * window[2])
+    signal = signal - signal.mean()
+    up = np.nonzero((signal[:-1] < 0) & (signal[1:] >= 0))[0]
+    if up.size < 4:
+        return None, "too few oscillations in the simulated window"
+    crossings = t[up] - signal[up] * (t[up + 1] - t[up]) / (signal[up + 1] - signal[up])
+    periods = np.diff(crossings)
+    T = float(np.median(periods[-10:]))
+    spread = float(np.std(periods[-10:]) / T)
+    if spread > 0.02:
+        return None, f"the simulated motion is not periodic (period spread {100 * spread:.1f} %)"
+    t0 = crossings[-2] - T if crossings[-1] + 1e-12 > run.t[-1] else crossings[-2]
+    tau = np.linspace(0.0, 1.0, 400)
+    x = np.column_stack([np.interp(t0 + tau * T, run.t, states[i]) for i in range(states.shape[0])])
+    return orbit_from_samples(t0 + tau * T, x, T, V, mesh), None
+
+
+def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popts, limits, branches,
+                   warnings, x0=None, label: str = "simulation") -> Branch | None:
+    mesh = Mesh.uniform(popts.ntst, popts.ncol)
+    guess, reason = periodic_orbit_from_simulation(config, Fz, v_seed, params, mesh, exact_nes=model.exact_nes,
+                                                   x0=x0)
+    if guess is None:
+        if "not periodic" in reason or "failed" in reason:
+            warnings.append(f"{label} at V = {v_seed:.6g} m/s: {reason}")
+        return None
+    psi_amp = float(np.abs(guess.X[:, 0]).max())
+    lat_amp = float(params.gear.l_g * np.abs(guess.X[:, 2]).max())
+    if _on_branch(branches, v_seed, guess.T, psi_amp, lat_amp):
+        return None
+    scale = STATE_SCALE[:model.n_states]
+    halves = []
+    for direction in (-1, +1):
+        try:
+            halves.append(periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts,
+                                          p_direction=direction, limits=limits))
+        except EngineConvergenceError as exc:  # the engine's, or ours derived from it
+            warnings.append(f"{label} at V = {v_seed:.6g} m/s: {exc}")
+            return None
+        if halves[0].stop_reason.startswith("closed branch"):  # a loop: one way round covers it
+            return _periodic_output(halves[0], params, f"{label} at V = {v_seed:.6g} m/s", [])
+    joined = _join(halves[0], halves[1])
+    return _periodic_output(joined, params, f"{label} at V = {v_seed:.6g} m/s", [])
+
+
+def _join(down: PeriodicBranch, up: PeriodicBranch) -> PeriodicBranch:
+    """One branch from two halves continued both ways from the same first point."""
+    k = down.p.size
+
+    def cat(a, b):
+        return np.concatenate([a[::-1], b[1:]])
+
+    special = [SpecialPoint(s.kind, s.p, k - 1 - s.index, s.data, s.solution) for s in down.special_points][::-1]
+    special += [SpecialPoint(s.kind, s.p, k - 1 + s.index, s.data, s.solution) for s in up.special_points]
+    return PeriodicBranch(cat(down.p, up.p), cat(down.period, up.period), cat(down.x_max, up.x_max),
+                          cat(down.x_min, up.x_min), cat(down.stable, up.stable),
+                          cat(down.multipliers, up.multipliers), special,
+                          f"decreasing V: {down.stop_reason}; increasing V: {up.stop_reason}",
+                          down.steps + up.steps, up.ntst, up.ncol, down.solutions[::-1] + up.solutions[1:],
+                          max(down.trivial_error, up.trivial_error))
+
+
+def _restore(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray,
+             to: int | None = None) -> tuple[PeriodicProblem, CurvePoint, float]:
+    """The problem on point i's mesh, the point with its tangent oriented towards point ``to``
+    (default i + 1), and the arclength to that point."""
+    mesh_points, u = raw.solutions[i]
+    problem = PeriodicProblem(system, Mesh(mesh_points, raw.ncol), scale, T_SCALE, V_SCALE)
+    problem.accept(u)
+    j = min(i + 1 if to is None else to, len(raw.solutions) - 1)
+    if j == i:
+        return problem, CurvePoint(u, tangent(problem, u, np.eye(u.size)[-1])), 0.0
+    other = PeriodicProblem(system, Mesh(raw.solutions[j][0], raw.ncol), scale, T_SCALE, V_SCALE)
+    direction = other.transfer(problem, raw.solutions[j][1]) - u
+    return problem, CurvePoint(u, tangent(problem, u, direction)), weighted_norm(direction, problem.weights)
+
+
+def cycle_at(result: BifurcationResult, branch: int, V: float, max_psi: float | None = None) -> dict[str, Any]:
+    """The periodic orbit of ``result.branches[branch]`` at speed V, located exactly on the branch
+    (secant on the step from the neighbouring branch point): period, amplitudes, stability and the
+    orbit itself (t, psi, l_g delta; ``x0`` the full state at t = 0). Raises ValueError if the
+    branch does not reach V. A branch that passes V more than once (a fold, a loop) gives the
+    orbit whose torsional amplitude is nearest to ``max_psi`` (default: the first one)."""
+    b = result.branches[branch]
+    if b.kind != "periodic" or b.raw is None:
+        raise ValueError(f"branch {branch} is not a periodic branch")
+    raw = b.raw
+    model = build_model(result.config, result.params, exact_nes=result.options.exact_nes)
+    system = gear_field(model, result.Fz)
+    scale = STATE_SCALE[:model.n_states]
+    crossings = [i for i in range(raw.p.size - 1) if (raw.p[i] - V) * (raw.p[i + 1] - V) <= 0]
+    if max_psi is not None:
+        amp = np.maximum(np.abs(raw.x_max[:, 0]), np.abs(raw.x_min[:, 0]))
+
+        def distance(i):
+            f = 0.0 if raw.p[i + 1] == raw.p[i] else (V - raw.p[i]) / (raw.p[i + 1] - raw.p[i])
+            return abs(amp[i] + f * (amp[i + 1] - amp[i]) - max_psi)
+
+        crossings.sort(key=distance)
+    for i in crossings:
+        problem, start, h = _restore(system, raw, i, scale)
+        if raw.p[i] == V:
+            point = start
+        else:
+            hit = locate(problem, start, h, lambda q: q.u[-1] - V, raw.p[i] - V, raw.p[i + 1] - V,
+                         ContinuationOptions(locate_tol=1e-10))
+            if hit is None:
+                raise ConvergenceError(f"could not locate the orbit at V = {V:g} m/s on branch {branch}")
+            point = hit[0]
+        tau, x = problem.sample(point.u)
+        mu = problem.multipliers(point.u)
+        T = float(point.u[-2])
+        l_g = result.params.gear.l_g
+        return {"V": float(point.u[-1]), "period": T, "max_psi": float(np.abs(x[:, 0]).max()),
+                "max_lateral": float(l_g * np.abs(x[:, 2]).max()), "stable": bool(np.all(np.abs(mu[1:]) < 1.0)),
+                "multipliers": mu, "t": tau * T, "psi": x[:, 0], "lateral": l_g * x[:, 2], "x0": x[0].copy()}
+    raise ValueError(f"branch {branch} does not reach V = {V:g} m/s")
+
+
+def _draw_located(branches: list[Branch], raw: PeriodicBranch, problem: PeriodicProblem, point: CurvePoint,
+                  psi_amp: float, l_g: float) -> None:
+    """Put the located maximum among the drawn points of its branch (between the drawn points that
+    bracket it), so that the plotted curve peaks where the reported maximum is."""
+    for k, b in enumerate(branches):
+        if b.raw is not raw:
+            continue
+        V = float(point.u[-1])
+        near = int(np.argmin(np.abs(b.V - V) / V_SCALE + np.abs(b.max_psi - psi_amp) / STATE_SCALE[0]))
+        j = next((m for m in (near - 1, near) if 0 <= m < len(b.V) - 1
+                  and min(b.V[m], b.V[m + 1]) <= V <= max(b.V[m], b.V[m + 1])), None)
+        if j is None:
+            return
+        _, x = problem.sample(point.u)
+        branches[k] = replace(b, V=np.insert(b.V, j + 1, V), period=np.insert(b.period, j + 1, float(point.u[-2])),
+                              max_psi=np.insert(b.max_psi, j + 1, psi_amp),
+                              max_lateral=np.insert(b.max_lateral, j + 1, l_g * float(np.abs(x[:, 2]).max())),
+                              stable=np.insert(b.stable, j + 1, True),
+                              mode=b.mode[:j + 1] + [b.mode[j]] + b.mode[j + 1:])
+        return
+
+
+def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale, warnings, l_g: float):
+    """Largest torsional amplitude of stable cycles, refined along the branch, and a mesh check."""
+    best = (0.0, None, None, None)  # amplitude, V, branch, index into its raw points
+    max_any = 0.0
+    for b in branches:
+        raw = b.raw
+        if b.kind != "periodic" or raw is None or raw.p.size == 0:
+            continue
+        psi_amp = np.maximum(np.abs(raw.x_max[:, 0]), np.abs(raw.x_min[:, 0]))
+        max_any = max(max_any, float(psi_amp.max()))
+        stable_amp = np.where(raw.stable, psi_amp, -np.inf)
+        i = int(np.argmax(stable_amp))
+        if np.isfinite(stable_amp[i]) and stable_amp[i] > best[0]:
+            best = (float(stable_amp[i]), float(raw.p[i]), raw, i)
+    amp, V, raw, i = best
+    if raw is None:
+        return 0.0, None, max_any, None
+    copts = ContinuationOptions(ds=options.ds, ds_max=options.ds_max)
+    lo = max(i - 1, 0)
+    if 0 < i < raw.p.size - 1 and raw.stable[lo] and raw.stable[i + 1]:
+        problem, start, span = _restore(system, raw, lo, scale, to=i + 1)
+        cache: dict[float, tuple[float, CurvePoint | None]] = {}
+
+        def minus_amp(h):
+            point = step(problem, start, h, copts, with_tangent=False) if h > 0 else start
+            if point is None:
+                cache[h] = (0.0, None)
+                return 0.0
+            a = problem.peak(point.u, 0)[2]  # on the collocation polynomial, not the nearest sample
+            cache[h] = (a, point)
+            return -a
+
+        opt = minimize_scalar(minus_amp, bounds=(0.0, span), method="bounded", options={"xatol": 1e-5 * span})
+        a_opt, point = cache.get(opt.x, (0.0, None))
+        if point is not None and a_opt >= amp:
+            amp, V = a_opt, float(point.u[-1])
+            i_point = point
+            _draw_located(branches, raw, problem, point, a_opt, l_g)
+        else:
+            i_point = None
+    else:
+        i_point = None
+    mesh_check = None
+    if options.mesh_check:
+        problem, start, _ = _restore(system, raw, i, scale)
+        point = i_point or start
+        fine = PeriodicProblem(system, problem.adapted_mesh(point.u, 2 * problem.mesh.ntst), scale, T_SCALE,
+                               V_SCALE)
+        u_f = problem.transfer(fine, point.u)
+        fine.accept(u_f)
+        t_f = np.zeros_like(u_f)
+        t_f[-1] = 1.0
+        fixed = step(fine, CurvePoint(u_f, t_f / weighted_norm(t_f, fine.weights)), 0.0, copts)
+        if fixed is None:
+            warnings.append("mesh check: no convergence on the doubled mesh")
+        else:
+            a_f = fine.peak(fixed.u, 0)[2]
+            a_c = problem.peak(point.u, 0)[2]
+            mesh_check = {"V": float(point.u[-1]), "ntst": problem.mesh.ntst, "ntst_fine": fine.mesh.ntst,
+                          "max_psi": a_c, "max_psi_fine": a_f, "change": abs(a_f - a_c)}
+    return amp, V, max(max_any, amp), mesh_check

@@ -1,0 +1,478 @@
+"""The gear's curves of cycle bifurcations in (V, Fz): every fold-of-cycles (LPC), torus (NS) and
+period-doubling (PD) curve of a configuration in a box, each continued to its ends.
+
+Found without being told where to look, from four kinds of start, each a located special point
+of a one-parameter branch in V at some load:
+
+1. generalised Hopf (GH) points of the Hopf curves (a fold curve is born there): the branch from
+   the Hopf point just beside the GH point, on either side, stopped at its first LPC;
+2. double-Hopf points (a torus curve is born there): the branches from both Hopf points just
+   beside it, stopped at their first NS point;
+3. one-parameter diagrams on a few loads (every LPC, NS and PD point of every branch), whose
+   seeds include large-amplitude starts (psi = 0.2 rad, l_g delta = 0.1 m) that reach cycles no
+   Hopf point feeds (the isola between two folds above ~720 kN).
+
+A start that lies on a curve already continued is skipped, so each curve is continued once
+(:func:`shimmy.continuation.cycle_curve`: minimally augmented systems on the collocation mesh
+of the one-parameter branch, so its points agree with the one-parameter points to the
+location tolerance). Along each curve: its crossings of requested loads, its turning points
+in Fz and its codimension-2 points, located.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from concurrent.futures import Executor
+from typing import Any, Callable
+
+import numpy as np
+
+from ...version import __version__
+from ...continuation import (ContinuationOptions, CycleCurve, CycleCurveOptions, SpecialPoint,
+                            TwoParameterVectorField, cycle_curve, start_beside)
+from ...continuation.errors import ContinuationError
+from ...errors import InvalidParameterError
+from ...model.configurations import Configuration
+from ...model.equations import build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
+from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
+from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation
+from .hopf_curves import hopf_curves
+from ..core.polylines import near_polyline
+from ..core.executors import open_executor, run_dynamic
+from ..core.stability import hopf_points
+
+KINDS = ("LPC", "NS", "PD")
+KEY_OF_KIND = {"LPC": "fold_curves", "NS": "torus_curves", "PD": "pd_curves"}
+FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 kN
+CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400,
+                                                                   max_angle=0.3))
+BESIDE = 0.015  # relative offset in Fz from a GH / double-Hopf point to the Hopf point a start branch leaves
+START_STEPS = 80  # step budget of a start branch
+SCAN_FRACTIONS = (0.3, 0.6, 0.9)  # loads of the one-parameter diagrams, as fractions of the box in Fz
+
+
+def gear_cycle_field(config: Configuration, params: Parameters) -> TwoParameterVectorField:
+    """The gear's vector field in (V, Fz), vectorised over columns, analytic derivatives."""
+    model = build_model(config, params)
+
+    def evaluate(x, p):
+        f, J, dV, dFz = field_and_derivatives(model, x, p[0], p[1])
+        return f, J, np.stack([dV, dFz])
+    return TwoParameterVectorField(model.n_states, lambda x, p: rhs(model, x, p[0], p[1]),
+                                   lambda x, p: jacobian(model, x, p[0], p[1]),
+                                   lambda x, p: np.stack(parameter_jacobian(model, x, p[0], p[1])),
+                                   f"{config.value} in (V, Fz)", evaluate)
+
+
+@dataclass(eq=False)  # compared by identity: list.remove takes the very start
+class Start:
+    kind: str
+    point: SpecialPoint  # located on a branch in V, with its solution
+    Fz: float
+    ncol: int
+    origin: str
+    #: next to the codimension-2 point it was found beside, where a curve is born: continued
+    #: before the other starts (a diagram's points mostly lie on curves already started)
+    eager: bool = False
+    from_diagram: bool = False  # a point of a one-parameter diagram (a slice or a scan)
+
+
+@dataclass
+class GearCycleCurve:
+    kind: str
+    curve: CycleCurve
+    origin: str
+
+    def points(self, l_g: float) -> list[dict[str, float]]:
+        c = self.curve
+        psi = np.maximum(np.abs(c.x_max[:, 0]), np.abs(c.x_min[:, 0]))
+        lateral = l_g * np.maximum(np.abs(c.x_max[:, 2]), np.abs(c.x_min[:, 2]))
+        return [{"V": float(p[0]), "Fz": float(p[1]), "period": float(T), "max_psi": float(a),
+                 "max_lateral": float(b)} for p, T, a, b in zip(c.p, c.period, psi, lateral, strict=True)]
+
+
+def _located_point(s: SpecialPoint, l_g: float) -> dict[str, Any]:
+    out: dict[str, Any] = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
+    if "located" in s.data:
+        out["located"] = bool(s.data["located"])
+    if "x_max" in s.data:
+        xmax, xmin = np.array(s.data["x_max"]), np.array(s.data["x_min"])
+        out.update({"period": s.data["period"], "max_psi": float(max(abs(xmax[0]), abs(xmin[0]))),
+                    "max_lateral": float(l_g * max(abs(xmax[2]), abs(xmin[2])))})
+    return out
+
+
+@dataclass
+class CycleCurvesResult:
+    config: Configuration
+    params: Parameters
+    v_range: tuple[float, float]
+    fz_range: tuple[float, float]
+    kinds: tuple[str, ...]
+    curves: list[GearCycleCurve]
+    gh_points: list[dict[str, float]]
+    double_hopf_points: list[dict[str, float]]
+    loads: tuple[float, ...]
+    elapsed_s: float
+    starts_tried: int
+    warnings: list[str] = field(default_factory=list)
+
+    def of_kind(self, kind: str) -> list[GearCycleCurve]:
+        return [c for c in self.curves if c.kind == kind]
+
+    def codim2_points(self) -> list[dict[str, Any]]:
+        """GH and double-Hopf points of the Hopf curves, and those located on the cycle curves
+        (one entry per point: the same point found on two curves is listed once)."""
+        out = [{"kind": "GH", "V": g["V"], "Fz": g["Fz"]} for g in self.gh_points]
+        out += [{"kind": "HH", "V": g["V"], "Fz": g["Fz"]} for g in self.double_hopf_points]
+        for c in self.curves:
+            for s in c.curve.special_points:
+                if s.kind in ("EP", "ZA", "P2_TURN", "P2_MARK") or not s.data.get("located", True):
+                    continue  # ends and load marks are not codimension-2 points; unlocated ones stay in "curves"
+                entry = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
+                # the same point on two curves (LPNS on a fold and a torus curve) agrees to the
+                # location accuracy of the multipliers (~1e-5): one entry
+                if not any(e["kind"] == entry["kind"] and _close(e, entry, 1e-3) for e in out):
+                    out.append(entry)
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        l_g = self.params.gear.l_g
+        out: dict[str, Any] = {"config": self.config.value, "params": self.params.to_dict(),
+                               "v_range": list(self.v_range), "fz_range": list(self.fz_range),
+                               "kinds": list(self.kinds)}
+        for kind in KINDS:
+            out[KEY_OF_KIND[kind]] = [c.points(l_g) for c in self.of_kind(kind)] if kind in self.kinds else []
+        details = []
+        for c in self.curves:
+            special = c.curve.special_points
+            turns = [_located_point(s, l_g) | {"turn": s.data["turn"]} for s in special if s.kind == "P2_TURN"]
+            fz = c.curve.p[:, 1]
+            lowest = min([{"V": float(c.curve.p[int(np.argmin(fz)), 0]), "Fz": float(fz.min())}]
+                         + [t for t in turns if t["turn"] == "min"], key=lambda e: e["Fz"])
+            highest = max([{"V": float(c.curve.p[int(np.argmax(fz)), 0]), "Fz": float(fz.max())}]
+                          + [t for t in turns if t["turn"] == "max"], key=lambda e: e["Fz"])
+            details.append({
+                "kind": c.kind, "origin": c.origin, "points": len(c.curve.p), "closed": c.curve.closed,
+                "stop_reasons": c.curve.stop_reasons, "steps": c.curve.steps,
+                "fz_min": {"V": lowest["V"], "Fz": lowest["Fz"]}, "fz_max": {"V": highest["V"], "Fz": highest["Fz"]},
+                "turning_points": turns,
+                "crossings": sorted((_located_point(s, l_g) for s in special if s.kind == "P2_MARK"),
+                                    key=lambda e: (e["Fz"], e["V"])),
+                "ends": [_located_point(s, l_g) for s in special if s.kind in ("EP", "ZA")],
+                "codim2_points": [_located_point(s, l_g) for s in special
+                                  if s.kind not in ("EP", "ZA", "P2_TURN", "P2_MARK")],
+            })
+        out.update({"curves": details, "codim2_points": self.codim2_points(), "gh_points": self.gh_points,
+                    "double_hopf_points": self.double_hopf_points, "loads": list(self.loads),
+                    "starts_tried": self.starts_tried, "warnings": list(self.warnings),
+                    "elapsed_s": self.elapsed_s, "version": __version__,
+                    "method": "two-parameter continuation of each curve (minimally augmented systems with bordered "
+                              "test functions on the collocation mesh), started from GH and double-Hopf points, "
+                              "one-parameter diagrams and large-amplitude starts; points exact to the location "
+                              "tolerance (1e-9 in the defining equations)"})
+        return out
+
+
+def _close(a: dict, b: dict, tol: float) -> bool:
+    return abs(a["V"] - b["V"]) <= tol * V_SCALE and abs(a["Fz"] - b["Fz"]) <= tol * FZ_SCALE
+
+
+class CurveSearch:
+    """The state of a search for every curve of some kinds in a box: the starts found so far,
+    the curves continued from them, the continuations under way. Units (see :func:`search_unit`)
+    come from :meth:`start_units` (branches beside codimension-2 points of the Hopf curves) and
+    from :meth:`continuations`; whoever runs them hands back their results (:meth:`add_beside`,
+    :meth:`add_source` for a diagram's points, :meth:`add_curve`).
+
+    A start is continued only if it lies on no curve known; one curve of each kind is under way
+    at a time (two starts may lie on one curve, and which do is known only once it is continued:
+    two double-Hopf points joined by a torus curve); starts born at a codimension-2 point go
+    first, in the order of those points; a diagram's starts wait until every diagram expected
+    (:meth:`expect_sources`), the Hopf curves and every branch beside a point are in, then go by
+    load and speed within each batch of diagrams.
+    So the curves, and the start each is continued from, do not depend on the order in which
+    units finish: a map or a set of curves is the same on any executor.
+    :func:`cycle_curves` and the stability maps both drive it."""
+
+    def __init__(self, config: Configuration, params: Parameters, box, kinds: tuple[str, ...],
+                 loads: tuple[float, ...]):
+        self.config, self.params, self.box, self.kinds, self.loads = config, params, box, kinds, loads
+        self.gh: list[dict[str, float]] = []
+        self.hh: list[dict[str, Any]] = []
+        self.starts: list[Start] = []
+        self.running: list[Start] = []
+        self.curves: list[GearCycleCurve] = []
+        self.warnings: list[str] = []
+        self.tried = 0
+        self.hopf_pending = True  # the Hopf curves (and so the units beside their points) not yet in
+        self.beside_order: list[tuple] = []  # the units beside codimension-2 points, in order
+        self.beside_in: dict[int, tuple[list[Start], list[str]]] = {}
+        self.beside_taken = 0
+        self.sources_pending = 0  # diagrams expected and not yet in
+        self.source_buffer: list[Start] = []
+
+    def start_units(self, hopf) -> list[tuple]:
+        """The branches beside the GH points (fold curves) and double-Hopf points (torus curves)."""
+        self.gh = [{"V": g["p"][0], "Fz": g["p"][1]} for c in hopf.curves for g in c.gh_points]
+        for c in hopf.curves:
+            for g in c.double_hopf:
+                entry = {"V": g["p"][0], "Fz": g["p"][1], "omega": g["omega"], "omega2": g["omega2"]}
+                if not any(_close(entry, e, 1e-4) for e in self.hh):
+                    self.hh.append(entry)
+        units = [("beside", self.config, self.params, g, "LPC", self.box,
+                  f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+                 for g in self.gh if "LPC" in self.kinds]
+        units += [("beside", self.config, self.params, g, "NS", self.box,
+                   f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+                  for g in self.hh if "NS" in self.kinds]
+        self.hopf_pending = False
+        self.beside_order += units
+        return units
+
+    def _usable(self, starts: list[Start]) -> list[Start]:
+        return [s for s in starts if s.kind in self.kinds and s.point.solution is not None]
+
+    def add_beside(self, task: tuple, starts: list[Start], warnings: list[str]) -> None:
+        """A unit beside a codimension-2 point is in; its starts count in the order of the points."""
+        self.beside_in[next(k for k, u in enumerate(self.beside_order) if u is task)] = (starts, warnings)
+        while self.beside_taken in self.beside_in:
+            starts, warnings = self.beside_in.pop(self.beside_taken)
+            self.starts += self._usable(starts)
+            self.warnings += list(warnings)
+            self.beside_taken += 1
+
+    def expect_sources(self, count: int) -> None:
+        """``count`` more diagrams will hand in their starts (:meth:`add_source`)."""
+        self.sources_pending += count
+
+    def add_source(self, starts: list[Start], warnings: list[str] = ()) -> None:
+        """A diagram's starts; they count once every diagram expected is in."""
+        self.source_buffer += self._usable(starts)
+        self.warnings += list(warnings)
+        self.sources_pending -= 1
+        if self.sources_pending <= 0:
+            self.sources_pending = 0
+            self.starts += sorted(self.source_buffer, key=lambda s: (s.Fz, s.point.p, s.kind))
+            self.source_buffer = []
+
+    def _gathering(self) -> bool:
+        return self.hopf_pending or self.beside_taken < len(self.beside_order) or self.sources_pending > 0
+
+    def _may_go(self, start: Start) -> bool:
+        """Born at a point: at once; another start beside a point: once every branch beside a point
+        is in; a diagram's: once every diagram is in, too."""
+        if start.eager:
+            return True
+        if self.hopf_pending or self.beside_taken < len(self.beside_order):
+            return False
+        return not (start.from_diagram and self.sources_pending > 0)
+
+    def add_curve(self, start: Start, curve: GearCycleCurve | None, warning: str | None) -> None:
+        self.running.remove(start)
+        self.tried += 1
+        if warning:
+            self.warnings.append(warning)
+        elif curve is not None and not any(_same_curve(curve, c, self.params.gear.l_g) for c in self.curves):
+            self.curves.append(curve)
+
+    def idle(self) -> bool:
+        """Nothing under way, waiting or expected: the curves stand as they are."""
+        return not (self.running or self.starts or self._gathering())
+
+    def continuations(self) -> list[tuple]:
+        """Units continuing the waiting starts that may (see the class)."""
+        l_g = self.params.gear.l_g
+        self.starts = [s for s in self.starts
+                       if not any(_on_curve(c, s, l_g) for c in self.curves if c.kind == s.kind)]
+        units = []
+        for s in sorted(self.starts, key=lambda s: (not s.eager, s.from_diagram)):
+            if any(r.kind == s.kind for r in self.running) or not self._may_go(s):
+                continue
+            self.starts.remove(s)
+            self.running.append(s)
+            units.append(("continue", self.config, self.params, s, self.box, self.loads))
+        return units
+
+    def result(self, elapsed_s: float) -> CycleCurvesResult:
+        (v_lo, v_hi), (f_lo, f_hi) = self.box
+        hh = [{"V": e["V"], "Fz": e["Fz"], "omega": e["omega"], "omega2": e["omega2"]} for e in self.hh]
+        curves = sorted(self.curves, key=lambda c: KINDS.index(c.kind))  # each kind's in the order continued
+        return CycleCurvesResult(self.config, self.params, (v_lo, v_hi), (f_lo, f_hi), self.kinds, curves,
+                                 self.gh, hh, self.loads, elapsed_s, self.tried, sorted(self.warnings))
+
+
+def search_unit(task: tuple) -> Any:
+    """One unit of a curve search, in any process: ("beside" | "scan", ...) -> (starts, warnings);
+    ("continue", ...) -> (curve or None, warning or None)."""
+    if task[0] == "continue":
+        return _continue(task[1:])
+    return _find_starts(task)
+
+
+def describe_search_unit(task: tuple) -> str:
+    if task[0] == "continue":
+        return f"{task[3].kind} curve from V = {task[3].point.p:.4g} m/s, Fz = {task[3].Fz / 1e3:.4g} kN"
+    return _describe_task(task)
+
+
+def search_done(search: CurveSearch, task: tuple, result: Any) -> list[tuple]:
+    """Hand a finished search unit's result to ``search``; the continuations it makes possible."""
+    if task[0] == "continue":
+        search.add_curve(task[3], *result)
+    elif task[0] == "beside":
+        search.add_beside(task, *result)
+    else:
+        search.add_source(*result)
+    return search.continuations()
+
+
+def cycle_curves(config: Configuration | str, params: Parameters | None = None,
+                 v_range: tuple[float, float] = (V_RANGE[0], 200.0), fz_range: tuple[float, float] = FZ_RANGE,
+                 kinds: tuple[str, ...] = KINDS, loads: tuple[float, ...] = (),
+                 progress: Callable[[float, str], None] | None = None,
+                 executor: Executor | None = None) -> CycleCurvesResult:
+    """Every fold, torus and period-doubling curve of cycles in the box (m/s, N); ``loads``: the
+    loads (N) at which each curve's crossings are located and reported.
+
+    The starts (branches beside each codimension-2 point, a diagram and large-amplitude starts
+    per scan load) are independent units, and so are the continuations of starts that lie on no
+    curve yet (:class:`CurveSearch`): all go through ``executor`` (default
+    :func:`~.executors.open_executor`: one process per core, or a Dask cluster), a curve's
+    continuation as soon as a start for it is known and before the remaining starts.
+    """
+    clock = time.perf_counter()
+    config = Configuration.parse(config)
+    params = params if params is not None else Parameters()
+    v_lo, v_hi = check_range("v", v_range, V_RANGE, "m/s")
+    f_lo, f_hi = check_range("fz", fz_range, FZ_RANGE, "N")
+    kinds = tuple(kinds)
+    for k in kinds:
+        if k not in KINDS:
+            raise InvalidParameterError("kinds", k, ", ".join(KINDS), "is not a kind of cycle curve")
+    if not kinds:
+        raise InvalidParameterError("kinds", "", ", ".join(KINDS), "is empty")
+    loads = tuple(float(check_number(f"loads[{i}]", f, f_lo, f_hi, "N")) for i, f in enumerate(loads))
+    if executor is None:
+        with open_executor() as own:
+            return cycle_curves(config, params, v_range, fz_range, kinds, loads, progress, own)
+    report = progress or (lambda fraction, message: None)
+    box = ((v_lo, v_hi), (f_lo, f_hi))
+
+    report(0.0, "Hopf curves and their GH and double-Hopf points")
+    hopf = hopf_curves(config, params, (v_lo, v_hi), (f_lo, f_hi))
+    search = CurveSearch(config, params, box, kinds, loads)
+    search.expect_sources(len(SCAN_FRACTIONS))
+    units = [(1, u) for u in search.start_units(hopf)]
+    units += [(2, ("scan", config, params, f_lo + fr * (f_hi - f_lo), box)) for fr in SCAN_FRACTIONS]
+    run_dynamic(search_unit, units, executor, lambda task, result: [(0, u) for u in search_done(search, task, result)],
+                lambda f, m: report(0.05 + 0.95 * f, m), describe_search_unit)
+    report(1.0, "done")
+    return search.result(time.perf_counter() - clock)
+
+
+def starts_of_diagram(diagram, Fz: float) -> list[Start]:
+    """The located LPC, NS and PD points (with their orbits) of a diagram's periodic branches."""
+    return [Start(s.kind, s, Fz, b.raw.ncol, f"{b.origin}, diagram at Fz = {Fz:.6g} N", from_diagram=True)
+            for b in diagram.branches if b.kind == "periodic" and b.raw is not None
+            for s in b.raw.special_points if s.kind in KINDS]
+
+
+def _describe_task(task: tuple) -> str:
+    if task[0] == "scan":
+        return f"diagram and large-amplitude starts at Fz = {task[3] / 1e3:.4g} kN"
+    return f"branches {task[6]}"
+
+
+def _find_starts(task: tuple) -> tuple[list[Start], list[str]]:
+    """Starts of one unit: the branches beside one codimension-2 point, or the diagram and the
+    large-amplitude starts at one load (a unit of :func:`cycle_curves`, run in any process)."""
+    if task[0] == "beside":
+        _, config, params, point, kind, box, origin = task
+        model = build_model(config, params)
+        return _starts_beside(config, model, params, point, kind, box[0], box[1], origin), []
+    _, config, params, Fz, box = task
+    try:
+        diagram = bifurcation(config, Fz, box[0][0], box[0][1], params, BifurcationOptions(mesh_check=False))
+    except ContinuationError as exc:
+        return [], [f"diagram at Fz = {Fz:.6g} N failed: {exc}"]
+    return starts_of_diagram(diagram, Fz), []
+
+
+def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
+    """One curve continued from one start (a unit of :func:`cycle_curves`)."""
+    config, params, start, box, loads = task
+    system = gear_cycle_field(config, params)
+    kappa = math.cos(start.point.data["torus_angle"]) if start.kind == "NS" else None
+    if kappa is not None and not -1.0 < kappa < 1.0:
+        return None, None
+    about = f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin})"
+    try:
+        curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box, STATE_SCALE[:system.n],
+                            (V_SCALE, FZ_SCALE), kappa=kappa, options=CURVE_OPTIONS, ncol=start.ncol, p2_marks=loads)
+    except ContinuationError as exc:
+        return None, f"{about} not continued: {exc}"
+    if len(curve.p) < 2:  # stopped at its start both ways (a start at a strong resonance): no curve to draw
+        return None, f"{about} gives no curve: {'; '.join(curve.stop_reasons)}"
+    return GearCycleCurve(start.kind, curve, start.origin), None
+
+
+def _same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:
+    """Whether a curve continued while another was under way is that curve again (its start, the
+    first point of its half traced first, lies on the other)."""
+    if new.kind != old.kind:
+        return False
+    c = new.curve
+    i = len(c.p) // 2
+    probe = SpecialPoint(new.kind, float(c.p[i, 0]), 0, {"x_max": c.x_max[i].tolist(), "x_min": c.x_min[i].tolist()})
+    return _on_curve(old, Start(new.kind, probe, float(c.p[i, 1]), 0, ""), l_g)
+
+
+def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin) -> list[Start]:
+    """LPC (beside GH) or NS (beside a double-Hopf point) points of the branches that leave the
+    Hopf points just above and below the codimension-2 point's load."""
+    out = []
+    n = model.n_states
+    system = gear_cycle_field(config, params)
+    options = BifurcationOptions(max_steps=START_STEPS).periodic()
+    for side in (-1.0, 1.0):
+        Fz = point["Fz"] * (1.0 + side * BESIDE)
+        if not fz_range[0] <= Fz <= fz_range[1]:
+            continue
+        hopf = hopf_points(config, Fz, params, v_min=v_range[0], v_max=v_range[1]).hopf_points
+        near = sorted(hopf, key=lambda h: abs(math.log(h.V / point["V"])))[:2 if kind == "NS" else 1]
+        for h in near:
+            if abs(math.log(h.V / point["V"])) > 0.2:
+                continue
+            found, ncol = start_beside(system, kind, np.zeros(n), np.array([h.V, Fz]), v_range, STATE_SCALE[:n],
+                                       V_SCALE, options, limits=_limits(model))
+            if found is not None:
+                # eager when born at the point (a branch beside it may fold or lose stability
+                # first on another curve, far away: that start waits like a diagram's)
+                out.append(Start(kind, found, Fz, ncol, origin, eager=abs(found.p - point["V"]) <= 0.1 * point["V"]))
+    return out
+
+
+def _on_curve(curve: GearCycleCurve, start: Start, l_g: float) -> bool:
+    """Whether a start point lies on a continued curve: within a fifth of the local step of its
+    polyline in (V, Fz) (scaled) with amplitudes within 5 % (of its own, or of the curve's there
+    where that is more) plus half their change along that step."""
+    c = curve.curve
+    scale = np.array([V_SCALE, FZ_SCALE])
+    hit = near_polyline(c.p / scale, np.array([start.point.p, start.Fz]) / scale)
+    if hit is None:
+        return False
+    i, s = hit
+    amp = 0.5 * (c.x_max - c.x_min)
+    here = amp[i] + s * (amp[i + 1] - amp[i])
+    xmax, xmin = np.array(start.point.data["x_max"]), np.array(start.point.data["x_min"])
+    theirs = 0.5 * (xmax - xmin)
+    scale = STATE_SCALE[:len(theirs)]
+    # near a zero-amplitude end the amplitude varies like the root of the distance and the
+    # polyline's linear interpolation is poor: the change of amplitude along the segment counts too
+    local = float(np.max(np.abs(amp[i:i + 2]) / scale))
+    change = float(np.max(np.abs(amp[i + 1] - amp[i]) / scale))
+    return bool(np.max(np.abs(here - theirs) / scale)
+                <= 0.05 * max(np.max(np.abs(theirs) / scale), local, 1e-12) + 0.5 * change)

@@ -1,0 +1,417 @@
+"""Ground runs: the gear through a take-off, a landing roll or a taxi, V(t) and Fz(t) from a profile.
+
+:func:`ground_run` integrates the non-autonomous equations with the compiled integrator
+(:func:`shimmy.model.integrator.integrate_profile`: the same Dormand-Prince 5(4), tolerances,
+output grid and failure reporting as :func:`~shimmy.analyses.core.simulation.simulate`; a constant
+profile gives the same history) and reports what a landing-gear engineer asks of a run:
+
+* **Envelopes** of the torsional angle psi (rad) and the lateral bending displacement
+  l_g delta (m): max |x| over a centred window of ``envelope_window`` (0.15 s, at least one
+  period of the shimmy modes, 6-16 Hz), so the envelope leads a growing oscillation and lags a
+  dying one by at most half that window.
+* **Time in shimmy**: how long either envelope is above its threshold (0.01 rad, 1 mm by
+  default), the intervals and the speed range they cover.
+* **Peaks** of |psi| and |l_g delta| and where (t, V, Fz) they occurred.
+* **Boundary crossings** of the Hopf curves: the times at which an eigenvalue pair of straight
+  rolling x = 0 crosses the imaginary axis along the trajectory (V(t), Fz(t)): the number of
+  unstable eigenvalues on a 0.05 s grid (and at every table point), each change located by
+  bisection to 1e-9 s. These are the trajectory's intersections with the Hopf curves of
+  :mod:`shimmy.analyses.diagrams.hopf_curves`, found without continuing them (a test checks each lies on
+  a continued curve). With ``cycle_curves=True`` also the crossings of the fold-of-cycles and
+  torus curves of :mod:`shimmy.analyses.diagrams.cycle_curves` (tens of seconds per configuration the
+  first time: the curves are continued over the whole load range; then kept for the process):
+  intersections of the trajectory's table segments with the curves' polylines.
+* **Onset delay**: from each crossing into the unstable region (x = 0 losing stability) to the
+  first moment |psi| or |l_g delta| itself exceeds its threshold. A slowly varying parameter
+  delays the onset well past the static Hopf point (the oscillation grows from the small
+  amplitude left by the stable stretch before it), and a faster ramp moves it further in V.
+
+:func:`ground_runs` runs one profile for several configurations and compares them with
+``original``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+from scipy.ndimage import maximum_filter1d
+
+from ...version import __version__
+from ...errors import InvalidParameterError
+from ...model import integrator
+from ...model.configurations import ALL_CONFIGURATIONS, Configuration
+from ...model.equations import build_model, jacobian
+from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number
+from .ground_profiles import GroundProfile, as_profile
+from ..core.response import torsional_share
+from ..core.simulation import _STATUS_MESSAGES, SimulationOptions, initial_state
+
+CROSSING_GRID = 0.05  # s: spacing of the eigenvalue checks along the trajectory
+CROSSING_TOL = 1e-9  # s
+
+
+@dataclass(frozen=True)
+class GroundRunOptions:
+    """Numerical settings and thresholds of a ground run (validated at construction).
+
+    dt_out, rtol, atol, max_steps, exact_nes: as :class:`~shimmy.analyses.core.simulation.SimulationOptions`.
+    psi_threshold (rad, 1e-6 to 1) and lateral_threshold (m, of l_g delta, 1e-7 to 1): the envelope
+    above either counts as shimmy. envelope_window (s, 0.01 to 5): the centred window of the
+    envelopes' running maximum. cycle_curves: also the crossings of the fold and torus curves.
+    """
+
+    dt_out: float = 0.001
+    rtol: float = 1e-7
+    atol: float = 1e-10
+    max_steps: int = 10_000_000
+    exact_nes: bool = False
+    psi_threshold: float = 0.01  # rad
+    lateral_threshold: float = 0.001  # m
+    envelope_window: float = 0.15  # s
+    cycle_curves: bool = False
+
+    def __post_init__(self):
+        # the integrator's settings are checked exactly as a time history's are
+        SimulationOptions(t_end=1.0, dt_out=self.dt_out, rtol=self.rtol, atol=self.atol, max_steps=self.max_steps,
+                          exact_nes=self.exact_nes)
+        object.__setattr__(self, "max_steps", int(self.max_steps))
+        object.__setattr__(self, "psi_threshold", check_number("psi_threshold", self.psi_threshold, 1e-6, 1.0, "rad"))
+        object.__setattr__(self, "lateral_threshold",
+                           check_number("lateral_threshold", self.lateral_threshold, 1e-7, 1.0, "m"))
+        object.__setattr__(self, "envelope_window",
+                           check_number("envelope_window", self.envelope_window, 0.01, 5.0, "s"))
+        if not isinstance(self.cycle_curves, bool):
+            raise InvalidParameterError("cycle_curves", self.cycle_curves, "true or false", "is not a boolean")
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True)
+class GroundRunResult:
+    """A ground run with its measures and how the integration went (times in s from the profile's clock)."""
+
+    config: Configuration
+    profile: GroundProfile
+    params: Parameters
+    options: GroundRunOptions
+    t: np.ndarray
+    V: np.ndarray
+    Fz: np.ndarray
+    states: np.ndarray  # (n_states, n_samples)
+    envelope_psi: np.ndarray
+    envelope_lateral: np.ndarray
+    time_in_shimmy_s: float
+    shimmy_intervals: list[dict[str, float]]
+    speed_range: list[float] | None  # [V_min, V_max] covered in shimmy (m/s)
+    peak_psi: dict[str, float]
+    peak_lateral: dict[str, float]
+    boundary_crossings: list[dict[str, Any]]
+    onsets: list[dict[str, Any]]
+    success: bool
+    status: int
+    message: str
+    counters: dict[str, int] = field(default_factory=dict)
+    elapsed_s: float = 0.0
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def psi(self) -> np.ndarray:
+        return self.states[0]
+
+    @property
+    def lateral(self) -> np.ndarray:
+        """Lateral bending displacement l_g * delta (m)."""
+        return self.params.gear.l_g * self.states[2]
+
+    @property
+    def onset_delay_s(self) -> float | None:
+        """Delay of the first onset that follows a crossing into the unstable region (None if none)."""
+        for o in self.onsets:
+            if o["delay_s"] is not None:
+                return o["delay_s"]
+        return None
+
+    def series(self, stride: int = 1) -> dict[str, list[float]]:
+        cols = {"t": self.t, "V": self.V, "Fz": self.Fz, "psi": self.psi, "lateral": self.lateral,
+                "envelope_psi": self.envelope_psi, "envelope_lateral": self.envelope_lateral}
+        if self.config.has_nes:
+            cols["psis"], cols["dpsis"] = self.states[5], self.states[6]
+            cols["nes_relative"] = self.states[0] - self.states[5]
+        return {k: v[::stride].tolist() for k, v in cols.items()}
+
+    def summary(self) -> dict[str, Any]:
+        return {"config": self.config.value, "time_in_shimmy_s": self.time_in_shimmy_s,
+                "shimmy_intervals": self.shimmy_intervals, "speed_range": self.speed_range,
+                "peak_psi": self.peak_psi, "peak_lateral": self.peak_lateral,
+                "boundary_crossings": self.boundary_crossings, "onsets": self.onsets,
+                "onset_delay_s": self.onset_delay_s, "success": self.success, "message": self.message}
+
+    def to_dict(self, series_stride: int = 1, include_series: bool = True) -> dict[str, Any]:
+        out = {**self.summary(), "profile": self.profile.to_dict(), "options": self.options.to_dict(),
+               "params": self.params.to_dict(), "counters": dict(self.counters), "elapsed_s": self.elapsed_s,
+               "warnings": list(self.warnings), "version": __version__}
+        if include_series:
+            out.update(self.series(series_stride))
+            out["series_dt"] = series_stride * self.options.dt_out
+        return out
+
+
+def ground_run(config: Configuration | str, profile: Any, params: Parameters | None = None, x0=None,
+               options: GroundRunOptions | None = None, preset_options: dict[str, Any] | None = None,
+               **option_overrides) -> GroundRunResult:
+    """Integrate the gear through ``profile`` (a :class:`GroundProfile`, a preset name "takeoff" /
+    "landing" / "taxi" with ``preset_options``, or rows [t (s), V (m/s), Fz (N)]).
+
+    ``x0`` defaults to psi = 0.001 rad, all else zero (as :func:`simulate`). Bad profiles and
+    options raise :class:`InvalidParameterError` before any work; integration failures come back
+    as ``success=False`` with a message and the part computed.
+    """
+    config = Configuration.parse(config)
+    profile = as_profile(profile, preset_options)
+    params = params if params is not None else Parameters()
+    options = options or GroundRunOptions()
+    if option_overrides:
+        options = GroundRunOptions(**{**options.to_dict(), **option_overrides})
+    model = build_model(config, params, exact_nes=options.exact_nes)
+    n = model.n_states
+    start = initial_state(x0, n)
+
+    clock = time.perf_counter()
+    t0 = float(profile.t[0])
+    n_out = int(math.floor(profile.duration / options.dt_out + 1e-9)) + 1
+    out = np.empty((n_out, integrator.N_FULL))
+    status, accepted, rejected, calls, written = integrator.integrate_profile(
+        start, profile.duration, options.dt_out, profile.t - t0, profile.V, profile.Fz, model.coefficients,
+        *model.flags, options.rtol, options.atol, options.max_steps, out)
+    integration_s = time.perf_counter() - clock
+
+    t = t0 + np.arange(written) * options.dt_out
+    V, Fz = profile.at(t)
+    states = np.ascontiguousarray(out[:written, :n].T)
+    lateral = params.gear.l_g * states[2]
+    width = max(1, int(round(options.envelope_window / options.dt_out)) | 1)
+    envelope_psi = maximum_filter1d(np.abs(states[0]), width, mode="nearest")
+    envelope_lateral = maximum_filter1d(np.abs(lateral), width, mode="nearest")
+
+    shimmy = (envelope_psi > options.psi_threshold) | (envelope_lateral > options.lateral_threshold)
+    intervals = _intervals(shimmy, t, V, options.dt_out)
+    in_shimmy = float(np.count_nonzero(shimmy) * options.dt_out)
+    speed_range = [float(V[shimmy].min()), float(V[shimmy].max())] if shimmy.any() else None
+
+    crossings = hopf_crossings(config, params, profile, t[-1] if written else t0)
+    warnings: list[str] = []
+    if options.cycle_curves:
+        try:
+            crossings += cycle_curve_crossings(config, params, profile, t[-1] if written else t0)
+        except Exception as exc:  # noqa: BLE001 - the run stands without them; say why they are missing
+            warnings.append(f"fold and torus crossings not computed: {exc}")
+        crossings.sort(key=lambda c: c["t"])
+    above = (np.abs(states[0]) > options.psi_threshold) | (np.abs(lateral) > options.lateral_threshold)
+    onsets = _onsets(crossings, above, shimmy, t, V, Fz)
+    return GroundRunResult(
+        config=config, profile=profile, params=params, options=options, t=t, V=V, Fz=Fz, states=states,
+        envelope_psi=envelope_psi, envelope_lateral=envelope_lateral, time_in_shimmy_s=in_shimmy,
+        shimmy_intervals=intervals, speed_range=speed_range,
+        peak_psi=_peak(np.abs(states[0]), t, V, Fz), peak_lateral=_peak(np.abs(lateral), t, V, Fz),
+        boundary_crossings=crossings, onsets=onsets, success=status == integrator.SUCCESS, status=int(status),
+        message=_STATUS_MESSAGES[status],
+        counters={"steps": int(accepted), "rejected": int(rejected), "rhs_calls": int(calls),
+                  "integration_ms": int(round(1e3 * integration_s))},
+        elapsed_s=time.perf_counter() - clock, warnings=warnings)
+
+
+def _peak(a: np.ndarray, t, V, Fz) -> dict[str, float]:
+    if a.size == 0:
+        return {"value": float("nan"), "t": float("nan"), "V": float("nan"), "Fz": float("nan")}
+    i = int(np.argmax(a))
+    return {"value": float(a[i]), "t": float(t[i]), "V": float(V[i]), "Fz": float(Fz[i])}
+
+
+def _intervals(mask: np.ndarray, t, V, dt: float) -> list[dict[str, float]]:
+    """The runs of ``mask`` as intervals with their start and end speeds."""
+    if not mask.any():
+        return []
+    edges = np.diff(np.concatenate([[0], mask.view(np.int8), [0]]))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    return [{"t_start": float(t[a]), "t_end": float(t[b] + dt), "V_start": float(V[a]), "V_end": float(V[b]),
+             "duration_s": float((b - a + 1) * dt)} for a, b in zip(starts, ends, strict=True)]
+
+
+def _onsets(crossings, above, shimmy, t, V, Fz) -> list[dict[str, Any]]:
+    """For each entry into the unstable region (and for a run starting in it) the first sample after it
+    where |psi| or |l_g delta| exceeds its threshold (``above``), unless the envelope is above it
+    already at the entry (``shimmy``: the oscillation of an earlier stretch is still there)."""
+    if t.size == 0:
+        return []
+    hopf = [c for c in crossings if c["curve"] == "hopf"]
+    entries = [(c["t"], c["V"], c["Fz"], True) for c in hopf if c["unstable_before"] == 0 and c["unstable_after"] > 0]
+    if hopf and hopf[0]["unstable_before"] > 0:  # the run starts where straight rolling is unstable
+        entries.insert(0, (float(t[0]), float(V[0]), float(Fz[0]), False))
+    out = []
+    for tc, vc, fc, crossed in entries:
+        i = int(np.searchsorted(t, tc))
+        hits = np.flatnonzero(above[i:])
+        entry = {"t_unstable": tc, "V_unstable": vc, "Fz_unstable": fc, "crossed": crossed,
+                 "t_onset": None, "V_onset": None, "Fz_onset": None, "delay_s": None}
+        if hits.size:
+            j = i + int(hits[0])
+            if not shimmy[min(i, shimmy.size - 1)]:  # already in shimmy at the crossing: no onset of its own
+                entry.update(t_onset=float(t[j]), V_onset=float(V[j]), Fz_onset=float(Fz[j]),
+                             delay_s=float(t[j] - tc) if crossed else None)
+        out.append(entry)
+    return out
+
+
+def _unstable_counts(model, V, Fz) -> np.ndarray:
+    J = jacobian(model, np.zeros((model.n_states, np.size(V))), np.atleast_1d(V), np.atleast_1d(Fz))
+    ev = np.linalg.eigvals(J)
+    return np.count_nonzero(ev.real > 0.0, axis=-1)
+
+
+def hopf_crossings(config: Configuration, params: Parameters, profile: GroundProfile,
+                   t_end: float | None = None) -> list[dict[str, Any]]:
+    """Where the trajectory (V(t), Fz(t)) crosses a Hopf curve: each change of the number of unstable
+    eigenvalues of x = 0, located by bisection to 1e-9 s, with the mode of the crossing pair."""
+    model = build_model(config, params)
+    t_end = profile.t[-1] if t_end is None else t_end
+    grid = np.union1d(np.arange(profile.t[0], t_end, CROSSING_GRID), profile.t[profile.t <= t_end])
+    grid = np.union1d(grid, [t_end])
+    counts = _unstable_counts(model, *profile.at(grid))
+    changes = np.flatnonzero(np.diff(counts))
+    out = []
+
+    def count_at(tt: float) -> int:
+        return int(_unstable_counts(model, *profile.at(np.array([tt])))[0])
+
+    def locate(a: float, ca: int, b: float, cb: int) -> None:
+        if ca == cb:
+            return
+        if b - a <= CROSSING_TOL:
+            out.append((0.5 * (a + b), ca, cb))
+            return
+        m = 0.5 * (a + b)
+        cm = count_at(m)
+        locate(a, ca, m, cm)
+        locate(m, cm, b, cb)
+
+    for k in changes:
+        locate(float(grid[k]), int(counts[k]), float(grid[k + 1]), int(counts[k + 1]))
+    crossings = []
+    k_psi, k_delta = params.gear.k_psi, params.gear.k_delta
+    for tc, before, after in out:
+        V, Fz = (float(v[0]) for v in profile.at(np.array([tc])))
+        ev, vectors = np.linalg.eig(jacobian(model, np.zeros(model.n_states), V, Fz))
+        i = int(np.argmin(np.abs(ev.real) + 1e-3 * (np.abs(ev.imag) == 0)))
+        q = vectors[:, i]
+        share = float(torsional_share(abs(q[0]), abs(q[2]), k_psi, k_delta))
+        crossings.append({"t": tc, "V": V, "Fz": Fz, "curve": "hopf",
+                          "mode": "torsional" if share >= 0.5 else "lateral",
+                          "frequency_hz": abs(float(ev[i].imag)) / (2 * math.pi),
+                          "direction": "destabilising" if after > before else "stabilising",
+                          "unstable_before": before, "unstable_after": after})
+    return crossings
+
+
+@functools.lru_cache(maxsize=16)
+def _cycle_curve_polylines(config: Configuration, params: Parameters, v_max: float) -> tuple:
+    """(kind, points (k, 2)) of every fold and torus curve in V 1..v_max, the full Fz range (kept per process)."""
+    from ..diagrams.cycle_curves import cycle_curves
+
+    result = cycle_curves(config, params, (V_RANGE[0], v_max), FZ_RANGE, kinds=("LPC", "NS"))
+    return tuple((c.kind, np.array(c.curve.p, dtype=float)) for c in result.curves if len(c.curve.p) > 1)
+
+
+CURVE_NAMES = {"LPC": "fold", "NS": "torus"}
+
+
+def cycle_curve_crossings(config: Configuration, params: Parameters, profile: GroundProfile,
+                          t_end: float | None = None) -> list[dict[str, Any]]:
+    """Intersections of the trajectory's table segments with the fold and torus curves' polylines."""
+    t_end = profile.t[-1] if t_end is None else t_end
+    v_max = float(min(V_RANGE[1], max(200.0, 1.1 * profile.V.max())))
+    scale = np.array([10.0, 1e5])
+    times = np.union1d(profile.t[profile.t < t_end], [t_end])
+    path = np.column_stack(profile.at(times)) / scale
+    out = []
+    for kind, points in _cycle_curve_polylines(config, params, v_max):
+        q = points / scale
+        for j in range(len(path) - 1):
+            for s, _ in _segment_hits(path[j], path[j + 1], q):
+                tc = float(times[j] + s * (times[j + 1] - times[j]))
+                V, Fz = (float(v) for v in (path[j] + s * (path[j + 1] - path[j])) * scale)
+                out.append({"t": tc, "V": V, "Fz": Fz, "curve": CURVE_NAMES[kind]})
+    return out
+
+
+def _segment_hits(a: np.ndarray, b: np.ndarray, q: np.ndarray) -> list[tuple[float, float]]:
+    """(s along a-b, u along the polyline segment) of each intersection of segment a-b with polyline q."""
+    d = b - a
+    e = q[1:] - q[:-1]
+    denom = d[0] * e[:, 1] - d[1] * e[:, 0]
+    w = q[:-1] - a
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (w[:, 0] * e[:, 1] - w[:, 1] * e[:, 0]) / denom
+        u = (w[:, 0] * d[1] - w[:, 1] * d[0]) / denom
+    hit = (denom != 0) & (s >= 0) & (s < 1) & (u >= 0) & (u < 1)
+    return [(float(s[i]), float(u[i])) for i in np.flatnonzero(hit)]
+
+
+@dataclass(frozen=True)
+class GroundRunComparison:
+    """One profile run for several configurations, each measure against ``original``.
+
+    :meth:`table` gives one row per configuration (time in shimmy, peaks, onset delay, speed range)
+    with, when ``original`` is among the runs, the change of the time in shimmy (s) and the ratios of
+    the peaks to those of ``original``."""
+
+    profile: GroundProfile
+    runs: dict[str, GroundRunResult]
+    elapsed_s: float
+
+    def table(self) -> list[dict[str, Any]]:
+        base = self.runs.get("original")
+        rows = []
+        for name, r in self.runs.items():
+            row = {"config": name, "time_in_shimmy_s": r.time_in_shimmy_s, "peak_psi": r.peak_psi["value"],
+                   "peak_lateral": r.peak_lateral["value"], "onset_delay_s": r.onset_delay_s,
+                   "speed_range": r.speed_range, "success": r.success}
+            if base is not None:
+                row["time_in_shimmy_change_s"] = r.time_in_shimmy_s - base.time_in_shimmy_s
+                row["peak_psi_ratio"] = _ratio(r.peak_psi["value"], base.peak_psi["value"])
+                row["peak_lateral_ratio"] = _ratio(r.peak_lateral["value"], base.peak_lateral["value"])
+            rows.append(row)
+        return rows
+
+    def to_dict(self, series_stride: int = 10, include_series: bool = True) -> dict[str, Any]:
+        return {"profile": self.profile.to_dict(), "comparison": self.table(), "elapsed_s": self.elapsed_s,
+                "runs": {k: r.to_dict(series_stride, include_series) for k, r in self.runs.items()},
+                "version": __version__}
+
+
+def _ratio(a: float, b: float) -> float | None:
+    return float(a / b) if b > 0 and math.isfinite(a) and math.isfinite(b) else None
+
+
+def ground_runs(profile: Any, params: Parameters | None = None,
+                configs: Sequence[Configuration | str] = ALL_CONFIGURATIONS, x0=None,
+                options: GroundRunOptions | None = None, preset_options: dict[str, Any] | None = None,
+                progress: Callable[[float, str], None] | None = None, **option_overrides) -> GroundRunComparison:
+    """:func:`ground_run` of one profile for each configuration (``x0`` must suit every one, or be None)."""
+    clock = time.perf_counter()
+    profile = as_profile(profile, preset_options)
+    configs = [Configuration.parse(c) for c in configs]
+    if not configs:
+        raise InvalidParameterError("configs", [], "a non-empty list of configurations")
+    report = progress or (lambda fraction, message: None)
+    runs = {}
+    for k, c in enumerate(configs):
+        report(k / len(configs), f"ground run of {c.value}")
+        runs[c.value] = ground_run(c, profile, params, x0, options, **option_overrides)
+    report(1.0, "done")
+    return GroundRunComparison(profile, runs, time.perf_counter() - clock)

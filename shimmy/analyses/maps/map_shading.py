@@ -1,0 +1,319 @@
+"""The map's regions, read off the classified slices along the continued region boundaries, so
+that they follow the Hopf, fold and torus curves instead of stepping from slice to slice.
+
+Between two consecutive boundary crossings of a row (a fixed load) the set of attractors, and so
+the shimmy type, changes only where a stable cycle's mode changes (torsional / lateral / both:
+a threshold on its amplitudes, not a bifurcation). Each interval of a row is named by the curves
+that bound it (which curve, and which of its crossings of the row counted from low V) and by
+the run of loads over which that name persists (:func:`labelled`): the same region on every
+slice between which and the row the name does not vanish. The row's
+interval takes the types of that interval on the slices that have it, as fractions of the
+interval: the nearest slice below and above the row that have it, their breakpoints (mode
+changes) interpolated linearly in Fz where both show the same sequence of types, else the
+nearer one. A region that no slice crosses (pinched between curves between two slice loads) is
+what :func:`uncovered` reports, so that the map classifies a slice through it; one left over
+(thinner than a grid cell or smaller than the map's threshold) is read off the nearest slice at
+the same speed, and counted.
+
+The result is, per row, segments (V_low, V_high, type) whose ends lie on the curves (to the
+polyline accuracy of the curves); from them the grid (:func:`grid`), the measure of each type
+per row (:func:`measures`) and the region polygons (:func:`polygons`: trapezoids between
+consecutive rows, chained into one polygon per region as long as it neither splits nor merges).
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from typing import Any, Sequence
+
+import numpy as np
+
+Curve = tuple[str, np.ndarray]  # (name, points (k, 2) in (V, Fz))
+Segment = tuple[float, float, str]  # (V_low, V_high, type)
+#: A piece of a slice's interval narrower than this fraction of it is taken as the rounding of
+#: where the slice's located points and the curves' polylines put the same crossing.
+SLIVER = 1e-3
+
+
+def crossings(curves: Sequence[Curve], Fz: float) -> list[tuple[float, tuple[str, int]]]:
+    """(V, (curve name, crossing number from low V)) where each curve crosses the load Fz, by V."""
+    found: list[tuple[float, str]] = []
+    for name, p in curves:
+        if len(p) < 2:
+            continue
+        a, b = p[:-1], p[1:]
+        # half-open segments: a vertex exactly on the load (a curve's start point) counts once
+        hit = ((a[:, 1] < Fz) & (Fz <= b[:, 1])) | ((b[:, 1] < Fz) & (Fz <= a[:, 1]))
+        for k in np.nonzero(hit)[0]:
+            f = (Fz - a[k, 1]) / (b[k, 1] - a[k, 1])
+            found.append((float(a[k, 0] + f * (b[k, 0] - a[k, 0])), name))
+    found.sort()
+    count: dict[str, int] = {}
+    out = []
+    for V, name in found:
+        count[name] = count.get(name, 0) + 1
+        out.append((V, (name, count[name])))
+    return out
+
+
+def named_intervals(curves: Sequence[Curve], Fz: float, v_range: tuple[float, float]):
+    """[(V_low, V_high, name)] between consecutive crossings of the load inside the speed range."""
+    v_min, v_max = v_range
+    inner = [(V, label) for V, label in crossings(curves, Fz) if v_min < V < v_max]
+    edges = [(v_min, ("edge", 0))] + inner + [(v_max, ("edge", 1))]
+    return [(edges[i][0], edges[i + 1][0], (edges[i][1], edges[i + 1][1])) for i in range(len(edges) - 1)]
+
+
+def type_at(intervals: Sequence[dict[str, Any]], V: float) -> str:
+    """A slice's type at V from its non-Stable intervals."""
+    for iv in intervals:
+        if iv["V_start"] <= V <= iv["V_end"]:
+            return iv["type"]
+    return "Stable"
+
+
+def _pieces(intervals: Sequence[dict[str, Any]], a: float, b: float) -> list[tuple[float, float, str]]:
+    """A slice's types on [a, b] as (fraction from, fraction to, type), slivers absorbed."""
+    if b <= a:
+        return [(0.0, 1.0, type_at(intervals, a))]
+    cuts = sorted({0.0, 1.0} | {min(max((v - a) / (b - a), 0.0), 1.0) for iv in intervals
+                               for v in (iv["V_start"], iv["V_end"])})
+    raw = []
+    for f0, f1 in zip(cuts[:-1], cuts[1:], strict=True):
+        if f1 > f0:
+            raw.append([f0, f1, type_at(intervals, a + 0.5 * (f0 + f1) * (b - a))])
+    wide = [p for p in raw if p[1] - p[0] >= SLIVER] or [max(raw, key=lambda p: p[1] - p[0])]
+    out: list[list] = []
+    for p in wide:  # slivers go to the piece before them (or after, at the start)
+        if out and out[-1][2] == p[2]:
+            out[-1][1] = p[1]
+        else:
+            out.append(list(p))
+    out[0][0], out[-1][1] = 0.0, 1.0
+    for k in range(1, len(out)):
+        out[k][0] = out[k - 1][1]
+    return [tuple(p) for p in out]
+
+
+def _interpolated(below, above, w: float):
+    """Pieces of two slices with the same types, breakpoints interpolated (w = 0: below)."""
+    return [(p[0] + w * (q[0] - p[0]), p[1] + w * (q[1] - p[1]), p[2]) for p, q in zip(below, above, strict=True)]
+
+
+def labelled(curves: Sequence[Curve], loads: Sequence[float], v_range: tuple[float, float]):
+    """{load: [(V_low, V_high, region)]} for the loads in ascending order, where a region is an
+    interval name with the number of its run: a name that vanishes between two loads (the curves
+    bounding it pinch off or turn) and appears again names another region at the other load (the
+    k-th crossings of two curves can bound the Torsion interval of low loads and a pocket of a
+    high load alike)."""
+    out: dict[float, list] = {}
+    runs: dict[Any, int] = defaultdict(int)
+    before: set = set()
+    for Fz in sorted(set(float(f) for f in loads)):
+        intervals = named_intervals(curves, Fz, v_range)
+        names = {name for _, _, name in intervals}
+        for name in names - before:
+            runs[name] += 1
+        before = names
+        out[Fz] = [(lo, hi, (name, runs[name])) for lo, hi, name in intervals]
+    return out
+
+
+class _Slices:
+    """The classified slices, each with its regions (:func:`labelled` over the rows and slice
+    loads together), for reading rows off."""
+
+    def __init__(self, slices: Sequence[Any], regions: dict[float, list]):
+        self.slices = sorted(slices, key=lambda s: s.Fz)
+        self.loads = np.array([s.Fz for s in self.slices])
+        self.named = [{region: (lo, hi) for lo, hi, region in regions[float(s.Fz)]} for s in self.slices]
+
+    def having(self, region) -> list[int]:
+        return [k for k, named in enumerate(self.named) if region in named]
+
+    def pieces(self, k: int, region):
+        a, b = self.named[k][region]
+        return _pieces(self.slices[k].intervals, a, b)
+
+
+def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequence[float],
+                 v_range: tuple[float, float]) -> tuple[list[list[Segment]], int]:
+    """Each row's segments (V_low, V_high, type), merged, covering the speed range; and how many
+    row intervals lie in a region no slice crosses (read off the nearest slice at the same speed
+    instead). ``slices`` carry ``Fz`` and ``intervals`` (see
+    :class:`~shimmy.analyses.maps.stability_map.SliceResult`)."""
+    regions = labelled(curves, [float(f) for f in fz_rows] + [float(s.Fz) for s in slices], v_range)
+    known = _Slices(slices, regions)
+    rows, fallbacks = [], 0
+    for Fz in fz_rows:
+        segments: list[list] = []
+        for lo, hi, region in regions[float(Fz)]:
+            have = known.having(region)
+            below = [k for k in have if known.loads[k] <= Fz]
+            above = [k for k in have if known.loads[k] >= Fz]
+            if have:
+                k0 = below[-1] if below else None
+                k1 = above[0] if above else None
+                p0 = known.pieces(k0, region) if k0 is not None else None
+                p1 = known.pieces(k1, region) if k1 is not None else None
+                if p0 is not None and p1 is not None and k0 != k1 and [p[2] for p in p0] == [p[2] for p in p1]:
+                    w = (Fz - known.loads[k0]) / (known.loads[k1] - known.loads[k0])
+                    parts = _interpolated(p0, p1, float(w))
+                elif p0 is not None and (p1 is None or Fz - known.loads[k0] <= known.loads[k1] - Fz):
+                    parts = p0
+                else:
+                    parts = p1
+            else:
+                fallbacks += 1
+                near = known.slices[int(np.argmin(np.abs(known.loads - Fz)))]
+                parts = _pieces(near.intervals, lo, hi)
+            for f0, f1, t in parts:
+                a, b = lo + f0 * (hi - lo), lo + f1 * (hi - lo)
+                if segments and segments[-1][2] == t:
+                    segments[-1][1] = b
+                elif b > a or not segments:
+                    segments.append([a, b, t])
+        rows.append([tuple(s) for s in segments])
+    return rows, fallbacks
+
+
+def uncovered(loads: Sequence[float], curves: Sequence[Curve], fz_rows: Sequence[float],
+              v_range: tuple[float, float], min_width: float = 0.0, min_area: float = 0.0,
+              at_most: int = 8) -> list[float]:
+    """Loads of further slices, so that every region between the curves that is at least
+    ``min_width`` (m/s) wide on some row and covers ``min_area`` (m/s x N, over the rows) is
+    crossed by a slice at one of ``loads`` or at one of these: for each such region no load
+    crosses, largest first, the row load where it is widest; a load crossing several once; at
+    most ``at_most``. (A thinner sliver is read off the nearest slice at the same speed.)"""
+    regions = labelled(curves, [float(f) for f in fz_rows] + [float(f) for f in loads], v_range)
+    have = set()
+    for Fz in loads:
+        have |= {region for _, _, region in regions[float(Fz)]}
+    step = float(fz_rows[1] - fz_rows[0]) if len(fz_rows) > 1 else 0.0
+    area: dict[Any, float] = defaultdict(float)
+    widest: dict[Any, tuple[float, float]] = {}
+    for Fz in fz_rows:
+        for lo, hi, region in regions[float(Fz)]:
+            if region in have or hi <= lo:
+                continue
+            area[region] += (hi - lo) * step
+            if hi - lo > widest.get(region, (0.0, 0.0))[0]:
+                widest[region] = (hi - lo, float(Fz))
+    extra: list[float] = []
+    for region in sorted(area, key=lambda r: -area[r]):
+        if region in have or widest[region][0] < min_width or area[region] < min_area:
+            continue
+        Fz = widest[region][1]
+        extra.append(Fz)
+        have |= {r for _, _, r in regions[Fz]}
+        if len(extra) == at_most:
+            break
+    return sorted(extra)
+
+
+def grid(rows: Sequence[Sequence[Segment]], v_grid: np.ndarray) -> list[list[str]]:
+    """The type at each grid speed of each row."""
+    out = []
+    for segments in rows:
+        highs = np.array([s[1] for s in segments])
+        index = np.minimum(np.searchsorted(highs, v_grid, side="left"), len(segments) - 1)
+        out.append([segments[int(k)][2] for k in index])
+    return out
+
+
+def measures(segments: Sequence[Segment]) -> dict[str, float]:
+    """Measure (m/s) of each type on a row."""
+    out: dict[str, float] = {}
+    for lo, hi, t in segments:
+        out[t] = out.get(t, 0.0) + (hi - lo)
+    return out
+
+
+def _split(segment: Segment, others: list[Segment]) -> list[tuple[float, float]]:
+    """``segment`` cut among the overlapping segments of the next (or previous) row, at the
+    middle of each gap between them."""
+    cuts = [segment[0]]
+    for k in range(len(others) - 1):
+        cuts.append(min(max(0.5 * (others[k][1] + others[k + 1][0]), segment[0]), segment[1]))
+    cuts.append(segment[1])
+    return [(cuts[k], cuts[k + 1]) for k in range(len(others))]
+
+
+def polygons(rows: Sequence[Sequence[Segment]], fz_rows: Sequence[float]) -> list[dict[str, Any]]:
+    """The regions as polygons ``{"type", "V", "Fz"}`` (rings: the low-speed edge upwards, then
+    the high-speed edge downwards). Between consecutive rows each segment is joined to the
+    overlapping segments of its type in the other row (cut at the middle of the gaps where it meets
+    several), and those with nothing of their type in the other row fill the gaps between those
+    joins as triangles: pieces that tile the strip between the rows. Those of one region are
+    chained into one polygon until it splits or merges."""
+    chains: list[dict[str, Any]] = []
+    open_at: dict[int, dict[str, Any]] = {}  # segment index in the current row -> chain ending there whole
+    for r in range(len(rows) - 1):
+        A, B = rows[r], rows[r + 1]
+        succ: dict[int, list[int]] = defaultdict(list)
+        pred: dict[int, list[int]] = defaultdict(list)
+        for i, a in enumerate(A):
+            for j, b in enumerate(B):
+                if a[2] == b[2] and a[0] < b[1] and b[0] < a[1]:
+                    succ[i].append(j)
+                    pred[j].append(i)
+        part_a = {(i, j): part for i, js in succ.items()
+                  for j, part in zip(js, _split(A[i], [B[j] for j in js]), strict=True)}
+        part_b = {(i, j): part for j, is_ in pred.items()
+                  for i, part in zip(is_, _split(B[j], [A[i] for i in is_]), strict=True)}
+        following: dict[int, dict[str, Any]] = {}
+        lower, upper = float(fz_rows[r]), float(fz_rows[r + 1])
+        # Between consecutive links (and the row ends) lies a gap: [bottom_lo, bottom_hi] on this row,
+        # [top_lo, top_hi] on the next, holding segments of this row with nothing of their type above
+        # (regions ending between the rows) and of the next with nothing below (regions starting).
+        # The diagonal from (top_lo, next row) to (bottom_hi, this row) cuts the gap in two triangles:
+        # the ending segments fan out from its top corner, the starting ones from its bottom corner,
+        # so that the pieces tile the gap.
+        links = sorted(part_a, key=lambda key: part_a[key][0])
+        edges_a = [A[0][0]] + [x for key in links for x in part_a[key]] + [A[-1][1]]
+        edges_b = [B[0][0]] + [x for key in links for x in part_b[key]] + [B[-1][1]]
+        ending = [i for i in range(len(A)) if i not in succ]
+        starting = [j for j in range(len(B)) if j not in pred]
+        for g in range(len(links) + 1):
+            bottom_lo, bottom_hi = edges_a[2 * g], edges_a[2 * g + 1]
+            top_lo, top_hi = edges_b[2 * g], edges_b[2 * g + 1]
+            for i in ending:
+                a = A[i]
+                if bottom_lo <= 0.5 * (a[0] + a[1]) <= bottom_hi:
+                    chain = open_at.pop(i, None)
+                    if chain is None:
+                        chain = {"type": a[2], "rows": [(lower, a[0], a[1])]}
+                        chains.append(chain)
+                    chain["rows"].append((upper, top_lo, top_lo))
+            for j in starting:
+                b = B[j]
+                if top_lo <= 0.5 * (b[0] + b[1]) <= top_hi:
+                    chain = {"type": b[2], "rows": [(lower, bottom_hi, bottom_hi), (upper, b[0], b[1])]}
+                    chains.append(chain)
+                    following[j] = chain
+            ending = [i for i in ending if not bottom_lo <= 0.5 * (A[i][0] + A[i][1]) <= bottom_hi]
+            starting = [j for j in starting if not top_lo <= 0.5 * (B[j][0] + B[j][1]) <= top_hi]
+        for i, js in succ.items():
+            for j in js:
+                chain = open_at.pop(i, None) if len(js) == 1 else None
+                if chain is None:
+                    lo, hi = part_a[(i, j)]
+                    chain = {"type": A[i][2], "rows": [(lower, lo, hi)]}
+                    chains.append(chain)
+                lo, hi = part_b[(i, j)]
+                chain["rows"].append((upper, lo, hi))
+                if len(pred[j]) == 1:
+                    following[j] = chain
+        open_at = following
+    out = []
+    for c in chains:
+        up, down = c["rows"], c["rows"][::-1]
+        out.append({"type": c["type"], "V": [p[1] for p in up] + [p[2] for p in down],
+                    "Fz": [p[0] for p in up] + [p[0] for p in down]})
+    return out
+
+
+def polygon_area(polygon: dict[str, Any]) -> float:
+    """Area (m/s x N) of a polygon, by the shoelace formula."""
+    x, y = np.asarray(polygon["V"], float), np.asarray(polygon["Fz"], float)
+    return float(0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))

@@ -1,0 +1,606 @@
+"""(V, Fz) stability maps and the shimmy type of an operating point.
+
+How a map is built (what :func:`stability_map` returns says the same in ``methods``):
+
+* **Region boundaries are continued curves**, exact in V and Fz: the Hopf curves and their GH and
+  double-Hopf points (:func:`shimmy.analyses.diagrams.hopf_curves.hopf_curves`; the extended system, l1
+  along the curve), and every fold-of-cycles (LPC) and torus (NS) curve
+  (:class:`shimmy.analyses.diagrams.cycle_curves.CurveSearch`: minimally augmented systems, started from
+  the GH and double-Hopf points and from the LPC / NS points of the slices' diagrams, whose seeds
+  include large-amplitude starts). Each curve's crossings of the first slices' loads are
+  located, so those slices' LPC and NS points lie on the drawn curves.
+* **The regions' types** come from classified slices: the stable attractors at each V read off
+  a slice's bifurcation diagram (:func:`attractors_at`): x = 0 where its eigenvalues say so, and
+  every periodic branch point with all nontrivial Floquet multipliers inside the unit circle,
+  with its mode (torsional / lateral / both, :func:`shimmy.analyses.core.response.mode_of`). The type
+  (:func:`shimmy_type`) is Bistable if a torsional and a lateral cycle are both stable, else
+  Both if a stable cycle has both motions large, else Torsion or Lateral after the stable
+  cycle, else Stable. Where neither x = 0 nor any cycle is stable (past a torus point the
+  attractor is quasi-periodic), the type comes from a time simulation from the standard
+  start (psi = 0.001 rad) at that V; the attractor is then reported with
+  ``"kind": "simulation"``. ``resolution`` slices evenly spaced in Fz, and one more through
+  each region between the curves that none of them crosses (:func:`map_shading.uncovered`).
+* **Shading and region polygons** are read off the slices along the curves
+  (:mod:`shimmy.analyses.maps.map_shading`): each row interval between two boundary crossings takes
+  the types of the same interval on the nearest slices (mode changes inside it interpolated
+  in Fz), on 180 rows (at least four per slice); the polygons chain the rows' segments.
+
+:func:`classify` runs exactly the slice computation at one Fz and reads the answer at V: at a
+slice load it gives the map's answer; between slices it agrees with the shading wherever the
+type is set by the curves (a mode change inside a region is interpolated by the shading).
+
+All units of a map (the Hopf curves, branches beside codimension-2 points, curve continuations,
+slices) go through :mod:`shimmy.analyses.core.executors` (a local process pool, or a Dask cluster),
+most urgent first (:func:`~shimmy.analyses.core.executors.run_dynamic`). :func:`stability_maps` runs
+several maps' units through one executor at once (no worker waits for one map's last unit while
+another map has units left); each map is the one :func:`stability_map` computes alone.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from ...version import __version__
+from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurcation
+from ...model.configurations import Configuration
+from ...errors import InvalidParameterError
+from . import map_shading
+from ..diagrams.cycle_curves import (CurveSearch, describe_search_unit, search_done, search_unit,
+                           starts_of_diagram)
+from ..core.executors import name_of, open_executor, run_dynamic
+from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
+from ...model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, V_RANGE, Parameters, check_number,
+                                check_operating_point, check_range)
+from ..core.response import ResponseType
+
+SHIMMY_TYPES = ("Stable", "Torsion", "Lateral", "Bistable", "Both")
+SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
+COVERAGE_ROUNDS = 2  # rounds of further slices through regions no slice crosses
+#: ... that are at least one grid cell wide and cover this fraction of the map (thinner slivers
+#: between curves that nearly meet are read off the nearest slice at the same speed, and counted)
+COVERAGE_AREA = 2e-4
+DEFAULT_V_RANGE = (1.0, 200.0)
+DEFAULT_FZ_RANGE = (1.0e4, 9.0e5)
+#: Simulated V per slice at most where no stable equilibrium or cycle exists; the other grid
+#: points of such a stretch take the answer of the nearest simulated one.
+MAX_SIMULATIONS_PER_SLICE = 12
+FALLBACK_T_END = 60.0  # s
+#: Fine grid (per output grid step) on which speed intervals and region lengths are measured.
+FINE = 10
+#: Low-load band of the pure-torsion area metric.
+BAND_FZ_MAX = 250.0e3  # N
+BAND_V = (1.0, 200.0)  # m/s
+#: Where x = 0 is stable, a "cycle" smaller than this (rad, m) is x = 0 itself: continuation with the
+#: particle damper can run a branch on through its Hopf point along the trivial orbit (amplitudes
+#: ~1e-100 observed). Where x = 0 is unstable, small cycles are real (with the PD they grow like
+#: (V - V_H)^2 from the Hopf point) and count.
+TRIVIAL_PSI = 1e-6
+TRIVIAL_LATERAL = 1e-7
+
+
+# --------------------------------------------------------------------------- attractors
+
+
+def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
+    """The stable equilibria and limit cycles of a bifurcation diagram at speed V."""
+    return attractors_on(result, np.array([float(V)]))[0]
+
+
+def attractors_on(result: BifurcationResult, speeds: np.ndarray) -> list[list[dict[str, Any]]]:
+    """:func:`attractors_at` at each of ``speeds`` (one pass over each branch for all of them): x = 0
+    where no unstable interval holds V, then, branch by branch, every branch segment whose speeds
+    bracket V, interpolated linearly, if stable (the nearer end's flag where the ends differ) with
+    a mode."""
+    speeds = np.asarray(speeds, float)
+    found: list[list[dict[str, Any]]] = [[] for _ in speeds]
+    equilibrium_stable = np.ones(speeds.size, bool)
+    for a, b in result.hopf.unstable_intervals:
+        equilibrium_stable &= ~((a <= speeds) & (speeds <= b))
+    for g in np.nonzero(equilibrium_stable)[0]:
+        found[g].append({"kind": "equilibrium", "mode": None, "max_psi": 0.0, "max_lateral": 0.0,
+                         "period": None, "branch": 0})
+    tol = 1e-7 * np.maximum(1.0, np.abs(speeds))  # end points located on a range bound to rounding
+    for k, b in enumerate(result.branches):
+        if b.kind != "periodic" or b.V.size < 2:
+            continue
+        first = np.arange(b.V.size - 1)
+        if b.stop_reason.startswith("closed branch"):  # a loop: its last orbit joins its first
+            first = np.append(first, b.V.size - 1)
+        second = (first + 1) % b.V.size
+        v0s, v1s = b.V[first], b.V[second]
+        lo, hi = np.minimum(v0s, v1s), np.maximum(v0s, v1s)
+        inside = (lo[None, :] - tol[:, None] <= speeds[:, None]) & (speeds[:, None] <= hi[None, :] + tol[:, None]) \
+            & (v0s != v1s)[None, :]
+        gs, segs = np.nonzero(inside)  # by speed, then along the branch
+        if gs.size == 0:
+            continue
+        i, j = first[segs], second[segs]
+        v0, v1 = b.V[i], b.V[j]
+        f = np.minimum(np.maximum((speeds[gs] - v0) / (v1 - v0), 0.0), 1.0)
+        near = np.where(f <= 0.5, i, j)
+        flags = np.asarray(b.stable, bool)
+        stable = np.where(flags[i] == flags[j], flags[i], flags[near])
+        amp = b.max_psi[i] + f * (b.max_psi[j] - b.max_psi[i])
+        lateral = b.max_lateral[i] + f * (b.max_lateral[j] - b.max_lateral[i])
+        period = b.period[i] + f * (b.period[j] - b.period[i])
+        for h in np.nonzero(stable)[0]:
+            mode = b.mode[near[h]] or b.mode[i[h]] or b.mode[j[h]]
+            if mode is None:
+                continue
+            g = gs[h]
+            if equilibrium_stable[g] and amp[h] <= TRIVIAL_PSI and lateral[h] <= TRIVIAL_LATERAL:
+                continue  # a zero-amplitude end point, or a branch run on along a stable x = 0
+            if amp[h] <= 0.0 and lateral[h] <= 0.0:
+                continue  # the zero-amplitude end point at a Hopf point
+            found[g].append({"kind": "limit cycle", "mode": mode, "max_psi": float(amp[h]),
+                             "max_lateral": float(lateral[h]), "period": float(period[h]), "branch": k})
+    return found
+
+
+def shimmy_type(attractors: list[dict[str, Any]]) -> str:
+    """Stable / Torsion / Lateral / Bistable / Both from a list of stable attractors."""
+    modes = {a["mode"] for a in attractors if a["kind"] != "equilibrium"}
+    if "torsional" in modes and "lateral" in modes:
+        return "Bistable"
+    if "both" in modes:
+        return "Both"
+    if "torsional" in modes:
+        return "Torsion"
+    if "lateral" in modes:
+        return "Lateral"
+    return "Stable"
+
+
+_RESPONSE_MODE = {ResponseType.TORSION: "torsional", ResponseType.LATERAL: "lateral", ResponseType.BOTH: "both"}
+
+
+def simulated_attractor(config: Configuration, V: float, Fz: float, params: Parameters) -> dict[str, Any]:
+    """The attractor reached from the standard start, for speeds with no stable equilibrium or cycle."""
+    from ..core.simulation import simulate
+
+    run = simulate(config, V, Fz, params, t_end=FALLBACK_T_END)
+    mode = _RESPONSE_MODE.get(run.response_type)
+    note = "" if run.success else f"simulation stopped: {run.message}"
+    if run.response_type is ResponseType.STABLE:
+        note = note or "the simulation decays (slowly) although x = 0 is unstable"
+    return {"kind": "simulation", "mode": mode, "max_psi": float(run.amplitude["psi"]),
+            "max_lateral": float(run.amplitude["lateral"]), "period": None,
+            "frequency_hz": None if not math.isfinite(run.frequency_hz) else float(run.frequency_hz),
+            "steady": bool(run.steady), "note": note}
+
+
+# --------------------------------------------------------------------------- one slice
+
+
+@dataclass
+class SliceResult:
+    """One Fz slice of a map: types on the V grid, special points, speed measures."""
+
+    Fz: float
+    V: np.ndarray  # output grid (m/s)
+    types: list[str]
+    hopf_points: list[dict[str, Any]]
+    special_points: list[dict[str, Any]]  # LPC / NS / PD / BPC on periodic branches: kind, V, mode
+    intervals: list[dict[str, Any]]  # maximal V intervals of one type other than Stable (fine grid)
+    lengths: dict[str, float]  # measure (m/s) of V with each type (fine grid)
+    max_psi: float
+    max_psi_V: float | None
+    simulated: list[float]  # V where the type came from a simulation
+    warnings: list[str]
+    elapsed_s: float
+    #: the diagram's located LPC / NS / PD points with their orbits: starts of the map's curves
+    #: (not in :meth:`to_dict`)
+    starts: list = field(default_factory=list, repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"Fz": self.Fz, "hopf_points": self.hopf_points, "special_points": self.special_points,
+                "intervals": self.intervals, "lengths": self.lengths, "max_psi": self.max_psi,
+                "max_psi_V": self.max_psi_V, "simulated_V": self.simulated, "warnings": self.warnings,
+                "elapsed_s": self.elapsed_s}
+
+
+def _grids(v_min: float, v_max: float, n_v: int) -> tuple[np.ndarray, np.ndarray]:
+    fine = np.linspace(v_min, v_max, (n_v - 1) * FINE + 1).round(10)  # no 6.800000000000001 in outputs
+    return fine[::FINE].copy(), fine
+
+
+def _slice_types(result: BifurcationResult, fine: np.ndarray, coarse_step: int, config: Configuration,
+                 params: Parameters) -> tuple[list[str], list[list[dict]], list[float]]:
+    """Types on the fine grid; stretches with no stable equilibrium or cycle are simulated at
+    their output-grid points (at most MAX_SIMULATIONS_PER_SLICE, spread evenly)."""
+    attractors = attractors_on(result, fine)
+    empty = [i for i, a in enumerate(attractors) if not a]
+    simulated: list[float] = []
+    if empty:
+        on_grid = [i for i in empty if i % coarse_step == 0] or [empty[len(empty) // 2]]
+        if len(on_grid) > MAX_SIMULATIONS_PER_SLICE:
+            pick = np.linspace(0, len(on_grid) - 1, MAX_SIMULATIONS_PER_SLICE).round().astype(int)
+            on_grid = [on_grid[k] for k in sorted(set(pick.tolist()))]
+        runs = {i: simulated_attractor(config, float(fine[i]), result.Fz, params) for i in on_grid}
+        simulated = [float(fine[i]) for i in on_grid]
+        keys = np.array(on_grid)
+        for i in empty:
+            j = int(keys[np.argmin(np.abs(keys - i))])
+            attractors[i] = [dict(runs[j], simulated_at=float(fine[j]))] if j != i else [runs[j]]
+    return [shimmy_type(a) for a in attractors], attractors, simulated
+
+
+def _intervals(fine: np.ndarray, types: list[str], critical: list[float] = ()) -> list[dict[str, Any]]:
+    """Maximal V intervals of one type other than Stable. An end between two grid points moves to
+    the located Hopf / fold / torus point between them, if there is one (exact), else to the
+    middle between them (within half a fine step: a cycle's mode changing), so that two
+    intervals that meet share their end."""
+    crit = np.sort(np.asarray(list(critical), float))
+
+    def snap(inside: int, outside: int) -> float:
+        lo, hi = sorted((fine[inside], fine[outside]))
+        hits = crit[(crit >= lo) & (crit <= hi)]
+        return float(hits[0]) if hits.size else float(0.5 * (lo + hi))
+
+    out = []
+    start = 0
+    n = len(types)
+    for i in range(1, n + 1):
+        if i == n or types[i] != types[start]:
+            if types[start] != "Stable":
+                out.append({"type": types[start],
+                            "V_start": snap(start, start - 1) if start > 0 else float(fine[0]),
+                            "V_end": snap(i - 1, i) if i < n else float(fine[-1])})
+            start = i
+    return out
+
+
+def _lengths(fine: np.ndarray, types: list[str]) -> dict[str, float]:
+    """Measure of V with each type: each fine point stands for the cell around it."""
+    edges = np.concatenate([[fine[0]], 0.5 * (fine[1:] + fine[:-1]), [fine[-1]]])
+    widths = np.diff(edges)
+    return {t: float(sum(w for w, ty in zip(widths, types, strict=True) if ty == t)) for t in SHIMMY_TYPES}
+
+
+def _special_points(result: BifurcationResult) -> list[dict[str, Any]]:
+    points = []
+    for b in result.branches:
+        if b.kind != "periodic":
+            continue
+        for s in b.special_points:
+            if s["kind"] in ("LPC", "NS", "PD", "BPC"):
+                k = int(np.argmin(np.abs(b.V - s["V"])))
+                points.append({"kind": s["kind"], "V": float(s["V"]), "mode": b.mode[k]})
+    return points
+
+
+def map_slice(config: Configuration | str, Fz: float, v_min: float, v_max: float, n_v: int,
+              params: Parameters, options: BifurcationOptions | None = None, result=None) -> SliceResult:
+    """The map's computation on one load: diagram in V (``result`` if already computed, with the same
+    load, range and parameters), types on the grid, special points."""
+    clock = time.perf_counter()
+    config = Configuration.parse(config)
+    options = options or BifurcationOptions(mesh_check=False)
+    result = result or bifurcation(config, Fz, v_min, v_max, params, options)
+    coarse, fine = _grids(v_min, v_max, n_v)
+    types_fine, _, simulated = _slice_types(result, fine, FINE, config, params)
+    hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value}
+            for h in result.hopf.hopf_points]
+    special = _special_points(result)
+    critical = [h["V"] for h in hopf] + [p["V"] for p in special]
+    return SliceResult(Fz, coarse, types_fine[::FINE], hopf, special, _intervals(fine, types_fine, critical),
+                       _lengths(fine, types_fine), result.max_psi, result.max_psi_V, simulated,
+                       list(result.warnings), time.perf_counter() - clock, starts_of_diagram(result, Fz))
+
+
+# --------------------------------------------------------------------------- classify
+
+
+def classify(config: Configuration | str, V: float, Fz: float, params: Parameters | None = None,
+             v_range: tuple[float, float] = DEFAULT_V_RANGE, options: BifurcationOptions | None = None,
+             result: BifurcationResult | None = None) -> dict[str, Any]:
+    """Shimmy type and stable attractors at (V, Fz): the map's computation on the slice at Fz.
+
+    ``result`` may pass an already computed diagram at this Fz over ``v_range``."""
+    config = Configuration.parse(config)
+    params = params if params is not None else Parameters()
+    V, Fz = check_operating_point(V, Fz)
+    v_min, v_max = check_range("v", v_range, V_RANGE, "m/s")
+    if not v_min <= V <= v_max:
+        raise InvalidParameterError("V", V, f"a number in [{v_min:g}, {v_max:g}] m/s (the diagram's range)")
+    if result is None:
+        result = bifurcation(config, Fz, v_min, v_max, params, options or BifurcationOptions(mesh_check=False))
+    found = attractors_at(result, V)
+    if not found:
+        found = [simulated_attractor(config, V, Fz, params)]
+    return {"config": config.value, "V": V, "Fz": Fz, "shimmy_type": shimmy_type(found), "attractors": found,
+            "hopf_points": [h.V for h in result.hopf.hopf_points], "warnings": list(result.warnings),
+            "version": __version__}
+
+
+@dataclass
+class StabilityMap:
+    config: Configuration
+    params: Parameters
+    v_range: tuple[float, float]
+    fz_range: tuple[float, float]
+    V: np.ndarray
+    Fz: np.ndarray
+    types: list[list[str]]  # [i_Fz][j_V] on the classified slices (Fz: their loads, ascending)
+    slices: list[SliceResult]
+    hopf: HopfCurvesResult
+    cycles: dict[str, Any]  # fold and torus curves with their details (:meth:`CycleCurvesResult.to_dict`)
+    shading_Fz: np.ndarray  # rows of the shading (N), on the grid V
+    shading: list[list[str]]  # [i_row][j_V]: types read off the slices along the curves
+    shading_lengths: list[dict[str, float]]  # per row: measure (m/s) of each type, exact for the read-off
+    shading_fallbacks: int  # row intervals read off the nearest slice at the same speed instead
+    regions: list[dict[str, Any]]  # polygons {"type", "V", "Fz"} (:func:`map_shading.polygons`)
+    min_shimmy: dict[str, Any] | None
+    executor: str
+    elapsed_s: float
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def min_shimmy_Fz(self) -> float | None:
+        return None if self.min_shimmy is None else self.min_shimmy["Fz"]
+
+    @property
+    def fold_curves(self) -> list[list[dict[str, float]]]:
+        return self.cycles["fold_curves"]
+
+    @property
+    def torus_curves(self) -> list[list[dict[str, float]]]:
+        return self.cycles["torus_curves"]
+
+    @property
+    def hopf_curves(self) -> list[list[dict[str, float]]]:
+        return [[{"V": float(p[0]), "Fz": float(p[1])} for p in c.p] for c in self.hopf.curves]
+
+    def type_at(self, V: float, Fz: float) -> str:
+        """The shading's type at the grid point nearest to (V, Fz)."""
+        i = int(np.argmin(np.abs(self.shading_Fz - Fz)))
+        j = int(np.argmin(np.abs(self.V - V)))
+        return self.shading[i][j]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"config": self.config.value, "params": self.params.to_dict(),
+                "v_range": list(self.v_range), "fz_range": list(self.fz_range),
+                "hopf_curves": self.hopf_curves, "gh_points": self.hopf.gh_points,
+                "double_hopf_points": self.hopf.double_hopf_points,
+                "fold_curves": self.fold_curves, "torus_curves": self.torus_curves,
+                "cycle_curves": self.cycles["curves"], "codim2_points": self.cycles["codim2_points"],
+                "V": self.V.tolist(), "Fz": self.Fz.tolist(), "types": self.types,
+                "min_shimmy_Fz": self.min_shimmy_Fz, "min_shimmy": self.min_shimmy,
+                "slices": [s.to_dict() for s in self.slices],
+                "shading": {"V": self.V.tolist(), "Fz": self.shading_Fz.tolist(), "types": self.shading,
+                            "fallback_intervals": self.shading_fallbacks},
+                "regions": self.regions,
+                "methods": {
+                    "hopf_curves": "two-parameter continuation of Hopf points (extended system)",
+                    "gh_points": "sign changes of the first Lyapunov coefficient along the Hopf curves "
+                                 "(not defined with the particle damper: not smooth at x = 0)",
+                    "double_hopf_points": "sign changes of the other eigenvalues' real parts along the Hopf curves",
+                    "fold_curves": "two-parameter continuation of folds of cycles (minimally augmented system on the "
+                                   "collocation mesh), started from GH points and the slices' LPC points; exact in V "
+                                   "and Fz",
+                    "torus_curves": "two-parameter continuation of Neimark-Sacker points of cycles (minimally "
+                                    "augmented system), started from double-Hopf points and the slices' NS points; "
+                                    "exact in V and Fz",
+                    "types": "stable attractors of each slice's one-parameter diagram (equilibrium eigenvalues, "
+                             "Floquet multipliers, cycle modes); a time simulation where none is stable; slices "
+                             "evenly spaced plus one through each region between the curves that they miss",
+                    "shading": "each row's intervals between the Hopf, fold and torus curves take the types of the "
+                               "same interval on the nearest slices, as fractions of it (mode changes inside it "
+                               "interpolated in Fz between the slices below and above)",
+                    "regions": "polygons of the shading's row segments between consecutive rows, one per region "
+                               "until it splits or merges; their edges are the curves' crossings of the rows"},
+                "executor": self.executor, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
+                "version": __version__}
+
+    def write_csv(self, path) -> None:
+        """The shading (the map's answer on its fine grid): one row per (Fz, V)."""
+        import csv
+
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["Fz_N", "V_m_s", "shimmy_type"])
+            for Fz, row in zip(self.shading_Fz, self.shading, strict=True):
+                for V, t in zip(self.V, row, strict=True):
+                    w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
+
+
+def _unit(task: tuple) -> Any:
+    """One independent unit of a map (top level, so that process pools and Dask can ship it)."""
+    if task[0] == "hopf_curves":
+        _, config, params, v_range, fz_range = task
+        return hopf_curves(config, params, v_range=v_range, fz_range=fz_range)
+    if task[0] == "slice":
+        _, config, Fz, v_min, v_max, n_v, params, options = task
+        return map_slice(config, Fz, v_min, v_max, n_v, params, options)
+    return search_unit(task)
+
+
+def _describe(task: tuple) -> str:
+    if task[0] == "hopf_curves":
+        return "Hopf curves"
+    if task[0] == "slice":
+        return f"slice Fz = {task[2] / 1e3:.4g} kN"
+    return describe_search_unit(task)
+
+
+class _MapBuild:
+    """One map's units and what their results add (see :func:`stability_maps`)."""
+
+    def __init__(self, config: Configuration | str, v_range: tuple[float, float], fz_range: tuple[float, float],
+                 resolution: int, params: Parameters | None, n_v: int, options: BifurcationOptions | None):
+        self.config = Configuration.parse(config)
+        self.params = params if params is not None else Parameters()
+        self.v_range = check_range("v", v_range, V_RANGE, "m/s")
+        self.fz_range = check_range("fz", fz_range, FZ_RANGE, "N")
+        self.resolution = int(check_number("resolution", resolution, 2, 400, integer=True))
+        self.n_v = int(check_number("n_v", n_v, 2, 2000, integer=True))
+        self.options = options or BifurcationOptions(mesh_check=False)
+        (v_min, v_max), (f_min, f_max) = self.v_range, self.fz_range
+        self.loads = np.linspace(f_min, f_max, self.resolution)
+        self.search = CurveSearch(self.config, self.params, ((v_min, v_max), (f_min, f_max)), ("LPC", "NS"),
+                                  tuple(float(f) for f in self.loads))
+        self.rows = np.linspace(f_min, f_max, max(SHADING_ROWS, 4 * self.resolution))
+        self.hopf: HopfCurvesResult | None = None
+        self.slices: list[SliceResult] = []
+        self.slice_loads = [float(f) for f in self.loads]
+        self.rounds = 0
+        self.search.expect_sources(len(self.loads))
+        self.pending = 0  # units submitted or queued and not finished
+        self.finished_at = 0.0  # s after the start when its last unit finished
+
+    def _slice_unit(self, Fz: float) -> tuple:
+        v_min, v_max = self.v_range
+        return ("slice", self.config, float(Fz), v_min, v_max, self.n_v, self.params, self.options)
+
+    def _counted(self, units: list[tuple[int, tuple]]) -> list[tuple[int, tuple]]:
+        self.pending += len(units)
+        return units
+
+    def first_units(self) -> list[tuple[int, tuple]]:
+        units = [(0, ("hopf_curves", self.config, self.params, self.v_range, self.fz_range))]
+        return self._counted(units + [(2, self._slice_unit(Fz)) for Fz in self.loads])
+
+    def _coverage(self) -> list[tuple[int, tuple]]:
+        """Slices through the regions that no slice load (computed or under way) crosses: what
+        a region's boundaries are does not depend on the slices, only on the curves."""
+        if self.rounds == COVERAGE_ROUNDS:
+            return []
+        (v_min, v_max), (f_min, f_max) = self.v_range, self.fz_range
+        extra = map_shading.uncovered(self.slice_loads, _boundaries(self.hopf, self.search), self.rows,
+                                      (v_min, v_max), min_width=(v_max - v_min) / (self.n_v - 1),
+                                      min_area=COVERAGE_AREA * (v_max - v_min) * (f_max - f_min))
+        self.rounds += bool(extra)
+        self.slice_loads += extra
+        self.search.expect_sources(len(extra))
+        return [(2, self._slice_unit(Fz)) for Fz in extra]
+
+    def done(self, task: tuple, result: Any, elapsed: float) -> list[tuple[int, tuple]]:
+        """The units that a finished unit's result adds: curves from its starts, coverage slices
+        once the curves as they stand are all continued."""
+        self.pending -= 1
+        if task[0] == "hopf_curves":
+            self.hopf = result
+            more = [(0, u) for u in self.search.start_units(result)] + [(0, u) for u in self.search.continuations()]
+        elif task[0] == "slice":
+            self.slices.append(result)
+            self.search.add_source(result.starts)
+            more = [(0, u) for u in self.search.continuations()]
+        else:
+            more = [(0, u) for u in search_done(self.search, task, result)]
+        if self.search.idle() and self.hopf is not None:  # the curves as they stand
+            more += self._coverage()
+        if not more and self.pending == 0:
+            self.finished_at = elapsed
+        return self._counted(more)
+
+    def result(self, executor: str) -> StabilityMap:
+        """The map from the finished units; ``elapsed_s``: until its last unit finished, plus this."""
+        clock = time.perf_counter()
+        (v_min, v_max), rows = self.v_range, self.rows
+        hopf: HopfCurvesResult = self.hopf
+        slices = sorted(self.slices, key=lambda s: s.Fz)
+        cycles = self.search.result(self.finished_at).to_dict()
+        warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
+        for s in slices:
+            warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
+        segments, fallbacks = map_shading.row_segments(slices, _boundaries(hopf, self.search), rows, (v_min, v_max))
+        V = slices[0].V
+        return StabilityMap(self.config, self.params, self.v_range, self.fz_range, V,
+                            np.array([s.Fz for s in slices]), [s.types for s in slices], slices, hopf, cycles, rows,
+                            map_shading.grid(segments, V), [map_shading.measures(r) for r in segments], fallbacks,
+                            map_shading.polygons(segments, rows), _min_shimmy(hopf, cycles, slices), executor,
+                            self.finished_at + time.perf_counter() - clock, warnings)
+
+
+def _tagged_unit(tagged: tuple[int, tuple]) -> Any:
+    """A unit of map ``tagged[0]`` of :func:`stability_maps` (top level, for process pools and Dask)."""
+    return _unit(tagged[1])
+
+
+def stability_maps(configs: Sequence[Configuration | str], v_range: tuple[float, float] = DEFAULT_V_RANGE,
+                   fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = DEFAULT_MAP_SLICES,
+                   params: Parameters | None = None, n_v: int = 100, executor=None,
+                   progress: Callable[[float, str], None] | None = None,
+                   options: BifurcationOptions | None = None) -> list[StabilityMap]:
+    """The maps of several configurations (same plane, resolution and parameters), in the order
+    given: :func:`stability_map` of each, their units all through one ``executor`` at once.
+
+    The maps' units share the workers, most urgent first (every map's curve units ahead of any
+    slice), so that no worker idles while another map's units wait: one map's last curve or slice
+    no longer holds the workers back. Each map's ``elapsed_s`` is the time until its own last unit
+    finished."""
+    clock = time.perf_counter()
+    configs = list(configs)
+    builds = [_MapBuild(c, v_range, fz_range, resolution, params, n_v, options) for c in configs]
+    if not builds:
+        raise InvalidParameterError("configs", list(configs), "one or more configurations")
+    if executor is None:
+        with open_executor() as own:
+            maps = stability_maps(configs, v_range, fz_range, resolution, params, n_v, own, progress, options)
+        for smap in maps:
+            smap.executor = name_of(None)
+        return maps
+    report = progress or (lambda fraction, message: None)
+    several = len(builds) > 1
+
+    def done(tagged: tuple[int, tuple], result: Any) -> list[tuple[int, tuple]]:
+        k, task = tagged
+        more = builds[k].done(task, result, time.perf_counter() - clock)
+        return [(priority, (k, unit)) for priority, unit in more]
+
+    def describe(tagged: tuple[int, tuple]) -> str:
+        k, task = tagged
+        return f"{builds[k].config.value}: {_describe(task)}" if several else _describe(task)
+
+    units = [(priority, (k, unit)) for k, b in enumerate(builds) for priority, unit in b.first_units()]
+    run_dynamic(_tagged_unit, units, executor, done, report, describe,
+                lambda tagged: "slices" if tagged[1][0] == "slice" else "curve units")
+    maps = [b.result(type(executor).__name__) for b in builds]
+    report(1.0, "done")
+    return maps
+
+
+def stability_map(config: Configuration | str, v_range: tuple[float, float] = DEFAULT_V_RANGE,
+                  fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = DEFAULT_MAP_SLICES,
+                  params: Parameters | None = None, n_v: int = 100, executor=None,
+                  progress: Callable[[float, str], None] | None = None,
+                  options: BifurcationOptions | None = None) -> StabilityMap:
+    """The (V, Fz) stability map of one configuration: its region boundaries continued as curves,
+    the regions' types from ``resolution`` classified Fz slices (and further ones where a region
+    lies between them), read off on a fine grid with ``n_v`` speeds.
+
+    One computation of units through ``executor`` (any :class:`concurrent.futures.Executor`;
+    default: see :mod:`shimmy.analyses.core.executors`), most urgent first: the Hopf curves, then the
+    branches beside their GH and double-Hopf points, and the slices' diagrams; each fold or torus
+    curve is continued as soon as a start for it is known (a GH or double-Hopf point, or a
+    slice's LPC / NS point), ahead of the remaining slices."""
+    return stability_maps([config], v_range, fz_range, resolution, params, n_v, executor, progress, options)[0]
+
+
+def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, np.ndarray]]:
+    """The region boundaries: every Hopf, fold and torus curve as a polyline in (V, Fz)."""
+    out = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
+    out += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(search.result(0.0).curves)]
+    return out
+
+
+def _min_shimmy(hopf: HopfCurvesResult, cycles: dict[str, Any], slices: list[SliceResult]) -> dict[str, Any] | None:
+    """Lowest load with any shimmy: the located lowest point of the Hopf and fold curves, or the
+    lowest slice with a type other than Stable, whichever is lower."""
+    candidates = []
+    low = hopf.fz_minimum
+    if low is not None and any(c.p.size for c in hopf.curves):
+        candidates.append({"Fz": low["Fz"], "V": low["V"], "source": "Hopf curve"})
+    for c in cycles["curves"]:
+        if c["kind"] == "LPC":
+            candidates.append({"Fz": c["fz_min"]["Fz"], "V": c["fz_min"]["V"], "source": "fold-of-cycles curve"})
+    for s in slices:
+        if s.intervals:
+            candidates.append({"Fz": s.Fz, "V": s.intervals[0]["V_start"], "source": "classified slice"})
+            break
+    return min(candidates, key=lambda c: c["Fz"]) if candidates else None

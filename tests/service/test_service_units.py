@@ -1,0 +1,157 @@
+"""Service pieces without a server: canonical requests, cache keys, the URL design state."""
+
+import pytest
+
+from shimmy.errors import InvalidParameterError
+from shimmy.model.parameters import Parameters
+from shimmy.service import cache, schemas
+
+
+def test_canonical_request_fills_defaults_and_the_whole_design():
+    req = schemas.validate("simulate", {"config": "nes", "V": 30, "Fz": 150000})
+    assert req["t_end"] == 60.0 and req["include_series"] is False
+    assert req["params"] == Parameters().to_dict()
+    tungsten = schemas.validate("simulate", {"config": "nes", "V": 30, "Fz": 150000, "material": "tungsten"})
+    assert tungsten["params"]["rho_p"] == 16500 and "material" not in tungsten
+
+
+def test_equal_questions_have_equal_cache_keys():
+    a = schemas.validate("hopf", {"config": "nes", "Fz": 150000, "params": {"r2": 0.08}})
+    b = schemas.validate("hopf", {"config": "nes", "Fz": 150000.0, "v_min": 1, "params": {}})
+    c = schemas.validate("hopf", {"config": "nes", "Fz": 150000, "params": {"r2": 0.081}})
+    assert cache.key("hopf", a) == cache.key("hopf", b) != cache.key("hopf", c)
+    assert cache.key("hopf", a) != cache.key("stability", a)
+
+
+@pytest.mark.parametrize("body,field", [
+    ({"config": "nes", "V": 30, "Fz": 150000, "params": {"r2": 0.2}}, "params.r2"),
+    ({"config": "nes", "V": 30, "Fz": 150000, "params": {"n": 2.5}}, "params.n"),
+    ({"config": "nes", "V": 30, "Fz": 150000, "params": {"zz": 1}}, "params.zz"),
+    ({"config": "nes", "V": 30, "Fz": 150000, "t_end": 601}, "t_end"),
+    ({"config": "nes", "V": 30, "Fz": 150000, "exact_nes": "yes"}, "exact_nes"),
+    ({"config": "nes", "V": 30, "Fz": 150000, "material": 3}, "material"),
+])
+def test_refusals_name_the_field(body, field):
+    with pytest.raises(InvalidParameterError) as info:
+        schemas.validate("simulate", body)
+    assert info.value.field == field
+
+
+def test_openapi_fields_match_the_schemas():
+    from shimmy.service.api import openapi_document
+
+    doc = openapi_document()
+    from shimmy.service.api import SYNC_ANALYSES
+
+    for name in SYNC_ANALYSES:
+        props = doc["components"]["schemas"][f"{name}_request"]["properties"]
+        assert set(props) == {f.name for f in schemas.SCHEMAS[name].fields}
+    for name in schemas.JOB_ANALYSES:
+        assert doc["components"]["schemas"][f"job_{name}"]["properties"]["analysis"]["enum"] == [name]
+    # The document says exactly which design parameters the server takes, with their ranges.
+    from shimmy.model.parameters import PARAMETER_SPECS
+
+    params = doc["components"]["schemas"]["hopf_request"]["properties"]["params"]
+    assert params["additionalProperties"] is False and set(params["properties"]) == set(PARAMETER_SPECS)
+    assert (params["properties"]["r2"]["minimum"], params["properties"]["r2"]["maximum"]) == (0.07, 0.09)
+    assert "Retry-After" in doc["paths"]["/jobs"]["post"]["responses"]["429"]["headers"]
+
+
+def test_url_design_state_round_trip_and_bad_keys():
+    from ui import state
+
+    material, values, problems = state.design_from_query({"r2": "0.085", "material": "tungsten", "V": "30"})
+    assert material == "tungsten" and values["r2"] == 0.085 and values["rho_p"] == 16500 and not problems
+    query = state.design_query(material, values)
+    assert query == {"material": "tungsten", "r2": "0.085"}
+    assert state.design_request(material, values) == {"material": "tungsten", "params": {"r2": 0.085}}
+    material, values, problems = state.design_from_query({"r2": "9", "e_p": "x", "material": "gold"})
+    assert material == "steel" and values["r2"] == 0.08 and len(problems) == 3
+
+
+def test_cache_directory_is_private_and_refused_when_shared(tmp_path, monkeypatch):
+    import os
+
+    from shimmy.service import settings
+
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path / "new"))
+    assert settings.cache_dir().stat().st_mode & 0o777 == 0o700
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(shared))
+    with pytest.raises(settings.CacheDirectoryError, match="writable by group or others"):
+        settings.cache_dir()
+    if os.getuid() == 0:  # root can give a directory away: another user's folder is refused
+        theirs = tmp_path / "theirs"
+        theirs.mkdir(mode=0o700)
+        os.chown(theirs, 65534, 65534)
+        monkeypatch.setenv("SHIMMY_CACHE_DIR", str(theirs))
+        with pytest.raises(settings.CacheDirectoryError, match="belongs to uid 65534"):
+            settings.cache_dir()
+
+
+def test_unusable_cache_is_reported_degraded_while_analyses_answer_uncached(tmp_path, monkeypatch):
+    import sqlite3
+
+    from shimmy.service import cache
+
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+
+    def broken(*args, **kwargs):
+        raise sqlite3.OperationalError("disk I/O error")
+
+    monkeypatch.setattr(cache, "open_store", broken)
+    import app
+
+    client = app.server.test_client()
+    health = client.get("/api/v1/health")
+    assert health.status_code == 503 and health.json["status"] == "degraded" and "disk I/O" in health.json["cache"]
+    answer = client.post("/api/v1/hopf", json={"config": "nes", "Fz": 150000})
+    assert answer.status_code == 200 and answer.headers["X-Shimmy-Cache"] == "miss"
+
+
+def test_non_json_posts_are_refused_and_responses_carry_security_headers(tmp_path, monkeypatch):
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+    import app
+
+    client = app.server.test_client()
+    body = '{"config": "nes", "analysis": "simulate", "V": 30, "Fz": 150000}'
+    for mimetype in ("text/plain", "application/x-www-form-urlencoded", "multipart/form-data"):
+        answer = client.post("/api/v1/jobs", data=body, content_type=mimetype)
+        assert answer.status_code == 415 and answer.json["field"] == "Content-Type", mimetype
+    answer = client.post("/_dash-update-component", data="{}", content_type="text/plain")
+    assert answer.status_code == 415
+    for path in ("/", "/api/v1/health", "/api/v1/nothing", "/_dash-layout"):
+        headers = client.get(path).headers
+        assert headers["X-Content-Type-Options"] == "nosniff", path
+        assert "frame-ancestors 'none'" in headers["Content-Security-Policy"], path
+        assert headers["X-Frame-Options"] == "DENY" and headers["Referrer-Policy"] == "no-referrer", path
+    page = client.get("/").get_data(as_text=True)
+    assert "Python/" not in page and "Werkzeug/" not in page
+
+
+def test_design_schemas_name_what_the_analyses_take():
+    """The optimiser's and robustness's names in the request schemas are the analyses' own (the schemas do
+    not import the numerics: the web server stays light)."""
+    from shimmy.analyses.decisions import optimise, robustness
+
+    assert list(schemas.FIGURE_LIMITS) == list(optimise.FIGURES)
+    for name, (unit, at_load, _, _) in schemas.FIGURE_LIMITS.items():
+        assert (unit, at_load) == (optimise.FIGURES[name].unit, optimise.FIGURES[name].at_load), name
+    assert schemas.DIFFERENTIABLE == optimise.DIFFERENTIABLE
+    assert list(schemas.DEFAULT_SEARCH) == optimise.device_parameters("nes_pd")
+    assert schemas.DISTRIBUTIONS == robustness.DISTRIBUTIONS
+    request = schemas.validate("optimise", {"config": "nes", "constraints": ["interval@200000<=40",
+                                                                             "min_shimmy_Fz>=8e4"]})
+    assert request["constraints"] == [{"figure": "interval", "op": "<=", "value": 40.0, "Fz": 200000.0},
+                                      {"figure": "min_shimmy_Fz", "op": ">=", "value": 80000.0, "Fz": None}]
+    assert request["parameters"] == ["r2", "e_p", "k_s", "r3"]
+    same = schemas.validate("optimise", {"config": "nes", "constraints": [
+        {"figure": "interval", "op": "<=", "value": 40, "Fz": 200000}, {"figure": "min_shimmy_Fz", "op": ">=",
+                                                                         "value": 80000}]})
+    assert same == request
+    a = schemas.validate("robustness", {"config": "nes", "tolerances": ["k_s=0.05:uniform"]})
+    b = schemas.validate("robustness", {"config": "nes", "tolerances": [{"name": "k_s", "relative": 0.05,
+                                                                         "distribution": "uniform"}]})
+    assert a == b and a["tolerances"] == [{"name": "k_s", "relative": 0.05, "distribution": "uniform"}]
