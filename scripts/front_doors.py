@@ -45,7 +45,7 @@ API = {
     "api_hopf_curves": ("hopf_curves", {"config": "original"}),
     "api_map": ("map", {"config": "original", "resolution": 8}),
     "api_study": ("study", {"parameter": "e_p", "values": [0.0005, 0.005], "configs": ["nes"]}),
-    "api_ground_run": ("ground_run", {"config": "nes", "profile": "landing"}),
+    "api_ground_run": ("ground_run", {"config": "nes", "preset": "landing"}),
     "api_sensitivity": ("sensitivity", {"config": "original", "Fz": 150000}),
 }
 
