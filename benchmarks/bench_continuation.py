@@ -57,7 +57,7 @@ def main() -> None:
     args = parser.parse_args()
     r = args.repeats
     for config in CONFIGS:  # warm the numba cache and imports
-        bifurcation(config, FZ, 1, 200)
+        bifurcation(config, FZ, v_range=(1, 200))
     print(f"bifurcation diagrams at Fz = {FZ / 1e3:g} kN, V 1-200 m/s; medians of {r} runs")
     print(f"{'config':<9}{'cli s':>7}{'in-proc s':>11}{'sweep s':>9}{'ratio':>7}{'mesh':>8}{'steps':>7}"
           f"{'max psi rad':>13}{'mesh change':>13}")
@@ -66,7 +66,7 @@ def main() -> None:
         inproc, result = [], None
         for _ in range(r):
             clock = time.perf_counter()
-            result = bifurcation(config, FZ, 1, 200)
+            result = bifurcation(config, FZ, v_range=(1, 200))
             inproc.append(time.perf_counter() - clock)
         sweep = statistics.median(sweep_seconds(config) for _ in range(max(1, r // 2)))
         t = statistics.median(inproc)

@@ -51,9 +51,9 @@ def finite_differences(config: str) -> None:
         h = 1e-5 * (abs(v) or 1.0)
         for value in (v + h, v - h):
             try:
-                hopf_points(config, 150e3, p.with_overrides({name: value}), v_min=1, v_max=200)
+                hopf_points(config, 150e3, params=p.with_overrides({name: value}), v_range=(1, 200))
             except Exception:  # a range end: the benchmark only times the work
-                hopf_points(config, 150e3, p, v_min=1, v_max=200)
+                hopf_points(config, 150e3, params=p, v_range=(1, 200))
 
 
 def sensitivities(repeats: int) -> None:
@@ -65,7 +65,7 @@ def sensitivities(repeats: int) -> None:
         hopf, _ = median_time(lambda c=c: sensitivity(c, 150e3, amplitude=False, min_shimmy=False), repeats)
         fd, _ = median_time(lambda c=c: finite_differences(c), max(1, repeats // 2))
         s = sensitivity(c, 150e3)
-        diagram, _ = median_time(lambda c=c: bifurcation(c, 150e3, 1, 200, options=BifurcationOptions(
+        diagram, _ = median_time(lambda c=c: bifurcation(c, 150e3, v_range=(1, 200), options=BifurcationOptions(
             mesh_check=False)), max(1, repeats // 2))
         print(f"  {c:<8}{1e3 * hopf:>18.1f}{1e3 * fd:>21.1f}{fd / hopf:>7.1f}{s.elapsed_s['min_shimmy_Fz']:>16.2f}"
               f"{s.elapsed_s['max_psi']:>15.2f}{diagram:>17.2f}")
@@ -74,7 +74,7 @@ def sensitivities(repeats: int) -> None:
 
 def optimisations(repeats: int, skip_dask: bool) -> None:
     def run(executor):
-        return optimise("nes", "min_shimmy_Fz", ("r2", "e_p", "k_s", "r3"), executor=executor)
+        return optimise("nes", "min_shimmy_Fz", parameters=("r2", "e_p", "k_s", "r3"), executor=executor)
 
     print(f"\noptimise nes, min shimmy load over r2, e_p, k_s, r3, medians of {repeats}:")
     results = {}
@@ -101,7 +101,7 @@ def optimisations(repeats: int, skip_dask: bool) -> None:
 
 def robust(repeats: int) -> None:
     with open_executor() as pool:
-        t, runs = median_time(lambda: robustness("nes_pd", TOLERANCES, 256, executor=pool), repeats)
+        t, runs = median_time(lambda: robustness("nes_pd", TOLERANCES, samples=256, executor=pool), repeats)
     print(f"\nrobustness nes_pd, 256 samples, 5 % on {', '.join(x.split('=')[0] for x in TOLERANCES)}: median "
           f"{t:.2f} s (runs {', '.join(f'{x:.2f}' for x in runs)})")
 

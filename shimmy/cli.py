@@ -75,7 +75,7 @@ def _cmd_params(args) -> int:
 def _cmd_hopf(args) -> int:
     from .analyses.core.stability import hopf_points
 
-    result = hopf_points(args.config, args.Fz, _params(args), v_min=args.v_min, v_max=args.v_max)
+    result = hopf_points(args.config, args.Fz, params=_params(args), v_range=(args.v_min, args.v_max))
     payload = result.to_dict()
     lines = [f"{result.config.value} at Fz = {result.Fz:g} N, V in [{result.v_min:g}, {result.v_max:g}] m/s"]
     if not result.hopf_points:
@@ -95,7 +95,7 @@ def _cmd_eigen(args) -> int:
 
     V, Fz = check_operating_point(args.V, args.Fz)
     params = _params(args)
-    ev = eigenvalues(args.config, V, Fz, params)
+    ev = eigenvalues(args.config, V, Fz, params=params)
     rows = [{"real": float(e.real), "imag": float(e.imag), "frequency_hz": float(abs(e.imag) / (2 * math.pi)),
              "damping_ratio": float(-e.real / abs(e)) if abs(e) > 0 else None} for e in ev]
     payload = {"config": args.config, "V": V, "Fz": Fz, "params": params.to_dict(), "eigenvalues": rows,
@@ -113,8 +113,8 @@ def _cmd_eigen(args) -> int:
 def _cmd_simulate(args) -> int:
     from .analyses.core.simulation import simulate
 
-    result = simulate(args.config, args.V, args.Fz, _params(args), t_end=_limit("simulate", "t_end", args.t_end),
-                      exact_nes=args.exact_nes)
+    result = simulate(args.config, args.V, args.Fz, params=_params(args),
+                      t_end=_limit("simulate", "t_end", args.t_end), exact_nes=args.exact_nes)
     if args.csv:
         result.write_csv(args.csv)
     payload = result.to_dict()
@@ -190,7 +190,7 @@ def _cmd_ground_run(args) -> int:
     series_dt = check_number("series_dt", args.series_dt, options.dt_out, 1.0, "s")
     stride = max(1, int(round(series_dt / options.dt_out)))
     configs = [c.value for c in Configuration] if args.config == "all" else [args.config]
-    comparison = ground_runs(profile, _params(args), configs, options=options)
+    comparison = ground_runs(profile, params=_params(args), configs=configs, options=options)
     runs = comparison.runs
     if len(runs) == 1:
         (result,) = runs.values()
@@ -224,8 +224,8 @@ def _cmd_devices(args) -> int:
     from .analyses.core.device_curves import nes_curve, pd_curves
 
     params = _params(args)
-    nes_c = nes_curve(params)
-    pds = pd_curves(params, v_max=_limit("devices", "v_max", args.v_max))
+    nes_c = nes_curve(params=params)
+    pds = pd_curves(params=params, v_max=_limit("devices", "v_max", args.v_max))
     payload = {"params": params.to_dict(), "nes": nes_c.to_dict(), "pd": [c.to_dict() for c in pds]}
     err = nes_c.cubic_error_at
     lines = [f"NES: k1 = {nes_c.k1:.6g} N m/rad, k3 = {nes_c.k3:.6g} N m/rad^3; cubic vs exact torque: "
@@ -285,7 +285,8 @@ def _cmd_bifurcation(args) -> int:
                                  exact_nes=args.exact_nes, seeds=not args.no_seeds)
     bar = _bar(args)
     try:
-        result = bifurcation(args.config, args.Fz, args.v_min, args.v_max, _params(args), options, progress=bar)
+        result = bifurcation(args.config, args.Fz, v_range=(args.v_min, args.v_max), params=_params(args),
+                             options=options, progress=bar)
     finally:
         bar.close()
     if args.csv:
@@ -318,8 +319,8 @@ def _cmd_hopf_curves(args) -> int:
 
     bar = _bar(args)
     try:
-        result = hopf_curves(args.config, _params(args), (args.v_min, args.v_max), (args.fz_min, args.fz_max),
-                             progress=bar)
+        result = hopf_curves(args.config, params=_params(args), v_range=(args.v_min, args.v_max),
+                             fz_range=(args.fz_min, args.fz_max), progress=bar)
     finally:
         bar.close()
     lines = [f"{result.config.value}: {len(result.curves)} Hopf curve(s) in "
@@ -351,8 +352,8 @@ def _cmd_curves(args) -> int:
     loads = tuple(_float_list("at_fz", args.at_fz)) if args.at_fz else ()
     bar = _bar(args)
     try:
-        result = cycle_curves(args.config, _params(args), (args.v_min, args.v_max), (args.fz_min, args.fz_max),
-                              kinds, loads, progress=bar)
+        result = cycle_curves(args.config, params=_params(args), v_range=(args.v_min, args.v_max),
+                              fz_range=(args.fz_min, args.fz_max), kinds=kinds, loads=loads, progress=bar)
     finally:
         bar.close()
     data = result.to_dict()
@@ -389,23 +390,22 @@ def _float_list(name: str, text: str) -> list[float]:
 
 def _cmd_map(args) -> int:
     from .analyses.maps.design_metrics import metrics
-    from .analyses.maps.stability_map import stability_map
+    from .analyses.maps.stability_map import SHIMMY_TYPES, stability_map
 
     resolution = _limit("map", "resolution", args.resolution)
     n_v = _limit("map", "n_v", args.n_v)
     bar = _bar(args)
     try:
-        smap = stability_map(args.config, (args.v_min, args.v_max), (args.fz_min, args.fz_max), resolution,
-                             _params(args), n_v=n_v, progress=bar)
-        figures = metrics(smap, _limit("map", "metrics_Fz", args.metrics_Fz))
+        smap = stability_map(args.config, v_range=(args.v_min, args.v_max), fz_range=(args.fz_min, args.fz_max),
+                             resolution=resolution, params=_params(args), n_v=n_v, progress=bar)
+        figures = metrics(smap, Fz=_limit("map", "metrics_Fz", args.metrics_Fz))
     finally:
         bar.close()
     payload = smap.to_dict()
     payload["metrics"] = figures
     if args.csv:
         smap.write_csv(args.csv)
-    counts = {t: sum(row.count(t) for row in smap.shading) for t in ("Stable", "Torsion", "Lateral", "Bistable",
-                                                                      "Both")}
+    counts = {t: sum(row.count(t) for row in smap.shading) for t in SHIMMY_TYPES}
     lines = [f"{smap.config.value}: {len(smap.Fz)} classified slices, {len(smap.shading_Fz)} x {len(smap.V)} grid, "
              f"V {smap.v_range[0]:g}.."
              f"{smap.v_range[1]:g} m/s, Fz {smap.fz_range[0]:g}..{smap.fz_range[1]:g} N "
@@ -428,7 +428,7 @@ def _cmd_map(args) -> int:
 def _cmd_classify(args) -> int:
     from .analyses.maps.stability_map import classify
 
-    result = classify(args.config, args.V, args.Fz, _params(args), (args.v_min, args.v_max))
+    result = classify(args.config, args.V, args.Fz, params=_params(args), v_range=(args.v_min, args.v_max))
     lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {result['shimmy_type']}"]
     for a in result["attractors"]:
         if a["kind"] == "equilibrium":
@@ -447,8 +447,8 @@ def _cmd_metrics(args) -> int:
     configs = [c.strip() for c in args.configs.split(",") if c.strip()]
     bar = _bar(args)
     try:
-        report = design_report(configs, _params(args), float(check_number("Fz", args.Fz, *FZ_RANGE, "N")),
-                               resolution, progress=bar)
+        report = design_report(configs, params=_params(args), Fz=float(check_number("Fz", args.Fz, *FZ_RANGE, "N")),
+                               resolution=resolution, progress=bar)
     finally:
         bar.close()
     report.pop("maps")
@@ -485,7 +485,8 @@ def _cmd_sensitivity(args) -> int:
     from .analyses.decisions.sensitivity import sensitivity
 
     Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
-    result = sensitivity(args.config, Fz, _params(args), _names(args.params), amplitude=not args.no_amplitude)
+    result = sensitivity(args.config, Fz, params=_params(args), names=_names(args.params),
+                         amplitude=not args.no_amplitude)
     payload = result.to_dict()
     lines = [f"{result.config.value} at Fz = {Fz / 1e3:g} kN: change of each quantity per +1 % of the parameter "
              f"(per half of its range in brackets); largest effects first, then the device parameters"]
@@ -517,9 +518,9 @@ def _cmd_optimise(args) -> int:
     Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
     bar = _bar(args)
     try:
-        result = optimise(args.config, args.objective, _names(args.params), Fz, args.constraint or [], _params(args),
-                          method=args.method, starts=args.starts, local_runs=args.local_runs, seed=args.seed,
-                          progress=bar)
+        result = optimise(args.config, args.objective, parameters=_names(args.params), Fz=Fz,
+                          constraints=args.constraint or [], params=_params(args), method=args.method,
+                          starts=args.starts, local_runs=args.local_runs, seed=args.seed, progress=bar)
     finally:
         bar.close()
     payload = result.to_dict()
@@ -550,8 +551,8 @@ def _cmd_robustness(args) -> int:
     Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
     bar = _bar(args)
     try:
-        result = robustness(args.config, args.tolerance or [], args.samples, Fz, _params(args), seed=args.seed,
-                            progress=bar)
+        result = robustness(args.config, args.tolerance or [], samples=args.samples, Fz=Fz, params=_params(args),
+                            seed=args.seed, progress=bar)
     finally:
         bar.close()
     payload = result.to_dict()
@@ -581,12 +582,12 @@ def _cmd_study(args) -> int:
     bar = _bar(args)
     try:
         if args.param2:
-            result = study_grid((args.param, args.param2),
-                                (_float_list("values", args.values), _float_list("values2", args.values2 or "")),
-                                configs, args.Fz, _params(args), (args.v_min, args.v_max), progress=bar)
+            values = (_float_list("values", args.values), _float_list("values2", args.values2 or ""))
+            result = study_grid((args.param, args.param2), values, configs=configs, Fz=args.Fz, params=_params(args),
+                                v_range=(args.v_min, args.v_max), progress=bar)
         else:
-            result = study(args.param, _float_list("values", args.values), configs, args.Fz, _params(args),
-                           (args.v_min, args.v_max), progress=bar)
+            result = study(args.param, _float_list("values", args.values), configs=configs, Fz=args.Fz,
+                           params=_params(args), v_range=(args.v_min, args.v_max), progress=bar)
     finally:
         bar.close()
     if args.csv:

@@ -44,6 +44,8 @@ class Configuration(str, Enum):
 
 
 ALL_CONFIGURATIONS = tuple(Configuration)
+#: Their names, in the same order: the default of every question asked of all configurations.
+CONFIGURATION_NAMES = tuple(c.value for c in Configuration)
 
 
 def affects(parameter: str, config: "Configuration | str") -> bool:

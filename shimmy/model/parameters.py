@@ -95,6 +95,15 @@ def check_number(name: str, value: Any, low: float, high: float, unit: str = "",
     return number
 
 
+def check_pair(name: str, value: Any) -> tuple[Any, Any]:
+    """``value`` as a (low, high) pair, or an error naming ``name``; the numbers are checked by the caller."""
+    try:
+        low, high = value
+    except (TypeError, ValueError):
+        raise InvalidParameterError(name, value, "a pair (low, high)") from None
+    return low, high
+
+
 def check_range(prefix: str, bounds: Any, allowed: tuple[float, float], unit: str = "") -> tuple[float, float]:
     """(low, high) of a range given as ``bounds``, checked as ``{prefix}_min`` and ``{prefix}_max``
     within ``allowed``, with high above low."""
@@ -313,6 +322,10 @@ def check_operating_point(V: Any, Fz: Any) -> tuple[float, float]:
 #: Operating ranges of the continuation parameters (docs/model.md).
 V_RANGE = (1.0, 500.0)
 FZ_RANGE = (1.0e4, 9.0e5)
+#: The speeds (m/s) of a bifurcation diagram, a map or a study: up to the top speed of the study's figures.
+DIAGRAM_V_RANGE = (V_RANGE[0], 200.0)
+#: The load (N) of the one-load questions (the study's Figs. 3-10): every such default reads it.
+DEFAULT_FZ = 150e3
 #: Classified Fz slices of a stability map by default (its boundaries are continued curves; the
 #: slices tell the regions' types, and more are added through regions they miss).
 DEFAULT_MAP_SLICES = 10

@@ -43,8 +43,8 @@ def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[
     params = _params(request)
     x0 = np.zeros(Configuration.parse(request["config"]).n_states)
     x0[0], x0[2] = request["psi0"], request["lateral0"] / params.gear.l_g
-    result = run_simulation(request["config"], request["V"], request["Fz"], params,
-                            t_end=request["t_end"], exact_nes=request["exact_nes"], x0=x0)
+    result = run_simulation(request["config"], request["V"], request["Fz"], params=params, t_end=request["t_end"],
+                            exact_nes=request["exact_nes"], x0=x0)
     out = result.to_dict()
     out["start"] = {"psi0": request["psi0"], "lateral0": request["lateral0"]}
     if request["include_series"]:
@@ -72,8 +72,8 @@ def _spectrum(result) -> dict[str, Any]:
 def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.core.stability import hopf_points
 
-    return hopf_points(request["config"], request["Fz"], _params(request), request["v_min"],
-                       request["v_max"]).to_dict()
+    return hopf_points(request["config"], request["Fz"], params=_params(request), v_range=(request["v_min"],
+                                                                                           request["v_max"])).to_dict()
 
 
 def stability(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
@@ -91,7 +91,8 @@ def stability(request: dict[str, Any], progress: Progress | None = None) -> dict
         lead = ev[np.arange(V.size), k]
         # A coarse grid suffices: the near-axis extremum scan catches pairs between grid points
         # (tests/analyses/core/test_stability.py: 12 points find what 20 000 do); 1e-7 m/s is far below display.
-        h = hopf_points(config, request["Fz"], params, request["v_min"], request["v_max"], n_grid=80, v_tol=1e-7)
+        h = hopf_points(config, request["Fz"], params=params, v_range=(request["v_min"], request["v_max"]), n_grid=80,
+                        v_tol=1e-7)
         out["configs"][config.value] = {
             "max_real": lead.real.tolist(), "frequency_hz": (np.abs(lead.imag) / (2 * np.pi)).tolist(),
             "hopf_points": [p.to_dict() for p in h.hopf_points],
@@ -103,25 +104,25 @@ def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[s
     from ..analyses.core.device_curves import nes_curve, pd_curves
 
     params = _params(request)
-    nes = nes_curve(params)
+    nes = nes_curve(params=params)
     return {"params": request["params"], "nes": nes.to_dict(),
             "nes_cubic_error": {str(a): e for a, e in nes.cubic_error_at.items()},
-            "pd": [c.to_dict() for c in pd_curves(params, v_max=request["v_max"])]}
+            "pd": [c.to_dict() for c in pd_curves(params=params, v_max=request["v_max"])]}
 
 
 def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.diagrams.bifurcation import BifurcationOptions, bifurcation as run_bifurcation
 
     options = BifurcationOptions(ntst=request["ntst"], seeds=request["seeds"])
-    return run_bifurcation(request["config"], request["Fz"], request["v_min"], request["v_max"], _params(request),
-                           options, progress=progress).to_dict()
+    return run_bifurcation(request["config"], request["Fz"], v_range=(request["v_min"], request["v_max"]),
+                           params=_params(request), options=options, progress=progress).to_dict()
 
 
 def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.diagrams.hopf_curves import hopf_curves as run_hopf_curves
 
-    return run_hopf_curves(request["config"], _params(request), (request["v_min"], request["v_max"]),
-                           (request["fz_min"], request["fz_max"]), progress=progress).to_dict()
+    return run_hopf_curves(request["config"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
+                           fz_range=(request["fz_min"], request["fz_max"]), progress=progress).to_dict()
 
 
 def stability_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
@@ -129,10 +130,11 @@ def stability_map(request: dict[str, Any], progress: Progress | None = None) -> 
     from ..analyses.maps.design_metrics import metrics
     from ..analyses.maps.stability_map import stability_map as run_map
 
-    smap = run_map(request["config"], (request["v_min"], request["v_max"]), (request["fz_min"], request["fz_max"]),
-                   request["resolution"], _params(request), n_v=request["n_v"], progress=progress)
+    smap = run_map(request["config"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
+                   fz_range=(request["fz_min"], request["fz_max"]), resolution=request["resolution"],
+                   n_v=request["n_v"], progress=progress)
     out = smap.to_dict()
-    out["metrics"] = metrics(smap, request["metrics_Fz"])
+    out["metrics"] = metrics(smap, Fz=request["metrics_Fz"])
     return out
 
 
@@ -156,7 +158,7 @@ def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dic
     options = GroundRunOptions(psi_threshold=request["psi_threshold"], lateral_threshold=request["lateral_threshold"],
                                exact_nes=request["exact_nes"], cycle_curves=request["fold_torus"])
     report(0.0, f"ground run of {request['config']}")
-    result = run_ground_run(request["config"], profile, _params(request), options=options,
+    result = run_ground_run(request["config"], profile, params=_params(request), options=options,
                             preset_options=request["preset_options"] if request["profile"] is None else None)
     stride = max(1, int(round(request["series_dt"] / options.dt_out)))
     out = result.to_dict(stride)
@@ -176,7 +178,7 @@ def sensitivity(request: dict[str, Any], progress: Progress | None = None) -> di
 
     report = progress or (lambda fraction, message: None)
     report(0.0, f"sensitivities of {request['config']} at {request['Fz'] / 1e3:g} kN")
-    out = run_sensitivity(request["config"], request["Fz"], _params(request), request["names"],
+    out = run_sensitivity(request["config"], request["Fz"], params=_params(request), names=request["names"],
                           amplitude=request["amplitude"], min_shimmy=request["min_shimmy"]).to_dict()
     report(1.0, "done")
     return out
@@ -187,11 +189,11 @@ def optimise(request: dict[str, Any], progress: Progress | None = None) -> dict[
     from ..analyses.decisions.optimise import Constraint, optimise as run_optimise
 
     constraints = [Constraint(c["figure"], c["op"], c["value"], c["Fz"]) for c in request["constraints"]]
-    return run_optimise(request["config"], request["objective"], request["parameters"], request["Fz"], constraints,
-                        _params(request), method=request["method"], starts=request["starts"],
-                        local_runs=request["local_runs"], max_iterations=request["max_iterations"],
-                        generations=request["generations"], popsize=request["popsize"], seed=request["seed"],
-                        progress=progress).to_dict()
+    return run_optimise(request["config"], request["objective"], parameters=request["parameters"], Fz=request["Fz"],
+                        constraints=constraints, params=_params(request), method=request["method"],
+                        starts=request["starts"], local_runs=request["local_runs"],
+                        max_iterations=request["max_iterations"], generations=request["generations"],
+                        popsize=request["popsize"], seed=request["seed"], progress=progress).to_dict()
 
 
 def robustness(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
@@ -199,8 +201,8 @@ def robustness(request: dict[str, Any], progress: Progress | None = None) -> dic
     from ..analyses.decisions.robustness import Tolerance, robustness as run_robustness
 
     tolerances = [Tolerance(t["name"], t["relative"], t["distribution"]) for t in request["tolerances"]]
-    return run_robustness(request["config"], tolerances, request["samples"], request["Fz"], _params(request),
-                          seed=request["seed"], progress=progress).to_dict()
+    return run_robustness(request["config"], tolerances, samples=request["samples"], Fz=request["Fz"],
+                          params=_params(request), seed=request["seed"], progress=progress).to_dict()
 
 
 def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str, Any]:

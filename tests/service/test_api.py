@@ -34,7 +34,7 @@ def test_simulate_matches_the_package_and_is_cached(server):
     body = {"config": "nes_pd", "V": 30, "Fz": 150000, "t_end": 20, "params": {"r2": 0.085}}
     status, headers, first = server.request("POST", "/api/v1/simulate", body)
     assert status == 200
-    direct = shimmy.simulate("nes_pd", 30, 150000, shimmy.Parameters().with_overrides(r2=0.085), t_end=20)
+    direct = shimmy.simulate("nes_pd", 30, 150000, params=shimmy.Parameters().with_overrides(r2=0.085), t_end=20)
     assert first["amplitude"]["psi"] == pytest.approx(direct.amplitude["psi"], rel=1e-12)
     status, headers, second = server.request("POST", "/api/v1/simulate", body)
     assert headers["X-Shimmy-Cache"] == "hit" and second == first
@@ -235,7 +235,7 @@ def test_map_and_study_jobs_give_what_the_package_gives(server):
     done, seen = _wait(server, job["id"])
     assert done["status"] == "done", done
     result = done["result"]
-    local = stability_map("original", (1, 200), (1e5, 4e5), 4, n_v=20)
+    local = stability_map("original", v_range=(1, 200), fz_range=(1e5, 4e5), resolution=4, n_v=20)
     assert result["types"] == local.types and result["min_shimmy_Fz"] == pytest.approx(local.min_shimmy_Fz)
     assert result["metrics"]["torsion_area"] > 0
     assert len({p for s, p in seen if s == "running"}) >= 2  # progress per finished slice
@@ -244,7 +244,7 @@ def test_map_and_study_jobs_give_what_the_package_gives(server):
     _, _, job = server.request("POST", "/api/v1/jobs", body)
     done, _ = _wait(server, job["id"])
     assert done["status"] == "done", done
-    assert done["result"]["rows"] == study("e_p", [0.0005, 0.005], ["nes"]).rows
+    assert done["result"]["rows"] == study("e_p", [0.0005, 0.005], configs=["nes"]).rows
 
 
 # Jobs that run for several seconds (a fine mesh at a load with four Hopf points: ~6 s here), so

@@ -51,7 +51,7 @@ def test_the_service_result_is_the_package_result_with_the_hopf_curves(tmp_path,
     assert not cached
     from shimmy import Parameters
 
-    direct = ground_run("pd", "takeoff", Parameters().with_overrides(a_p=0.8), preset_options={"V_rotate": 70})
+    direct = ground_run("pd", "takeoff", params=Parameters().with_overrides(a_p=0.8), preset_options={"V_rotate": 70})
     assert result["time_in_shimmy_s"] == direct.time_in_shimmy_s
     assert result["peak_psi"] == direct.peak_psi and result["onset_delay_s"] == direct.onset_delay_s
     assert len(result["t"]) == len(direct.t[::20]) and result["series_dt"] == pytest.approx(0.02)

@@ -78,7 +78,7 @@ class CalibrationResult:
 
 
 def _hopf_speeds(config: str, params: Parameters) -> np.ndarray:
-    result = hopf_points(config, FZ_REFERENCE, params, v_min=1.0, v_max=200.0)
+    result = hopf_points(config, FZ_REFERENCE, params=params, v_range=(1.0, 200.0))
     speeds = np.array([h.V for h in result.hopf_points])
     if speeds.size != 2:
         return np.array([np.nan, np.nan])
@@ -96,7 +96,7 @@ def _bounds(name: str) -> tuple[float, float]:
 
 def _amplitude(params: Parameters) -> float:
     t = AMPLITUDE_TARGET
-    return simulate(t["config"], t["V"], t["Fz"], params, t_end=AMPLITUDE_T_END).amplitude["psi"]
+    return simulate(t["config"], t["V"], t["Fz"], params=params, t_end=AMPLITUDE_T_END).amplitude["psi"]
 
 
 def calibrate(base: Parameters | None = None) -> CalibrationResult:

@@ -51,7 +51,7 @@ class PDCurve:
                 "torsional_damping": self.torsional_damping.tolist(), "torque": self.torque.tolist()}
 
 
-def nes_curve(params: Parameters | None = None, n_points: int = 201, fraction: float = 0.98) -> NESCurve:
+def nes_curve(*, params: Parameters | None = None, n_points: int = 201, fraction: float = 0.98) -> NESCurve:
     """NES torque and stiffness on ``n_points`` angles spanning ``fraction`` of |a| < pi/6."""
     p = params if params is not None else Parameters()
     n_points = int(check_number("n_points", n_points, 3, 100_001, integer=True))
@@ -68,7 +68,7 @@ def nes_curve(params: Parameters | None = None, n_points: int = 201, fraction: f
                     nes.stiffness_exact(a, *geometry), k1 + 3.0 * k3 * a * a, float(k1), float(k3), errors)
 
 
-def pd_curves(params: Parameters | None = None, v_max: float = 2.0, n_points: int = 201) -> list[PDCurve]:
+def pd_curves(*, params: Parameters | None = None, v_max: float = 2.0, n_points: int = 201) -> list[PDCurve]:
     """PD damping against tangential speed for the current design and each material preset."""
     p = params if params is not None else Parameters()
     v_max = check_number("v_max", v_max, 1e-3, 20.0, "m/s")

@@ -25,12 +25,12 @@ Criteria (documented here because every caller shares them):
 
 from __future__ import annotations
 
-from enum import Enum
+from enum import StrEnum
 
 import numpy as np
 
 
-class ResponseType(str, Enum):
+class ResponseType(StrEnum):
     STABLE = "Stable"
     TORSION = "Torsion"
     LATERAL = "Lateral"
@@ -78,12 +78,41 @@ def dominant_frequency(signals: list[np.ndarray], dt: float) -> float:
     return float((k + offset) / (n_fft * dt))
 
 
-class Mode(str, Enum):
+class Mode(StrEnum):
     """Which motion dominates a limit cycle (same thresholds as the response type)."""
 
     TORSIONAL = "torsional"
     LATERAL = "lateral"
     BOTH = "both"
+
+
+class ShimmyType(StrEnum):
+    """The type of a point of a stability map, from its stable attractors (:func:`shimmy_type`)."""
+
+    STABLE = "Stable"
+    TORSION = "Torsion"
+    LATERAL = "Lateral"
+    BISTABLE = "Bistable"  # a torsional and a lateral cycle both stable
+    BOTH = "Both"  # one cycle with both modes
+
+
+def shimmy_type(attractors: list[dict]) -> ShimmyType:
+    """The map's type at a point from its stable attractors (``{"kind", "mode", ...}`` dicts)."""
+    modes = {a["mode"] for a in attractors if a["kind"] != "equilibrium"}
+    if Mode.TORSIONAL in modes and Mode.LATERAL in modes:
+        return ShimmyType.BISTABLE
+    if Mode.BOTH in modes:
+        return ShimmyType.BOTH
+    if Mode.TORSIONAL in modes:
+        return ShimmyType.TORSION
+    if Mode.LATERAL in modes:
+        return ShimmyType.LATERAL
+    return ShimmyType.STABLE
+
+
+def dominant_mode(share: float) -> Mode:
+    """Torsional or lateral, whichever holds the larger share of elastic energy (an eigenvector's)."""
+    return Mode.TORSIONAL if share >= 0.5 else Mode.LATERAL
 
 
 def torsional_share(psi_amp, delta_amp, k_psi: float, k_delta: float):

@@ -133,7 +133,7 @@ def _json_float(x: float):
     return None if not np.isfinite(x) else float(x)
 
 
-def simulate(config: Configuration | str, V: float, Fz: float, params: Parameters | None = None,
+def simulate(config: Configuration | str, V: float, Fz: float, *, params: Parameters | None = None,
              t_end: float | None = None, x0=None, options: SimulationOptions | None = None,
              frequency: bool = True, **option_overrides) -> SimulationResult:
     """Integrate the model at forward speed V (m/s) and vertical load Fz (N).

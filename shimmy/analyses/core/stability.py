@@ -46,7 +46,7 @@ from ...continuation import lyapunov
 from ...model.configurations import Configuration
 from ...model.equations import Model, build_model, jacobian
 from ...errors import InvalidParameterError
-from ...model.parameters import V_RANGE, Parameters, check_number, check_operating_point
+from ...model.parameters import V_RANGE, Parameters, check_number, check_operating_point, check_pair
 
 
 class Criticality(str, Enum):
@@ -137,7 +137,7 @@ class HopfResult:
                 "n_grid": self.n_grid, "version": __version__}
 
 
-def eigenvalues(config: Configuration | str, V, Fz: float, params: Parameters | None = None) -> np.ndarray:
+def eigenvalues(config: Configuration | str, V, Fz: float, *, params: Parameters | None = None) -> np.ndarray:
     """Eigenvalues (1/s) of the Jacobian at x = 0; shape (n,) or (len(V), n), sorted by real part."""
     model = build_model(config, params)
     V_arr = np.atleast_1d(np.asarray(V, dtype=float))
@@ -148,13 +148,14 @@ def eigenvalues(config: Configuration | str, V, Fz: float, params: Parameters | 
     return ev[0] if np.ndim(V) == 0 else ev
 
 
-def hopf_points(config: Configuration | str, Fz: float, params: Parameters | None = None,
-                v_min: float = V_RANGE[0], v_max: float = V_RANGE[1], n_grid: int = 400,
+def hopf_points(config: Configuration | str, Fz: float, *, params: Parameters | None = None,
+                v_range: tuple[float, float] = V_RANGE, n_grid: int = 400,
                 v_tol: float = 1e-9, near_axis: float = 1.0) -> HopfResult:
-    """Locate every Hopf point of x = 0 in V in [v_min, v_max] at load Fz (N)."""
+    """Locate every Hopf point of x = 0 in V in ``v_range`` = (v_min, v_max) (m/s) at load Fz (N)."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
+    v_min, v_max = check_pair("v_range", v_range)
     v_min, Fz = check_operating_point(v_min, Fz)
     v_max = check_number("v_max", v_max, V_RANGE[0], V_RANGE[1], "m/s")
     if not v_max > v_min:

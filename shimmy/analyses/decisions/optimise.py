@@ -41,7 +41,7 @@ from ...version import __version__
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import Configuration, affects
 from ...model.equations import build_model
-from ...model.parameters import PARAMETER_SPECS, Parameters, check_number, unknown_name_error
+from ...model.parameters import DEFAULT_FZ, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from ..core.executors import open_executor, run_units
 from .design_space import DIFFERENTIABLE, FIGURES, Figure, device_parameters  # noqa: F401 (Figure: re-exported)
 from .sensitivity import (V_BAND, amplitude_sensitivity, coefficient_pairs, hopf_sensitivities,
@@ -102,7 +102,7 @@ class Constraint:
 def _interval_of(result, Fz, params, config, names, gradient, pairs, model):
     from ..maps.stability_map import map_slice
 
-    s = map_slice(config, Fz, V_BAND[0], V_BAND[1], 200, params, result=result)
+    s = map_slice(config, Fz, v_range=(V_BAND[0], V_BAND[1]), n_v=200, params=params, result=result)
     if not s.intervals:
         return {"value": 0.0, "gradient": {n: 0.0 for n in names} if gradient else None}
     lo, hi = s.intervals[0]["V_start"], s.intervals[-1]["V_end"]
@@ -141,8 +141,8 @@ def figures_of(config: Configuration | str, params: Parameters, wanted: Sequence
                 out[key] = {"value": low["Fz"], "gradient": low["dFz_dp"] if gradient else None, "V": low["V"]}
         elif figure in ("interval", "max_psi"):
             if Fz not in diagrams:
-                diagrams[Fz] = bifurcation(config, Fz, V_BAND[0], V_BAND[1], params,
-                                           BifurcationOptions(mesh_check=False))
+                diagrams[Fz] = bifurcation(config, Fz, v_range=(V_BAND[0], V_BAND[1]), params=params,
+                                           options=BifurcationOptions(mesh_check=False))
             if figure == "interval":
                 out[key] = _interval_of(diagrams[Fz], Fz, params, config, names, gradient, pairs, model)
             else:
@@ -155,7 +155,8 @@ def figures_of(config: Configuration | str, params: Parameters, wanted: Sequence
             from ..maps.stability_map import BAND_FZ_MAX, stability_map
 
             with open_executor(max_workers=1) as inline:
-                smap = stability_map(config, V_BAND, (FZ_BOX[0], BAND_FZ_MAX), 6, params, executor=inline)
+                smap = stability_map(config, v_range=V_BAND, fz_range=(FZ_BOX[0], BAND_FZ_MAX), resolution=6,
+                                     params=params, executor=inline)
             out[key] = {"value": torsion_area(smap)["torsion_area"], "gradient": None}
     return out
 
@@ -399,8 +400,8 @@ def search(problem: SearchProblem, method: str, z_start: np.ndarray, starts: int
     return history, message
 
 
-def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
-             parameters: Sequence[str] | None = None, Fz: float = 150e3,
+def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz", *,
+             parameters: Sequence[str] | None = None, Fz: float = DEFAULT_FZ,
              constraints: Sequence[Constraint | str] = (), params: Parameters | None = None,
              method: str = "auto", starts: int = 8, local_runs: int = 2, max_iterations: int = 30,
              generations: int = 6, popsize: int = 5, seed: int = 0, executor=None,
@@ -452,8 +453,9 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz",
     report = progress or (lambda fraction, message: None)
     if executor is None:
         with open_executor() as own:
-            return optimise(config, objective, names, Fz, cons, params, chosen, starts, local_runs, max_iterations,
-                            generations, popsize, seed, own, progress)
+            return optimise(config, objective, parameters=names, Fz=Fz, constraints=cons, params=params,
+                            method=chosen, starts=starts, local_runs=local_runs, max_iterations=max_iterations,
+                            generations=generations, popsize=popsize, seed=seed, executor=own, progress=progress)
     warnings: list[str] = []
     z_nominal = np.clip(problem.z_of(params), 0.0, 1.0)
     history, message = search(problem, chosen, z_nominal, starts, local_runs, max_iterations, generations, popsize,

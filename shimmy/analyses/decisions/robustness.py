@@ -36,7 +36,7 @@ from ...version import __version__
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import OPERATING_POINTS, Configuration, affects
 from ...model.equations import build_model
-from ...model.parameters import PARAMETER_SPECS, Parameters, check_number, unknown_name_error
+from ...model.parameters import DEFAULT_FZ, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from .design_space import DISTRIBUTIONS, TOLERANCE_LIMITS
 from ..core.executors import open_executor, run_units
 from .sensitivity import (V_BAND, coefficient_pairs, hopf_sensitivities, jacobian_derivatives, min_shimmy_sensitivity,
@@ -108,13 +108,13 @@ def _sample_unit(task: tuple) -> list[dict[str, Any]]:
             out.append({"ok": False, "reason": str(exc)})
             continue
         model = build_model(config, params)
-        speeds = [h.V for h in hopf_points(config, Fz, params, v_min=V_BAND[0], v_max=V_BAND[1]).hopf_points]
+        speeds = [h.V for h in hopf_points(config, Fz, params=params, v_range=(V_BAND[0], V_BAND[1])).hopf_points]
         entry: dict[str, Any] = {"ok": True, "hopf": speeds}
         entry["min_shimmy_Fz"] = None
         if low == "curves":  # the nominal lowest point is on an edge of the box: each sample's own curves
             from ..diagrams.hopf_curves import hopf_curves
 
-            found = hopf_curves(config, params, V_BAND, FZ_BOX).fz_minimum
+            found = hopf_curves(config, params=params, v_range=V_BAND, fz_range=FZ_BOX).fz_minimum
             entry["min_shimmy_Fz"] = None if found is None else found["Fz"]
         elif low:
             try:
@@ -127,7 +127,7 @@ def _sample_unit(task: tuple) -> list[dict[str, Any]]:
                 # this sample's curves
                 from ..diagrams.hopf_curves import hopf_curves
 
-                found = hopf_curves(config, params, V_BAND, FZ_BOX).fz_minimum
+                found = hopf_curves(config, params=params, v_range=V_BAND, fz_range=FZ_BOX).fz_minimum
                 entry["min_shimmy_Fz"] = None if found is None else found["Fz"]
                 entry["min_recomputed"] = True
         entry["unstable"] = {p: _growth(model, V, F) > 0.0 for p, (V, F) in OPERATING_POINTS.items()}
@@ -197,7 +197,7 @@ class RobustnessResult:
 
 
 def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str] | Mapping[str, float],
-               samples: int = 128, Fz: float = 150e3, params: Parameters | None = None, seed: int = 0,
+               *, samples: int = 128, Fz: float = DEFAULT_FZ, params: Parameters | None = None, seed: int = 0,
                executor=None, progress: Callable[[float, str], None] | None = None) -> RobustnessResult:
     """Distributions of the Hopf speeds at ``Fz``, of the minimum shimmy load and of shimmy at the nine
     operating points under ``tolerances``, sampled and by linear propagation."""
@@ -220,11 +220,12 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     warnings = [f"{n} is not fitted in configuration {config.value}: its tolerance has no effect" for n in unused]
     if executor is None:
         with open_executor() as own:
-            return robustness(config, tols, samples, Fz, params, seed, own, progress)
+            return robustness(config, tols, samples=samples, Fz=Fz, params=params, seed=seed, executor=own,
+                              progress=progress)
     report = progress or (lambda fraction, message: None)
     model = build_model(config, params)
     pairs = coefficient_pairs(config, params, names)
-    nominal_speeds = [h.V for h in hopf_points(config, Fz, params, v_min=V_BAND[0], v_max=V_BAND[1]).hopf_points]
+    nominal_speeds = [h.V for h in hopf_points(config, Fz, params=params, v_range=(V_BAND[0], V_BAND[1])).hopf_points]
     hopf_sens = hopf_sensitivities(model, Fz, nominal_speeds, pairs)
     low = min_shimmy_sensitivity(model, pairs, FZ_BOX)
     sigma = np.array([float(getattr(params, t.name)) * t.std_factor for t in tols])

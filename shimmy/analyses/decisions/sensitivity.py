@@ -325,7 +325,7 @@ def min_shimmy_sensitivity(model: Model, pairs: dict[str, tuple], fz_box: tuple[
     """dFz/dtheta of the lowest point of the Hopf curves (None without Hopf curves)."""
     from ..diagrams.hopf_curves import hopf_curves
 
-    hopf = hopf or hopf_curves(model.config, model.params, V_BAND, fz_box)
+    hopf = hopf or hopf_curves(model.config, params=model.params, v_range=V_BAND, fz_range=fz_box)
     low = hopf.fz_minimum
     if low is None:
         return None
@@ -389,8 +389,8 @@ def _orbit_at(result, V: float, amplitude: float):
 def amplitude_sensitivity(model: Model, Fz: float, pairs: dict[str, tuple], v_range=V_BAND,
                           result=None) -> dict[str, Any]:
     """dA/dtheta of the largest stable torsional amplitude at Fz (one diagram, one factorisation)."""
-    result = result or bifurcation(model.config, Fz, v_range[0], v_range[1], model.params,
-                                   BifurcationOptions(mesh_check=False))
+    result = result or bifurcation(model.config, Fz, v_range=(v_range[0], v_range[1]), params=model.params,
+                                   options=BifurcationOptions(mesh_check=False))
     A, V = float(result.max_psi), result.max_psi_V
     if V is None or A <= 0.0:
         return {"value": 0.0, "V": None, "dA_dp": None, "reason": "no stable limit cycle at this load"}
@@ -443,7 +443,7 @@ def amplitude_sensitivity(model: Model, Fz: float, pairs: dict[str, tuple], v_ra
             "where": "interior maximum" if interior else "end of the speed range"}
 
 
-def sensitivity(config: Configuration | str, Fz: float, params: Parameters | None = None,
+def sensitivity(config: Configuration | str, Fz: float, *, params: Parameters | None = None,
                 names: Sequence[str] | None = None, amplitude: bool = True, min_shimmy: bool = True,
                 fz_box: tuple[float, float] = (1.0e4, 9.0e5), v_range: tuple[float, float] = V_BAND,
                 hopf_curves_result=None, bifurcation_result=None) -> SensitivityResult:
@@ -457,7 +457,7 @@ def sensitivity(config: Configuration | str, Fz: float, params: Parameters | Non
     timings = {}
     clock = time.perf_counter()
     pairs = coefficient_pairs(config, params, names)
-    hp = hopf_points(config, Fz, params, v_min=v_range[0], v_max=v_range[1])
+    hp = hopf_points(config, Fz, params=params, v_range=(v_range[0], v_range[1]))
     hopf = hopf_sensitivities(model, Fz, [h.V for h in hp.hopf_points], pairs)
     for h, p in zip(hopf, hp.hopf_points, strict=True):
         h["destabilising"] = p.destabilising

@@ -16,14 +16,15 @@ from typing import Any, Callable, Sequence
 
 from ...version import __version__
 from ..diagrams.bifurcation import BifurcationOptions, bifurcation
-from ...model.configurations import Configuration
+from ...model.configurations import CONFIGURATION_NAMES, Configuration
 from ...errors import InvalidParameterError
 from ..core.executors import name_of, run_units
-from ...model.parameters import PARAMETER_SPECS, V_RANGE, Parameters, check_operating_point, check_range
+from ...model.parameters import (DEFAULT_FZ, DIAGRAM_V_RANGE, PARAMETER_SPECS, V_RANGE, Parameters,
+                                 check_operating_point, check_range)
 
 MAX_VALUES = 200  # per parameter
 MAX_UNITS = 2000  # designs x configurations
-DEFAULT_CONFIGS = ("original", "nes", "pd", "nes_pd")
+DEFAULT_CONFIGS = CONFIGURATION_NAMES
 
 
 @dataclass
@@ -80,7 +81,7 @@ def _check_configs(configs: Sequence[str]) -> list[str]:
 def _unit(task: tuple) -> dict[str, Any]:
     config, overrides, Fz, v_min, v_max, params, options = task
     design = params.with_overrides(overrides)
-    result = bifurcation(config, Fz, v_min, v_max, design, options)
+    result = bifurcation(config, Fz, v_range=(v_min, v_max), params=design, options=options)
     speeds = sorted(h.V for h in result.hopf.hopf_points)
     return {**overrides, "config": config, "hopf_start": speeds[0] if speeds else None,
             "hopf_end": speeds[-1] if speeds else None, "max_psi": result.max_psi, "max_psi_V": result.max_psi_V,
@@ -110,10 +111,10 @@ def _run(parameters: list[str], designs: list[dict[str, float]], configs, Fz, v_
                        warnings)
 
 
-def study(parameter: str, values: Sequence[float], configs: Sequence[str] = DEFAULT_CONFIGS, Fz: float = 150e3,
-          params: Parameters | None = None, v_range: tuple[float, float] = (1.0, 200.0), executor=None,
-          progress: Callable[[float, str], None] | None = None,
-          options: BifurcationOptions | None = None) -> StudyResult:
+def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = DEFAULT_CONFIGS,
+          Fz: float = DEFAULT_FZ, params: Parameters | None = None, v_range: tuple[float, float] = DIAGRAM_V_RANGE,
+          options: BifurcationOptions | None = None, executor=None,
+          progress: Callable[[float, str], None] | None = None) -> StudyResult:
     """One-parameter study: a row per (value, configuration)."""
     base = params if params is not None else Parameters()
     checked = _check_values(parameter, values, base)
@@ -122,10 +123,10 @@ def study(parameter: str, values: Sequence[float], configs: Sequence[str] = DEFA
 
 
 def study_grid(parameters: tuple[str, str], values: tuple[Sequence[float], Sequence[float]],
-               configs: Sequence[str] = DEFAULT_CONFIGS, Fz: float = 150e3, params: Parameters | None = None,
-               v_range: tuple[float, float] = (1.0, 200.0), executor=None,
-               progress: Callable[[float, str], None] | None = None,
-               options: BifurcationOptions | None = None) -> StudyResult:
+               *, configs: Sequence[str] = DEFAULT_CONFIGS, Fz: float = DEFAULT_FZ,
+               params: Parameters | None = None, v_range: tuple[float, float] = DIAGRAM_V_RANGE,
+               options: BifurcationOptions | None = None, executor=None,
+               progress: Callable[[float, str], None] | None = None) -> StudyResult:
     """Two-parameter study on the grid values[0] x values[1]: a row per (pair, configuration)."""
     base = params if params is not None else Parameters()
     if len(parameters) != 2 or len(values) != 2 or parameters[0] == parameters[1]:

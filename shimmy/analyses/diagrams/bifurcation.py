@@ -1,6 +1,6 @@
 """One-parameter bifurcation diagrams of the landing gear in the forward speed V.
 
-``bifurcation(config, Fz, v_min, v_max, params)`` computes
+``bifurcation(config, Fz, params=..., v_range=(v_min, v_max))`` computes
 
 1. the straight-rolling equilibrium x = 0 continued in V by the generic engine
    (:func:`shimmy.continuation.equilibrium_branch`), with its stability and Hopf points;
@@ -54,7 +54,7 @@ from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch,
 from ...model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.nes import VALID_ANGLE
-from ...model.parameters import V_RANGE, Parameters, check_number, check_operating_point
+from ...model.parameters import DIAGRAM_V_RANGE, V_RANGE, Parameters, check_number, check_operating_point, check_pair
 from ...continuation.periodic_orbits import (PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
                               periodic_branch)
 from ..core.response import mode_of, torsional_share
@@ -182,14 +182,15 @@ class BifurcationResult:
                                 f"{lat:.10g}", int(bool(s)), m or ""])
 
 
-def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0], v_max: float = 200.0,
-                params: Parameters | None = None, options: BifurcationOptions | None = None,
+def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | None = None,
+                v_range: tuple[float, float] = DIAGRAM_V_RANGE, options: BifurcationOptions | None = None,
                 progress: Callable[[float, str], None] | None = None) -> BifurcationResult:
-    """The bifurcation diagram in V at load Fz (N) over [v_min, v_max] (m/s)."""
+    """The bifurcation diagram in V at load Fz (N) over ``v_range`` = (v_min, v_max) (m/s)."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
     options = options or BifurcationOptions()
+    v_min, v_max = check_pair("v_range", v_range)
     v_min, Fz = check_operating_point(v_min, Fz)
     v_max = check_number("v_max", v_max, V_RANGE[0], V_RANGE[1], "m/s")
     if not v_max > v_min:
@@ -203,7 +204,7 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
     warnings: list[str] = []
 
     report(0.0, "equilibrium branch")
-    hopf = hopf_points(config, Fz, params, v_min=v_min, v_max=v_max)
+    hopf = hopf_points(config, Fz, params=params, v_range=(v_min, v_max))
     eq = equilibrium_branch(system, np.zeros(n), v_min, v_min, v_max,
                             ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000), scale=scale,
                             p_scale=V_SCALE)
@@ -406,17 +407,18 @@ def _on_branch(branches: list[Branch], V: float, period: float, psi_amp: float, 
     return False
 
 
-def periodic_orbit_from_simulation(config: Configuration, Fz: float, V: float, params: Parameters,
+def periodic_orbit_from_simulation(config: Configuration, Fz: float, V: float, *, params: Parameters,
                                    mesh: Mesh, t_end: float = SEED_T_END, exact_nes: bool = False, x0=None):
     """(guess, None) from a simulated settled periodic motion, or (None, reason). ``x0``: the
     start state (default the standard start, psi = 0.001 rad)."""
     from ..core.simulation import simulate  # analyses may use analyses; kept local to keep start-up light
 
-    run = simulate(config, V, Fz, params, t_end=t_end, exact_nes=exact_nes, x0=x0, rtol=SEED_RTOL, frequency=False)
+    run = simulate(config, V, Fz, params=params, t_end=t_end, exact_nes=exact_nes, x0=x0, rtol=SEED_RTOL,
+                   frequency=False)
     for _ in range(SEED_RETRIES):  # slow growth or decay: go on from where the run ended
         if not run.success or run.steady:
             break
-        run = simulate(config, V, Fz, params, t_end=2 * t_end, x0=run.states[:, -1], exact_nes=exact_nes,
+        run = simulate(config, V, Fz, params=params, t_end=2 * t_end, x0=run.states[:, -1], exact_nes=exact_nes,
                        rtol=SEED_RTOL, frequency=False)
     if not run.success:
         return None, f"simulation failed: {run.message}"
@@ -449,8 +451,8 @@ def periodic_orbit_from_simulation(config: Configuration, Fz: float, V: float, p
 def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popts, limits, branches,
                    warnings, x0=None, label: str = "simulation") -> Branch | None:
     mesh = Mesh.uniform(popts.ntst, popts.ncol)
-    guess, reason = periodic_orbit_from_simulation(config, Fz, v_seed, params, mesh, exact_nes=model.exact_nes,
-                                                   x0=x0)
+    guess, reason = periodic_orbit_from_simulation(config, Fz, v_seed, params=params, mesh=mesh,
+                                                   exact_nes=model.exact_nes, x0=x0)
     if guess is None:
         if "not periodic" in reason or "failed" in reason:
             warnings.append(f"{label} at V = {v_seed:.6g} m/s: {reason}")

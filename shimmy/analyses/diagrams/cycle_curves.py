@@ -36,7 +36,7 @@ from ...continuation.errors import ContinuationError
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.equations import build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
-from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
+from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation
 from .hopf_curves import hopf_curves
 from ..core.polylines import near_polyline
@@ -329,11 +329,11 @@ def search_done(search: CurveSearch, task: tuple, result: Any) -> list[tuple]:
     return search.continuations()
 
 
-def cycle_curves(config: Configuration | str, params: Parameters | None = None,
-                 v_range: tuple[float, float] = (V_RANGE[0], 200.0), fz_range: tuple[float, float] = FZ_RANGE,
+def cycle_curves(config: Configuration | str, *, params: Parameters | None = None,
+                 v_range: tuple[float, float] = DIAGRAM_V_RANGE, fz_range: tuple[float, float] = FZ_RANGE,
                  kinds: tuple[str, ...] = KINDS, loads: tuple[float, ...] = (),
-                 progress: Callable[[float, str], None] | None = None,
-                 executor: Executor | None = None) -> CycleCurvesResult:
+                 executor: Executor | None = None,
+                 progress: Callable[[float, str], None] | None = None) -> CycleCurvesResult:
     """Every fold, torus and period-doubling curve of cycles in the box (m/s, N); ``loads``: the
     loads (N) at which each curve's crossings are located and reported.
 
@@ -357,12 +357,13 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
     loads = tuple(float(check_number(f"loads[{i}]", f, f_lo, f_hi, "N")) for i, f in enumerate(loads))
     if executor is None:
         with open_executor() as own:
-            return cycle_curves(config, params, v_range, fz_range, kinds, loads, progress, own)
+            return cycle_curves(config, params=params, v_range=v_range, fz_range=fz_range, kinds=kinds, loads=loads,
+                                progress=progress, executor=own)
     report = progress or (lambda fraction, message: None)
     box = ((v_lo, v_hi), (f_lo, f_hi))
 
     report(0.0, "Hopf curves and their GH and double-Hopf points")
-    hopf = hopf_curves(config, params, (v_lo, v_hi), (f_lo, f_hi))
+    hopf = hopf_curves(config, params=params, v_range=(v_lo, v_hi), fz_range=(f_lo, f_hi))
     search = CurveSearch(config, params, box, kinds, loads)
     search.expect_sources(len(SCAN_FRACTIONS))
     units = [(1, u) for u in search.start_units(hopf)]
@@ -395,7 +396,8 @@ def _find_starts(task: tuple) -> tuple[list[Start], list[str]]:
         return _starts_beside(config, model, params, point, kind, box[0], box[1], origin), []
     _, config, params, Fz, box = task
     try:
-        diagram = bifurcation(config, Fz, box[0][0], box[0][1], params, BifurcationOptions(mesh_check=False))
+        diagram = bifurcation(config, Fz, v_range=(box[0][0], box[0][1]), params=params,
+                              options=BifurcationOptions(mesh_check=False))
     except ContinuationError as exc:
         return [], [f"diagram at Fz = {Fz:.6g} N failed: {exc}"]
     return starts_of_diagram(diagram, Fz), []
@@ -441,7 +443,7 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
         Fz = point["Fz"] * (1.0 + side * BESIDE)
         if not fz_range[0] <= Fz <= fz_range[1]:
             continue
-        hopf = hopf_points(config, Fz, params, v_min=v_range[0], v_max=v_range[1]).hopf_points
+        hopf = hopf_points(config, Fz, params=params, v_range=(v_range[0], v_range[1])).hopf_points
         near = sorted(hopf, key=lambda h: abs(math.log(h.V / point["V"])))[:2 if kind == "NS" else 1]
         for h in near:
             if abs(math.log(h.V / point["V"])) > 0.2:

@@ -25,7 +25,7 @@ from ...model.equations import build_model, jacobian, parameter_jacobian, rhs
 from ...continuation.hopf import HopfCurve, TwoParameterField, hopf_curve
 from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from ..core.polylines import near_polyline
-from ..core.response import torsional_share
+from ..core.response import Mode, dominant_mode, torsional_share
 from ..core.stability import hopf_points
 
 V_SCALE = 10.0  # m/s
@@ -65,7 +65,7 @@ class HopfCurvesResult:
         return [{"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi)}
                 for c in self.curves for g in c.gh_points]
 
-    def mode_of_curve(self, curve: HopfCurve) -> str:
+    def mode_of_curve(self, curve: HopfCurve) -> Mode:
         """"torsional" or "lateral": the larger share of elastic energy in the critical eigenvector
         (psi against delta, weighted by k_psi and k_delta) at the curve's middle point."""
         model = build_model(self.config, self.params)
@@ -74,13 +74,13 @@ class HopfCurvesResult:
         ev, vectors = np.linalg.eig(jacobian(model, np.zeros(model.n_states), V, Fz))
         q = vectors[:, int(np.argmin(np.abs(ev - 1j * curve.omega[i])))]
         share = torsional_share(abs(q[0]), abs(q[2]), self.params.gear.k_psi, self.params.gear.k_delta)
-        return "torsional" if share >= 0.5 else "lateral"
+        return dominant_mode(share)
 
     @property
     def lateral_minimum(self) -> dict[str, float] | None:
         """The lowest load on a lateral Hopf curve (its located turning point, or a box edge): the
         lateral bending boundary's lowest point."""
-        return self._lowest([c for c in self.curves if c.p.size and self.mode_of_curve(c) == "lateral"])
+        return self._lowest([c for c in self.curves if c.p.size and self.mode_of_curve(c) == Mode.LATERAL])
 
     @property
     def double_hopf_points(self) -> list[dict[str, float]]:
@@ -129,7 +129,7 @@ def gear_two_parameter_field(config: Configuration, params: Parameters) -> TwoPa
                              lambda x, p: jacobian(model, x, p[0], p[1]), dfdp, smooth=config.is_smooth)
 
 
-def hopf_curves(config: Configuration | str, params: Parameters | None = None,
+def hopf_curves(config: Configuration | str, *, params: Parameters | None = None,
                 v_range: tuple[float, float] = V_RANGE, fz_range: tuple[float, float] = FZ_RANGE,
                 n_slices: int = 12, progress: Callable[[float, str], None] | None = None) -> HopfCurvesResult:
     """All Hopf curves of x = 0 that cross the box v_range x fz_range (m/s, N)."""
@@ -150,7 +150,7 @@ def hopf_curves(config: Configuration | str, params: Parameters | None = None,
     slices = np.linspace(f_lo, f_hi, n_slices)
     for k, Fz in enumerate(slices):
         report(k / n_slices, f"Hopf points at Fz = {Fz / 1e3:.4g} kN")
-        for h in hopf_points(config, float(Fz), params, v_min=v_lo, v_max=v_hi).hopf_points:
+        for h in hopf_points(config, float(Fz), params=params, v_range=(v_lo, v_hi)).hopf_points:
             if any(_on_curve(c, h.V, float(Fz)) for c in curves):
                 continue
             try:

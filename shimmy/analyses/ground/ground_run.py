@@ -48,7 +48,7 @@ from ...model.configurations import ALL_CONFIGURATIONS, Configuration
 from ...model.equations import build_model, jacobian
 from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number
 from .ground_profiles import GroundProfile, as_profile
-from ..core.response import torsional_share
+from ..core.response import dominant_mode, torsional_share
 from ..core.simulation import _STATUS_MESSAGES, SimulationOptions, initial_state
 
 CROSSING_GRID = 0.05  # s: spacing of the eigenvalue checks along the trajectory
@@ -162,7 +162,7 @@ class GroundRunResult:
         return out
 
 
-def ground_run(config: Configuration | str, profile: Any, params: Parameters | None = None, x0=None,
+def ground_run(config: Configuration | str, profile: Any, *, params: Parameters | None = None, x0=None,
                options: GroundRunOptions | None = None, preset_options: dict[str, Any] | None = None,
                **option_overrides) -> GroundRunResult:
     """Integrate the gear through ``profile`` (a :class:`GroundProfile`, a preset name "takeoff" /
@@ -204,11 +204,11 @@ def ground_run(config: Configuration | str, profile: Any, params: Parameters | N
     in_shimmy = float(np.count_nonzero(shimmy) * options.dt_out)
     speed_range = [float(V[shimmy].min()), float(V[shimmy].max())] if shimmy.any() else None
 
-    crossings = hopf_crossings(config, params, profile, t[-1] if written else t0)
+    crossings = hopf_crossings(config, profile, params=params, t_end=t[-1] if written else t0)
     warnings: list[str] = []
     if options.cycle_curves:
         try:
-            crossings += cycle_curve_crossings(config, params, profile, t[-1] if written else t0)
+            crossings += cycle_curve_crossings(config, profile, params=params, t_end=t[-1] if written else t0)
         except Exception as exc:  # noqa: BLE001 - the run stands without them; say why they are missing
             warnings.append(f"fold and torus crossings not computed: {exc}")
         crossings.sort(key=lambda c: c["t"])
@@ -274,7 +274,7 @@ def _unstable_counts(model, V, Fz) -> np.ndarray:
     return np.count_nonzero(ev.real > 0.0, axis=-1)
 
 
-def hopf_crossings(config: Configuration, params: Parameters, profile: GroundProfile,
+def hopf_crossings(config: Configuration, profile: GroundProfile, *, params: Parameters,
                    t_end: float | None = None) -> list[dict[str, Any]]:
     """Where the trajectory (V(t), Fz(t)) crosses a Hopf curve: each change of the number of unstable
     eigenvalues of x = 0, located by bisection to 1e-9 s, with the mode of the crossing pair."""
@@ -311,7 +311,7 @@ def hopf_crossings(config: Configuration, params: Parameters, profile: GroundPro
         q = vectors[:, i]
         share = float(torsional_share(abs(q[0]), abs(q[2]), k_psi, k_delta))
         crossings.append({"t": tc, "V": V, "Fz": Fz, "curve": "hopf",
-                          "mode": "torsional" if share >= 0.5 else "lateral",
+                          "mode": dominant_mode(share),
                           "frequency_hz": abs(float(ev[i].imag)) / (2 * math.pi),
                           "direction": "destabilising" if after > before else "stabilising",
                           "unstable_before": before, "unstable_after": after})
@@ -323,14 +323,14 @@ def _cycle_curve_polylines(config: Configuration, params: Parameters, v_max: flo
     """(kind, points (k, 2)) of every fold and torus curve in V 1..v_max, the full Fz range (kept per process)."""
     from ..diagrams.cycle_curves import cycle_curves
 
-    result = cycle_curves(config, params, (V_RANGE[0], v_max), FZ_RANGE, kinds=("LPC", "NS"))
+    result = cycle_curves(config, params=params, v_range=(V_RANGE[0], v_max), fz_range=FZ_RANGE, kinds=("LPC", "NS"))
     return tuple((c.kind, np.array(c.curve.p, dtype=float)) for c in result.curves if len(c.curve.p) > 1)
 
 
 CURVE_NAMES = {"LPC": "fold", "NS": "torus"}
 
 
-def cycle_curve_crossings(config: Configuration, params: Parameters, profile: GroundProfile,
+def cycle_curve_crossings(config: Configuration, profile: GroundProfile, *, params: Parameters,
                           t_end: float | None = None) -> list[dict[str, Any]]:
     """Intersections of the trajectory's table segments with the fold and torus curves' polylines."""
     t_end = profile.t[-1] if t_end is None else t_end
@@ -398,8 +398,8 @@ def _ratio(a: float, b: float) -> float | None:
     return float(a / b) if b > 0 and math.isfinite(a) and math.isfinite(b) else None
 
 
-def ground_runs(profile: Any, params: Parameters | None = None,
-                configs: Sequence[Configuration | str] = ALL_CONFIGURATIONS, x0=None,
+def ground_runs(profile: Any, *, configs: Sequence[Configuration | str] = ALL_CONFIGURATIONS,
+                params: Parameters | None = None, x0=None,
                 options: GroundRunOptions | None = None, preset_options: dict[str, Any] | None = None,
                 progress: Callable[[float, str], None] | None = None, **option_overrides) -> GroundRunComparison:
     """:func:`ground_run` of one profile for each configuration (``x0`` must suit every one, or be None)."""
@@ -412,6 +412,6 @@ def ground_runs(profile: Any, params: Parameters | None = None,
     runs = {}
     for k, c in enumerate(configs):
         report(k / len(configs), f"ground run of {c.value}")
-        runs[c.value] = ground_run(c, profile, params, x0, options, **option_overrides)
+        runs[c.value] = ground_run(c, profile, params=params, x0=x0, options=options, **option_overrides)
     report(1.0, "done")
     return GroundRunComparison(profile, runs, time.perf_counter() - clock)

@@ -23,9 +23,10 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..diagrams.bifurcation import BifurcationOptions
-from ...model.configurations import OPERATING_POINTS, Configuration
-from ...model.parameters import DEFAULT_MAP_SLICES, Parameters
+from ...model.configurations import CONFIGURATION_NAMES, OPERATING_POINTS, Configuration
+from ...model.parameters import DEFAULT_FZ, DEFAULT_MAP_SLICES, Parameters
 from ..core.executors import run_units
+from ..core.response import ShimmyType
 from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, classify, map_slice, stability_maps
 
 BASELINE = "original"
@@ -36,7 +37,7 @@ def torsion_area(smap: StabilityMap, fz_max: float = BAND_FZ_MAX) -> dict[str, A
     """Area ((m/s) kN) of the Torsion region of a map below ``fz_max``, and its share of the band:
     the Torsion measure of each row of the shading read off the curves, trapezoidal in Fz."""
     Fz = np.asarray(smap.shading_Fz, float)
-    length = np.array([row.get("Torsion", 0.0) for row in smap.shading_lengths])
+    length = np.array([row.get(ShimmyType.TORSION, 0.0) for row in smap.shading_lengths])
     top = min(fz_max, smap.fz_range[1])
     inside = Fz <= top
     f = Fz[inside]
@@ -51,25 +52,25 @@ def torsion_area(smap: StabilityMap, fz_max: float = BAND_FZ_MAX) -> dict[str, A
             "band": {"V": list(smap.v_range), "Fz": [smap.fz_range[0], top], "rows": int(f.size)}}
 
 
-def speed_metrics(config: Configuration | str, Fz: float, params: Parameters | None = None,
+def speed_metrics(config: Configuration | str, Fz: float, *, params: Parameters | None = None,
                   v_range: tuple[float, float] = BAND_V, n_v: int = 200,
                   options: BifurcationOptions | None = None) -> dict[str, Any]:
     """Shimmy speed intervals and the largest stable torsional amplitude at one load."""
     params = params if params is not None else Parameters()
-    s = map_slice(config, Fz, v_range[0], v_range[1], n_v, params, options)
+    s = map_slice(config, Fz, v_range=(v_range[0], v_range[1]), n_v=n_v, params=params, options=options)
     hull = None if not s.intervals else [s.intervals[0]["V_start"], s.intervals[-1]["V_end"]]
     return {"Fz": s.Fz, "shimmy_intervals": s.intervals, "shimmy_speed_range": hull,
             "hopf_points": [h["V"] for h in s.hopf_points], "max_psi": s.max_psi, "max_psi_V": s.max_psi_V,
             "grid_step": (v_range[1] - v_range[0]) / ((n_v - 1) * 10)}
 
 
-def metrics(smap: StabilityMap, Fz: float = 150e3, options: BifurcationOptions | None = None) -> dict[str, Any]:
+def metrics(smap: StabilityMap, *, Fz: float = DEFAULT_FZ, options: BifurcationOptions | None = None) -> dict[str, Any]:
     """All figures of merit of one configuration from its map (plus one slice at ``Fz``)."""
     lateral = smap.hopf.lateral_minimum
     out = {"config": smap.config.value, "min_shimmy_Fz": smap.min_shimmy_Fz, "min_shimmy": smap.min_shimmy,
            "lateral_min_Fz": None if lateral is None else lateral["Fz"], "lateral_min": lateral}
     out.update(torsion_area(smap))
-    out["at_Fz"] = speed_metrics(smap.config, Fz, smap.params, smap.v_range, options=options)
+    out["at_Fz"] = speed_metrics(smap.config, Fz, params=smap.params, v_range=smap.v_range, options=options)
     return out
 
 
@@ -96,11 +97,13 @@ def _operating_point_unit(task: tuple) -> dict[str, Any]:
     config, Fz, names, params = task
     from ..diagrams.bifurcation import bifurcation
 
-    result = bifurcation(config, Fz, BAND_V[0], BAND_V[1], params, BifurcationOptions(mesh_check=False))
-    return {name: classify(config, OPERATING_POINTS[name][0], Fz, params, BAND_V, result=result) for name in names}
+    result = bifurcation(config, Fz, v_range=(BAND_V[0], BAND_V[1]), params=params,
+                         options=BifurcationOptions(mesh_check=False))
+    return {name: classify(config, OPERATING_POINTS[name][0], Fz, params=params, v_range=BAND_V,
+                           result=result) for name in names}
 
 
-def operating_point_types(configs: Sequence[str], params: Parameters | None = None, executor=None,
+def operating_point_types(configs: Sequence[str], *, params: Parameters | None = None, executor=None,
                           progress: Callable[[float, str], None] | None = None) -> dict[str, dict[str, Any]]:
     """{config: {point: classify(...)}} at the nine operating points (docs/model.md)."""
     params = params if params is not None else Parameters()
@@ -117,8 +120,8 @@ def operating_point_types(configs: Sequence[str], params: Parameters | None = No
     return {c: {name: out[c][name] for name in OPERATING_POINTS} for c in configs}
 
 
-def design_report(configs: Sequence[str] = ("original", "nes", "pd", "nes_pd"), params: Parameters | None = None,
-                  Fz: float = 150e3, resolution: int = DEFAULT_MAP_SLICES, executor=None,
+def design_report(configs: Sequence[str] = CONFIGURATION_NAMES, *, params: Parameters | None = None,
+                  Fz: float = DEFAULT_FZ, resolution: int = DEFAULT_MAP_SLICES, executor=None,
                   progress: Callable[[float, str], None] | None = None) -> dict[str, Any]:
     """Maps and figures of merit of several configurations, each against ``original``."""
     configs = [Configuration.parse(c).value for c in configs]
@@ -126,15 +129,15 @@ def design_report(configs: Sequence[str] = ("original", "nes", "pd", "nes_pd"), 
     report = progress or (lambda fraction, message: None)
     results: dict[str, Any] = {}
     # all maps' units on the executor at once: no worker idles at the end of one map
-    computed = stability_maps(wanted, BAND_V, (1.0e4, 9.0e5), resolution, params, executor=executor,
-                              progress=lambda fraction, message: report(0.97 * fraction, message))
+    computed = stability_maps(wanted, v_range=BAND_V, fz_range=(1.0e4, 9.0e5), resolution=resolution, params=params,
+                              executor=executor, progress=lambda fraction, message: report(0.97 * fraction, message))
     maps: dict[str, StabilityMap] = dict(zip(wanted, computed, strict=True))
     for c in wanted:
-        results[c] = metrics(maps[c], Fz)
+        results[c] = metrics(maps[c], Fz=Fz)
     for c in configs:
         results[c]["against_original"] = against_baseline(results[c], results[BASELINE])
-    points = operating_point_types(configs, params, executor,
-                                   lambda fraction, message: report(0.99, f"operating points: {message}"))
+    points = operating_point_types(configs, params=params, executor=executor, progress=lambda fraction,
+                                   message: report(0.99, f"operating points: {message}"))
     for c in configs:
         results[c]["operating_points"] = {name: a["shimmy_type"] for name, a in points[c].items()}
     return {"Fz": Fz, "resolution": resolution, "configs": configs, "metrics": {c: results[c] for c in configs},

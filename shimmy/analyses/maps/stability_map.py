@@ -56,9 +56,9 @@ from ..core.executors import name_of, open_executor, run_dynamic
 from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
 from ...model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, V_RANGE, Parameters, check_number,
                                 check_operating_point, check_range)
-from ..core.response import ResponseType
+from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
 
-SHIMMY_TYPES = ("Stable", "Torsion", "Lateral", "Bistable", "Both")
+SHIMMY_TYPES = tuple(ShimmyType)
 SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
 COVERAGE_ROUNDS = 2  # rounds of further slices through regions no slice crosses
 #: ... that are at least one grid cell wide and cover this fraction of the map (thinner slivers
@@ -142,28 +142,15 @@ def attractors_on(result: BifurcationResult, speeds: np.ndarray) -> list[list[di
     return found
 
 
-def shimmy_type(attractors: list[dict[str, Any]]) -> str:
-    """Stable / Torsion / Lateral / Bistable / Both from a list of stable attractors."""
-    modes = {a["mode"] for a in attractors if a["kind"] != "equilibrium"}
-    if "torsional" in modes and "lateral" in modes:
-        return "Bistable"
-    if "both" in modes:
-        return "Both"
-    if "torsional" in modes:
-        return "Torsion"
-    if "lateral" in modes:
-        return "Lateral"
-    return "Stable"
-
-
-_RESPONSE_MODE = {ResponseType.TORSION: "torsional", ResponseType.LATERAL: "lateral", ResponseType.BOTH: "both"}
+_RESPONSE_MODE = {ResponseType.TORSION: Mode.TORSIONAL, ResponseType.LATERAL: Mode.LATERAL,
+                  ResponseType.BOTH: Mode.BOTH}
 
 
 def simulated_attractor(config: Configuration, V: float, Fz: float, params: Parameters) -> dict[str, Any]:
     """The attractor reached from the standard start, for speeds with no stable equilibrium or cycle."""
     from ..core.simulation import simulate
 
-    run = simulate(config, V, Fz, params, t_end=FALLBACK_T_END)
+    run = simulate(config, V, Fz, params=params, t_end=FALLBACK_T_END)
     mode = _RESPONSE_MODE.get(run.response_type)
     note = "" if run.success else f"simulation stopped: {run.message}"
     if run.response_type is ResponseType.STABLE:
@@ -274,15 +261,15 @@ def _special_points(result: BifurcationResult) -> list[dict[str, Any]]:
     return points
 
 
-def map_slice(config: Configuration | str, Fz: float, v_min: float, v_max: float, n_v: int,
-              params: Parameters, options: BifurcationOptions | None = None, result=None) -> SliceResult:
+def map_slice(config: Configuration | str, Fz: float, *, params: Parameters, v_range: tuple[float, float], n_v: int,
+              options: BifurcationOptions | None = None, result=None) -> SliceResult:
     """The map's computation on one load: diagram in V (``result`` if already computed, with the same
     load, range and parameters), types on the grid, special points."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     options = options or BifurcationOptions(mesh_check=False)
-    result = result or bifurcation(config, Fz, v_min, v_max, params, options)
-    coarse, fine = _grids(v_min, v_max, n_v)
+    result = result or bifurcation(config, Fz, v_range=v_range, params=params, options=options)
+    coarse, fine = _grids(*v_range, n_v)
     types_fine, _, simulated = _slice_types(result, fine, FINE, config, params)
     hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value}
             for h in result.hopf.hopf_points]
@@ -296,7 +283,7 @@ def map_slice(config: Configuration | str, Fz: float, v_min: float, v_max: float
 # --------------------------------------------------------------------------- classify
 
 
-def classify(config: Configuration | str, V: float, Fz: float, params: Parameters | None = None,
+def classify(config: Configuration | str, V: float, Fz: float, *, params: Parameters | None = None,
              v_range: tuple[float, float] = DEFAULT_V_RANGE, options: BifurcationOptions | None = None,
              result: BifurcationResult | None = None) -> dict[str, Any]:
     """Shimmy type and stable attractors at (V, Fz): the map's computation on the slice at Fz.
@@ -309,7 +296,8 @@ def classify(config: Configuration | str, V: float, Fz: float, params: Parameter
     if not v_min <= V <= v_max:
         raise InvalidParameterError("V", V, f"a number in [{v_min:g}, {v_max:g}] m/s (the diagram's range)")
     if result is None:
-        result = bifurcation(config, Fz, v_min, v_max, params, options or BifurcationOptions(mesh_check=False))
+        result = bifurcation(config, Fz, v_range=(v_min, v_max), params=params,
+                             options=options or BifurcationOptions(mesh_check=False))
     found = attractors_at(result, V)
     if not found:
         found = [simulated_attractor(config, V, Fz, params)]
@@ -413,10 +401,10 @@ def _unit(task: tuple) -> Any:
     """One independent unit of a map (top level, so that process pools and Dask can ship it)."""
     if task[0] == "hopf_curves":
         _, config, params, v_range, fz_range = task
-        return hopf_curves(config, params, v_range=v_range, fz_range=fz_range)
+        return hopf_curves(config, params=params, v_range=v_range, fz_range=fz_range)
     if task[0] == "slice":
         _, config, Fz, v_min, v_max, n_v, params, options = task
-        return map_slice(config, Fz, v_min, v_max, n_v, params, options)
+        return map_slice(config, Fz, v_range=(v_min, v_max), n_v=n_v, params=params, options=options)
     return search_unit(task)
 
 
@@ -522,11 +510,10 @@ def _tagged_unit(tagged: tuple[int, tuple]) -> Any:
     return _unit(tagged[1])
 
 
-def stability_maps(configs: Sequence[Configuration | str], v_range: tuple[float, float] = DEFAULT_V_RANGE,
-                   fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = DEFAULT_MAP_SLICES,
-                   params: Parameters | None = None, n_v: int = 100, executor=None,
-                   progress: Callable[[float, str], None] | None = None,
-                   options: BifurcationOptions | None = None) -> list[StabilityMap]:
+def stability_maps(configs: Sequence[Configuration | str], *, params: Parameters | None = None,
+                   v_range: tuple[float, float] = DEFAULT_V_RANGE, fz_range: tuple[float, float] = DEFAULT_FZ_RANGE,
+                   resolution: int = DEFAULT_MAP_SLICES, n_v: int = 100, options: BifurcationOptions | None = None,
+                   executor=None, progress: Callable[[float, str], None] | None = None) -> list[StabilityMap]:
     """The maps of several configurations (same plane, resolution and parameters), in the order
     given: :func:`stability_map` of each, their units all through one ``executor`` at once.
 
@@ -541,7 +528,8 @@ def stability_maps(configs: Sequence[Configuration | str], v_range: tuple[float,
         raise InvalidParameterError("configs", list(configs), "one or more configurations")
     if executor is None:
         with open_executor() as own:
-            maps = stability_maps(configs, v_range, fz_range, resolution, params, n_v, own, progress, options)
+            maps = stability_maps(configs, v_range=v_range, fz_range=fz_range, resolution=resolution, params=params,
+                                  n_v=n_v, executor=own, progress=progress, options=options)
         for smap in maps:
             smap.executor = name_of(None)
         return maps
@@ -565,11 +553,10 @@ def stability_maps(configs: Sequence[Configuration | str], v_range: tuple[float,
     return maps
 
 
-def stability_map(config: Configuration | str, v_range: tuple[float, float] = DEFAULT_V_RANGE,
-                  fz_range: tuple[float, float] = DEFAULT_FZ_RANGE, resolution: int = DEFAULT_MAP_SLICES,
-                  params: Parameters | None = None, n_v: int = 100, executor=None,
-                  progress: Callable[[float, str], None] | None = None,
-                  options: BifurcationOptions | None = None) -> StabilityMap:
+def stability_map(config: Configuration | str, *, params: Parameters | None = None,
+                  v_range: tuple[float, float] = DEFAULT_V_RANGE, fz_range: tuple[float, float] = DEFAULT_FZ_RANGE,
+                  resolution: int = DEFAULT_MAP_SLICES, n_v: int = 100, options: BifurcationOptions | None = None,
+                  executor=None, progress: Callable[[float, str], None] | None = None) -> StabilityMap:
     """The (V, Fz) stability map of one configuration: its region boundaries continued as curves,
     the regions' types from ``resolution`` classified Fz slices (and further ones where a region
     lies between them), read off on a fine grid with ``n_v`` speeds.
@@ -579,7 +566,8 @@ def stability_map(config: Configuration | str, v_range: tuple[float, float] = DE
     branches beside their GH and double-Hopf points, and the slices' diagrams; each fold or torus
     curve is continued as soon as a start for it is known (a GH or double-Hopf point, or a
     slice's LPC / NS point), ahead of the remaining slices."""
-    return stability_maps([config], v_range, fz_range, resolution, params, n_v, executor, progress, options)[0]
+    return stability_maps([config], v_range=v_range, fz_range=fz_range, resolution=resolution, params=params, n_v=n_v,
+                          executor=executor, progress=progress, options=options)[0]
 
 
 def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, np.ndarray]]:

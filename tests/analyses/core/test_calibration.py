@@ -41,8 +41,8 @@ def test_pd_amplitude_target_is_out_of_reach_and_the_closest_value_is_kept(fit):
 def test_sanity_checks_of_reference_md():
     # a_p 0.8 -> 0.9 lowers the nes_pd amplitude by roughly 10 %; tungsten damps more than steel
     p = Parameters()
-    amp = {ap: simulate("nes_pd", 30.0, 150e3, p.with_overrides(a_p=ap), t_end=120).amplitude["psi"]
+    amp = {ap: simulate("nes_pd", 30.0, 150e3, params=p.with_overrides(a_p=ap), t_end=120).amplitude["psi"]
            for ap in (0.8, 0.9)}
     assert 0.05 < 1 - amp[0.9] / amp[0.8] < 0.15
-    tungsten = simulate("nes_pd", 30.0, 150e3, p.with_material("tungsten"), t_end=120).amplitude["psi"]
+    tungsten = simulate("nes_pd", 30.0, 150e3, params=p.with_material("tungsten"), t_end=120).amplitude["psi"]
     assert tungsten < amp[0.9]

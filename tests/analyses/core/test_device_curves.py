@@ -20,12 +20,12 @@ def test_nes_curve_spans_the_valid_range_and_is_consistent():
 
 
 def test_nes_curve_follows_the_design():
-    stiffer = nes_curve(Parameters().with_overrides(e_p=0.002))
+    stiffer = nes_curve(params=Parameters().with_overrides(e_p=0.002))
     assert stiffer.k1 == pytest.approx(2 * nes_curve().k1)
 
 
 def test_pd_curves_for_design_and_presets():
-    curves = pd_curves(Parameters().with_material("tungsten"), v_max=1.0, n_points=11)
+    curves = pd_curves(params=Parameters().with_material("tungsten"), v_max=1.0, n_points=11)
     assert [c.material for c in curves] == ["design", "steel", "tungsten"]
     design, steel, tungsten = curves
     np.testing.assert_array_equal(design.torsional_damping, tungsten.torsional_damping)

@@ -88,11 +88,12 @@ def dask_cluster(tmp_path_factory):
 
 
 def test_a_study_on_the_dask_cluster_equals_the_local_one(dask_cluster, monkeypatch):
-    args = ("e_p", [0.0005, 0.005], ["original", "nes"], 150e3)
-    local = study(*args, executor=InlineExecutor())
+    args = ("e_p", [0.0005, 0.005])
+    kwargs = dict(configs=["original", "nes"], Fz=150e3)
+    local = study(*args, **kwargs, executor=InlineExecutor())
     seen = []
     monkeypatch.setenv(DASK_ENV, dask_cluster)
-    remote = study(*args, progress=lambda f, m: seen.append(f))
+    remote = study(*args, **kwargs, progress=lambda f, m: seen.append(f))
     assert remote.executor == f"dask cluster at {dask_cluster}"
     assert remote.rows == local.rows
     assert seen == [0.25, 0.5, 0.75, 1.0]

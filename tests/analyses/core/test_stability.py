@@ -12,7 +12,7 @@ PUBLISHED = {"original": (5.61, 93.43), "nes": (6.730, 71.255), "nes_pd": (6.410
 
 @pytest.mark.parametrize("config", sorted(PUBLISHED))
 def test_calibrated_defaults_reproduce_the_published_hopf_points(config):
-    result = hopf_points(config, 150e3, v_min=1.0, v_max=200.0)
+    result = hopf_points(config, 150e3, v_range=(1.0, 200.0))
     speeds = [h.V for h in result.hopf_points]
     assert len(speeds) == 2
     np.testing.assert_allclose(speeds, PUBLISHED[config], rtol=2e-3)
@@ -125,8 +125,8 @@ def test_lyapunov_coefficient_predicts_the_simulated_cycle_amplitude():
 
 @pytest.mark.parametrize("kwargs,match", [
     (dict(Fz=5e3), r"Fz=5000.0 is out of range"),
-    (dict(v_min=50.0, v_max=20.0), r"v_max=20.0 must exceed v_min"),
-    (dict(v_max=float("inf")), r"v_max=inf is not finite"),
+    (dict(v_range=(50.0, 20.0)), r"v_max=20.0 must exceed v_min"),
+    (dict(v_range=(1.0, float("inf"))), r"v_max=inf is not finite"),
     (dict(n_grid=3), r"n_grid=3 is out of range"),
     (dict(v_tol=0.1), r"v_tol=0.1 is out of range"),
 ])
@@ -137,6 +137,6 @@ def test_bad_hopf_requests_are_refused(kwargs, match):
 
 
 def test_result_serialises_with_the_cli_fields():
-    d = hopf_points("nes", 150e3, Parameters().with_overrides(e_p=0.002)).to_dict()
+    d = hopf_points("nes", 150e3, params=Parameters().with_overrides(e_p=0.002)).to_dict()
     assert d["config"] == "nes" and d["Fz"] == 150e3 and d["params"]["e_p"] == 0.002
     assert {"V", "frequency_hz", "criticality"} <= set(d["hopf_points"][0])

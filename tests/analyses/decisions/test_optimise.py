@@ -76,14 +76,14 @@ def test_search_says_so_when_no_start_design_can_be_evaluated():
 
 @pytest.mark.slow
 def test_gear_optimum_is_recomputed_from_scratch_and_beats_the_nominal_design():
-    result = optimise("nes", "min_shimmy_Fz", ["e_p", "k_s"], starts=4, local_runs=1, seed=1)
+    result = optimise("nes", "min_shimmy_Fz", parameters=["e_p", "k_s"], starts=4, local_runs=1, seed=1)
     assert result.method == "gradient" and result.feasible
     assert result.objective_value >= result.nominal_objective
     assert result.nominal_objective == pytest.approx(hopf_curves("nes").fz_minimum["Fz"], rel=1e-7)
     params = Parameters().with_overrides(result.design)
     again = figures_of("nes", params, [("min_shimmy_Fz", None)])[("min_shimmy_Fz", None)]["value"]
     assert again == pytest.approx(result.objective_value, rel=1e-9)
-    independent = hopf_curves("nes", params).fz_minimum["Fz"]  # the continued curve's located turning point
+    independent = hopf_curves("nes", params=params).fz_minimum["Fz"]  # the continued curve's located turning point
     assert independent == pytest.approx(result.objective_value, rel=1e-6)
     assert result.figures["optimum"]["min_shimmy_Fz"] == pytest.approx(result.objective_value, rel=1e-9)
     assert result.figures["original"]["min_shimmy_Fz"] == pytest.approx(hopf_curves("original").fz_minimum["Fz"],
@@ -108,13 +108,13 @@ def test_constraints_and_options_are_checked_naming_the_field():
     with pytest.raises(InvalidParameterError, match="method"):  # the torsion area has no derivative
         optimise("nes", "torsion_area", method="gradient")
     with pytest.raises(InvalidParameterError, match="method"):  # n is a count
-        optimise("pd", "max_psi", ["n"], method="gradient")
+        optimise("pd", "max_psi", parameters=["n"], method="gradient")
     with pytest.raises(InvalidParameterError, match="no device parameters"):
         optimise("original", "min_shimmy_Fz")
     with pytest.raises(InvalidParameterError, match="not fitted"):
-        optimise("original", "min_shimmy_Fz", ["k_s"])
+        optimise("original", "min_shimmy_Fz", parameters=["k_s"])
     with pytest.raises(InvalidParameterError, match="k_sx"):
-        optimise("nes", "min_shimmy_Fz", ["k_sx"])
+        optimise("nes", "min_shimmy_Fz", parameters=["k_sx"])
 
 
 TYRE_AND_SPRING = ("k_lam", "c_lam", "L", "k_s")

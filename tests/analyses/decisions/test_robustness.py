@@ -17,7 +17,7 @@ def test_a_sample_whose_newton_start_leads_out_of_the_box_gets_its_lowest_point_
     start = (nominal["V"], nominal["Fz"], 2 * math.pi * nominal["frequency_hz"])
     task = ("nes_pd", Parameters().to_dict(), list(values), [list(values.values())], 150e3, start)
     (entry,) = _sample_unit(task)
-    expected = hopf_curves("nes_pd", Parameters().with_overrides(values)).fz_minimum["Fz"]
+    expected = hopf_curves("nes_pd", params=Parameters().with_overrides(values)).fz_minimum["Fz"]
     assert entry["min_shimmy_Fz"] == pytest.approx(expected, rel=1e-6) and expected > 8e4
     assert entry["min_recomputed"]
 
@@ -29,5 +29,5 @@ def test_a_sample_whose_newton_start_reaches_another_mode_gets_its_lowest_point_
     values = {"k_lam": 0.00196, "c_psi": 367.745226, "k_s": 1152470.611408}
     start = (nominal["V"], nominal["Fz"], 2 * math.pi * nominal["frequency_hz"])
     (entry,) = _sample_unit(("nes_pd", Parameters().to_dict(), list(values), [list(values.values())], 150e3, start))
-    expected = hopf_curves("nes_pd", Parameters().with_overrides(values)).fz_minimum["Fz"]
+    expected = hopf_curves("nes_pd", params=Parameters().with_overrides(values)).fz_minimum["Fz"]
     assert entry["min_shimmy_Fz"] == pytest.approx(expected, rel=1e-6) and expected < 1e5

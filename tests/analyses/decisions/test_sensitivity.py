@@ -25,14 +25,14 @@ CHECKED = ("r2", "e_p", "k_s", "r3", "I_nes", "c_nes", "k_lam", "c_psi", "Iz", "
 def _fd_speeds(config, name, rel=1e-5, Fz=150e3):
     v = float(getattr(PARAMS, name))
     h = rel * v
-    up = hopf_points(config, Fz, PARAMS.with_overrides({name: v + h}), v_min=1, v_max=200).hopf_points
-    down = hopf_points(config, Fz, PARAMS.with_overrides({name: v - h}), v_min=1, v_max=200).hopf_points
+    up = hopf_points(config, Fz, params=PARAMS.with_overrides({name: v + h}), v_range=(1, 200)).hopf_points
+    down = hopf_points(config, Fz, params=PARAMS.with_overrides({name: v - h}), v_range=(1, 200)).hopf_points
     return [(a.V - b.V) / (2 * h) for a, b in zip(up, down, strict=True)]
 
 
 @pytest.mark.parametrize("config", ["nes", "nes_pd", "original", "pd"])
 def test_hopf_speed_derivatives_equal_central_differences_of_re_solved_points(config):
-    s = sensitivity(config, 150e3, PARAMS, amplitude=False, min_shimmy=False)
+    s = sensitivity(config, 150e3, params=PARAMS, amplitude=False, min_shimmy=False)
     assert len(s.hopf) == 2
     for name in CHECKED:
         analytic = [h["dV_dp"][name] for h in s.hopf]
@@ -45,24 +45,24 @@ def test_hopf_speed_derivatives_equal_central_differences_of_re_solved_points(co
 
 
 def test_frequency_derivatives_equal_central_differences():
-    s = sensitivity("nes", 150e3, PARAMS, ["k_s", "k_lam"], amplitude=False, min_shimmy=False)
+    s = sensitivity("nes", 150e3, params=PARAMS, names=["k_s", "k_lam"], amplitude=False, min_shimmy=False)
     for name in ("k_s", "k_lam"):
         v = float(getattr(PARAMS, name))
         h = 1e-5 * v
-        up = hopf_points("nes", 150e3, PARAMS.with_overrides({name: v + h}), v_min=1, v_max=200).hopf_points
-        down = hopf_points("nes", 150e3, PARAMS.with_overrides({name: v - h}), v_min=1, v_max=200).hopf_points
+        up = hopf_points("nes", 150e3, params=PARAMS.with_overrides({name: v + h}), v_range=(1, 200)).hopf_points
+        down = hopf_points("nes", 150e3, params=PARAMS.with_overrides({name: v - h}), v_range=(1, 200)).hopf_points
         fd = [(a.omega - b.omega) / (2 * h) for a, b in zip(up, down, strict=True)]
         np.testing.assert_allclose([x["domega_dp"][name] for x in s.hopf], fd, rtol=1e-4,
                                    atol=1e-4 * max(map(abs, fd)))
 
 
 def test_parameters_without_effect_are_exact_zeros_with_their_reason():
-    s = sensitivity("pd", 150e3, PARAMS, amplitude=False, min_shimmy=False)
+    s = sensitivity("pd", 150e3, params=PARAMS, amplitude=False, min_shimmy=False)
     for name in ("a_p", "rho_p", "e_r", "d_p"):
         assert s.no_effect["hopf"][name] == ZERO_SLOPE
         assert all(h["dV_dp"][name] == 0.0 for h in s.hopf)
     assert "I_pd" not in s.no_effect["hopf"]  # the added inertia does move the Hopf speeds
-    o = sensitivity("original", 150e3, PARAMS, amplitude=False, min_shimmy=False)
+    o = sensitivity("original", 150e3, params=PARAMS, amplitude=False, min_shimmy=False)
     for name in ("r2", "k_s", "a_p", "I_pd"):
         assert o.no_effect["hopf"][name] == NOT_FITTED
     rows = o.tornado("hopf_V2")
@@ -99,19 +99,19 @@ def test_min_shimmy_load_on_a_speed_edge_moves_along_the_edge():
     from shimmy.analyses.diagrams.hopf_curves import hopf_curves
 
     params = Parameters().with_overrides(L=0.1087, c_lam=554.4, k_a=0.502)
-    low = sensitivity("original", 150e3, params, ["k_lam", "c_psi"], amplitude=False).min_shimmy
+    low = sensitivity("original", 150e3, params=params, names=["k_lam", "c_psi"], amplitude=False).min_shimmy
     assert low["V"] == 1.0 and "speed edge" in low["source"]
     for name in ("k_lam", "c_psi"):
         v = float(getattr(params, name))
         h = 1e-4 * v
-        up = hopf_curves("original", params.with_overrides({name: v + h})).fz_minimum["Fz"]
-        down = hopf_curves("original", params.with_overrides({name: v - h})).fz_minimum["Fz"]
+        up = hopf_curves("original", params=params.with_overrides({name: v + h})).fz_minimum["Fz"]
+        down = hopf_curves("original", params=params.with_overrides({name: v - h})).fz_minimum["Fz"]
         assert low["dFz_dp"][name] == pytest.approx((up - down) / (2 * h), rel=1e-5), name
 
 
 @pytest.mark.parametrize("config", ["nes", "pd"])
 def test_min_shimmy_load_derivative_equals_differences_of_independently_solved_minima(config):
-    s = sensitivity(config, 150e3, PARAMS, ["k_s", "k_lam", "c_psi", "I_pd"], amplitude=False)
+    s = sensitivity(config, 150e3, params=PARAMS, names=["k_s", "k_lam", "c_psi", "I_pd"], amplitude=False)
     low = s.min_shimmy
     assert low["source"] == "lowest point of the Hopf curves"
     assert low["Fz"] == pytest.approx(_independent_lowest_point(config, PARAMS), rel=1e-8)
@@ -161,7 +161,7 @@ def test_amplitude_derivative_equals_differences_of_re_solved_orbits(config):
 
     Fz = 150e3
     model = build_model(config, PARAMS)
-    result = bifurcation(config, Fz, 1, 200, PARAMS, BifurcationOptions(mesh_check=False))
+    result = bifurcation(config, Fz, v_range=(1, 200), params=PARAMS, options=BifurcationOptions(mesh_check=False))
     names = ["e_p", "k_s", "a_p", "k_lam", "c_nes"]
     pairs = coefficient_pairs(Configuration(config), PARAMS, names)
     amp = amplitude_sensitivity(model, Fz, pairs, result=result)
@@ -187,8 +187,10 @@ def test_amplitude_derivative_equals_differences_of_re_solved_orbits(config):
     # diagrams re-computed, 1 % steps: their own mesh and refinement noise limits the comparison).
     v = float(PARAMS.e_p)
     h = 0.01 * v
-    up = bifurcation(config, Fz, 1, 200, PARAMS.with_overrides(e_p=v + h), BifurcationOptions(mesh_check=False))
-    down = bifurcation(config, Fz, 1, 200, PARAMS.with_overrides(e_p=v - h), BifurcationOptions(mesh_check=False))
+    up = bifurcation(config, Fz, v_range=(1, 200), params=PARAMS.with_overrides(e_p=v + h),
+                     options=BifurcationOptions(mesh_check=False))
+    down = bifurcation(config, Fz, v_range=(1, 200), params=PARAMS.with_overrides(e_p=v - h),
+                       options=BifurcationOptions(mesh_check=False))
     assert amp["dA_dp"]["e_p"] == pytest.approx((up.max_psi - down.max_psi) / (2 * h), rel=2e-2)
 
 

@@ -15,22 +15,22 @@ from shimmy.analyses.decisions.studies import study, study_grid
 
 @pytest.fixture(scope="module")
 def e_p_study():
-    return study("e_p", [0.0005, 0.005], ["original", "nes"], 150e3)
+    return study("e_p", [0.0005, 0.005], configs=["original", "nes"], Fz=150e3)
 
 
 def test_hopf_speeds_of_a_row_are_where_the_growth_rate_changes_sign(e_p_study):
     for row in e_p_study.rows:
         params = Parameters().with_overrides({"e_p": row["e_p"]})
         for V, rising in ((row["hopf_start"], True), (row["hopf_end"], False)):
-            below = eigenvalues(row["config"], V - 1e-3, 150e3, params).real.max()
-            above = eigenvalues(row["config"], V + 1e-3, 150e3, params).real.max()
+            below = eigenvalues(row["config"], V - 1e-3, 150e3, params=params).real.max()
+            above = eigenvalues(row["config"], V + 1e-3, 150e3, params=params).real.max()
             assert (below < 0 < above) if rising else (above < 0 < below), (row, V)
 
 
 def test_a_row_equals_the_diagram_of_that_design(e_p_study):
     row = next(r for r in e_p_study.rows if r["config"] == "nes" and r["e_p"] == 0.005)
-    direct = bifurcation("nes", 150e3, 1.0, 200.0, Parameters().with_overrides({"e_p": 0.005}),
-                         BifurcationOptions(mesh_check=False))
+    direct = bifurcation("nes", 150e3, v_range=(1.0, 200.0), params=Parameters().with_overrides({"e_p": 0.005}),
+                         options=BifurcationOptions(mesh_check=False))
     assert row["max_psi"] == direct.max_psi and row["max_psi_V"] == direct.max_psi_V
     assert row["hopf_points"] == sorted(h.V for h in direct.hopf.hopf_points)
 
@@ -46,7 +46,7 @@ def test_the_nes_pre_stretch_changes_nes_rows_only(e_p_study):
 
 
 def test_two_parameter_grid_has_a_row_per_pair_and_configuration():
-    result = study_grid(("e_p", "k_s"), ([0.0005, 0.005], [1.0e6, 1.4e6]), ["nes"], 150e3,
+    result = study_grid(("e_p", "k_s"), ([0.0005, 0.005], [1.0e6, 1.4e6]), configs=["nes"], Fz=150e3,
                         executor=InlineExecutor())
     assert len(result.rows) == 4
     assert {(r["e_p"], r["k_s"]) for r in result.rows} == {(a, b) for a in (0.0005, 0.005) for b in (1.0e6, 1.4e6)}
@@ -56,20 +56,20 @@ def test_two_parameter_grid_has_a_row_per_pair_and_configuration():
     lines = buf.getvalue().splitlines()
     assert lines[0].startswith("e_p,k_s,config,hopf_start_m_s") and len(lines) == 5
     # each grid row equals the one-parameter study at the same design
-    one = study("k_s", [1.4e6], ["nes"], 150e3, params=Parameters().with_overrides({"e_p": 0.005}),
+    one = study("k_s", [1.4e6], configs=["nes"], Fz=150e3, params=Parameters().with_overrides({"e_p": 0.005}),
                 executor=InlineExecutor()).rows[0]
     grid_row = next(r for r in result.rows if r["e_p"] == 0.005 and r["k_s"] == 1.4e6)
     assert np.isclose(grid_row["max_psi"], one["max_psi"], rtol=0, atol=0)
 
 
 @pytest.mark.parametrize("call, field", [
-    (lambda: study("zeta", [1.0], ["nes"]), "parameter"),
-    (lambda: study("e_p", [0.5], ["nes"]), "e_p"),
-    (lambda: study("e_p", [], ["nes"]), "values"),
-    (lambda: study("e_p", [0.001], ["gear"]), "config"),
-    (lambda: study("e_p", [0.001], []), "configs"),
-    (lambda: study("e_p", [0.001], ["nes"], Fz=5.0), "Fz"),
-    (lambda: study_grid(("e_p", "e_p"), ([0.001], [0.002]), ["nes"]), "parameters"),
+    (lambda: study("zeta", [1.0], configs=["nes"]), "parameter"),
+    (lambda: study("e_p", [0.5], configs=["nes"]), "e_p"),
+    (lambda: study("e_p", [], configs=["nes"]), "values"),
+    (lambda: study("e_p", [0.001], configs=["gear"]), "config"),
+    (lambda: study("e_p", [0.001], configs=[]), "configs"),
+    (lambda: study("e_p", [0.001], configs=["nes"], Fz=5.0), "Fz"),
+    (lambda: study_grid(("e_p", "e_p"), ([0.001], [0.002]), configs=["nes"]), "parameters"),
 ])
 def test_bad_study_requests_name_the_field(call, field):
     with pytest.raises(InvalidParameterError) as err:

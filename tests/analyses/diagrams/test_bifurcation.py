@@ -7,7 +7,8 @@ import sys
 import numpy as np
 import pytest
 
-from shimmy.analyses.diagrams.bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, cycle_at, gear_field
+from shimmy.analyses.diagrams.bifurcation import (STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, cycle_at,
+                                                  gear_field)
 from shimmy.continuation import ContinuationOptions, equilibrium_branch
 from shimmy.model.equations import build_model
 from shimmy.errors import InvalidParameterError
@@ -19,12 +20,12 @@ FZ = 150e3
 
 @pytest.fixture(scope="module")
 def diagrams():
-    return {c: bifurcation(c, FZ, 1.0, 200.0) for c in ("original", "nes", "pd", "nes_pd")}
+    return {c: bifurcation(c, FZ, v_range=(1.0, 200.0)) for c in ("original", "nes", "pd", "nes_pd")}
 
 
 @pytest.fixture(scope="module")
 def high_load():
-    return bifurcation("original", 850e3, 1.0, 200.0)
+    return bifurcation("original", 850e3, v_range=(1.0, 200.0))
 
 
 # Ten speeds on the stable part of each branch (away from the Hopf points, where the
@@ -60,7 +61,7 @@ def test_equilibrium_continuation_finds_every_hopf_point_of_the_scan(config, Fz)
                             ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000),
                             scale=STATE_SCALE[:model.n_states], p_scale=V_SCALE)
     engine = [s.p for s in eq.special_points if s.kind == "H"]
-    scan = [h.V for h in hopf_points(config, Fz, v_min=1.0, v_max=200.0).hopf_points]
+    scan = [h.V for h in hopf_points(config, Fz, v_range=(1.0, 200.0)).hopf_points]
     assert len(engine) == len(scan) >= 2
     np.testing.assert_allclose(engine, scan, rtol=1e-6)
 
@@ -68,7 +69,7 @@ def test_equilibrium_continuation_finds_every_hopf_point_of_the_scan(config, Fz)
 @pytest.mark.parametrize("config", ["original", "nes", "pd", "nes_pd"])
 def test_diagram_structure_at_150_kN(diagrams, config):
     result = diagrams[config]
-    scan = hopf_points(config, FZ, v_min=1.0, v_max=200.0)
+    scan = hopf_points(config, FZ, v_range=(1.0, 200.0))
     eq = result.branches[0]
     assert eq.kind == "equilibrium" and not result.warnings
     assert [s["V"] for s in eq.special_points if s["kind"] == "H"] == [h.V for h in scan.hopf_points]
@@ -101,8 +102,8 @@ def test_max_amplitude_converged_under_mesh_refinement(diagrams, config):
 
 
 def test_max_amplitude_independent_of_mesh_size():
-    coarse = bifurcation("pd", FZ, 1.0, 200.0, options=BifurcationOptions(ntst=30, seeds=False))
-    fine = bifurcation("pd", FZ, 1.0, 200.0, options=BifurcationOptions(ntst=80, seeds=False))
+    coarse = bifurcation("pd", FZ, v_range=(1.0, 200.0), options=BifurcationOptions(ntst=30, seeds=False))
+    fine = bifurcation("pd", FZ, v_range=(1.0, 200.0), options=BifurcationOptions(ntst=80, seeds=False))
     assert coarse.max_psi == pytest.approx(fine.max_psi, abs=1e-4)
     assert coarse.max_psi_V == pytest.approx(fine.max_psi_V, abs=0.5)
 
@@ -147,9 +148,9 @@ def test_to_dict_has_the_documented_schema(diagrams):
 
 def test_bad_input_names_the_field():
     with pytest.raises(InvalidParameterError, match="v_max"):
-        bifurcation("original", FZ, 50.0, 20.0)
+        bifurcation("original", FZ, v_range=(50.0, 20.0))
     with pytest.raises(InvalidParameterError, match="Fz"):
-        bifurcation("original", 5.0, 1.0, 20.0)
+        bifurcation("original", 5.0, v_range=(1.0, 20.0))
     with pytest.raises(InvalidParameterError, match="ntst"):
         BifurcationOptions(ntst=1)
 
@@ -184,7 +185,7 @@ def test_fold_of_cycles_bounds_a_bistable_speed_range():
     (LPC) above it. Between the two, the large torsional cycle is stable while the lateral mode of
     x = 0 is unstable at every speed (its cycle, seeded by simulation, is stable too): two stable
     limit cycles, which time simulations from two initial conditions confirm."""
-    result = bifurcation("original", 450e3, 1.0, 200.0)
+    result = bifurcation("original", 450e3, v_range=(1.0, 200.0))
     upper = result.hopf.hopf_points[-1]
     assert upper.criticality.value == "subcritical"
     assert not result.branches[0].stable.any()
@@ -233,7 +234,7 @@ def test_isolated_loop_of_torsional_cycles_at_high_load():
     """At 700 kN no torsional Hopf point lies in 1-200 m/s, yet a loop (isola) of torsional cycles
     exists beside the lateral cycle: found by a simulation seed, traversed once (two folds), and
     its stable part is confirmed by a simulation started on it."""
-    result = bifurcation("original", 700e3, 1.0, 200.0)
+    result = bifurcation("original", 700e3, v_range=(1.0, 200.0))
     loops = [b for b in result.branches if b.kind == "periodic" and b.stop_reason.startswith("closed branch")]
     assert len(loops) == 1
     loop = loops[0]

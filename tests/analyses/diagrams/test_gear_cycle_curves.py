@@ -112,7 +112,7 @@ def test_a_torus_start_at_a_strong_resonance_gives_no_one_point_curve():
     from shimmy.model.parameters import Parameters
 
     Fz = 243687.15083798883  # a slice of the pd map
-    diagram = bifurcation("pd", Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    diagram = bifurcation("pd", Fz, v_range=(1.0, 200.0), options=BifurcationOptions(mesh_check=False))
     born = [b for b in diagram.branches if b.kind == "periodic" and abs(b.V.min() - 4.0175) < 1e-3]
     assert len(born) == 1
     # Branches that shrink onto x = 0 end there: no fold or torus point of the constant 'orbit' x = 0
@@ -146,7 +146,7 @@ def test_a_fold_start_next_to_a_hopf_point_converges():
     from shimmy.model.parameters import Parameters
 
     Fz = 277e3
-    diagram = bifurcation("nes_pd", Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    diagram = bifurcation("nes_pd", Fz, v_range=(1.0, 200.0), options=BifurcationOptions(mesh_check=False))
     starts = [s for s in starts_of_diagram(diagram, Fz) if s.kind == "LPC" and abs(s.point.p - 127.387) < 0.01]
     assert len(starts) == 1
     curve, warning = _continue((Configuration.parse("nes_pd"), Parameters(), starts[0], ((1.0, 200.0), (1e4, 9e5)),

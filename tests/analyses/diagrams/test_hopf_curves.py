@@ -122,12 +122,12 @@ def test_a_curve_is_not_cut_where_newton_jumps_to_another_branch():
     from shimmy.analyses.decisions.sensitivity import sensitivity
 
     params = Parameters().with_overrides(r2=0.08145057809022613, e_p=0.005, k_s=1399769.10649413, r3=0.005)
-    result = hopf_curves("nes", params)
+    result = hopf_curves("nes", params=params)
     loop = next(c for c in result.curves if c.closed)
     assert loop.stop_reasons == ["closed curve: returned to its start"]
     assert np.max(np.abs(np.diff(loop.p[:, 0]))) < 12.0  # no jump across the plane (ds_max is 10 m/s in V)
     low = result.fz_minimum
     assert any(abs(e["p"][1] - low["Fz"]) < 1e-6 * low["Fz"] for e in loop.extrema)  # a located turning point
-    s = sensitivity("nes", 150e3, params, ["k_s", "e_p"], amplitude=False)
+    s = sensitivity("nes", 150e3, params=params, names=["k_s", "e_p"], amplitude=False)
     assert s.min_shimmy["source"] == "lowest point of the Hopf curves"
     assert s.min_shimmy["Fz"] == pytest.approx(low["Fz"], rel=1e-6)

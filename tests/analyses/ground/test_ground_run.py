@@ -7,7 +7,8 @@ import pytest
 
 import shimmy
 from shimmy.analyses.diagrams.bifurcation import bifurcation
-from shimmy.analyses.ground.ground_profiles import MAX_PROFILE_POINTS, PRESETS, preset, preset_fields, profile_from_table
+from shimmy.analyses.ground.ground_profiles import (MAX_PROFILE_POINTS, PRESETS, preset, preset_fields,
+                                                   profile_from_table)
 from shimmy.analyses.ground.ground_run import GroundRunOptions, _segment_hits, ground_run, ground_runs
 from shimmy.analyses.diagrams.hopf_curves import FZ_SCALE, V_SCALE, hopf_curves
 from shimmy.analyses.core.polylines import near_polyline
@@ -41,7 +42,7 @@ def test_a_constant_profile_reproduces_simulate(config):
 @pytest.fixture(scope="module")
 def original_branch():
     """The periodic branch of `original` from its lower (supercritical) Hopf point at 150 kN."""
-    diagram = bifurcation("original", 150e3, 5.0, 16.0)
+    diagram = bifurcation("original", 150e3, v_range=(5.0, 16.0))
     branch = next(b for b in diagram.branches if b.kind == "periodic")
     order = np.argsort(branch.V)
     assert np.all(np.asarray(branch.stable)[order])
@@ -50,7 +51,7 @@ def original_branch():
 
 @pytest.mark.slow
 def test_a_slow_ramp_through_a_supercritical_hopf_point_follows_the_periodic_branch(original_branch):
-    hopf = shimmy.hopf_points("original", 150e3, v_min=1, v_max=50).hopf_points[0]
+    hopf = shimmy.hopf_points("original", 150e3, v_range=(1, 50)).hopf_points[0]
     assert hopf.criticality.value == "supercritical" and hopf.V == pytest.approx(5.6118, abs=1e-3)
     run = ground_run("original", [[0.0, 5.0, 150e3], [900.0, 14.0, 150e3]])  # 0.01 m/s^2
     assert run.success
@@ -90,7 +91,7 @@ def test_crossings_agree_with_the_hopf_curves(config, name):
         q = np.array([crossing["V"], crossing["Fz"]]) / scale
         assert any(near_polyline(c.p / scale, q) is not None for c in curves.curves)  # on a continued curve
         # and exactly on the Hopf curve: straight rolling has a Hopf point there at that load
-        at_load = shimmy.hopf_points(config, crossing["Fz"], v_min=1.0, v_max=200.0).hopf_points
+        at_load = shimmy.hopf_points(config, crossing["Fz"], v_range=(1.0, 200.0)).hopf_points
         assert min(abs(h.V - crossing["V"]) for h in at_load) < 1e-6
         V, Fz = profile.at(crossing["t"])
         assert (V, Fz) == pytest.approx((crossing["V"], crossing["Fz"]))
@@ -260,7 +261,7 @@ def test_fold_and_torus_crossings_agree_with_the_one_parameter_diagram():
     assert run.success and not run.warnings
     kinds = [c["curve"] for c in run.boundary_crossings]
     assert kinds.count("fold") == 2 and kinds.count("torus") == 2  # out on the way up and back on the way down
-    diagram = bifurcation("original", 600e3, 1.0, 20.0)
+    diagram = bifurcation("original", 600e3, v_range=(1.0, 20.0))
     located = {"fold": [], "torus": []}
     for b in diagram.branches:
         for s in b.special_points:

@@ -18,7 +18,8 @@ from shimmy.analyses.core.executors import InlineExecutor
 from shimmy.analyses.core.simulation import simulate
 from shimmy.analyses.core.stability import hopf_points
 from shimmy.analyses.maps import map_shading
-from shimmy.analyses.maps.stability_map import (SHIMMY_TYPES, TRIVIAL_LATERAL, TRIVIAL_PSI, attractors_at, attractors_on,
+from shimmy.analyses.maps.stability_map import (SHIMMY_TYPES, TRIVIAL_LATERAL, TRIVIAL_PSI, attractors_at,
+                                                attractors_on,
                                           classify, shimmy_type, stability_map, stability_maps)
 
 RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"}
@@ -27,7 +28,7 @@ RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"
 @pytest.fixture(scope="module")
 def original_map():
     """original over V 1-200 m/s, Fz 10-900 kN on 12 slices (about 10 s on two workers)."""
-    return stability_map("original", (1.0, 200.0), (1.0e4, 9.0e5), resolution=12, n_v=60)
+    return stability_map("original", v_range=(1.0, 200.0), fz_range=(1.0e4, 9.0e5), resolution=12, n_v=60)
 
 
 def _cycle(mode, amp=0.1):
@@ -96,7 +97,7 @@ def test_classification_is_confirmed_by_simulation_from_several_starts(config, V
     """Each start (rest + 0.001 rad, a large torsion, a large lateral bending, and each stable
     cycle's own orbit) settles on one of the attractors the classifier lists; each listed cycle
     keeps a run started on it; the type is the expected one."""
-    result = bifurcation(config, Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    result = bifurcation(config, Fz, v_range=(1.0, 200.0), options=BifurcationOptions(mesh_check=False))
     answer = classify(config, V, Fz, result=result)
     assert answer["shimmy_type"] == expected, answer
     n = result.branches[0].V.size and (7 if "nes" in config else 5)
@@ -187,11 +188,11 @@ def test_every_fold_and_torus_point_of_a_slice_lies_on_a_drawn_curve(original_ma
 def test_torsion_area_of_original_equals_the_unstable_area_of_straight_rolling():
     """Below 250 kN every Hopf point of `original` is supercritical and every cycle torsional,
     so the pure-torsion region is where x = 0 is unstable: its area from 241 eigenvalue scans."""
-    band = stability_map("original", (1.0, 200.0), (1.0e4, 2.5e5), resolution=13, n_v=100,
+    band = stability_map("original", v_range=(1.0, 200.0), fz_range=(1.0e4, 2.5e5), resolution=13, n_v=100,
                          executor=InlineExecutor())
     assert {t for row in band.types for t in row} == {"Stable", "Torsion"}
     loads = np.linspace(1.0e4, 2.5e5, 241)
-    lengths = [sum(b - a for a, b in hopf_points("original", float(Fz), v_min=1.0, v_max=200.0).unstable_intervals)
+    lengths = [sum(b - a for a, b in hopf_points("original", float(Fz), v_range=(1.0, 200.0)).unstable_intervals)
                for Fz in loads]
     reference = float(np.trapezoid(lengths, loads / 1e3))
     area = torsion_area(band)
@@ -232,7 +233,7 @@ def test_changes_against_original_are_differences_and_ratios():
 def test_attractors_ignore_a_branch_run_on_along_x_equal_0():
     """With the particle damper a seeded branch can continue through its Hopf points along the
     trivial orbit; those points are x = 0, not cycles (nes_pd at 78.5 kN, V 1-14 m/s)."""
-    result = bifurcation("nes_pd", 78461.5, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    result = bifurcation("nes_pd", 78461.5, v_range=(1.0, 200.0), options=BifurcationOptions(mesh_check=False))
     for V in (5.0, 60.0):
         found = attractors_at(result, V)
         assert [a["kind"] for a in found] == ["equilibrium"]
@@ -274,7 +275,7 @@ def attractors_one_by_one(result, V):
 def test_attractors_on_a_grid_are_those_at_each_speed(config, Fz):
     """The read-off of a whole grid at once (closed loops, folds, Hopf ends, a branch run on along
     x = 0 among them) gives, speed by speed, the attractors of the plain one-speed read-off."""
-    result = bifurcation(config, Fz, 1.0, 200.0, options=BifurcationOptions(mesh_check=False))
+    result = bifurcation(config, Fz, v_range=(1.0, 200.0), options=BifurcationOptions(mesh_check=False))
     ends = [float(v) for b in result.branches for v in b.V]
     grid = np.concatenate([np.linspace(1.0, 200.0, 991), ends])
     on_grid = attractors_on(result, grid)
@@ -441,7 +442,7 @@ def test_shading_is_on_the_right_side_of_every_hopf_curve(original_map):
     gh_low = min(g["Fz"] for g in m.hopf.gh_points)
     checked = 0
     for Fz, row in zip(m.shading_Fz[::6], m.shading[::6], strict=True):
-        unstable = hopf_points("original", float(Fz), v_min=1.0, v_max=200.0).unstable_intervals
+        unstable = hopf_points("original", float(Fz), v_range=(1.0, 200.0)).unstable_intervals
         for V, t in zip(m.V, row, strict=True):
             inside = any(a + cell < V < b - cell for a, b in unstable)
             outside = all(V < a - cell or V > b + cell for a, b in unstable)
