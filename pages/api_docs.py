@@ -8,7 +8,7 @@ import dash
 from dash import html
 
 from shimmy.service import schemas, settings
-from shimmy.service.api import PREFIX, SYNC_ANALYSES, openapi_document
+from shimmy.service.api import JOB_ANALYSES, PREFIX, SYNC_ANALYSES, openapi_document
 from ui import components as ui
 from ui.layout import page
 
@@ -56,12 +56,12 @@ def layout(**query):
         sections += [html.H2(f"POST {PREFIX}/{name}"), html.P(schemas.SCHEMAS[name].summary), _fields(name),
                      _curl(f"/{name}", EXAMPLES[name])]
     sections += [html.H2(f"POST {PREFIX}/jobs"),
-                 html.P("Body: {\"analysis\": " + " | ".join(f'"{a}"' for a in schemas.JOB_ANALYSES) + ", ...the "
+                 html.P("Body: {\"analysis\": " + " | ".join(f'"{a}"' for a in JOB_ANALYSES) + ", ...the "
                         "analysis' fields}. Answers 202 with the job; poll GET /jobs/{id} (status queued, running, "
                         "done, failed or cancelled; progress 0-1; the result when done); DELETE /jobs/{id} "
                         "cancels. A finished result is cached: the same request is done at once."),
                  _curl("/jobs", EXAMPLES["jobs"])]
-    for name in schemas.JOB_ANALYSES:
+    for name in JOB_ANALYSES:
         if name not in SYNC_ANALYSES:
             sections += [html.H2(f"job analysis \"{name}\""), html.P(schemas.SCHEMAS[name].summary), _fields(name)]
             if name in EXAMPLES:

@@ -8,6 +8,7 @@ numerics directly). :func:`run` validates, consults the shared cache and compute
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
@@ -19,6 +20,29 @@ from . import cache, schemas
 from .settings import MAX_SERIES_POINTS
 
 Progress = Callable[[float, str], None]
+Runner = Callable[[dict[str, Any], Progress | None], dict[str, Any]]
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """One analysis the service offers: its request schema, its runner and how it may be asked."""
+
+    schema: schemas.RequestSchema
+    runner: Runner
+    sync: bool  # answered in the request: POST /api/v1/<name>
+    job: bool  # runs as a background job: POST /api/v1/jobs {"analysis": <name>}
+
+
+#: Every analysis by name, in the order their runners are declared below (the API lists them so).
+ANALYSES: dict[str, Analysis] = {}
+
+
+def serves(name: str, *, sync: bool, job: bool) -> Callable[[Runner], Runner]:
+    """Declare the decorated runner as the service's analysis ``name`` (its schema: ``schemas.SCHEMAS[name]``)."""
+    def declare(runner: Runner) -> Runner:
+        ANALYSES[name] = Analysis(schemas.SCHEMAS[name], runner, sync, job)
+        return runner
+    return declare
 
 
 def _params(request: dict[str, Any]) -> Parameters:
@@ -29,6 +53,7 @@ def _finite(x) -> float | None:
     return float(x) if x is not None and math.isfinite(x) else None
 
 
+@serves("simulate", sync=True, job=True)
 def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.core.simulation import SimulationOptions, simulate as run_simulation
 
@@ -50,25 +75,11 @@ def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[
     if request["include_series"]:
         out["series"] = {k: v[::stride] for k, v in result.series().items()}
         out["series_dt"] = stride * result.options.dt_out
-        out["spectrum"] = _spectrum(result)
+        out["spectrum"] = result.spectrum()
     return out
 
 
-def _spectrum(result) -> dict[str, Any]:
-    """Power spectrum of the steady window (psi and l_g delta, Hann window), for plots."""
-    dt = result.options.dt_out
-    span = max(8, int(round(result.options.steady_window / dt)))
-    psi = result.states[0, -span:]
-    lat = result.lateral[-span:]
-    window = np.hanning(psi.size)
-    freq = np.fft.rfftfreq(psi.size, dt)
-    keep = freq <= 60.0
-    p_psi = np.abs(np.fft.rfft((psi - psi.mean()) * window)) ** 2
-    p_lat = np.abs(np.fft.rfft((lat - lat.mean()) * window)) ** 2
-    return {"frequency_hz": freq[keep].tolist(), "psi": p_psi[keep].tolist(), "lateral": p_lat[keep].tolist(),
-            "dominant_hz": _finite(result.frequency_hz)}
-
-
+@serves("hopf", sync=True, job=False)
 def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.core.stability import hopf_points
 
@@ -76,30 +87,17 @@ def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str,
                                                                                            request["v_max"])).to_dict()
 
 
+@serves("stability", sync=True, job=False)
 def stability(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """Largest real part of the eigenvalues of x = 0 against V, and the Hopf points, per configuration."""
-    from ..model.equations import build_model
-    from ..analyses.core.stability import Linearisation, hopf_points
+    from ..analyses.core.stability import growth_rates
 
-    params = _params(request)
-    V = np.geomspace(request["v_min"], request["v_max"], request["n_points"])
-    out: dict[str, Any] = {"Fz": request["Fz"], "V": V.tolist(), "params": request["params"], "configs": {}}
-    for config in Configuration:
-        lin = Linearisation(build_model(config, params), request["Fz"])
-        ev = lin.eigenvalues(V)
-        k = np.argmax(ev.real, axis=1)
-        lead = ev[np.arange(V.size), k]
-        # A coarse grid suffices: the near-axis extremum scan catches pairs between grid points
-        # (tests/analyses/core/test_stability.py: 12 points find what 20 000 do); 1e-7 m/s is far below display.
-        h = hopf_points(config, request["Fz"], params=params, v_range=(request["v_min"], request["v_max"]), n_grid=80,
-                        v_tol=1e-7)
-        out["configs"][config.value] = {
-            "max_real": lead.real.tolist(), "frequency_hz": (np.abs(lead.imag) / (2 * np.pi)).tolist(),
-            "hopf_points": [p.to_dict() for p in h.hopf_points],
-            "unstable_intervals": [list(iv) for iv in h.unstable_intervals]}
-    return out
+    rates = growth_rates(request["Fz"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
+                         n_points=request["n_points"])
+    return {"Fz": request["Fz"], "V": rates["V"], "params": request["params"], "configs": rates["configs"]}
 
 
+@serves("devices", sync=True, job=False)
 def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.core.device_curves import nes_curve, pd_curves
 
@@ -110,6 +108,7 @@ def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[s
             "pd": [c.to_dict() for c in pd_curves(params=params, v_max=request["v_max"])]}
 
 
+@serves("bifurcation", sync=False, job=True)
 def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.diagrams.bifurcation import BifurcationOptions, bifurcation as run_bifurcation
 
@@ -118,6 +117,7 @@ def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> di
                            params=_params(request), options=options, progress=progress).to_dict()
 
 
+@serves("hopf_curves", sync=False, job=True)
 def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.diagrams.hopf_curves import hopf_curves as run_hopf_curves
 
@@ -125,6 +125,7 @@ def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> di
                            fz_range=(request["fz_min"], request["fz_max"]), progress=progress).to_dict()
 
 
+@serves("map", sync=False, job=True)
 def stability_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """The map with its design metrics; slices go through the executor of this environment."""
     from ..analyses.maps.design_metrics import metrics
@@ -138,6 +139,7 @@ def stability_map(request: dict[str, Any], progress: Progress | None = None) -> 
     return out
 
 
+@serves("study", sync=False, job=True)
 def study(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.decisions.studies import study as run_study, study_grid
 
@@ -149,6 +151,7 @@ def study(request: dict[str, Any], progress: Progress | None = None) -> dict[str
                       **common).to_dict()
 
 
+@serves("ground_run", sync=False, job=True)
 def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """One configuration through the profile; with ``hopf_curves`` its Hopf curves (from the shared cache)."""
     from ..analyses.ground.ground_run import GroundRunOptions, ground_run as run_ground_run
@@ -172,6 +175,7 @@ def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dic
     return out
 
 
+@serves("sensitivity", sync=True, job=True)
 def sensitivity(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """Derivatives of the boundaries at one load to the chosen parameters, with the tornado rows."""
     from ..analyses.decisions.sensitivity import sensitivity as run_sensitivity
@@ -184,6 +188,7 @@ def sensitivity(request: dict[str, Any], progress: Progress | None = None) -> di
     return out
 
 
+@serves("optimise", sync=False, job=True)
 def optimise(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """The optimiser; its design evaluations and local searches go through the executor of this environment."""
     from ..analyses.decisions.optimise import Constraint, optimise as run_optimise
@@ -196,6 +201,7 @@ def optimise(request: dict[str, Any], progress: Progress | None = None) -> dict[
                         popsize=request["popsize"], seed=request["seed"], progress=progress).to_dict()
 
 
+@serves("robustness", sync=False, job=True)
 def robustness(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """Quasi-Monte Carlo and linear propagation of the tolerances; chunks of samples through the executor."""
     from ..analyses.decisions.robustness import Tolerance, robustness as run_robustness
@@ -215,11 +221,12 @@ def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str
             "assumptions": profile.assumptions}
 
 
-RUNNERS: dict[str, Callable[[dict[str, Any], Progress | None], dict[str, Any]]] = {
-    "simulate": simulate, "hopf": hopf, "stability": stability, "devices": devices,
-    "bifurcation": bifurcation, "hopf_curves": hopf_curves, "map": stability_map, "study": study,
-    "ground_run": ground_run, "sensitivity": sensitivity, "optimise": optimise, "robustness": robustness}
-assert set(RUNNERS) == set(schemas.SCHEMAS)
+#: The runner of each analysis.
+RUNNERS: dict[str, Runner] = {name: a.runner for name, a in ANALYSES.items()}
+#: Analyses answered in the request (POST /api/v1/NAME).
+SYNC_ANALYSES = tuple(name for name, a in ANALYSES.items() if a.sync)
+#: Analyses that run as background jobs (POST /api/v1/jobs).
+JOB_ANALYSES = tuple(name for name, a in ANALYSES.items() if a.job)
 
 
 def run(analysis: str, body: Any, progress: Progress | None = None) -> tuple[dict[str, Any], bool]:

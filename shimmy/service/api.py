@@ -20,10 +20,9 @@ from ..continuation import errors as engine_errors
 from ..errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
 from ..model.parameters import PARAMETER_SPECS
 from . import analyses, cache, jobs, schemas, settings
+from .analyses import JOB_ANALYSES, SYNC_ANALYSES
 
 PREFIX = "/api/v1"
-#: Analyses answered in the request (POST /api/v1/NAME); the long ones run as jobs (schemas.JOB_ANALYSES).
-SYNC_ANALYSES = ("simulate", "hopf", "stability", "devices", "sensitivity")
 api = Blueprint("api", __name__, url_prefix=PREFIX)
 
 
@@ -232,10 +231,10 @@ def submit_job():
     if not isinstance(body, dict):
         raise InvalidParameterError("body", type(body).__name__, "a JSON object", "is not a JSON object")
     if "analysis" not in body:
-        raise InvalidParameterError("analysis", None, "one of " + ", ".join(schemas.JOB_ANALYSES), "is required")
+        raise InvalidParameterError("analysis", None, "one of " + ", ".join(JOB_ANALYSES), "is required")
     analysis = body["analysis"]
     if not isinstance(analysis, str):
-        raise InvalidParameterError("analysis", analysis, "one of " + ", ".join(schemas.JOB_ANALYSES),
+        raise InvalidParameterError("analysis", analysis, "one of " + ", ".join(JOB_ANALYSES),
                                     "is not a string")
     try:
         job = jobs.submit(analysis, body)
@@ -282,7 +281,7 @@ def openapi_document() -> dict[str, Any]:
     comps: dict[str, Any] = {"Error": {"type": "object", "required": ["error", "field", "allowed"], "properties": {
         "error": {"type": "string"}, "field": {"type": ["string", "null"]}, "allowed": {"type": ["string", "null"]}}},
         "Job": {"type": "object", "properties": {
-            "id": {"type": "string"}, "analysis": {"type": "string", "enum": list(schemas.JOB_ANALYSES)},
+            "id": {"type": "string"}, "analysis": {"type": "string", "enum": list(JOB_ANALYSES)},
             "status": {"type": "string", "enum": ["queued", "running", "done", "failed", "cancelled"]},
             "progress": {"type": "number", "minimum": 0, "maximum": 1}, "message": {"type": "string"},
             "error": {"type": ["string", "null"]}, "request": {"type": "object"}, "result": {"type": "object"}}}}
@@ -301,7 +300,7 @@ def openapi_document() -> dict[str, Any]:
             "responses": {"200": {"description": "the result (X-Shimmy-Cache: hit|miss)"}, "400": err, "408": err,
                           "413": err, "415": err, "422": err}}}
     job_bodies = []
-    for name in schemas.JOB_ANALYSES:
+    for name in JOB_ANALYSES:
         s = schemas.SCHEMAS[name]
         body = s.openapi()
         body["properties"] = {"analysis": {"type": "string", "enum": [name]}, **body["properties"]}
@@ -309,7 +308,7 @@ def openapi_document() -> dict[str, Any]:
         comps[f"job_{name}"] = body
         job_bodies.append({"$ref": f"#/components/schemas/job_{name}"})
     paths["/jobs"] = {"post": {
-        "summary": "start a long analysis (" + ", ".join(schemas.JOB_ANALYSES) + ")",
+        "summary": "start a long analysis (" + ", ".join(JOB_ANALYSES) + ")",
         "requestBody": {"required": True, "content": {"application/json": {"schema": {"oneOf": job_bodies}}}},
         "responses": {"202": {"description": "accepted", "content": {"application/json": {
             "schema": {"$ref": "#/components/schemas/Job"}}}}, "400": err, "408": err, "413": err, "415": err,

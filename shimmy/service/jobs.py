@@ -36,7 +36,7 @@ from typing import Any
 import diskcache
 import psutil
 
-from . import cache, schemas, settings
+from . import analyses, cache, schemas, settings
 
 ACTIVE = ("queued", "running")
 HOST = socket.gethostname()
@@ -85,10 +85,10 @@ def update(job_id: str, **changes) -> dict[str, Any] | None:
 def submit(analysis: str, body: dict[str, Any]) -> dict[str, Any]:
     """The job for ``body``: done at once from the cache, the same job when an identical one is
     queued or running, else a new queued job (QueueFull when the queue is full)."""
-    if analysis not in schemas.JOB_ANALYSES:
+    if analysis not in analyses.JOB_ANALYSES:
         from ..model.parameters import unknown_name_error
 
-        raise unknown_name_error(analysis, list(schemas.JOB_ANALYSES), "analysis")
+        raise unknown_name_error(analysis, list(analyses.JOB_ANALYSES), "analysis")
     request = schemas.validate(analysis, body, extra=("analysis",))
     return submit_canonical(analysis, request)
 
@@ -306,8 +306,6 @@ def run(job_id: str) -> None:
 
 def _run_one(job_id: str) -> bool:
     """Run one job; False if it was cancelled."""
-    from . import analyses
-
     job = update(job_id, status="running", message="running", heartbeat=_now())
     if job is None or job["status"] != "running":
         return job is not None and job["status"] != "cancelled"

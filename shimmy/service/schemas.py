@@ -642,11 +642,6 @@ SCHEMAS: dict[str, RequestSchema] = {
         PARAMS, MATERIAL)),
 }
 
-#: Analyses that run as background jobs (POST /api/v1/jobs).
-JOB_ANALYSES = ("simulate", "bifurcation", "hopf_curves", "map", "study", "ground_run", "sensitivity", "optimise",
-                "robustness")
-
-
 def validate(analysis: str, body: Any, extra: tuple[str, ...] = ()) -> dict[str, Any]:
     if analysis not in SCHEMAS:
         raise unknown_name_error(analysis, list(SCHEMAS), "analysis")

@@ -37,16 +37,28 @@ def test_refusals_name_the_field(body, field):
     assert info.value.field == field
 
 
+def test_every_analysis_is_declared_once_with_its_schema_and_runner():
+    """The registries derive from one declaration per analysis (schema, runner, sync or job)."""
+    from shimmy.service import analyses
+
+    assert list(analyses.ANALYSES) == list(analyses.RUNNERS) and set(analyses.ANALYSES) == set(schemas.SCHEMAS)
+    for name, a in analyses.ANALYSES.items():
+        assert a.schema is schemas.SCHEMAS[name] and (a.sync or a.job), name
+    assert analyses.SYNC_ANALYSES == ("simulate", "hopf", "stability", "devices", "sensitivity")
+    assert analyses.JOB_ANALYSES == ("simulate", "bifurcation", "hopf_curves", "map", "study", "ground_run",
+                                     "sensitivity", "optimise", "robustness")
+
+
 def test_openapi_fields_match_the_schemas():
     from shimmy.service.api import openapi_document
 
     doc = openapi_document()
-    from shimmy.service.api import SYNC_ANALYSES
+    from shimmy.service.api import JOB_ANALYSES, SYNC_ANALYSES
 
     for name in SYNC_ANALYSES:
         props = doc["components"]["schemas"][f"{name}_request"]["properties"]
         assert set(props) == {f.name for f in schemas.SCHEMAS[name].fields}
-    for name in schemas.JOB_ANALYSES:
+    for name in JOB_ANALYSES:
         assert doc["components"]["schemas"][f"job_{name}"]["properties"]["analysis"]["enum"] == [name]
     # The document says exactly which design parameters the server takes, with their ranges.
     from shimmy.model.parameters import PARAMETER_SPECS

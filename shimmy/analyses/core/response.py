@@ -55,6 +55,23 @@ def peak_amplitude(signal: np.ndarray) -> float:
     return float(a[i])
 
 
+def windowed_power(signal: np.ndarray, window: np.ndarray, n_fft: int | None = None) -> np.ndarray:
+    """|FFT|^2 of the signal with its mean removed, times ``window``, zero-padded to ``n_fft`` samples."""
+    signal = np.asarray(signal, dtype=float)
+    return np.abs(np.fft.rfft((signal - signal.mean()) * window, n_fft)) ** 2
+
+
+def power_spectra(signals: dict[str, np.ndarray], dt: float, f_max: float) -> dict[str, list[float]]:
+    """Power spectra (Hann window, mean removed, no padding) of equally sampled signals up to ``f_max``
+    (Hz), for plots: ``{"frequency_hz": [...], name: [...] for each signal}``."""
+    n = next(iter(signals.values())).size
+    window = np.hanning(n)
+    freq = np.fft.rfftfreq(n, dt)
+    keep = freq <= f_max
+    return {"frequency_hz": freq[keep].tolist(), **{k: windowed_power(s, window)[keep].tolist()
+                                                    for k, s in signals.items()}}
+
+
 def dominant_frequency(signals: list[np.ndarray], dt: float) -> float:
     """Peak frequency (Hz) of the summed power spectra of equally sampled signals."""
     n = signals[0].size
@@ -64,8 +81,7 @@ def dominant_frequency(signals: list[np.ndarray], dt: float) -> float:
     n_fft = 8 * int(2 ** np.ceil(np.log2(n)))
     power = np.zeros(n_fft // 2 + 1)
     for s in signals:
-        s = np.asarray(s, dtype=float)
-        power += np.abs(np.fft.rfft((s - s.mean()) * window, n_fft)) ** 2
+        power += windowed_power(s, window, n_fft)
     k = int(np.argmax(power[1:])) + 1
     if power[k] <= 0.0:
         return float("nan")

@@ -20,14 +20,16 @@ from ...model.configurations import STATE_NAMES, Configuration
 from ...model.equations import build_model
 from ...errors import InvalidParameterError
 from ...model.parameters import Parameters, check_number, check_operating_point
-from .response import DECAYED_FRACTION, ResponseType, classify_run, dominant_frequency, peak_amplitude
+from .response import (DECAYED_FRACTION, ResponseType, classify_run, dominant_frequency, peak_amplitude,
+                       power_spectra)
 
 #: Largest simulated time and the densest output accepted (service limits build on these).
 MAX_T_END = 3600.0
 MAX_SAMPLES = 5_000_000
 DEFAULT_PSI0 = 0.001
 
-_STATUS_MESSAGES = {
+#: What each integrator status means, as a result's message (ground runs use the same).
+STATUS_MESSAGES = {
     integrator.SUCCESS: "integration finished",
     integrator.MAX_STEPS: "step budget exhausted before t_end (max_steps); the result is truncated",
     integrator.NES_OUT_OF_RANGE: ("the NES relative rotation |psi - psis| reached pi/6, where the exact "
@@ -123,6 +125,14 @@ class SimulationResult:
         cols["lateral"] = self.lateral
         return {k: v.tolist() for k, v in cols.items()}
 
+    def spectrum(self, f_max: float = 60.0) -> dict[str, Any]:
+        """Power spectra of psi and l_g delta over the steady window up to ``f_max`` (Hz), for plots, with
+        the dominant frequency (Hz; None where there is none)."""
+        dt = self.options.dt_out
+        span = max(8, int(round(self.options.steady_window / dt)))
+        spectra = power_spectra({"psi": self.states[0, -span:], "lateral": self.lateral[-span:]}, dt, f_max)
+        return {**spectra, "dominant_hz": _json_float(self.frequency_hz)}
+
     def write_csv(self, path) -> None:
         names = ["t", *STATE_NAMES[:self.states.shape[0]], "lateral"]
         data = np.column_stack([self.t, self.states.T, self.lateral])
@@ -171,7 +181,7 @@ def simulate(config: Configuration | str, V: float, Fz: float, *, params: Parame
     measures = _steady_measures(states, start[:n], params, options, frequency)
     return SimulationResult(
         config=config, V=V, Fz=Fz, params=params, options=options, t=t, states=states,
-        success=status == integrator.SUCCESS, status=int(status), message=_STATUS_MESSAGES[status],
+        success=status == integrator.SUCCESS, status=int(status), message=STATUS_MESSAGES[status],
         counters={"steps": int(accepted), "rejected": int(rejected), "rhs_calls": int(calls)},
         elapsed_s=elapsed, **measures)
 

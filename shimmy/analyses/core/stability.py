@@ -56,11 +56,6 @@ class Criticality(str, Enum):
     DEGENERATE = "degenerate"
 
 
-class CrossingKind(str, Enum):
-    HOPF = "H"
-    BRANCH_POINT = "BP"
-
-
 class Linearisation:
     """J(V) = J0 + V J1 + J2 / V at x = 0 for one model and load Fz."""
 
@@ -260,3 +255,27 @@ def first_lyapunov_coefficient(model: Model, V: float, Fz: float, eps: float = 1
     """l1 of x = 0 at a Hopf point (V, Fz) of a smooth configuration; < 0 is supercritical."""
     return lyapunov.first_lyapunov_coefficient(lambda x: jacobian(model, x, V, Fz), model.n_states,
                                                eps=eps)
+
+
+def growth_rates(Fz: float, *, params: Parameters | None = None, v_range: tuple[float, float] = V_RANGE,
+                 n_points: int = 200) -> dict[str, Any]:
+    """Straight rolling's leading eigenvalue against V on a geometric grid of ``n_points`` speeds in
+    ``v_range`` (m/s), with the Hopf points and unstable intervals, for every configuration:
+    ``{"V": [...], "configs": {name: {"max_real" (1/s), "frequency_hz", "hopf_points", "unstable_intervals"}}}``."""
+    params = params or Parameters()
+    v_min, v_max = check_pair("v_range", v_range)
+    V = np.geomspace(v_min, v_max, n_points)
+    out: dict[str, Any] = {"V": V.tolist(), "configs": {}}
+    for config in Configuration:
+        lin = Linearisation(build_model(config, params), Fz)
+        ev = lin.eigenvalues(V)
+        k = np.argmax(ev.real, axis=1)
+        lead = ev[np.arange(V.size), k]
+        # A coarse grid suffices: the near-axis extremum scan catches pairs between grid points
+        # (tests/analyses/core/test_stability.py: 12 points find what 20 000 do); 1e-7 m/s is far below display.
+        h = hopf_points(config, Fz, params=params, v_range=(v_min, v_max), n_grid=80, v_tol=1e-7)
+        out["configs"][config.value] = {
+            "max_real": lead.real.tolist(), "frequency_hz": (np.abs(lead.imag) / (2 * np.pi)).tolist(),
+            "hopf_points": [p.to_dict() for p in h.hopf_points],
+            "unstable_intervals": [list(iv) for iv in h.unstable_intervals]}
+    return out

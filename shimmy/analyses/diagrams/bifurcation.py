@@ -222,7 +222,7 @@ def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | 
     branches = [_equilibrium_output(eq, hopf)]
 
     popts = options.periodic()
-    limits = _limits(model)
+    limits = orbit_limits(model)
     done: list[float] = []
     large = [(V, what, size) for V in LARGE_SEED_SPEEDS if v_min < V < v_max for what, size in LARGE_STARTS]
     units = max(1, len(starts)) + (len(_seed_speeds(hopf)) + len(large) if options.seeds else 0)
@@ -294,7 +294,9 @@ def _seed_speeds(hopf: HopfResult) -> list[float]:
     return sorted(speeds)
 
 
-def _limits(model: Model):
+def orbit_limits(model: Model):
+    """The stop rule of the gear's periodic branches (and curves of cycles): a check of an orbit's
+    extremes, period and speed that returns why the branch must stop there, or None."""
     has_nes = model.config.has_nes
 
     def check(x_max, x_min, T, V):

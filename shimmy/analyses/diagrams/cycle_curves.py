@@ -37,7 +37,7 @@ from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.equations import build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number, check_range
-from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation
+from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, orbit_limits, bifurcation
 from .hopf_curves import hopf_curves
 from ..core.polylines import near_polyline
 from ..core.executors import open_executor, run_dynamic
@@ -449,7 +449,7 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
             if abs(math.log(h.V / point["V"])) > 0.2:
                 continue
             found, ncol = start_beside(system, kind, np.zeros(n), np.array([h.V, Fz]), v_range, STATE_SCALE[:n],
-                                       V_SCALE, options, limits=_limits(model))
+                                       V_SCALE, options, limits=orbit_limits(model))
             if found is not None:
                 # eager when born at the point (a branch beside it may fold or lose stability
                 # first on another curve, far away: that start waits like a diagram's)

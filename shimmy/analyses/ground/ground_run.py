@@ -49,7 +49,7 @@ from ...model.equations import build_model, jacobian
 from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number
 from .ground_profiles import GroundProfile, as_profile
 from ..core.response import dominant_mode, torsional_share
-from ..core.simulation import _STATUS_MESSAGES, SimulationOptions, initial_state
+from ..core.simulation import STATUS_MESSAGES, SimulationOptions, initial_state
 
 CROSSING_GRID = 0.05  # s: spacing of the eigenvalue checks along the trajectory
 CROSSING_TOL = 1e-9  # s
@@ -220,7 +220,7 @@ def ground_run(config: Configuration | str, profile: Any, *, params: Parameters 
         shimmy_intervals=intervals, speed_range=speed_range,
         peak_psi=_peak(np.abs(states[0]), t, V, Fz), peak_lateral=_peak(np.abs(lateral), t, V, Fz),
         boundary_crossings=crossings, onsets=onsets, success=status == integrator.SUCCESS, status=int(status),
-        message=_STATUS_MESSAGES[status],
+        message=STATUS_MESSAGES[status],
         counters={"steps": int(accepted), "rejected": int(rejected), "rhs_calls": int(calls),
                   "integration_ms": int(round(1e3 * integration_s))},
         elapsed_s=time.perf_counter() - clock, warnings=warnings)
