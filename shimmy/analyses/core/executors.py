@@ -29,7 +29,7 @@ import multiprocessing
 import os
 import threading
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, as_completed, wait
-from typing import Any, Callable, Iterator, Sequence
+from typing import Any, Callable, Iterator, Protocol, Sequence
 
 from ...errors import InvalidParameterError
 
@@ -49,6 +49,23 @@ class InlineExecutor(Executor):
         except BaseException as exc:  # noqa: B036 - handed to the caller through the future
             future.set_exception(exc)
         return future
+
+
+class WorkUnit(Protocol):
+    """An independent unit of work: a small frozen dataclass, shipped to any process or Dask worker."""
+
+    def run(self) -> Any: ...
+
+    def describe(self) -> str: ...
+
+
+def run_work_unit(unit: WorkUnit) -> Any:
+    """Run one unit (top level, so that process pools and Dask can ship it)."""
+    return unit.run()
+
+
+def describe_work_unit(unit: WorkUnit) -> str:
+    return unit.describe()
 
 
 def worker_count(max_workers: int | None = None) -> int:

@@ -40,7 +40,7 @@ from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, 
 from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, orbit_limits, bifurcation
 from .hopf_curves import hopf_curves
 from ..core.polylines import near_polyline
-from ..core.executors import open_executor, run_dynamic
+from ..core.executors import describe_work_unit, open_executor, run_dynamic, run_work_unit
 from ..core.stability import hopf_points
 
 KINDS = ("LPC", "NS", "PD")
@@ -182,9 +182,9 @@ def _close(a: dict, b: dict, tol: float) -> bool:
 
 class CurveSearch:
     """The state of a search for every curve of some kinds in a box: the starts found so far,
-    the curves continued from them, the continuations under way. Units (see :func:`search_unit`)
-    come from :meth:`start_units` (branches beside codimension-2 points of the Hopf curves) and
-    from :meth:`continuations`; whoever runs them hands back their results (:meth:`add_beside`,
+    the curves continued from them, the continuations under way. Units (:data:`SearchUnit`) come
+    from :meth:`start_units` (branches beside codimension-2 points of the Hopf curves) and from
+    :meth:`continuations`; whoever runs them hands back their results (:meth:`add_beside`,
     :meth:`add_source` for a diagram's points, :meth:`add_curve`).
 
     A start is continued only if it lies on no curve known; one curve of each kind is under way
@@ -208,13 +208,13 @@ class CurveSearch:
         self.warnings: list[str] = []
         self.tried = 0
         self.hopf_pending = True  # the Hopf curves (and so the units beside their points) not yet in
-        self.beside_order: list[tuple] = []  # the units beside codimension-2 points, in order
+        self.beside_order: list[BesideUnit] = []  # the units beside codimension-2 points, in order
         self.beside_in: dict[int, tuple[list[Start], list[str]]] = {}
         self.beside_taken = 0
         self.sources_pending = 0  # diagrams expected and not yet in
         self.source_buffer: list[Start] = []
 
-    def start_units(self, hopf) -> list[tuple]:
+    def start_units(self, hopf) -> list[BesideUnit]:
         """The branches beside the GH points (fold curves) and double-Hopf points (torus curves)."""
         self.gh = [{"V": g["p"][0], "Fz": g["p"][1]} for c in hopf.curves for g in c.gh_points]
         for c in hopf.curves:
@@ -222,11 +222,11 @@ class CurveSearch:
                 entry = {"V": g["p"][0], "Fz": g["p"][1], "omega": g["omega"], "omega2": g["omega2"]}
                 if not any(_close(entry, e, 1e-4) for e in self.hh):
                     self.hh.append(entry)
-        units = [("beside", self.config, self.params, g, "LPC", self.box,
-                  f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+        units = [BesideUnit(self.config, self.params, g, "LPC", self.box,
+                            f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
                  for g in self.gh if "LPC" in self.kinds]
-        units += [("beside", self.config, self.params, g, "NS", self.box,
-                   f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+        units += [BesideUnit(self.config, self.params, g, "NS", self.box,
+                             f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
                   for g in self.hh if "NS" in self.kinds]
         self.hopf_pending = False
         self.beside_order += units
@@ -235,9 +235,9 @@ class CurveSearch:
     def _usable(self, starts: list[Start]) -> list[Start]:
         return [s for s in starts if s.kind in self.kinds and s.point.solution is not None]
 
-    def add_beside(self, task: tuple, starts: list[Start], warnings: list[str]) -> None:
+    def add_beside(self, unit: BesideUnit, starts: list[Start], warnings: list[str]) -> None:
         """A unit beside a codimension-2 point is in; its starts count in the order of the points."""
-        self.beside_in[next(k for k, u in enumerate(self.beside_order) if u is task)] = (starts, warnings)
+        self.beside_in[next(k for k, u in enumerate(self.beside_order) if u is unit)] = (starts, warnings)
         while self.beside_taken in self.beside_in:
             starts, warnings = self.beside_in.pop(self.beside_taken)
             self.starts += self._usable(starts)
@@ -282,7 +282,7 @@ class CurveSearch:
         """Nothing under way, waiting or expected: the curves stand as they are."""
         return not (self.running or self.starts or self._gathering())
 
-    def continuations(self) -> list[tuple]:
+    def continuations(self) -> list[ContinueUnit]:
         """Units continuing the waiting starts that may (see the class)."""
         l_g = self.params.gear.l_g
         self.starts = [s for s in self.starts
@@ -293,7 +293,7 @@ class CurveSearch:
                 continue
             self.starts.remove(s)
             self.running.append(s)
-            units.append(("continue", self.config, self.params, s, self.box, self.loads))
+            units.append(ContinueUnit(self.config, self.params, s, self.box, self.loads))
         return units
 
     def result(self, elapsed_s: float) -> CycleCurvesResult:
@@ -304,28 +304,81 @@ class CurveSearch:
                                  self.gh, hh, self.loads, elapsed_s, self.tried, sorted(self.warnings))
 
 
-def search_unit(task: tuple) -> Any:
-    """One unit of a curve search, in any process: ("beside" | "scan", ...) -> (starts, warnings);
-    ("continue", ...) -> (curve or None, warning or None)."""
-    if task[0] == "continue":
-        return _continue(task[1:])
-    return _find_starts(task)
+@dataclass(frozen=True, eq=False)
+class BesideUnit:
+    """The branches beside one codimension-2 point of the Hopf curves: (starts, warnings)."""
+
+    config: Configuration
+    params: Parameters
+    point: dict[str, Any]
+    kind: str
+    box: tuple[tuple[float, float], tuple[float, float]]
+    origin: str
+
+    def run(self) -> tuple[list[Start], list[str]]:
+        model = build_model(self.config, self.params)
+        return _starts_beside(self.config, model, self.params, self.point, self.kind, self.box[0], self.box[1],
+                              self.origin), []
+
+    def describe(self) -> str:
+        return f"branches {self.origin}"
+
+    def hand_in(self, search: CurveSearch, result: tuple[list[Start], list[str]]) -> None:
+        search.add_beside(self, *result)
 
 
-def describe_search_unit(task: tuple) -> str:
-    if task[0] == "continue":
-        return f"{task[3].kind} curve from V = {task[3].point.p:.4g} m/s, Fz = {task[3].Fz / 1e3:.4g} kN"
-    return _describe_task(task)
+@dataclass(frozen=True, eq=False)
+class ScanUnit:
+    """The diagram and the large-amplitude starts at one load: (starts, warnings)."""
 
+    config: Configuration
+    params: Parameters
+    Fz: float
+    box: tuple[tuple[float, float], tuple[float, float]]
 
-def search_done(search: CurveSearch, task: tuple, result: Any) -> list[tuple]:
-    """Hand a finished search unit's result to ``search``; the continuations it makes possible."""
-    if task[0] == "continue":
-        search.add_curve(task[3], *result)
-    elif task[0] == "beside":
-        search.add_beside(task, *result)
-    else:
+    def run(self) -> tuple[list[Start], list[str]]:
+        try:
+            diagram = bifurcation(self.config, self.Fz, v_range=self.box[0], params=self.params,
+                                  options=BifurcationOptions(mesh_check=False))
+        except ContinuationError as exc:
+            return [], [f"diagram at Fz = {self.Fz:.6g} N failed: {exc}"]
+        return starts_of_diagram(diagram, self.Fz), []
+
+    def describe(self) -> str:
+        return f"diagram and large-amplitude starts at Fz = {self.Fz / 1e3:.4g} kN"
+
+    def hand_in(self, search: CurveSearch, result: tuple[list[Start], list[str]]) -> None:
         search.add_source(*result)
+
+
+@dataclass(frozen=True, eq=False)
+class ContinueUnit:
+    """One curve continued from one start: (curve or None, warning or None)."""
+
+    config: Configuration
+    params: Parameters
+    start: Start
+    box: tuple[tuple[float, float], tuple[float, float]]
+    loads: tuple[float, ...]
+
+    def run(self) -> tuple[GearCycleCurve | None, str | None]:
+        return _continue(self.config, self.params, self.start, self.box, self.loads)
+
+    def describe(self) -> str:
+        return f"{self.start.kind} curve from V = {self.start.point.p:.4g} m/s, Fz = {self.start.Fz / 1e3:.4g} kN"
+
+    def hand_in(self, search: CurveSearch, result: tuple[GearCycleCurve | None, str | None]) -> None:
+        search.add_curve(self.start, *result)
+
+
+#: A unit of a curve search: run in any process (:func:`~..core.executors.run_work_unit`), its result handed
+#: back to the search by :meth:`hand_in`.
+SearchUnit = BesideUnit | ScanUnit | ContinueUnit
+
+
+def search_done(search: CurveSearch, unit: SearchUnit, result: Any) -> list[ContinueUnit]:
+    """Hand a finished search unit's result to ``search``; the continuations it makes possible."""
+    unit.hand_in(search, result)
     return search.continuations()
 
 
@@ -367,9 +420,10 @@ def cycle_curves(config: Configuration | str, *, params: Parameters | None = Non
     search = CurveSearch(config, params, box, kinds, loads)
     search.expect_sources(len(SCAN_FRACTIONS))
     units = [(1, u) for u in search.start_units(hopf)]
-    units += [(2, ("scan", config, params, f_lo + fr * (f_hi - f_lo), box)) for fr in SCAN_FRACTIONS]
-    run_dynamic(search_unit, units, executor, lambda task, result: [(0, u) for u in search_done(search, task, result)],
-                lambda f, m: report(0.05 + 0.95 * f, m), describe_search_unit)
+    units += [(2, ScanUnit(config, params, f_lo + fr * (f_hi - f_lo), box)) for fr in SCAN_FRACTIONS]
+    run_dynamic(run_work_unit, units, executor,
+                lambda unit, result: [(0, u) for u in search_done(search, unit, result)],
+                lambda f, m: report(0.05 + 0.95 * f, m), describe_work_unit)
     report(1.0, "done")
     return search.result(time.perf_counter() - clock)
 
@@ -381,31 +435,9 @@ def starts_of_diagram(diagram, Fz: float) -> list[Start]:
             for s in b.raw.special_points if s.kind in KINDS]
 
 
-def _describe_task(task: tuple) -> str:
-    if task[0] == "scan":
-        return f"diagram and large-amplitude starts at Fz = {task[3] / 1e3:.4g} kN"
-    return f"branches {task[6]}"
-
-
-def _find_starts(task: tuple) -> tuple[list[Start], list[str]]:
-    """Starts of one unit: the branches beside one codimension-2 point, or the diagram and the
-    large-amplitude starts at one load (a unit of :func:`cycle_curves`, run in any process)."""
-    if task[0] == "beside":
-        _, config, params, point, kind, box, origin = task
-        model = build_model(config, params)
-        return _starts_beside(config, model, params, point, kind, box[0], box[1], origin), []
-    _, config, params, Fz, box = task
-    try:
-        diagram = bifurcation(config, Fz, v_range=(box[0][0], box[0][1]), params=params,
-                              options=BifurcationOptions(mesh_check=False))
-    except ContinuationError as exc:
-        return [], [f"diagram at Fz = {Fz:.6g} N failed: {exc}"]
-    return starts_of_diagram(diagram, Fz), []
-
-
-def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
+def _continue(config: Configuration, params: Parameters, start: Start, box, loads: tuple[float, ...]
+              ) -> tuple[GearCycleCurve | None, str | None]:
     """One curve continued from one start (a unit of :func:`cycle_curves`)."""
-    config, params, start, box, loads = task
     system = gear_cycle_field(config, params)
     kappa = math.cos(start.point.data["torus_angle"]) if start.kind == "NS" else None
     if kappa is not None and not -1.0 < kappa < 1.0:

@@ -50,8 +50,7 @@ from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurc
 from ...model.configurations import Configuration
 from ...errors import InvalidParameterError
 from . import map_shading
-from ..diagrams.cycle_curves import (CurveSearch, describe_search_unit, search_done, search_unit,
-                           starts_of_diagram)
+from ..diagrams.cycle_curves import CurveSearch, SearchUnit, search_done, starts_of_diagram
 from ..core.executors import name_of, open_executor, run_dynamic
 from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
 from ...model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, V_RANGE, Parameters, check_number,
@@ -397,23 +396,43 @@ class StabilityMap:
                     w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
 
 
-def _unit(task: tuple) -> Any:
-    """One independent unit of a map (top level, so that process pools and Dask can ship it)."""
-    if task[0] == "hopf_curves":
-        _, config, params, v_range, fz_range = task
-        return hopf_curves(config, params=params, v_range=v_range, fz_range=fz_range)
-    if task[0] == "slice":
-        _, config, Fz, v_min, v_max, n_v, params, options = task
-        return map_slice(config, Fz, v_range=(v_min, v_max), n_v=n_v, params=params, options=options)
-    return search_unit(task)
+@dataclass(frozen=True, eq=False)
+class HopfCurvesUnit:
+    """A map's Hopf curves."""
 
+    config: Configuration
+    params: Parameters
+    v_range: tuple[float, float]
+    fz_range: tuple[float, float]
 
-def _describe(task: tuple) -> str:
-    if task[0] == "hopf_curves":
+    def run(self) -> HopfCurvesResult:
+        return hopf_curves(self.config, params=self.params, v_range=self.v_range, fz_range=self.fz_range)
+
+    def describe(self) -> str:
         return "Hopf curves"
-    if task[0] == "slice":
-        return f"slice Fz = {task[2] / 1e3:.4g} kN"
-    return describe_search_unit(task)
+
+
+@dataclass(frozen=True, eq=False)
+class SliceUnit:
+    """A map's classified slice at one load."""
+
+    config: Configuration
+    Fz: float
+    v_range: tuple[float, float]
+    n_v: int
+    params: Parameters
+    options: BifurcationOptions
+
+    def run(self) -> SliceResult:
+        return map_slice(self.config, self.Fz, v_range=self.v_range, n_v=self.n_v, params=self.params,
+                         options=self.options)
+
+    def describe(self) -> str:
+        return f"slice Fz = {self.Fz / 1e3:.4g} kN"
+
+
+#: A unit of a map: its Hopf curves, a slice, or a unit of its curve search.
+MapUnit = HopfCurvesUnit | SliceUnit | SearchUnit
 
 
 class _MapBuild:
@@ -441,19 +460,18 @@ class _MapBuild:
         self.pending = 0  # units submitted or queued and not finished
         self.finished_at = 0.0  # s after the start when its last unit finished
 
-    def _slice_unit(self, Fz: float) -> tuple:
-        v_min, v_max = self.v_range
-        return ("slice", self.config, float(Fz), v_min, v_max, self.n_v, self.params, self.options)
+    def _slice_unit(self, Fz: float) -> SliceUnit:
+        return SliceUnit(self.config, float(Fz), self.v_range, self.n_v, self.params, self.options)
 
-    def _counted(self, units: list[tuple[int, tuple]]) -> list[tuple[int, tuple]]:
+    def _counted(self, units: list[tuple[int, MapUnit]]) -> list[tuple[int, MapUnit]]:
         self.pending += len(units)
         return units
 
-    def first_units(self) -> list[tuple[int, tuple]]:
-        units = [(0, ("hopf_curves", self.config, self.params, self.v_range, self.fz_range))]
+    def first_units(self) -> list[tuple[int, MapUnit]]:
+        units = [(0, HopfCurvesUnit(self.config, self.params, self.v_range, self.fz_range))]
         return self._counted(units + [(2, self._slice_unit(Fz)) for Fz in self.loads])
 
-    def _coverage(self) -> list[tuple[int, tuple]]:
+    def _coverage(self) -> list[tuple[int, SliceUnit]]:
         """Slices through the regions that no slice load (computed or under way) crosses: what
         a region's boundaries are does not depend on the slices, only on the curves."""
         if self.rounds == COVERAGE_ROUNDS:
@@ -467,19 +485,19 @@ class _MapBuild:
         self.search.expect_sources(len(extra))
         return [(2, self._slice_unit(Fz)) for Fz in extra]
 
-    def done(self, task: tuple, result: Any, elapsed: float) -> list[tuple[int, tuple]]:
+    def done(self, unit: MapUnit, result: Any, elapsed: float) -> list[tuple[int, MapUnit]]:
         """The units that a finished unit's result adds: curves from its starts, coverage slices
         once the curves as they stand are all continued."""
         self.pending -= 1
-        if task[0] == "hopf_curves":
+        if isinstance(unit, HopfCurvesUnit):
             self.hopf = result
             more = [(0, u) for u in self.search.start_units(result)] + [(0, u) for u in self.search.continuations()]
-        elif task[0] == "slice":
+        elif isinstance(unit, SliceUnit):
             self.slices.append(result)
             self.search.add_source(result.starts)
             more = [(0, u) for u in self.search.continuations()]
         else:
-            more = [(0, u) for u in search_done(self.search, task, result)]
+            more = [(0, u) for u in search_done(self.search, unit, result)]
         if self.search.idle() and self.hopf is not None:  # the curves as they stand
             more += self._coverage()
         if not more and self.pending == 0:
@@ -505,9 +523,9 @@ class _MapBuild:
                             self.finished_at + time.perf_counter() - clock, warnings)
 
 
-def _tagged_unit(tagged: tuple[int, tuple]) -> Any:
+def _tagged_unit(tagged: tuple[int, MapUnit]) -> Any:
     """A unit of map ``tagged[0]`` of :func:`stability_maps` (top level, for process pools and Dask)."""
-    return _unit(tagged[1])
+    return tagged[1].run()
 
 
 def stability_maps(configs: Sequence[Configuration | str], *, params: Parameters | None = None,
@@ -536,18 +554,18 @@ def stability_maps(configs: Sequence[Configuration | str], *, params: Parameters
     report = progress or (lambda fraction, message: None)
     several = len(builds) > 1
 
-    def done(tagged: tuple[int, tuple], result: Any) -> list[tuple[int, tuple]]:
-        k, task = tagged
-        more = builds[k].done(task, result, time.perf_counter() - clock)
-        return [(priority, (k, unit)) for priority, unit in more]
+    def done(tagged: tuple[int, MapUnit], result: Any) -> list[tuple[int, tuple[int, MapUnit]]]:
+        k, unit = tagged
+        more = builds[k].done(unit, result, time.perf_counter() - clock)
+        return [(priority, (k, u)) for priority, u in more]
 
-    def describe(tagged: tuple[int, tuple]) -> str:
-        k, task = tagged
-        return f"{builds[k].config.value}: {_describe(task)}" if several else _describe(task)
+    def describe(tagged: tuple[int, MapUnit]) -> str:
+        k, unit = tagged
+        return f"{builds[k].config.value}: {unit.describe()}" if several else unit.describe()
 
     units = [(priority, (k, unit)) for k, b in enumerate(builds) for priority, unit in b.first_units()]
     run_dynamic(_tagged_unit, units, executor, done, report, describe,
-                lambda tagged: "slices" if tagged[1][0] == "slice" else "curve units")
+                lambda tagged: "slices" if isinstance(tagged[1], SliceUnit) else "curve units")
     maps = [b.result(type(executor).__name__) for b in builds]
     report(1.0, "done")
     return maps

@@ -105,7 +105,7 @@ def test_a_torus_start_at_a_strong_resonance_gives_no_one_point_curve():
     the circle and leaves kappa's range [-1, 1] in both directions at once. That is not a curve
     (one point bounds no region): the search is told why, in a warning, and keeps no curve."""
     from shimmy.analyses.diagrams.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
-    from shimmy.analyses.diagrams.cycle_curves import Start, _continue
+    from shimmy.analyses.diagrams.cycle_curves import ContinueUnit, Start
     from shimmy.continuation import Mesh, PeriodicProblem, SpecialPoint
     from shimmy.model.configurations import Configuration
     from shimmy.model.equations import build_model
@@ -132,7 +132,7 @@ def test_a_torus_start_at_a_strong_resonance_gives_no_one_point_curve():
     assert angle > 3.1 and abs(abs(pair[0]) - 1.0) < 0.02
     start = Start("NS", SpecialPoint("NS", float(raw.p[0]), 0, {"torus_angle": angle}, solution=(mesh_points, u)),
                   Fz, raw.ncol, "the cycles born at the Hopf point at 4.0175 m/s")
-    curve, warning = _continue((Configuration.parse("pd"), Parameters(), start, ((1.0, 200.0), (1e4, 9e5)), ()))
+    curve, warning = ContinueUnit(Configuration.parse("pd"), Parameters(), start, ((1.0, 200.0), (1e4, 9e5)), ()).run()
     assert curve is None and "gives no curve" in warning and "kappa = -1 left" in warning
 
 
@@ -141,7 +141,7 @@ def test_a_fold_start_next_to_a_hopf_point_converges():
     starts the fold curve, which crosses the whole speed range. (Small cycles: the fold test
     function is nearly flat; with the condensed LU its rounding noise once gave Newton
     corrections of 1.6e-9, above the tolerance, that never shrank, and the curve was lost.)"""
-    from shimmy.analyses.diagrams.cycle_curves import _continue, starts_of_diagram
+    from shimmy.analyses.diagrams.cycle_curves import ContinueUnit, starts_of_diagram
     from shimmy.model.configurations import Configuration
     from shimmy.model.parameters import Parameters
 
@@ -149,8 +149,8 @@ def test_a_fold_start_next_to_a_hopf_point_converges():
     diagram = bifurcation("nes_pd", Fz, v_range=(1.0, 200.0), options=BifurcationOptions(mesh_check=False))
     starts = [s for s in starts_of_diagram(diagram, Fz) if s.kind == "LPC" and abs(s.point.p - 127.387) < 0.01]
     assert len(starts) == 1
-    curve, warning = _continue((Configuration.parse("nes_pd"), Parameters(), starts[0], ((1.0, 200.0), (1e4, 9e5)),
-                                ()))
+    curve, warning = ContinueUnit(Configuration.parse("nes_pd"), Parameters(), starts[0],
+                                  ((1.0, 200.0), (1e4, 9e5)), ()).run()
     assert warning is None and curve is not None, warning
     V = curve.curve.p[:, 0]
     assert V.min() == pytest.approx(1.0) and V.max() == pytest.approx(200.0)
