@@ -133,6 +133,26 @@ def test_analyses_never_import_the_service_the_cli_or_a_ui():
         assert not {n.split(".")[0] for n in imports(path)} & UI_LIBRARIES, path.name
 
 
+def test_no_private_name_is_imported_across_modules():
+    """A leading underscore means "this module's own": another module that needs it gets a public name."""
+    files = [*PACKAGE.rglob("*.py"), ROOT / "app.py", *(ROOT / "pages").glob("*.py"), *(ROOT / "ui").rglob("*.py")]
+    for path in files:
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module != "__future__":
+                private = [a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+                assert not private, (path.relative_to(ROOT), node.module, private)
+
+
+def test_the_service_does_no_numerics():
+    """The service validates, caches, queues and serialises; spectra, eigenvalues and sweeps are analyses."""
+    for path in files_of("service"):
+        tree = ast.parse(path.read_text())
+        assert not {n.split(".")[0] for n in imports(path)} & {"scipy", "numba"}, path.name
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "np":
+                assert node.attr not in ("fft", "linalg", "hanning", "geomspace", "argmax"), (path.name, node.attr)
+
+
 def test_service_never_imports_dash_or_the_ui():
     for path in files_of("service"):
         assert not {n.split(".")[0] for n in imports(path)} & {"dash", "plotly", "ui", "pages", "app"}, path.name
