@@ -371,8 +371,8 @@ class ContinueUnit:
         search.add_curve(self.start, *result)
 
 
-#: A unit of a curve search: run in any process (:func:`~..core.executors.run_work_unit`), its result handed
-#: back to the search by :meth:`hand_in`.
+#: A unit of a curve search: run in any process (``executors.run_work_unit``), its result handed
+#: back to the search by its ``hand_in``.
 SearchUnit = BesideUnit | ScanUnit | ContinueUnit
 
 
