@@ -26,20 +26,27 @@ def module_name(path: pathlib.Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def imports(path: pathlib.Path) -> set[str]:
-    """Absolute dotted names of every module (or module attribute) the file imports."""
+def import_statements(path: pathlib.Path):
+    """(module the statement loads, the names it takes, bare) for each import of the file, relative
+    imports resolved to absolute dotted names; bare: a relative ``from . import a`` (a: a module)."""
     package = module_name(path) if path.name == "__init__.py" else module_name(path).rpartition(".")[0]
-    found = set()
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.Import):
-            found |= {a.name for a in node.names}
+            yield from ((a.name, [], False) for a in node.names)
         elif isinstance(node, ast.ImportFrom):
+            names = [a.name for a in node.names]
             if node.level:
                 base = package.split(".")[: len(package.split(".")) - node.level + 1]
-                stem = ".".join(base + ([node.module] if node.module else []))
-                found |= {f"{stem}.{a.name}" for a in node.names} if not node.module else {stem}
+                yield ".".join(base + ([node.module] if node.module else [])), names, not node.module
             else:
-                found.add(node.module)
+                yield node.module, names, False
+
+
+def imports(path: pathlib.Path) -> set[str]:
+    """Absolute dotted names of every module (or module attribute) the file imports."""
+    found = set()
+    for module, names, bare in import_statements(path):
+        found |= {f"{module}.{name}" for name in names} if bare else {module}
     return found
 
 
@@ -51,18 +58,7 @@ def files_of(layer: str) -> list[pathlib.Path]:
 
 def imported_modules(path: pathlib.Path) -> set[str]:
     """The modules a file's import statements load (for ``from M import a``: M itself)."""
-    package = module_name(path) if path.name == "__init__.py" else module_name(path).rpartition(".")[0]
-    found = set()
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.Import):
-            found |= {a.name for a in node.names}
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[: len(package.split(".")) - node.level + 1]
-                found.add(".".join(base + ([node.module] if node.module else [])))
-            else:
-                found.add(node.module)
-    return found
+    return {module for module, _, _ in import_statements(path)}
 
 
 def shimmy_imports(path: pathlib.Path) -> set[str]:

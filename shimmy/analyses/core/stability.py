@@ -56,6 +56,18 @@ class Criticality(str, Enum):
     DEGENERATE = "degenerate"
 
 
+def check_speeds_and_load(v_range: Any, Fz: Any) -> tuple[float, float, float]:
+    """(v_min, v_max, Fz) of a question on a speed range at one load, checked against the model's
+    ranges (errors name v_min, v_max or Fz)."""
+    v_min, v_max = check_pair("v_range", v_range)
+    v_min, Fz = check_operating_point(v_min, Fz)
+    v_max = check_number("v_max", v_max, V_RANGE[0], V_RANGE[1], "m/s")
+    if not v_max > v_min:
+        raise InvalidParameterError("v_max", v_max, f"a number in ({v_min:g}, {V_RANGE[1]:g}] m/s",
+                                    "must exceed v_min")
+    return v_min, v_max, Fz
+
+
 class Linearisation:
     """J(V) = J0 + V J1 + J2 / V at x = 0 for one model and load Fz."""
 
@@ -150,12 +162,7 @@ def hopf_points(config: Configuration | str, Fz: float, *, params: Parameters | 
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
-    v_min, v_max = check_pair("v_range", v_range)
-    v_min, Fz = check_operating_point(v_min, Fz)
-    v_max = check_number("v_max", v_max, V_RANGE[0], V_RANGE[1], "m/s")
-    if not v_max > v_min:
-        raise InvalidParameterError("v_max", v_max, f"a number in ({v_min:g}, {V_RANGE[1]:g}] m/s",
-                                    "must exceed v_min")
+    v_min, v_max, Fz = check_speeds_and_load(v_range, Fz)
     n_grid = int(check_number("n_grid", n_grid, 10, 100_000, integer=True))
     v_tol = check_number("v_tol", v_tol, 1e-12, 1e-3, "m/s")
     near_axis = check_number("near_axis", near_axis, 0.0, 100.0, "1/s")

@@ -54,11 +54,11 @@ from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch,
 from ...model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.nes import VALID_ANGLE
-from ...model.parameters import DIAGRAM_V_RANGE, V_RANGE, Parameters, check_number, check_operating_point, check_pair
+from ...model.parameters import DIAGRAM_V_RANGE, Parameters, check_number
 from ...continuation.periodic_orbits import (PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
                               periodic_branch)
 from ..core.response import mode_of, torsional_share
-from ..core.stability import HopfResult, hopf_points
+from ..core.stability import HopfResult, check_speeds_and_load, hopf_points
 
 # Size of a unit step in each unknown (the arclength metric): psi, dpsi, delta, ddelta, lam, psis, dpsis.
 STATE_SCALE = np.array([0.05, 5.0, 0.005, 0.5, 0.01, 0.05, 5.0])
@@ -190,12 +190,7 @@ def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | 
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
     options = options or BifurcationOptions()
-    v_min, v_max = check_pair("v_range", v_range)
-    v_min, Fz = check_operating_point(v_min, Fz)
-    v_max = check_number("v_max", v_max, V_RANGE[0], V_RANGE[1], "m/s")
-    if not v_max > v_min:
-        raise InvalidParameterError("v_max", v_max, f"a number in ({v_min:g}, {V_RANGE[1]:g}] m/s",
-                                    "must exceed v_min")
+    v_min, v_max, Fz = check_speeds_and_load(v_range, Fz)
     report = progress or (lambda fraction, message: None)
     model = build_model(config, params, exact_nes=options.exact_nes)
     system = gear_field(model, Fz)
