@@ -15,10 +15,10 @@ from shimmy.model.configurations import affects
 from shimmy.model.parameters import PARAMETER_SPECS
 from shimmy.service import schemas
 from ui import components as ui
-from ui import fields, jobs
+from ui import fields, ids, jobs
 from ui import style
 from ui.fields import Quantity
-from ui.layout import DESIGN, design_id, page
+from ui.layout import DESIGN, page
 
 dash.register_page(__name__, path="/design", name="Decisions", title="Design decisions", order=5.5)
 
@@ -136,62 +136,63 @@ def layout(config: str | None = None, Fz: str | None = None, bars: str | None = 
     n_samples, bad_samples = SAMPLES.from_url("samples", samples, 64)
     r_seed, bad_rseed = ROB_SEED.from_url("seed", seed, 0)
     return page(
-        query, "des",
+        query, ids.DES,
         ui.header("Design decisions", "For the current design, one configuration and one load: which parameters "
                   "move the shimmy boundaries and by how much (sensitivities by implicit differentiation), the best "
                   "device parameters for a figure of merit under constraints on the others (optimiser), and how "
                   "manufacturing and tyre tolerances spread the boundaries and the risk of shimmy at the nine "
                   "operating points (robustness). Methods: the documentation's Design decisions tutorial."),
         html.Div([
-            html.Div([html.Label("Configuration", htmlFor="des-config"),
-                      dcc.Dropdown(id="des-config", value=config, clearable=False, style={"width": "150px"},
+            html.Div([html.Label("Configuration", htmlFor=ids.DES_CONFIG),
+                      dcc.Dropdown(id=ids.DES_CONFIG, value=config, clearable=False, style={"width": "150px"},
                                    options=[{"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS]),
-                      _error("des-config-error", bad_config)], className="field"),
-            html.Div([html.Label("Load Fz (kN)", htmlFor="des-fz"), FZ.box("des-fz", fz, debounce=True),
-                      _error("des-fz-error", bad_fz)], className="field",
+                      _error(ids.DES_CONFIG_ERROR, bad_config)], className="field"),
+            html.Div([html.Label("Load Fz (kN)", htmlFor=ids.DES_FZ), FZ.box(ids.DES_FZ, fz, debounce=True),
+                      _error(ids.DES_FZ_ERROR, bad_fz)], className="field",
                      title=f"the load of the Hopf speeds and of the figures taken at a load; {FZ.allowed}"),
-            html.Nav([html.A("Sensitivities", href="#sensitivities"), " · ", html.A("Optimiser", href="#optimiser"),
-                      " · ", html.A("Robustness", href="#robustness")], className="hint"),
+            html.Nav([html.A("Sensitivities", href=f"#{ids.SENSITIVITIES}"), " · ",
+                      html.A("Optimiser", href=f"#{ids.OPTIMISER}"), " · ",
+                      html.A("Robustness", href=f"#{ids.ROBUSTNESS}")], className="hint"),
         ], className="controls"),
         # -- (a) sensitivities
-        html.H2("Sensitivities", id="sensitivities"),
+        html.H2("Sensitivities", id=ids.SENSITIVITIES),
         html.P("Change of each quantity when one parameter moves by half its design range (or by 1 % of its value), "
                "the others held: the derivative by implicit differentiation times the step (linear). Largest effect "
                "on top; blue raises the quantity, vermilion lowers it. Parameters that cannot move a quantity are "
                "listed under its chart with the reason.", className="hint"),
         html.Div([
-            ui.field("Bars", dcc.RadioItems(id="sens-by", value=by, inline=True,
+            ui.field("Bars", dcc.RadioItems(id=ids.SENS_BY, value=by, inline=True,
                                             options=[{"label": v, "value": k} for k, v in BARS.items()])),
-            ui.field("Parameters", dcc.RadioItems(id="sens-show", value=shown, inline=True,
+            ui.field("Parameters", dcc.RadioItems(id=ids.SENS_SHOW, value=shown, inline=True,
                                                   options=[{"label": v, "value": k} for k, v in SHOWN.items()])),
-            *jobs.controls("sens"),
+            *jobs.controls(ids.SENS),
         ], className="controls"),
-        html.Div(" ".join(p for p in (bad_bars, bad_show) if p), id="sens-error", className="error", role="alert"),
-        html.Div(id="sens-stale", className="hint", role="status"),
-        html.Div(id="sens-summary", className="hint"),
-        html.Div(_placeholder(SENS_WAITING), id="sens-charts"),
-        ui.downloads("sens"),
-        dcc.Store(id="sens-data"),
-        *jobs.stores("sens"),
+        html.Div(" ".join(p for p in (bad_bars, bad_show) if p), id=ids.SENS.error, className="error", role="alert"),
+        html.Div(id=ids.SENS.stale, className="hint", role="status"),
+        html.Div(id=ids.SENS_SUMMARY, className="hint"),
+        html.Div(_placeholder(SENS_WAITING), id=ids.SENS_CHARTS),
+        ui.downloads(ids.SENS),
+        dcc.Store(id=ids.SENS_DATA),
+        *jobs.stores(ids.SENS),
         # -- (b) optimiser
-        html.H2("Optimiser", id="optimiser"),
+        html.H2("Optimiser", id=ids.OPTIMISER),
         html.P("Searches the chosen device parameters within their ranges (the others as in the design panel). "
                "Gradient method: Sobol start designs (the current design among them), then SLSQP with the "
                "sensitivities as gradients; differential evolution where a figure has no derivative.",
                className="hint"),
         html.Div([
-            ui.field("Objective", dcc.Dropdown(id="opt-objective", value=goal, clearable=False,
+            ui.field("Objective", dcc.Dropdown(id=ids.OPT_OBJECTIVE, value=goal, clearable=False,
                                                style={"width": "430px"},
                                                options=[{"label": v, "value": k} for k, v in OBJECTIVES.items()])),
             html.Div([html.Label("Parameters to search"),
-                      dcc.Checklist(id="opt-search", value=chosen, inline=True, options=_search_options(config)),
-                      _error("opt-search-error", bad_search)], className="field"),
+                      dcc.Checklist(id=ids.OPT_SEARCH, value=chosen, inline=True, options=_search_options(config)),
+                      _error(ids.OPT_SEARCH_ERROR, bad_search)], className="field"),
         ], className="controls"),
         html.Div([
             html.Label("Constraints (each value in the figure's unit; Fz: the load above)",
                        style={"fontSize": "13px", "color": "var(--muted)"}),
             dash_table.DataTable(
-                id="opt-constraints", data=constraint_rows, editable=True, row_deletable=True, **TABLE_STYLE,
+                id=ids.OPT_CONSTRAINTS, data=constraint_rows, editable=True, row_deletable=True, **TABLE_STYLE,
                 columns=[{"name": "figure", "id": "figure", "presentation": "dropdown"},
                          {"name": "", "id": "op", "presentation": "dropdown"},
                          {"name": "value", "id": "value", "type": "numeric",
@@ -202,31 +203,31 @@ def layout(config: str | None = None, Fz: str | None = None, bars: str | None = 
                 style_cell_conditional=[{"if": {"column_id": "figure"}, "width": "270px", "minWidth": "270px"},
                                         {"if": {"column_id": "op"}, "width": "64px", "minWidth": "64px"},
                                         {"if": {"column_id": "value"}, "width": "110px", "minWidth": "110px"}]),
-            html.Button("Add constraint", id="opt-add", className="secondary", style={"marginTop": "6px"}),
-            _error("opt-constraints-error", bad_cons),
+            html.Button("Add constraint", id=ids.OPT_ADD, className="secondary", style={"marginTop": "6px"}),
+            _error(ids.OPT_CONSTRAINTS_ERROR, bad_cons),
         ]),
         html.Div([
             html.Div([ui.field(f"Start designs ({STARTS.low:g}-{STARTS.high:g})",
-                               STARTS.box("opt-starts", n_starts, debounce=True)),
-                      _error("opt-starts-error", bad_starts)]),
+                               STARTS.box(ids.OPT_STARTS, n_starts, debounce=True)),
+                      _error(ids.OPT_STARTS_ERROR, bad_starts)]),
             html.Div([ui.field(f"Local searches ({RUNS.low:g}-{RUNS.high:g})",
-                               RUNS.box("opt-runs", n_runs, debounce=True)),
-                      _error("opt-runs-error", bad_runs)]),
-            html.Div([ui.field("Seed", OPT_SEED.box("opt-seed", o_seed, debounce=True)),
-                      _error("opt-seed-error", bad_oseed)]),
-            *jobs.controls("opt", "Optimise"),
+                               RUNS.box(ids.OPT_RUNS, n_runs, debounce=True)),
+                      _error(ids.OPT_RUNS_ERROR, bad_runs)]),
+            html.Div([ui.field("Seed", OPT_SEED.box(ids.OPT_SEED, o_seed, debounce=True)),
+                      _error(ids.OPT_SEED_ERROR, bad_oseed)]),
+            *jobs.controls(ids.OPT, "Optimise"),
         ], className="controls"),
-        html.Div(id="opt-error", className="error", role="alert"),
-        html.Div(id="opt-stale", className="hint", role="status"),
-        html.Div(id="opt-summary"),
-        html.Div([html.Div(id="opt-design", className="table-wrap"), html.Div(id="opt-figures",
+        html.Div(id=ids.OPT.error, className="error", role="alert"),
+        html.Div(id=ids.OPT.stale, className="hint", role="status"),
+        html.Div(id=ids.OPT_SUMMARY),
+        html.Div([html.Div(id=ids.OPT_DESIGN, className="table-wrap"), html.Div(id=ids.OPT_FIGURES,
                                                                                className="table-wrap")],
                  style={**GRID, "alignItems": "start"}),
-        ui.graph("opt-history", figure=style.message_figure("The convergence history appears here", 300)),
-        ui.downloads("opt"),
-        *jobs.stores("opt"),
+        ui.graph(ids.OPT_HISTORY, figure=style.message_figure("The convergence history appears here", 300)),
+        ui.downloads(ids.OPT),
+        *jobs.stores(ids.OPT),
         # -- (c) robustness
-        html.H2("Robustness", id="robustness"),
+        html.H2("Robustness", id=ids.ROBUSTNESS),
         html.P("Each toleranced parameter varies around its design value: normal (the tolerance is one standard "
                "deviation) or uniform (± the tolerance). Quasi-Monte Carlo samples (scrambled Sobol, seeded) give "
                "the distributions; the curves are first-order propagation of the sensitivities. Shimmy at an "
@@ -234,7 +235,7 @@ def layout(config: str | None = None, Fz: str | None = None, bars: str | None = 
         html.Div([
             html.Label("Tolerances", style={"fontSize": "13px", "color": "var(--muted)"}),
             dash_table.DataTable(
-                id="rob-tolerances", data=tolerance_rows, editable=True, row_deletable=True, **TABLE_STYLE,
+                id=ids.ROB_TOLERANCES, data=tolerance_rows, editable=True, row_deletable=True, **TABLE_STYLE,
                 columns=[{"name": "parameter", "id": "name", "presentation": "dropdown"},
                          {"name": "tolerance (%)", "id": "pct", "type": "numeric",
                           "on_change": {"action": "coerce", "failure": "accept"}},
@@ -247,26 +248,26 @@ def layout(config: str | None = None, Fz: str | None = None, bars: str | None = 
                 style_cell_conditional=[{"if": {"column_id": "name"}, "width": "220px", "minWidth": "180px"},
                                         {"if": {"column_id": "pct"}, "width": "120px"},
                                         {"if": {"column_id": "distribution"}, "width": "160px"}]),
-            html.Button("Add tolerance", id="rob-add", className="secondary", style={"marginTop": "6px"}),
-            _error("rob-tolerances-error", bad_tols),
+            html.Button("Add tolerance", id=ids.ROB_ADD, className="secondary", style={"marginTop": "6px"}),
+            _error(ids.ROB_TOLERANCES_ERROR, bad_tols),
         ]),
         html.Div([
             html.Div([ui.field(f"Samples ({SAMPLES.low:g}-{SAMPLES.high:g})",
-                               SAMPLES.box("rob-samples", n_samples, debounce=True)),
-                      _error("rob-samples-error", bad_samples)]),
-            html.Div([ui.field("Seed", ROB_SEED.box("rob-seed", r_seed, debounce=True)),
-                      _error("rob-seed-error", bad_rseed)]),
-            *jobs.controls("rob", "Sample"),
+                               SAMPLES.box(ids.ROB_SAMPLES, n_samples, debounce=True)),
+                      _error(ids.ROB_SAMPLES_ERROR, bad_samples)]),
+            html.Div([ui.field("Seed", ROB_SEED.box(ids.ROB_SEED, r_seed, debounce=True)),
+                      _error(ids.ROB_SEED_ERROR, bad_rseed)]),
+            *jobs.controls(ids.ROB, "Sample"),
         ], className="controls"),
-        html.Div(id="rob-error", className="error", role="alert"),
-        html.Div(id="rob-stale", className="hint", role="status"),
-        html.Div(id="rob-warnings", className="hint"),
-        html.Div(_placeholder("The histograms appear here (about 1 s per 100 samples cold)"), id="rob-histograms",
+        html.Div(id=ids.ROB.error, className="error", role="alert"),
+        html.Div(id=ids.ROB.stale, className="hint", role="status"),
+        html.Div(id=ids.ROB_WARNINGS, className="hint"),
+        html.Div(_placeholder("The histograms appear here (about 1 s per 100 samples cold)"), id=ids.ROB_HISTOGRAMS,
                  style=GRID),
-        html.Div(id="rob-table", className="table-wrap"),
-        ui.graph("rob-shimmy", figure=style.message_figure("The probability of shimmy at A-I appears here", 300)),
-        ui.downloads("rob"),
-        *jobs.stores("rob"),
+        html.Div(id=ids.ROB_TABLE, className="table-wrap"),
+        ui.graph(ids.ROB_SHIMMY, figure=style.message_figure("The probability of shimmy at A-I appears here", 300)),
+        ui.downloads(ids.ROB),
+        *jobs.stores(ids.ROB),
     )
 
 
@@ -383,40 +384,44 @@ def _check(read, value) -> str:
 
 
 # Each field says at once what is wrong with it, in its unit (the run refuses the same, by the same rules).
-for _box, _quantity in (("des-fz", FZ), ("opt-starts", STARTS), ("opt-runs", RUNS), ("opt-seed", OPT_SEED),
-                        ("rob-samples", SAMPLES), ("rob-seed", ROB_SEED)):
-    dash.callback(Output(f"{_box}-error", "children"), Input(_box, "value"), prevent_initial_call=True)(
+for _box, _error_id, _quantity in ((ids.DES_FZ, ids.DES_FZ_ERROR, FZ), (ids.OPT_STARTS, ids.OPT_STARTS_ERROR, STARTS),
+                                   (ids.OPT_RUNS, ids.OPT_RUNS_ERROR, RUNS), (ids.OPT_SEED, ids.OPT_SEED_ERROR,
+                                                                              OPT_SEED),
+                                   (ids.ROB_SAMPLES, ids.ROB_SAMPLES_ERROR, SAMPLES),
+                                   (ids.ROB_SEED, ids.ROB_SEED_ERROR, ROB_SEED)):
+    dash.callback(Output(_error_id, "children"), Input(_box, "value"), prevent_initial_call=True)(
         lambda value, q=_quantity: _check(q.read, value))
 
 
-@dash.callback(Output("opt-constraints-error", "children"), Input("opt-constraints", "data"),
+@dash.callback(Output(ids.OPT_CONSTRAINTS_ERROR, "children"), Input(ids.OPT_CONSTRAINTS, "data"),
                prevent_initial_call=True)
 def check_constraints(rows):
     return _check(_constraints, rows)
 
 
-@dash.callback(Output("rob-tolerances-error", "children"), Input("rob-tolerances", "data"),
+@dash.callback(Output(ids.ROB_TOLERANCES_ERROR, "children"), Input(ids.ROB_TOLERANCES, "data"),
                prevent_initial_call=True)
 def check_tolerances(rows):
     return _check(_tolerances, rows)
 
 
-@dash.callback(Output("opt-search", "options"), Output("opt-search", "value"), Output("opt-search-error", "children"),
-               Input("des-config", "value"), State("opt-search", "value"), prevent_initial_call=True)
+@dash.callback(Output(ids.OPT_SEARCH, "options"), Output(ids.OPT_SEARCH, "value"), Output(ids.OPT_SEARCH_ERROR,
+                                                                                          "children"),
+               Input(ids.DES_CONFIG, "value"), State(ids.OPT_SEARCH, "value"), prevent_initial_call=True)
 def search_options(config, chosen):
     """The device parameters the configuration has can be ticked; the others are greyed out."""
     kept = [n for n in chosen or [] if affects(n, config)]
     return _search_options(config), kept or _default_search(config), ""
 
 
-@dash.callback(Output("opt-constraints", "data", allow_duplicate=True), Input("opt-add", "n_clicks"),
-               State("opt-constraints", "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.OPT_CONSTRAINTS, "data", allow_duplicate=True), Input(ids.OPT_ADD, "n_clicks"),
+               State(ids.OPT_CONSTRAINTS, "data"), prevent_initial_call=True)
 def add_constraint(_n, rows):
     return [*(rows or []), {"figure": "max_psi", "op": "<=", "value": 0.2}]
 
 
-@dash.callback(Output("rob-tolerances", "data", allow_duplicate=True), Input("rob-add", "n_clicks"),
-               State("rob-tolerances", "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.ROB_TOLERANCES, "data", allow_duplicate=True), Input(ids.ROB_ADD, "n_clicks"),
+               State(ids.ROB_TOLERANCES, "data"), prevent_initial_call=True)
 def add_tolerance(_n, rows):
     used = {r.get("name") for r in rows or []}
     name = next((n for n in ("k_s", "e_p", "r2", "r3", "k_lam", "c_psi", "I_nes", "c_nes") if n not in used), "Iz")
@@ -452,11 +457,12 @@ def _sens_csv(results):
 
 
 jobs.register(
-    "sens", "sensitivity", requests=_sens_requests, initial=True,
+    ids.SENS, "sensitivity", requests=_sens_requests, initial=True,
     render=lambda results: (_sens_data(results), _sens_summary(results)),
-    outputs=[Output("sens-data", "data"), Output("sens-summary", "children")],
-    triggers=[Input("des-config", "value"), Input("des-fz", "value")], states=[State(design_id("des"), "data")],
-    download=jobs.Download("sens", "sensitivities", _sens_csv, single=True,
+    outputs=[Output(ids.SENS_DATA, "data"), Output(ids.SENS_SUMMARY, "children")],
+    triggers=[Input(ids.DES_CONFIG, "value"), Input(ids.DES_FZ, "value")], states=[State(ids.design_store(ids.DES),
+                                                                                         "data")],
+    download=jobs.Download(ids.SENS, "sensitivities", _sens_csv, single=True,
                            filename=lambda r: f"sensitivities_{r[0]['config']}_{r[0]['Fz'] / 1e3:g}kN"),
     blank=lambda: (None, ""))
 
@@ -505,8 +511,8 @@ def tornado(q, rows, by, Fz):
     return fig
 
 
-@dash.callback(Output("sens-charts", "children"), Input("sens-data", "data"), Input("sens-by", "value"),
-               Input("sens-show", "value"))
+@dash.callback(Output(ids.SENS_CHARTS, "children"), Input(ids.SENS_DATA, "data"), Input(ids.SENS_BY, "value"),
+               Input(ids.SENS_SHOW, "value"))
 def draw_sensitivities(data, by, shown):
     """One tornado chart per quantity, the parameters without effect under it."""
     if not data:
@@ -516,7 +522,7 @@ def draw_sensitivities(data, by, shown):
     for q in data["quantities"]:
         rows = [r for r in q["rows"] if shown == "all" or r["name"] in DESIGN]
         active = [r for r in rows if r["reason"] is None]
-        body = [ui.graph(f"sens-{q['key']}", figure=tornado(q, rows, by, data["Fz"]))] if active else [
+        body = [ui.graph(ids.sens_chart(q["key"]), figure=tornado(q, rows, by, data["Fz"]))] if active else [
             html.H3(_quantity(q, data["Fz"])[0], style={"fontSize": "15px"}),
             html.P(f"None of the {SHOWN[shown]} moves it: show all parameters.", className="hint")]
         charts.append(html.Div([*body, _no_effect(rows)], className="tornado"))
@@ -557,8 +563,8 @@ def opt_summary(result):
                 f"{result['nominal_objective'] / scale:.5g} {unit} for the current design ({change / scale:+.4g} "
                 f"{unit}); {result['evaluations']} evaluations ({result['method']}), {result['elapsed_s']:.1f} s. "
                 f"{result['message']}.{status}"],
-               id="opt-result-line"),
-        html.P([html.A("Open the optimum in the workbench", href=link, id="opt-link"),
+               id=ids.OPT_RESULT_LINE),
+        html.P([html.A("Open the optimum in the workbench", href=link, id=ids.OPT_LINK),
                 html.Span(f"  ({link})", className="hint")]),
         *[html.P(w, className="note") for w in result["warnings"]],
     ]
@@ -572,7 +578,7 @@ def opt_design(result):
         old, new = base[name], result["design"][name]
         rows.append([name, spec.unit or "–", f"{_g(spec.low)} – {_g(spec.high)}", _g(old), _g(new),
                      ui.pct(100 * (new - old) / old if old else None)])
-    return ui.table(["parameter", "unit", "range", "current design", "optimum", "change"], rows, "opt-design-table")
+    return ui.table(["parameter", "unit", "range", "current design", "optimum", "change"], rows, ids.OPT_DESIGN_TABLE)
 
 
 def opt_figures(result):
@@ -586,7 +592,7 @@ def opt_figures(result):
             value = tables[which].get(key) if "error" not in tables[which] else None
             cells.append("–" if value is None else f"{value / scale:.5g}")
         rows.append([f"{label} ({unit})", *cells])
-    return ui.table(["figure", "optimum", "current design", "original"], rows, "opt-figures-table")
+    return ui.table(["figure", "optimum", "current design", "original"], rows, ids.OPT_FIGURES_TABLE)
 
 
 def opt_history(result):
@@ -649,16 +655,17 @@ def _opt_csv(results):
 
 
 jobs.register(
-    "opt", "optimise", requests=_opt_requests,
+    ids.OPT, "optimise", requests=_opt_requests,
     render=lambda results: (opt_summary(results[0]), opt_design(results[0]), opt_figures(results[0]),
                             opt_history(results[0])),
-    outputs=[Output("opt-summary", "children"), Output("opt-design", "children"), Output("opt-figures", "children"),
-             Output("opt-history", "figure")],
-    states=[State("des-config", "value"), State("des-fz", "value"), State("opt-objective", "value"),
-            State("opt-search", "value"), State("opt-constraints", "data"), State("opt-starts", "value"),
-            State("opt-runs", "value"), State("opt-seed", "value"), State(design_id("des"), "data")],
-    lock=["opt-objective", "opt-search", "opt-starts", "opt-runs", "opt-seed"],
-    download=jobs.Download("opt", "optimisation", _opt_csv, single=True,
+    outputs=[Output(ids.OPT_SUMMARY, "children"), Output(ids.OPT_DESIGN, "children"), Output(ids.OPT_FIGURES,
+                                                                                             "children"),
+             Output(ids.OPT_HISTORY, "figure")],
+    states=[State(ids.DES_CONFIG, "value"), State(ids.DES_FZ, "value"), State(ids.OPT_OBJECTIVE, "value"),
+            State(ids.OPT_SEARCH, "value"), State(ids.OPT_CONSTRAINTS, "data"), State(ids.OPT_STARTS, "value"),
+            State(ids.OPT_RUNS, "value"), State(ids.OPT_SEED, "value"), State(ids.design_store(ids.DES), "data")],
+    lock=[ids.OPT_OBJECTIVE, ids.OPT_SEARCH, ids.OPT_STARTS, ids.OPT_RUNS, ids.OPT_SEED],
+    download=jobs.Download(ids.OPT, "optimisation", _opt_csv, single=True,
                            filename=lambda r: f"optimisation_{r[0]['config']}_{r[0]['objective_figure']['name']}"),
     blank=lambda: (None, None, None, style.message_figure("Refused: see the message above", 300)),
     running=lambda: (None, None, None, style.message_figure("Optimising…", 300)))
@@ -696,10 +703,10 @@ def histogram(title: str, unit: str, stats: dict, scale: float, graph_id: str):
 
 def _rob_quantities(result):
     """(title, unit, SI per shown unit, stats, id) of every sampled quantity."""
-    out = [(f"Hopf speed {k + 1} at {result['Fz'] / 1e3:g} kN", "m/s", 1.0, h, f"rob-hist-V{k + 1}")
+    out = [(f"Hopf speed {k + 1} at {result['Fz'] / 1e3:g} kN", "m/s", 1.0, h, ids.rob_histogram(f"V{k + 1}"))
            for k, h in enumerate(result["hopf_points"])]
     if result["min_shimmy_Fz"] is not None:
-        out.append(("Minimum shimmy load", "kN", 1e3, result["min_shimmy_Fz"], "rob-hist-Fzmin"))
+        out.append(("Minimum shimmy load", "kN", 1e3, result["min_shimmy_Fz"], ids.rob_histogram("Fzmin")))
     return out
 
 
@@ -718,7 +725,7 @@ def rob_table(result):
                      f"{s['std'] / scale:.3g}", f"{s['p05'] / scale:.5g}", f"{s['p95'] / scale:.5g}",
                      ui.fmt(None if s["linear_std"] is None else s["linear_std"] / scale, 3), lp, len(s["samples"])])
     return ui.table(["quantity", "nominal", "mean", "std", "p05", "p95", "linear std", "linear p05 – p95",
-                     "samples"], rows, "rob-stats")
+                     "samples"], rows, ids.ROB_STATS)
 
 
 def rob_shimmy(result):
@@ -753,15 +760,16 @@ def _rob_csv(results):
 
 
 jobs.register(
-    "rob", "robustness", requests=_rob_requests,
+    ids.ROB, "robustness", requests=_rob_requests,
     render=lambda results: (rob_histograms(results[0]), rob_table(results[0]), rob_shimmy(results[0]),
                             rob_warnings(results[0])),
-    outputs=[Output("rob-histograms", "children"), Output("rob-table", "children"), Output("rob-shimmy", "figure"),
-             Output("rob-warnings", "children")],
-    states=[State("des-config", "value"), State("des-fz", "value"), State("rob-tolerances", "data"),
-            State("rob-samples", "value"), State("rob-seed", "value"), State(design_id("des"), "data")],
-    lock=["rob-samples", "rob-seed"],
-    download=jobs.Download("rob", "robustness", _rob_csv, single=True,
+    outputs=[Output(ids.ROB_HISTOGRAMS, "children"), Output(ids.ROB_TABLE, "children"), Output(ids.ROB_SHIMMY,
+                                                                                               "figure"),
+             Output(ids.ROB_WARNINGS, "children")],
+    states=[State(ids.DES_CONFIG, "value"), State(ids.DES_FZ, "value"), State(ids.ROB_TOLERANCES, "data"),
+            State(ids.ROB_SAMPLES, "value"), State(ids.ROB_SEED, "value"), State(ids.design_store(ids.DES), "data")],
+    lock=[ids.ROB_SAMPLES, ids.ROB_SEED],
+    download=jobs.Download(ids.ROB, "robustness", _rob_csv, single=True,
                            filename=lambda r: f"robustness_{r[0]['config']}_{r[0]['Fz'] / 1e3:g}kN"),
     blank=lambda: (None, None, style.message_figure("Refused: see the message above", 300), None))
 
@@ -789,17 +797,18 @@ def _stale(shown, config, fz_kn, design) -> str:
             "button to update.")
 
 
-for _prefix in ("sens", "opt", "rob"):
-    dash.callback(Output(f"{_prefix}-stale", "children"), Input(f"{_prefix}-requests", "data"),
-                  Input("des-config", "value"), Input("des-fz", "value"), Input(design_id("des"), "data"))(_stale)
+for _group in (ids.SENS, ids.OPT, ids.ROB):
+    dash.callback(Output(_group.stale, "children"), Input(_group.requests, "data"),
+                  Input(ids.DES_CONFIG, "value"), Input(ids.DES_FZ, "value"), Input(ids.design_store(ids.DES),
+                                                                                    "data"))(_stale)
 
 
-@dash.callback(Output("url-update", "data", allow_duplicate=True),
-               Input("des-config", "value"), Input("des-fz", "value"), Input("sens-by", "value"),
-               Input("sens-show", "value"), Input("opt-objective", "value"), Input("opt-search", "value"),
-               Input("opt-constraints", "data"), Input("opt-starts", "value"), Input("opt-runs", "value"),
-               Input("opt-seed", "value"), Input("rob-tolerances", "data"), Input("rob-samples", "value"),
-               Input("rob-seed", "value"), prevent_initial_call=True)
+@dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),
+               Input(ids.DES_CONFIG, "value"), Input(ids.DES_FZ, "value"), Input(ids.SENS_BY, "value"),
+               Input(ids.SENS_SHOW, "value"), Input(ids.OPT_OBJECTIVE, "value"), Input(ids.OPT_SEARCH, "value"),
+               Input(ids.OPT_CONSTRAINTS, "data"), Input(ids.OPT_STARTS, "value"), Input(ids.OPT_RUNS, "value"),
+               Input(ids.OPT_SEED, "value"), Input(ids.ROB_TOLERANCES, "data"), Input(ids.ROB_SAMPLES, "value"),
+               Input(ids.ROB_SEED, "value"), prevent_initial_call=True)
 def remember(config, fz, by, shown, objective, search, constraints, starts, runs, opt_seed, tolerances, samples,
              seed):
     """The page's state in the address (constraints and tolerances in the API's string form, SI units)."""

@@ -11,6 +11,8 @@ from dash import dcc, html
 
 from shimmy.model.configurations import OPERATING_POINTS as _OPERATING_POINTS_N
 
+from .ids import Group
+
 
 def _whole(x: float) -> float | int:
     return int(x) if float(x).is_integer() else x
@@ -30,18 +32,18 @@ def graph(graph_id: str, **kwargs) -> dcc.Graph:
     return dcc.Graph(id=graph_id, config=GRAPH_CONFIG, **kwargs)
 
 
-def downloads(prefix: str) -> html.Div:
-    """CSV and JSON download buttons (ids PREFIX-csv, PREFIX-json) and their dcc.Download."""
+def downloads(group: Group, csv_label: str = "Download CSV", json_label: str = "Download JSON") -> html.Div:
+    """CSV and JSON download buttons (the group's csv and json ids) and their dcc.Download."""
     return html.Div([
-        html.Button("Download CSV", id=f"{prefix}-csv", className="secondary", disabled=True),
-        html.Button("Download JSON", id=f"{prefix}-json", className="secondary", disabled=True),
-        dcc.Download(id=f"{prefix}-download"),
+        html.Button(csv_label, id=group.csv, className="secondary", disabled=True),
+        html.Button(json_label, id=group.json, className="secondary", disabled=True),
+        dcc.Download(id=group.download),
     ], className="downloads")
 
 
-def progress_bar(prefix: str) -> html.Div:
-    return html.Div([html.Progress(id=f"{prefix}-progress", value="0", max="100"),
-                     html.Span(id=f"{prefix}-status", className="status")], className="progress-row")
+def progress_bar(group: Group) -> html.Div:
+    return html.Div([html.Progress(id=group.progress, value="0", max="100"),
+                     html.Span(id=group.status, className="status")], className="progress-row")
 
 
 def field(label: str, control, hint: str | None = None) -> html.Div:
