@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import dash
-from dash import Input, Output, State, dcc, html
+from dash import Input, Output, State, html
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
@@ -15,7 +15,7 @@ from ui.layout import page
 
 dash.register_page(__name__, path="/bifurcation", name="Bifurcation", order=3)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
+CONFIGS = ui.CONFIGS
 SYMBOLS = {"H": "diamond", "LPC": "triangle-up", "NS": "square", "PD": "x", "BPC": "cross", "BP": "circle-open"}
 
 
@@ -45,8 +45,7 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
             ui.field("Fz (kN)", FZ.box(ids.BIF_FZ, fz)),
             html.Div([ui.field("V from (m/s)", V_MIN.box(ids.BIF_VMIN, lo)),
                       ui.field("to (m/s)", V_MAX.box(ids.BIF_VMAX, hi))], className="pair"),
-            ui.field("Configurations", dcc.Checklist(id=ids.BIF_CONFIGS, value=chosen, inline=True, options=[
-                {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
+            ui.field("Configurations", ui.configurations(ids.BIF_CONFIGS, chosen, multi=True)),
             *jobs.controls(ids.BIF_GROUP),
         ], className="controls"),
         html.Div(problems, id=ids.BIF_GROUP.error, className="error", role="alert"),
@@ -59,10 +58,7 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
                "at this page's load and speed range, for one configuration: one colour per design, the first the "
                "reference of the changes in the table. The x = 0 strip shows each design's Hopf interval (dashed: "
                "straight rolling unstable).", className="hint"),
-        html.Div([ui.field("Configuration", dcc.Dropdown(id=ids.BIFC_CONFIG, value=compared, clearable=False,
-                                                         style={"width": "150px"},
-                                                         options=[{"label": style.CONFIG_LABELS[c], "value": c}
-                                                                  for c in CONFIGS])),
+        html.Div([ui.field("Configuration", ui.configurations(ids.BIFC_CONFIG, compared)),
                   *jobs.controls(ids.BIFC, "Compare")], className="controls"),
         html.Div(id=ids.BIFC.designs, className="compare-designs"),
         html.Div(bad_compared, id=ids.BIFC.error, className="error", role="alert"),

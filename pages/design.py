@@ -22,7 +22,7 @@ from ui.layout import DESIGN, page
 
 dash.register_page(__name__, path="/design", name="Decisions", title="Design decisions", order=5.5)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
+CONFIGS = ui.CONFIGS
 FZ = Quantity("sensitivity", "Fz", "Fz", "kN", 1e3)
 STARTS = Quantity("optimise", "starts", "start designs", "")
 RUNS = Quantity("optimise", "local_runs", "local searches", "")
@@ -144,8 +144,7 @@ def layout(config: str | None = None, Fz: str | None = None, bars: str | None = 
                   "operating points (robustness). Methods: the documentation's Design decisions tutorial."),
         html.Div([
             html.Div([html.Label("Configuration", htmlFor=ids.DES_CONFIG),
-                      dcc.Dropdown(id=ids.DES_CONFIG, value=config, clearable=False, style={"width": "150px"},
-                                   options=[{"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS]),
+                      ui.configurations(ids.DES_CONFIG, config),
                       _error(ids.DES_CONFIG_ERROR, bad_config)], className="field"),
             html.Div([html.Label("Load Fz (kN)", htmlFor=ids.DES_FZ), FZ.box(ids.DES_FZ, fz, debounce=True),
                       _error(ids.DES_FZ_ERROR, bad_fz)], className="field",

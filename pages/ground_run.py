@@ -16,7 +16,7 @@ from ui.layout import page
 
 dash.register_page(__name__, path="/ground-run", name="Ground run", order=4.5)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
+CONFIGS = ui.CONFIGS
 PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi"}
 SERIES_DT = 0.02  # s: the envelopes are smooth; 1500 points per configuration for a 30 s take-off
 TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overflowX": "auto"},
@@ -48,10 +48,7 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
                                                     style={"width": "160px"},
                                                     options=[{"label": v, "value": k}
                                                              for k, v in PRESET_LABELS.items()])),
-            ui.field("Map and curves of", dcc.Dropdown(id=ids.GR_CONFIG, value=config, clearable=False,
-                                                       style={"width": "150px"},
-                                                       options=[{"label": style.CONFIG_LABELS[c], "value": c}
-                                                                for c in CONFIGS])),
+            ui.field("Map and curves of", ui.configurations(ids.GR_CONFIG, config)),
             ui.field("Shimmy threshold |psi| (rad)", PSI_THR.box(ids.GR_PSI_THR, psi_value)),
             ui.field("Shimmy threshold |l_g delta| (mm)", LAT_THR.box(ids.GR_LAT_THR, lat_value)),
             *jobs.controls(ids.GR_GROUP, "Run"),

@@ -17,7 +17,7 @@ from ui import style
 
 dash.register_page(__name__, path="/", name="Overview", order=0)
 
-CONFIGS = ("original", "nes", "pd", "nes_pd")
+CONFIGS = ui.CONFIGS
 
 
 FZ = Quantity("stability", "Fz", "Fz", "kN", 1e3)

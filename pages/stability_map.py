@@ -16,7 +16,7 @@ from ui.layout import page
 
 dash.register_page(__name__, path="/stability-map", name="Stability map", order=4)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
+CONFIGS = ui.CONFIGS
 TYPES = tuple(style.SHIMMY_TYPE_COLOURS)
 CURVE_STYLES = {"hopf_curves": ("Hopf", "solid", 2.6), "fold_curves": ("fold of cycles", "dash", 2.2),
                 "torus_curves": ("torus", "dot", 2.2)}
@@ -54,11 +54,8 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
                   "curves, GH and double-Hopf points by two-parameter continuation; the operating points A-I "
                   "marked. Click a point to open its time history."),
         html.Div([
-            ui.field("Shade by", dcc.Dropdown(id=ids.MAP_SHADE, value=shade, clearable=False, style={"width": "150px"},
-                                              options=[{"label": style.CONFIG_LABELS[c], "value": c}
-                                                       for c in CONFIGS])),
-            ui.field("Overlay curves of", dcc.Checklist(id=ids.MAP_OVERLAY, value=others, inline=True, options=[
-                {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
+            ui.field("Shade by", ui.configurations(ids.MAP_SHADE, shade)),
+            ui.field("Overlay curves of", ui.configurations(ids.MAP_OVERLAY, others, multi=True)),
             html.Div([ui.field("Fz from (kN)", FZ_MIN.box(ids.MAP_FZMIN, values["fz_min"])),
                       ui.field("to (kN)", FZ_MAX.box(ids.MAP_FZMAX, values["fz_max"]))], className="pair"),
             html.Div([ui.field("V from (m/s)", V_MIN.box(ids.MAP_VMIN, values["v_min"])),
@@ -78,10 +75,7 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
                "over this page's Fz and V ranges and slices, for one configuration: the Hopf, fold and torus curves "
                "of each design in its colour, the shading of the first; their figures of merit below, each with "
                "its change against the first.", className="hint"),
-        html.Div([ui.field("Configuration", dcc.Dropdown(id=ids.MAPC_CONFIG, value=compared, clearable=False,
-                                                         style={"width": "150px"},
-                                                         options=[{"label": style.CONFIG_LABELS[c], "value": c}
-                                                                  for c in CONFIGS])),
+        html.Div([ui.field("Configuration", ui.configurations(ids.MAPC_CONFIG, compared)),
                   ui.field("Figures at Fz (kN)", METRICS_FZ.box(ids.MAPC_FZ, merit_fz)),
                   *jobs.controls(ids.MAPC, "Compare")], className="controls"),
         html.Div(id=ids.MAPC.designs, className="compare-designs"),

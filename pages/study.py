@@ -17,7 +17,7 @@ from ui.layout import page
 
 dash.register_page(__name__, path="/study", name="Parametric study", order=5)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
+CONFIGS = ui.CONFIGS
 DEFAULT_VALUES = "0.0005, 0.001, 0.002, 0.003, 0.004, 0.005"
 
 
@@ -53,8 +53,7 @@ def layout(parameter: str | None = None, values: str = DEFAULT_VALUES, configs: 
             html.Div(ui.field("Values (comma-separated)", dcc.Input(id=ids.STUDY_VALUES, type="text", value=values,
                                                                     debounce=True)), className="wide"),
             ui.field("Fz (kN)", FZ.box(ids.STUDY_FZ, fz)),
-            ui.field("Configurations", dcc.Checklist(id=ids.STUDY_CONFIGS, value=chosen, inline=True, options=[
-                {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
+            ui.field("Configurations", ui.configurations(ids.STUDY_CONFIGS, chosen, multi=True)),
             *jobs.controls(ids.STUDY_GROUP),
         ], className="controls"),
         html.Div(id=ids.STUDY_RANGE, className="hint"),

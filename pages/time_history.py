@@ -19,7 +19,6 @@ from ui.layout import page
 
 dash.register_page(__name__, path="/time-history", name="Time history", order=2)
 
-CONFIG_OPTIONS = [{"label": style.CONFIG_LABELS[c], "value": c} for c in style.CONFIG_COLOURS]
 SPEED = Quantity("simulate", "V", "V", "m/s")
 FZ = Quantity("simulate", "Fz", "Fz", "kN", 1e3)
 T_END = Quantity("simulate", "t_end", "simulated time", "s")
@@ -45,7 +44,7 @@ def _start_of(psi0, lateral0) -> str:
 
 def layout(config: str | None = None, V: str | None = None, Fz: str | None = None, t_end: str | None = None,
            psi0: str | None = None, lateral0: str | None = None, run: str | None = None, **query):
-    config, bad_config = fields.choice("config", config, list(style.CONFIG_COLOURS), "nes_pd", "a configuration")
+    config, bad_config = fields.choice("config", config, list(ui.CONFIGS), "nes_pd", "a configuration")
     problems = [bad_config]
     v, problem_v = SPEED.from_url("V", V, 30)
     fz, problem_fz = FZ.from_url("Fz", Fz, 150)
@@ -62,8 +61,7 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
                   "bistable point settles on a different limit cycle from a large torsional or a large lateral "
                   "start. Runs in the background; repeated questions come from the cache."),
         html.Div([
-            ui.field("Configuration", dcc.Dropdown(id=ids.TH_CONFIG, options=CONFIG_OPTIONS, value=config,
-                                                   clearable=False, style={"width": "160px"})),
+            ui.field("Configuration", ui.configurations(ids.TH_CONFIG, config, width="160px")),
             ui.field("V (m/s)", SPEED.box(ids.TH_V, v, debounce=True)),
             ui.field("Fz (kN)", FZ.box(ids.TH_FZ, fz, debounce=True)),
             ui.field("Simulated time (s)", T_END.box(ids.TH_TEND, t)),

@@ -11,6 +11,7 @@ from dash import dcc, html
 
 from shimmy.model.configurations import OPERATING_POINTS as _OPERATING_POINTS_N
 
+from . import style
 from .ids import Group
 
 
@@ -22,6 +23,8 @@ def _whole(x: float) -> float | int:
 OPERATING_POINTS = {name: (_whole(v), _whole(fz / 1e3)) for name, (v, fz) in _OPERATING_POINTS_N.items()}
 
 GRAPH_CONFIG = {"displaylogo": False, "toImageButtonOptions": {"format": "png", "scale": 2}}
+#: The four configurations in the order the pages list them (original, NES, PD, NES + PD).
+CONFIGS = tuple(style.CONFIG_LABELS)
 
 
 def header(title: str, lead: str) -> html.Div:
@@ -44,6 +47,15 @@ def downloads(group: Group, csv_label: str = "Download CSV", json_label: str = "
 def progress_bar(group: Group) -> html.Div:
     return html.Div([html.Progress(id=group.progress, value="0", max="100"),
                      html.Span(id=group.status, className="status")], className="progress-row")
+
+
+def configurations(component_id: str, value, multi: bool = False, width: str = "150px") -> dcc.Dropdown | dcc.Checklist:
+    """The configuration picker, labelled as the pages name the configurations: a dropdown of one
+    (``value`` a configuration) or, ``multi``, a row of check boxes (``value`` a list of them)."""
+    options = [{"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS]
+    if multi:
+        return dcc.Checklist(id=component_id, value=value, inline=True, options=options)
+    return dcc.Dropdown(id=component_id, value=value, clearable=False, style={"width": width}, options=options)
 
 
 def field(label: str, control, hint: str | None = None) -> html.Div:
