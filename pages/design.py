@@ -15,7 +15,7 @@ from shimmy.model.configurations import affects
 from shimmy.model.parameters import PARAMETER_SPECS
 from shimmy.service import schemas
 from ui import components as ui
-from ui import fields, ids, jobs
+from ui import fields, formats, ids, jobs
 from ui import style
 from ui.fields import Quantity
 from ui.layout import DESIGN, page
@@ -58,11 +58,6 @@ TABLE_STYLE = {"style_table": {"overflowX": "auto", "maxWidth": "640px"},
                "style_cell": {"fontFamily": "inherit", "fontSize": "13px", "padding": "3px 8px", "textAlign": "left"},
                "style_header": {"backgroundColor": "#eef2f8", "fontWeight": "600"},
                "css": [{"selector": ".Select-menu-outer", "rule": "display: block !important"}]}
-
-
-def _g(x: float, digits: int = 6) -> str:
-    """1.4e+06 -> 1.4e6 (compact, for tables and hover text)."""
-    return f"{x:.{digits}g}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
 
 
 def _unit(name: str) -> str:
@@ -497,7 +492,8 @@ def tornado(q, rows, by, Fz):
     hover = []
     for r in active:
         u = f" {r['unit']}" if r["unit"] else ""
-        hover.append(f"{r['name']} = {_g(r['value'])}{u} (range {_g(r['low'])} – {_g(r['high'])}{u})<br>"
+        hover.append(f"{r['name']} = {formats.compact(r['value'])}{u} "
+                     f"(range {formats.compact(r['low'])} – {formats.compact(r['high'])}{u})<br>"
                      f"d{symbol}/d{r['name']} = {r['derivative'] / scale:.4g} {unit} per {r['unit'] or 'unit'}<br>"
                      f"half range: {r['per_half_range'] / scale:+.4g} {unit}<br>"
                      f"+1 %: {r['per_percent'] / scale:+.4g} {unit}")
@@ -575,8 +571,9 @@ def opt_design(result):
     for name in result["parameters"]:
         spec = PARAMETER_SPECS[name]
         old, new = base[name], result["design"][name]
-        rows.append([name, spec.unit or "–", f"{_g(spec.low)} – {_g(spec.high)}", _g(old), _g(new),
-                     ui.pct(100 * (new - old) / old if old else None)])
+        rows.append([name, spec.unit or "–", f"{formats.compact(spec.low)} – {formats.compact(spec.high)}",
+                     formats.compact(old), formats.compact(new),
+                     formats.signed_percent(100 * (new - old) / old if old else None)])
     return ui.table(["parameter", "unit", "range", "current design", "optimum", "change"], rows, ids.OPT_DESIGN_TABLE)
 
 
@@ -722,7 +719,8 @@ def rob_table(result):
         lp = "–" if s.get("linear_p05") is None else f"{s['linear_p05'] / scale:.5g} – {s['linear_p95'] / scale:.5g}"
         rows.append([f"{title} ({unit})", f"{s['nominal'] / scale:.5g}", f"{s['mean'] / scale:.5g}",
                      f"{s['std'] / scale:.3g}", f"{s['p05'] / scale:.5g}", f"{s['p95'] / scale:.5g}",
-                     ui.fmt(None if s["linear_std"] is None else s["linear_std"] / scale, 3), lp, len(s["samples"])])
+                     formats.significant(None if s["linear_std"] is None else s["linear_std"] / scale, 3), lp,
+                     len(s["samples"])])
     return ui.table(["quantity", "nominal", "mean", "std", "p05", "p95", "linear std", "linear p05 – p95",
                      "samples"], rows, ids.ROB_STATS)
 

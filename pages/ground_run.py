@@ -9,7 +9,7 @@ from plotly.subplots import make_subplots
 from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
-from ui import fields, ids, jobs
+from ui import fields, formats, ids, jobs
 from ui.fields import Quantity
 from ui import style
 from ui.layout import page
@@ -274,7 +274,7 @@ def summary(results):
             if base["peak_psi"]["value"] > 0:
                 psi += f" (×{p['value'] / base['peak_psi']['value']:.2f})"
         crossings = ", ".join(f"{c['V']:.4g} m/s" for c in r["boundary_crossings"]) or "none"
-        delay = ui.fmt(r["onset_delay_s"], 3)
+        delay = formats.significant(r["onset_delay_s"], 3)
         rows.append([style.CONFIG_LABELS[r["config"]], time_in, speeds, psi, lat, crossings, delay])
     return ui.table(["configuration", "time in shimmy (s, against original)", "speed range in shimmy (m/s)",
                      "peak |psi| (rad)", "peak |l_g delta| (mm)", "crosses the Hopf curves at", "onset delay (s)"],

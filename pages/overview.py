@@ -9,7 +9,7 @@ from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from plotly.subplots import make_subplots
 
-from ui import compare, designs, ids, jobs
+from ui import compare, designs, formats, ids, jobs
 from ui import components as ui
 from ui.fields import Quantity
 from ui.layout import page
@@ -113,7 +113,8 @@ def update(design, fz_kn, v_max):
         freq = data["hopf_points"][0]["frequency_hz"] if data["hopf_points"] else None
         rows.append([style.CONFIG_LABELS[config],
                      ", ".join(f"{a:.4g}–{b:.4g}" for a, b in intervals) or "stable",
-                     ui.fmt(onset), ui.fmt(end), ui.signed(d_onset), ui.fmt(freq),
+                     formats.significant(onset), formats.significant(end), formats.signed(d_onset),
+                     formats.significant(freq),
                      ", ".join(h["criticality"] for h in data["hopf_points"]) or "–"])
     lay = style.layout(f"Growth rate of straight rolling at Fz = {fz_kn:g} kN", "forward speed V (m/s)",
                        "largest eigenvalue real part (1/s)", x_log=True)

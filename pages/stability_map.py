@@ -8,7 +8,7 @@ import dash
 from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.errors import InvalidParameterError
-from ui import compare, designs, fields, ids, jobs
+from ui import compare, designs, fields, formats, ids, jobs
 from ui import components as ui
 from ui import style
 from ui.fields import Quantity
@@ -242,7 +242,7 @@ def figure(results, series=None, what="configuration"):
 
 def _pct(value, base):
     """Relative change against original, for the table."""
-    return "–" if value is None or not base else ui.pct(100 * (value - base) / base, 1)
+    return "–" if value is None or not base else formats.signed_percent(100 * (value - base) / base, 1)
 
 
 def summary(results):
@@ -254,8 +254,9 @@ def summary(results):
         hull = at["shimmy_speed_range"]
         low = None if r["min_shimmy_Fz"] is None else r["min_shimmy_Fz"] / 1e3
         speeds = "–" if hull is None else f"{hull[0]:.4g} – {hull[1]:.4g}"
-        row = [style.CONFIG_LABELS[r["config"]], ui.fmt(low), ui.fmt(m["torsion_area"], 5), speeds,
-               ui.fmt(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]), len(r["torus_curves"])]
+        row = [style.CONFIG_LABELS[r["config"]], formats.significant(low), formats.significant(m["torsion_area"], 5),
+               speeds, formats.significant(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]),
+               len(r["torus_curves"])]
         if base is not None and r is not base:
             b = base["metrics"]
             row[1] += f" ({_pct(r['min_shimmy_Fz'], base['min_shimmy_Fz'])})"

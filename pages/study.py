@@ -10,7 +10,7 @@ from shimmy.errors import InvalidParameterError
 from shimmy.model.configurations import affects
 from shimmy.model.parameters import PARAMETER_SPECS
 from ui import components as ui
-from ui import fields, ids, jobs
+from ui import fields, formats, ids, jobs
 from ui import style
 from ui.fields import Quantity
 from ui.layout import page
@@ -168,8 +168,9 @@ def summary(result):
     """Both layouts of the table (the page shows the one chosen): long, and pivoted by configuration."""
     name = result["parameters"][0]
     ordered = sorted(result["rows"], key=lambda r: (r[name], CONFIGS.index(r["config"])))
-    rows = [[f"{r[name]:.6g}", style.CONFIG_LABELS[r["config"]], ui.fmt(r["hopf_start"], 6), ui.fmt(r["hopf_end"], 6),
-             ui.fmt(r["max_psi"], 5), ui.fmt(r["max_psi_V"], 4), "; ".join(r["warnings"]) or "–"]
+    rows = [[f"{r[name]:.6g}", style.CONFIG_LABELS[r["config"]], formats.significant(r["hopf_start"], 6),
+             formats.significant(r["hopf_end"], 6), formats.significant(r["max_psi"], 5),
+             formats.significant(r["max_psi_V"], 4), "; ".join(r["warnings"]) or "–"]
             for r in ordered]
     long = ui.table([f"{name}{_unit(name)}", "configuration", "first Hopf V (m/s)", "last Hopf V (m/s)",
                      "max stable |psi| (rad)", "at V (m/s)", "warnings"], rows, ids.STUDY_SUMMARY)
@@ -184,7 +185,7 @@ def summary(result):
     for value, per in by_value.items():
         row = [f"{value:.6g}"]
         for key, digits in (("hopf_start", 6), ("hopf_end", 6), ("max_psi", 5)):
-            row += [ui.fmt(per[c][key], digits) if c in per else "–" for c in configs]
+            row += [formats.significant(per[c][key], digits) if c in per else "–" for c in configs]
         pivot_rows.append(row)
     pivot = ui.table(columns, pivot_rows, ids.STUDY_PIVOT)
     return [html.Div(long, className="study-long"), html.Div(pivot, className=ids.STUDY_PIVOT)]

@@ -7,7 +7,7 @@ from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.service import analyses
 from ui import components as ui
-from ui import ids
+from ui import formats, ids
 from ui.layout import page
 
 dash.register_page(__name__, path="/validation", name="Validation", order=6)
@@ -52,17 +52,17 @@ def build(_n):
     for config, published in PUBLISHED_HOPF.items():
         computed = _hopf(config)
         for p, c in zip(published, computed, strict=False):
-            rows.append([config, f"{p:g}", f"{c:.4f}", ui.pct(100 * (c / p - 1), 3)])
+            rows.append([config, f"{p:g}", f"{c:.4f}", formats.signed_percent(100 * (c / p - 1), 3)])
     hopf_table = ui.table(["configuration", "published Hopf V (m/s)", "computed (m/s)", "difference"], rows,
                           ids.VAL_HOPF)
     amp = _amplitude("nes_pd", 30.0)
     amp_table = ui.table(["quantity", "published", "computed", "difference"], [
         ["nes_pd torsional amplitude at V = 30 m/s (rad)", f"{PUBLISHED_AMPLITUDE:g}", f"{amp:.4f}",
-         ui.pct(100 * (amp / PUBLISHED_AMPLITUDE - 1), 1)]], ids.VAL_AMPLITUDE)
+         formats.signed_percent(100 * (amp / PUBLISHED_AMPLITUDE - 1), 1)]], ids.VAL_AMPLITUDE)
     a08, a09 = _amplitude("nes_pd", 30.0, {"a_p": 0.8}), _amplitude("nes_pd", 30.0, {"a_p": 0.9})
     tungsten = _amplitude("nes_pd", 30.0, material="tungsten")
     sanity = ui.table(["sanity check (not a target)", "expected", "computed"], [
-        ["a_p 0.8 -> 0.9 lowers the nes_pd amplitude", "about -10 %", ui.pct(100 * (a09 / a08 - 1), 1)],
+        ["a_p 0.8 -> 0.9 lowers the nes_pd amplitude", "about -10 %", formats.signed_percent(100 * (a09 / a08 - 1), 1)],
         ["tungsten powder damps more than steel shot", "tungsten < steel",
          f"{tungsten:.4f} < {amp:.4f} rad" if tungsten < amp else f"{tungsten:.4f} >= {amp:.4f} rad (FAILS)"]],
         ids.VAL_SANITY)

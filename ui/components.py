@@ -89,24 +89,3 @@ def number(raw, default: float) -> float:
     except (TypeError, ValueError):
         return default
 
-
-def pct(x: float | None, digits: int = 1) -> str:
-    """A signed percentage with ``digits`` decimals; one that rounds to zero is "0.0 %", never "-0.0 %"."""
-    if x is None:
-        return "–"
-    text = f"{x:+.{digits}f}"
-    if float(text) == 0:
-        text = f"{0:.{digits}f}"
-    return f"{text} %"
-
-
-def signed(x: float | None, digits: int = 3) -> str:
-    """A signed number to ``digits`` significant digits; zero without a sign (no "-0")."""
-    if x is None:
-        return "–"
-    text = f"{x:+.{digits}g}"
-    return "0" if float(text) == 0 else text
-
-
-def fmt(x: float | None, digits: int = 4) -> str:
-    return "–" if x is None else f"{x:.{digits}g}"

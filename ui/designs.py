@@ -24,6 +24,7 @@ from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters, chec
 from shimmy.version import __version__ as SHIMMY_VERSION
 
 from . import state
+from .formats import significant, significant_or_whole, signed_or_whole, signed_percent
 
 FORMAT = "shimmy design"
 FORMAT_VERSION = 1
@@ -45,13 +46,9 @@ class DesignError(ValueError):
         super().__init__(f"{what}: " + "; ".join(self.problems))
 
 
-def _g(x: float) -> str:
-    return f"{x:.6g}"
-
-
 def _with_unit(name: str, value: Any) -> str:
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return f"{name} = {_g(value)} {PARAMETER_SPECS[name].unit}".rstrip()
+        return f"{name} = {significant(value, 6)} {PARAMETER_SPECS[name].unit}".rstrip()
     return f"{name} = {json.dumps(value)}"
 
 
@@ -437,26 +434,9 @@ class Figure:
     relative: bool = True  # also the change in per cent
 
 
-def fmt(x: float | None, digits: int = 4) -> str:
-    """4 significant digits; whole numbers from 10 000 up to 1e9 written out (11300, not 1.13e+04)."""
-    if x is None:
-        return "–"
-    return f"{x:.0f}" if 1e4 <= abs(x) < 1e9 else f"{x:.{digits}g}"
-
-
 def _zero(d: float, *values: float) -> bool:
     """A change that is rounding noise of the computation (1e-9 of the values), shown as "same"."""
     return abs(d) <= 1e-9 * max([1e-300, *(abs(v) for v in values)])
-
-
-def _signed(x: float, digits: int = 3) -> str:
-    text = f"{x:+.0f}" if 1e3 <= abs(x) < 1e9 else f"{x:+.{digits}g}"
-    return "0" if float(text) == 0 else text
-
-
-def _pct(x: float) -> str:
-    text = f"{x:+.1f}"
-    return "0.0 %" if float(text) == 0 else f"{text} %"
 
 
 def _shown(f: Figure, value: Any) -> Any:
@@ -475,13 +455,13 @@ def _shown(f: Figure, value: Any) -> Any:
 
 def _text(f: Figure, v: Any) -> str:
     if f.kind == "number":
-        return fmt(v)
+        return significant_or_whole(v)
     if f.kind == "list":
-        return ", ".join(fmt(x) for x in v) if v else "none"
+        return ", ".join(significant_or_whole(x) for x in v) if v else "none"
     if f.kind == "range":
-        return "none" if v is None else f"{fmt(v[0])} – {fmt(v[1])}"
+        return "none" if v is None else f"{significant_or_whole(v[0])} – {significant_or_whole(v[1])}"
     if f.kind == "ranges":
-        return "; ".join(f"{fmt(a)} – {fmt(b)}" for a, b in v) if v else "none"
+        return "; ".join(f"{significant_or_whole(a)} – {significant_or_whole(b)}" for a, b in v) if v else "none"
     return "–" if v in (None, "") else str(v)
 
 
@@ -495,15 +475,17 @@ def _change(f: Figure, v: Any, b: Any) -> tuple[str, Any]:
         d = v - b
         if _zero(d, v, b):
             return "same", 0.0
-        text = f"{_signed(d)}{unit}"
+        text = f"{signed_or_whole(d)}{unit}"
         if f.relative and b != 0:
-            text += f" ({_pct(100 * d / b)})"
+            text += f" ({signed_percent(100 * d / b)})"
         return text, d
     if f.kind == "range":
         if v is None or b is None:
             return ("same" if v == b else f"{_text(f, b)} → {_text(f, v)}"), None
         d = [v[0] - b[0], v[1] - b[1]]
-        return ("same" if all(_zero(x, *v, *b) for x in d) else f"onset {_signed(d[0])}, end {_signed(d[1])}{unit}"), d
+        if all(_zero(x, *v, *b) for x in d):
+            return "same", d
+        return f"onset {signed_or_whole(d[0])}, end {signed_or_whole(d[1])}{unit}", d
     if f.kind == "ranges":
         v, b = v or [], b or []
         if len(v) != len(b):
@@ -512,7 +494,7 @@ def _change(f: Figure, v: Any, b: Any) -> tuple[str, Any]:
         bounds = [x for pair in v + b for x in pair]
         if all(_zero(x, *bounds) for pair in d for x in pair):
             return "same", d
-        return "; ".join(f"onset {_signed(x)}, end {_signed(y)}" for x, y in d) + unit, d
+        return "; ".join(f"onset {signed_or_whole(x)}, end {signed_or_whole(y)}" for x, y in d) + unit, d
     # lists: element by element when they have as many entries
     v, b = v or [], b or []
     if len(v) != len(b):
@@ -520,7 +502,7 @@ def _change(f: Figure, v: Any, b: Any) -> tuple[str, Any]:
     d = [x - y for x, y in zip(v, b, strict=True)]
     if all(_zero(x, p, q) for x, p, q in zip(d, v, b, strict=True)):
         return "same", d
-    return ", ".join(_signed(x) for x in d) + unit, d
+    return ", ".join(signed_or_whole(x) for x in d) + unit, d
 
 
 def comparison(names: Sequence[str], results: Sequence[dict[str, Any]], figures: Sequence[Figure]

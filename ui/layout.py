@@ -10,7 +10,7 @@ from dash import ALL, Input, Output, State, dcc, html
 from shimmy.errors import InvalidParameterError
 from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
 
-from . import ids, sessions, state
+from . import formats, ids, sessions, state
 
 #: The design parameters with sliders (the six a device design moves); every other one is in the advanced panel.
 DESIGN = ("r2", "e_p", "k_s", "r3", "a_p", "rho_p")
@@ -23,11 +23,6 @@ def _label(name: str) -> html.Label:
     unit = f" ({spec.unit})" if spec.unit else ""
     return html.Label([html.Span(name, className="param-name"), html.Span(unit, className="param-unit")],
                       title=f"{spec.description}; {spec.allowed}; {spec.provenance}", htmlFor=f"param-{name}")
-
-
-def _short(x: float) -> str:
-    """1.4e+06 -> 1.4e6: slider end labels that fit the panel."""
-    return f"{x:g}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
 
 
 def _field_error(name: str, problem: str | None) -> html.Div:
@@ -48,7 +43,7 @@ def _slider(name: str, value: float, problem: str | None = None) -> html.Div:
         html.Div([
             html.Div(dcc.Slider(id=ids.param(name), min=spec.low, max=spec.high,
                                 step=(spec.high - spec.low) / SLIDER_STEPS, value=value, updatemode="drag",
-                                marks={spec.low: _short(spec.low), spec.high: _short(spec.high)},
+                                marks={spec.low: formats.compact(spec.low), spec.high: formats.compact(spec.high)},
                                 tooltip={"placement": "bottom", "always_visible": False}), className="slider-track"),
             _box(name, value),
         ], className="slider-line"),
