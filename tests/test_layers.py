@@ -153,7 +153,7 @@ UI_MAY_IMPORT = ("shimmy.service", "shimmy.errors", "shimmy.version", "shimmy.mo
 
 
 def test_ui_uses_only_the_service_layer_and_definitions():
-    files = [ROOT / "app.py", *(ROOT / "pages").glob("*.py"), *(ROOT / "ui").glob("*.py")]
+    files = [ROOT / "app.py", *(ROOT / "pages").glob("*.py"), *(ROOT / "ui").rglob("*.py")]
     assert len(files) > 5
     for path in files:
         for name in imports(path):
