@@ -6,6 +6,7 @@ import dash
 from dash import Input, Output, State, html
 from plotly.subplots import make_subplots
 
+from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
 from ui import compare, designs, fields, ids, jobs
 from ui import components as ui
@@ -16,7 +17,13 @@ from ui.layout import page
 dash.register_page(__name__, path="/bifurcation", name="Bifurcation", order=3)
 
 CONFIGS = ui.CONFIGS
-SYMBOLS = {"H": "diamond", "LPC": "triangle-up", "NS": "square", "PD": "x", "BPC": "cross", "BP": "circle-open"}
+#: The special points drawn, each kind with its marker (and the legend in this order).
+SYMBOLS = {PointKind.HOPF: "diamond", PointKind.FOLD_OF_CYCLES: "triangle-up", PointKind.TORUS: "square",
+           PointKind.PERIOD_DOUBLING: "x", PointKind.BRANCH_POINT_OF_CYCLES: "cross",
+           PointKind.BRANCH_POINT: "circle-open"}
+#: What the special points of cycles are (the summary table lists them).
+CYCLE_POINTS = (PointKind.FOLD_OF_CYCLES, PointKind.TORUS, PointKind.PERIOD_DOUBLING,
+                PointKind.BRANCH_POINT_OF_CYCLES)
 
 
 
@@ -39,7 +46,8 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
         ui.header("Bifurcation diagram", "Equilibrium and limit-cycle branches in the forward speed at one load, "
                   "by pseudo-arclength continuation with orthogonal collocation; stability from Floquet multipliers "
                   "(solid stable, dashed unstable); special points labelled as the continuation tools do: Hopf (H1, "
-                  "H2, ...), fold of cycles (LPC), torus (NS), period doubling (PD); hover one for its details. "
+                  f"H2, ...), fold of cycles ({PointKind.FOLD_OF_CYCLES}), torus ({PointKind.TORUS}), period doubling "
+                  f"({PointKind.PERIOD_DOUBLING}); hover one for its details. "
                   "The bottom strip shows where straight rolling is stable for each configuration."),
         html.Div([
             ui.field("Fz (kN)", FZ.box(ids.BIF_FZ, fz)),
@@ -132,8 +140,9 @@ jobs.register(
 compare.register_selection(ids.BIFC, ids.BIF)
 
 
-KIND_NAMES = {"H": "Hopf", "LPC": "fold of cycles", "NS": "torus", "PD": "period doubling",
-              "BPC": "branch point of cycles", "BP": "branch point"}
+KIND_NAMES = {PointKind.HOPF: "Hopf", PointKind.FOLD_OF_CYCLES: "fold of cycles", PointKind.TORUS: "torus",
+              PointKind.PERIOD_DOUBLING: "period doubling", PointKind.BRANCH_POINT_OF_CYCLES: "branch point of cycles",
+              PointKind.BRANCH_POINT: "branch point"}
 HEIGHT, BOTTOM = 780, 190
 
 
@@ -143,7 +152,7 @@ def _labelled(results):
     out = []
     for result in results:
         found = [(b, sp) for b in result["branches"] for sp in b["special_points"] if sp["kind"] in SYMBOLS
-                 and not (sp["kind"] == "H" and b["kind"] != "equilibrium")]
+                 and not (sp["kind"] == PointKind.HOPF and b["kind"] != "equilibrium")]
         count: dict[str, int] = {}
         for b, sp in sorted(found, key=lambda item: (item[1]["kind"], item[1]["V"])):
             count[sp["kind"]] = count.get(sp["kind"], 0) + 1
@@ -212,7 +221,7 @@ def figure(results, series=None, what="configuration"):
                              line={"color": colour, "width": 3})
     style.legend_key(fig, "stable", "legend2", mode="lines", line={"color": "#555", "width": 2.5})
     style.legend_key(fig, "unstable", "legend2", mode="lines", line={"color": "#555", "width": 1.5, "dash": "dash"})
-    present = {sp["kind"] for _, _, sp, _ in _labelled(results)} or {"H"}
+    present = {sp["kind"] for _, _, sp, _ in _labelled(results)} or {PointKind.HOPF}
     for kind, symbol in SYMBOLS.items():
         if kind not in present:
             continue
@@ -260,15 +269,16 @@ def summary(results):
     rows = []
     for r in results:
         names = {(round(sp["V"], 9), sp["kind"]): name for res, _, sp, name in labelled if res is r}
-        hopf = ", ".join(f"{names.get((round(h['V'], 9), 'H'), 'H')} {h['V']:.4g} ({h['criticality']})"
-                         for h in r["hopf_points"]) or "none in range"
+        hopf = ", ".join(f"{names.get((round(h['V'], 9), PointKind.HOPF), PointKind.HOPF)} {h['V']:.4g} "
+                         f"({h['criticality']})" for h in r["hopf_points"]) or "none in range"
         special = [f"{name} {sp['V']:.4g}" for res, b, sp, name in labelled
-                   if res is r and b["kind"] == "periodic" and sp["kind"] in ("LPC", "NS", "PD", "BPC")]
+                   if res is r and b["kind"] == "periodic" and sp["kind"] in CYCLE_POINTS]
         rows.append([style.CONFIG_LABELS[r["config"]], hopf, f"{r['max_psi']:.4g}",
                      "–" if r["max_psi_V"] is None else f"{r['max_psi_V']:.4g}", ", ".join(special) or "–",
                      "; ".join(r["warnings"]) or "–"])
     return ui.table(["configuration", "Hopf points V (m/s)", "max stable |psi| (rad)", "at V (m/s)",
-                     "fold (LPC) / torus (NS) / period-doubling (PD) points, V (m/s)", "warnings"], rows,
+                     f"fold ({PointKind.FOLD_OF_CYCLES}) / torus ({PointKind.TORUS}) / period-doubling "
+                     f"({PointKind.PERIOD_DOUBLING}) points, V (m/s)", "warnings"], rows,
                     ids.BIF_SUMMARY)
 
 

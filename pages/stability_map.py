@@ -7,8 +7,9 @@ from urllib.parse import urlencode
 import dash
 from dash import Input, Output, State, dcc, html, no_update
 
+from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from ui import compare, designs, fields, formats, ids, jobs
+from ui import compare, designs, fields, formats, ids, jobs, merits
 from ui import components as ui
 from ui import style
 from ui.fields import Quantity
@@ -160,7 +161,7 @@ jobs.register(
 compare.register_selection(ids.MAPC, ids.MAP)
 
 
-MARKERS = {"gh_points": ("GH", "diamond", 12), "double_hopf_points": ("double Hopf", "star", 13)}
+MARKERS = {"gh_points": (PointKind.GENERALISED_HOPF, "diamond", 12), "double_hopf_points": ("double Hopf", "star", 13)}
 
 
 def figure(results, series=None, what="configuration"):
@@ -264,8 +265,9 @@ def summary(results):
             row[4] += f" ({_pct(at['max_psi'], b['at_Fz']['max_psi'])})"
         rows.append(row)
     fz = results[0]["metrics"]["at_Fz"]["Fz"] / 1e3
-    return ui.table(["configuration", "min shimmy Fz (kN)", "pure-torsion area, Fz ≤ 250 kN ((m/s) kN)",
-                     f"shimmy V at {fz:g} kN (m/s)", f"max stable |psi| at {fz:g} kN (rad)", "GH points",
+    area = f"{merits.label('torsion_area')} ({merits.unit('torsion_area')})"
+    return ui.table(["configuration", "min shimmy Fz (kN)", area, f"shimmy V at {fz:g} kN (m/s)",
+                     f"max stable |psi| at {fz:g} kN (rad)", f"{PointKind.GENERALISED_HOPF} points",
                      "fold curves", "torus curves"], rows, ids.MAP_SUMMARY)
 
 

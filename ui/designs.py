@@ -18,12 +18,13 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 from urllib.parse import parse_qs
 
+from shimmy.continuation.kinds import CYCLE_BIFURCATIONS, PointKind
 from shimmy.errors import InvalidParameterError
 from shimmy.model.configurations import Configuration
 from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters, check_number
 from shimmy.version import __version__ as SHIMMY_VERSION
 
-from . import state
+from . import merits, state
 from .formats import significant, significant_or_whole, signed_or_whole, signed_percent
 
 FORMAT = "shimmy design"
@@ -542,7 +543,7 @@ def merit_figures(fz: float) -> list[Figure]:
         Figure("lowest shimmy load, min_shimmy_Fz (kN)", lambda m: m["min_shimmy_Fz"], scale=1e3, unit="kN"),
         Figure("lateral Hopf curve's lowest load, lateral_min_Fz (kN)", lambda m: m["lateral_min_Fz"], scale=1e3,
                unit="kN"),
-        Figure("pure-torsion area, Fz ≤ 250 kN ((m/s) kN)", lambda m: m["torsion_area"]),
+        Figure(f"{merits.label('torsion_area')} ({merits.unit('torsion_area')})", lambda m: m["torsion_area"]),
         Figure(f"Hopf speeds {at} (m/s)", lambda m: m["at_Fz"]["hopf_points"], "list", unit="m/s"),
         Figure(f"shimmy speed range {at} (m/s)", lambda m: m["at_Fz"]["shimmy_speed_range"], "range", unit="m/s"),
         Figure(f"largest stable |psi| {at} (rad)", lambda m: m["at_Fz"]["max_psi"], unit="rad"),
@@ -553,17 +554,18 @@ def merit_figures(fz: float) -> list[Figure]:
 
 def bifurcation_figures() -> list[Figure]:
     """What a bifurcation diagram says of a design: its Hopf points and its largest stable cycle."""
-    def special(r, kinds=("LPC", "NS", "PD")):
+    def special(r, kinds=CYCLE_BIFURCATIONS):
         return sorted(sp["V"] for b in r["branches"] if b["kind"] == "periodic" for sp in b["special_points"]
                       if sp["kind"] in kinds)
 
+    fold, torus, flip = PointKind.FOLD_OF_CYCLES, PointKind.TORUS, PointKind.PERIOD_DOUBLING
     return [
         Figure("Hopf points V (m/s)", lambda r: [h["V"] for h in r["hopf_points"]], "list", unit="m/s"),
         Figure("their criticality", lambda r: ", ".join(h["criticality"] for h in r["hopf_points"]) or "–", "text"),
         Figure("largest stable |psi| (rad)", lambda r: r["max_psi"], unit="rad"),
         Figure("speed of that largest |psi| (m/s)", lambda r: r["max_psi_V"], unit="m/s", relative=False),
-        Figure("folds of cycles (LPC) V (m/s)", lambda r: special(r, ("LPC",)), "list", unit="m/s"),
-        Figure("torus (NS) and period-doubling (PD) V (m/s)", lambda r: special(r, ("NS", "PD")), "list",
+        Figure(f"folds of cycles ({fold}) V (m/s)", lambda r: special(r, (fold,)), "list", unit="m/s"),
+        Figure(f"torus ({torus}) and period-doubling ({flip}) V (m/s)", lambda r: special(r, (torus, flip)), "list",
                unit="m/s"),
         Figure("warnings", lambda r: "; ".join(r["warnings"]) or "–", "text"),
     ]

@@ -11,17 +11,18 @@ from shimmy.errors import InvalidParameterError
 from shimmy.model.parameters import PARAMETER_SPECS
 from shimmy.service import schemas
 from ui import components as ui
-from ui import style
+from ui import merits, style
 from ui.fields import Quantity
 
 CONFIGS = ui.CONFIGS
 FZ = Quantity("sensitivity", "Fz", "Fz", "kN", 1e3)
 
-#: How the page shows each figure of merit: label, unit shown, SI units per shown unit.
-FIGURES = {"min_shimmy_Fz": ("minimum shimmy load", "kN", 1e3),
-           "interval": ("shimmy speed interval width at Fz", "m/s", 1.0),
-           "max_psi": ("largest stable torsional amplitude at Fz", "rad", 1.0),
-           "torsion_area": ("pure-torsion area, Fz ≤ 250 kN", "(m/s) kN", 1.0)}
+#: The units the page shows a figure of merit in where they are not the package's: unit, SI units per shown unit.
+SHOWN_UNITS = {"min_shimmy_Fz": ("kN", 1e3)}
+#: How the page shows each figure of merit: label (the package's, "at Fz" for one taken at the load), unit
+#: shown, SI units per shown unit.
+FIGURES = {name: (merits.label(name) + (" at Fz" if f.at_load else ""), *SHOWN_UNITS.get(name, (f.unit, 1.0)))
+           for name, f in schemas.FIGURES.items()}
 OPS = {"<=": "≤", ">=": "≥"}
 UP, DOWN = "#0072B2", "#D55E00"  # Okabe–Ito blue and vermilion: raises / lowers
 GRID = {"display": "grid", "gridTemplateColumns": "repeat(auto-fill, minmax(min(100%, 470px), 1fr))", "gap": "12px"}

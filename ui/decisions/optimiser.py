@@ -23,16 +23,24 @@ from .common import DOWN, FIGURES, FZ, GRID, OPS, TABLE_STYLE, UP, check_field, 
 STARTS = Quantity("optimise", "starts", "start designs", "")
 RUNS = Quantity("optimise", "local_runs", "local searches", "")
 OPT_SEED = Quantity("optimise", "seed", "optimiser seed", "")
-OBJECTIVES = {"min_shimmy_Fz": "maximise the minimum shimmy load",
-              "interval": "minimise the shimmy speed interval at Fz",
-              "max_psi": "minimise the largest stable torsional amplitude at Fz",
-              "torsion_area": "minimise the pure-torsion area (differential evolution: minutes)"}
+#: Shorter names of the figures where a control has less room than a table (the objectives, the constraints).
+SHORT = {"interval": "shimmy speed interval at Fz", "torsion_area": "pure-torsion area"}
+
+
+def _objective(name: str) -> str:
+    """'maximise the minimum shimmy load': the figure's sense and name; the slow method said."""
+    verb = "maximise" if schemas.FIGURES[name].sense > 0 else "minimise"
+    slow = "" if name in schemas.DIFFERENTIABLE else " (differential evolution: minutes)"
+    return f"{verb} the {SHORT.get(name, FIGURES[name][0])}{slow}"
+
+
+OBJECTIVES = {name: _objective(name) for name in FIGURES}
 
 
 def figure_option(name: str) -> str:
     """How the constraint table's dropdown names a figure: short, with the unit its value is typed in."""
-    return {"min_shimmy_Fz": "minimum shimmy load (kN)", "interval": "shimmy speed interval at Fz (m/s)",
-            "max_psi": "largest stable |psi| at Fz (rad)", "torsion_area": "pure-torsion area ((m/s) kN)"}[name]
+    short = {**SHORT, "max_psi": "largest stable |psi| at Fz"}
+    return f"{short.get(name, FIGURES[name][0])} ({FIGURES[name][1]})"
 
 
 def default_search(config: str) -> list[str]:
