@@ -10,6 +10,7 @@ from dash import html
 from shimmy.service import schemas, settings
 from shimmy.service.api import JOB_ANALYSES, PREFIX, SYNC_ANALYSES, openapi_document
 from ui import components as ui
+from ui import ids
 from ui.layout import page
 
 dash.register_page(__name__, path="/api", name="API", order=7)
@@ -47,7 +48,7 @@ def layout(**query):
                           f"{PREFIX}/openapi.json (generated from the request schemas below). Every bad input gets "
                           "a 4xx answer {\"error\", \"field\", \"allowed\"} naming the field; long analyses run as "
                           "jobs."),
-                ui.table(["method", "path", "what"], endpoint_rows, "api-endpoints"),
+                ui.table(["method", "path", "what"], endpoint_rows, ids.API_ENDPOINTS),
                 html.P([html.A("openapi.json", href=f"{PREFIX}/openapi.json"), " · limits: body at most "
                         f"{settings.MAX_BODY_BYTES} bytes, t_end at most {settings.MAX_T_END:g} s, ntst at most "
                         f"{settings.MAX_NTST}, at most "
@@ -72,4 +73,4 @@ def layout(**query):
                  html.P("400 malformed body, 404 unknown endpoint or job, 405 wrong method, 413 body too large, "
                         "422 a field out of its range, of the wrong type, missing, NaN/inf, an unknown parameter or "
                         "configuration, or a solver that did not converge.", className="hint")]
-    return page(query, "api", *sections, design=False)
+    return page(query, ids.API, *sections, design=False)

@@ -3,21 +3,27 @@
 from __future__ import annotations
 
 import dash
-from dash import Input, Output, State, dcc, html
+from dash import Input, Output, State, html
 from plotly.subplots import make_subplots
 
+from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from ui import compare, designs, fields, jobs
+from ui import compare, designs, fields, ids, jobs
 from ui import components as ui
 from ui import style
 from ui.fields import Quantity
-from ui.layout import design_id, page
-from ui.sessions import LOCAL
+from ui.layout import page
 
 dash.register_page(__name__, path="/bifurcation", name="Bifurcation", order=3)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
-SYMBOLS = {"H": "diamond", "LPC": "triangle-up", "NS": "square", "PD": "x", "BPC": "cross", "BP": "circle-open"}
+CONFIGS = ui.CONFIGS
+#: The special points drawn, each kind with its marker (and the legend in this order).
+SYMBOLS = {PointKind.HOPF: "diamond", PointKind.FOLD_OF_CYCLES: "triangle-up", PointKind.TORUS: "square",
+           PointKind.PERIOD_DOUBLING: "x", PointKind.BRANCH_POINT_OF_CYCLES: "cross",
+           PointKind.BRANCH_POINT: "circle-open"}
+#: What the special points of cycles are (the summary table lists them).
+CYCLE_POINTS = (PointKind.FOLD_OF_CYCLES, PointKind.TORUS, PointKind.PERIOD_DOUBLING,
+                PointKind.BRANCH_POINT_OF_CYCLES)
 
 
 
@@ -36,42 +42,39 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
     hi, p_hi = V_MAX.from_url("v_max", v_max, 200)
     problems = " ".join(p for p in (bad, p_fz, p_lo, p_hi) if p)
     return page(
-        query, "bif",
+        query, ids.BIF,
         ui.header("Bifurcation diagram", "Equilibrium and limit-cycle branches in the forward speed at one load, "
                   "by pseudo-arclength continuation with orthogonal collocation; stability from Floquet multipliers "
                   "(solid stable, dashed unstable); special points labelled as the continuation tools do: Hopf (H1, "
-                  "H2, ...), fold of cycles (LPC), torus (NS), period doubling (PD); hover one for its details. "
+                  f"H2, ...), fold of cycles ({PointKind.FOLD_OF_CYCLES}), torus ({PointKind.TORUS}), period doubling "
+                  f"({PointKind.PERIOD_DOUBLING}); hover one for its details. "
                   "The bottom strip shows where straight rolling is stable for each configuration."),
         html.Div([
-            ui.field("Fz (kN)", FZ.box("bif-fz", fz)),
-            html.Div([ui.field("V from (m/s)", V_MIN.box("bif-vmin", lo)),
-                      ui.field("to (m/s)", V_MAX.box("bif-vmax", hi))], className="pair"),
-            ui.field("Configurations", dcc.Checklist(id="bif-configs", value=chosen, inline=True, options=[
-                {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
-            *jobs.controls("bif"),
+            ui.field("Fz (kN)", FZ.box(ids.BIF_FZ, fz)),
+            html.Div([ui.field("V from (m/s)", V_MIN.box(ids.BIF_VMIN, lo)),
+                      ui.field("to (m/s)", V_MAX.box(ids.BIF_VMAX, hi))], className="pair"),
+            ui.field("Configurations", ui.configurations(ids.BIF_CONFIGS, chosen, multi=True)),
+            *jobs.controls(ids.BIF_GROUP),
         ], className="controls"),
-        html.Div(problems, id="bif-error", className="error", role="alert"),
-        ui.graph("bif-graph", figure=style.message_figure(WAITING, 520)),
-        html.Div(id="bif-table", className="table-wrap"),
-        ui.downloads("bif"),
-        *jobs.stores("bif"),
+        html.Div(problems, id=ids.BIF_GROUP.error, className="error", role="alert"),
+        ui.graph(ids.BIF_GRAPH, figure=style.message_figure(WAITING, 520)),
+        html.Div(id=ids.BIF_TABLE, className="table-wrap"),
+        ui.downloads(ids.BIF_GROUP),
+        *jobs.stores(ids.BIF_GROUP),
         html.H2("Compare saved designs"),
         html.P("The designs ticked under Compare in the design panel (2 to 4; the current one may be one of them) "
                "at this page's load and speed range, for one configuration: one colour per design, the first the "
                "reference of the changes in the table. The x = 0 strip shows each design's Hopf interval (dashed: "
                "straight rolling unstable).", className="hint"),
-        html.Div([ui.field("Configuration", dcc.Dropdown(id="bifc-config", value=compared, clearable=False,
-                                                         style={"width": "150px"},
-                                                         options=[{"label": style.CONFIG_LABELS[c], "value": c}
-                                                                  for c in CONFIGS])),
-                  *jobs.controls("bifc", "Compare")], className="controls"),
-        html.Div(id="bifc-designs", className="compare-designs"),
-        html.Div(bad_compared, id="bifc-error", className="error", role="alert"),
-        ui.graph("bifc-graph", figure=style.message_figure(compare.waiting_text("about 2-5 s per design cold, "
+        html.Div([ui.field("Configuration", ui.configurations(ids.BIFC_CONFIG, compared)),
+                  *jobs.controls(ids.BIFC, "Compare")], className="controls"),
+        html.Div(id=ids.BIFC.designs, className="compare-designs"),
+        html.Div(bad_compared, id=ids.BIFC.error, className="error", role="alert"),
+        ui.graph(ids.BIFC_GRAPH, figure=style.message_figure(compare.waiting_text("about 2-5 s per design cold, "
                                                                                 "instant from the cache"), 360)),
-        html.Div(id="bifc-table", className="table-wrap"),
-        ui.downloads("bifc"),
-        *jobs.stores("bifc"),
+        html.Div(id=ids.BIFC_TABLE, className="table-wrap"),
+        ui.downloads(ids.BIFC),
+        *jobs.stores(ids.BIFC),
     )
 
 
@@ -94,11 +97,11 @@ def _csv_rows(results):
 
 
 jobs.register(
-    "bif", "bifurcation", requests=_requests, render=lambda results: (figure(results), summary(results)),
-    outputs=[Output("bif-graph", "figure"), Output("bif-table", "children")],
-    states=[State("bif-fz", "value"), State("bif-vmin", "value"), State("bif-vmax", "value"),
-            State("bif-configs", "value"), State(design_id("bif"), "data")],
-    lock=["bif-fz", "bif-vmin", "bif-vmax"], download=jobs.Download("bif", "bifurcation", _csv_rows),
+    ids.BIF_GROUP, "bifurcation", requests=_requests, render=lambda results: (figure(results), summary(results)),
+    outputs=[Output(ids.BIF_GRAPH, "figure"), Output(ids.BIF_TABLE, "children")],
+    states=[State(ids.BIF_FZ, "value"), State(ids.BIF_VMIN, "value"), State(ids.BIF_VMAX, "value"),
+            State(ids.BIF_CONFIGS, "value"), State(ids.design_store(ids.BIF), "data")],
+    lock=[ids.BIF_FZ, ids.BIF_VMIN, ids.BIF_VMAX], download=jobs.Download(ids.BIF_GROUP, "bifurcation", _csv_rows),
     blank=lambda: (style.message_figure("Refused: see the message above", 520), None))
 
 
@@ -116,7 +119,7 @@ def _compare_names(*values):
 def _compare_render(results, names):
     series = compare.series(names)
     table = designs.comparison(names, results, designs.bifurcation_figures())
-    return figure(results, series, what="design"), compare.table(table, "bifc-summary")
+    return figure(results, series, what="design"), compare.table(table, ids.BIFC_SUMMARY)
 
 
 def _compare_csv(results, names):
@@ -127,18 +130,19 @@ def _compare_csv(results, names):
 
 
 jobs.register(
-    "bifc", "bifurcation", requests=_compare_requests, labels=_compare_names, render=_compare_render,
-    outputs=[Output("bifc-graph", "figure"), Output("bifc-table", "children")],
-    states=[State("bif-fz", "value"), State("bif-vmin", "value"), State("bif-vmax", "value"),
-            State("bifc-config", "value"), State("design-compare", "value"), State(LOCAL, "data"),
-            State(design_id("bif"), "data")],
-    lock=["bifc-config"], download=jobs.Download("bifc", "bifurcation_designs", _compare_csv),
+    ids.BIFC, "bifurcation", requests=_compare_requests, labels=_compare_names, render=_compare_render,
+    outputs=[Output(ids.BIFC_GRAPH, "figure"), Output(ids.BIFC_TABLE, "children")],
+    states=[State(ids.BIF_FZ, "value"), State(ids.BIF_VMIN, "value"), State(ids.BIF_VMAX, "value"),
+            State(ids.BIFC_CONFIG, "value"), State(ids.DESIGN_COMPARE, "value"), State(ids.SAVED, "data"),
+            State(ids.design_store(ids.BIF), "data")],
+    lock=[ids.BIFC_CONFIG], download=jobs.Download(ids.BIFC, "bifurcation_designs", _compare_csv),
     blank=lambda: (style.message_figure("Refused: see the message above", 360), None))
-compare.register_selection("bifc", "bif")
+compare.register_selection(ids.BIFC, ids.BIF)
 
 
-KIND_NAMES = {"H": "Hopf", "LPC": "fold of cycles", "NS": "torus", "PD": "period doubling",
-              "BPC": "branch point of cycles", "BP": "branch point"}
+KIND_NAMES = {PointKind.HOPF: "Hopf", PointKind.FOLD_OF_CYCLES: "fold of cycles", PointKind.TORUS: "torus",
+              PointKind.PERIOD_DOUBLING: "period doubling", PointKind.BRANCH_POINT_OF_CYCLES: "branch point of cycles",
+              PointKind.BRANCH_POINT: "branch point"}
 HEIGHT, BOTTOM = 780, 190
 
 
@@ -148,7 +152,7 @@ def _labelled(results):
     out = []
     for result in results:
         found = [(b, sp) for b in result["branches"] for sp in b["special_points"] if sp["kind"] in SYMBOLS
-                 and not (sp["kind"] == "H" and b["kind"] != "equilibrium")]
+                 and not (sp["kind"] == PointKind.HOPF and b["kind"] != "equilibrium")]
         count: dict[str, int] = {}
         for b, sp in sorted(found, key=lambda item: (item[1]["kind"], item[1]["V"])):
             count[sp["kind"]] = count.get(sp["kind"], 0) + 1
@@ -217,7 +221,7 @@ def figure(results, series=None, what="configuration"):
                              line={"color": colour, "width": 3})
     style.legend_key(fig, "stable", "legend2", mode="lines", line={"color": "#555", "width": 2.5})
     style.legend_key(fig, "unstable", "legend2", mode="lines", line={"color": "#555", "width": 1.5, "dash": "dash"})
-    present = {sp["kind"] for _, _, sp, _ in _labelled(results)} or {"H"}
+    present = {sp["kind"] for _, _, sp, _ in _labelled(results)} or {PointKind.HOPF}
     for kind, symbol in SYMBOLS.items():
         if kind not in present:
             continue
@@ -265,21 +269,22 @@ def summary(results):
     rows = []
     for r in results:
         names = {(round(sp["V"], 9), sp["kind"]): name for res, _, sp, name in labelled if res is r}
-        hopf = ", ".join(f"{names.get((round(h['V'], 9), 'H'), 'H')} {h['V']:.4g} ({h['criticality']})"
-                         for h in r["hopf_points"]) or "none in range"
+        hopf = ", ".join(f"{names.get((round(h['V'], 9), PointKind.HOPF), PointKind.HOPF)} {h['V']:.4g} "
+                         f"({h['criticality']})" for h in r["hopf_points"]) or "none in range"
         special = [f"{name} {sp['V']:.4g}" for res, b, sp, name in labelled
-                   if res is r and b["kind"] == "periodic" and sp["kind"] in ("LPC", "NS", "PD", "BPC")]
+                   if res is r and b["kind"] == "periodic" and sp["kind"] in CYCLE_POINTS]
         rows.append([style.CONFIG_LABELS[r["config"]], hopf, f"{r['max_psi']:.4g}",
                      "–" if r["max_psi_V"] is None else f"{r['max_psi_V']:.4g}", ", ".join(special) or "–",
                      "; ".join(r["warnings"]) or "–"])
     return ui.table(["configuration", "Hopf points V (m/s)", "max stable |psi| (rad)", "at V (m/s)",
-                     "fold (LPC) / torus (NS) / period-doubling (PD) points, V (m/s)", "warnings"], rows,
-                    "bif-summary")
+                     f"fold ({PointKind.FOLD_OF_CYCLES}) / torus ({PointKind.TORUS}) / period-doubling "
+                     f"({PointKind.PERIOD_DOUBLING}) points, V (m/s)", "warnings"], rows,
+                    ids.BIF_SUMMARY)
 
 
-@dash.callback(Output("url-update", "data", allow_duplicate=True),
-               Input("bif-fz", "value"), Input("bif-vmin", "value"), Input("bif-vmax", "value"),
-               Input("bif-configs", "value"), Input("bifc-config", "value"), prevent_initial_call=True)
+@dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),
+               Input(ids.BIF_FZ, "value"), Input(ids.BIF_VMIN, "value"), Input(ids.BIF_VMAX, "value"),
+               Input(ids.BIF_CONFIGS, "value"), Input(ids.BIFC_CONFIG, "value"), prevent_initial_call=True)
 def remember(fz, v_min, v_max, configs, compared):
     return {"Fz": fz, "v_min": v_min, "v_max": v_max, "configs": ",".join(configs or []),
             "compare_config": None if compared == "nes_pd" else compared}

@@ -8,8 +8,8 @@ from dash import Input, Output, State, html, no_update
 from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
-from ui import style
-from ui.layout import design_id, page
+from ui import ids, style
+from ui.layout import page
 
 dash.register_page(__name__, path="/devices", name="Devices", order=1)
 
@@ -17,21 +17,22 @@ MATERIAL_COLOURS = {"design": "#009E73", "steel": "#0072B2", "tungsten": "#D55E0
 
 
 def layout(**query):
-    return page(query, "dev",
+    return page(query, ids.DEV,
                 ui.header("Devices", "The torsional NES: restoring torque and stiffness of the roller-spring "
                           "geometry against the cubic fit the dynamics use, over the angle range where the roller "
                           "stays on its track (|a| < pi/6). The particle damper: equivalent torsional damping "
                           "against tangential speed for steel shot and tungsten powder at the current filling."),
-                html.Div(id="dev-error", className="error", role="alert"),
-                html.Div(id="dev-metrics", className="metrics"),
-                html.Div([ui.graph("dev-torque"), ui.graph("dev-stiffness")], className="grid-2"),
-                ui.graph("dev-pd"),
-                ui.downloads("dev"))
+                html.Div(id=ids.DEV_GROUP.error, className="error", role="alert"),
+                html.Div(id=ids.DEV_METRICS, className="metrics"),
+                html.Div([ui.graph(ids.DEV_TORQUE), ui.graph(ids.DEV_STIFFNESS)], className="grid-2"),
+                ui.graph(ids.DEV_PD),
+                ui.downloads(ids.DEV_GROUP))
 
 
-@dash.callback(Output("dev-torque", "figure"), Output("dev-stiffness", "figure"), Output("dev-pd", "figure"),
-               Output("dev-metrics", "children"), Output("dev-error", "children"), Output("dev-csv", "disabled"),
-               Output("dev-json", "disabled"), Input(design_id("dev"), "data"))
+@dash.callback(Output(ids.DEV_TORQUE, "figure"), Output(ids.DEV_STIFFNESS, "figure"), Output(ids.DEV_PD, "figure"),
+               Output(ids.DEV_METRICS, "children"), Output(ids.DEV_GROUP.error, "children"), Output(ids.DEV_GROUP.csv,
+                                                                                                    "disabled"),
+               Output(ids.DEV_GROUP.json, "disabled"), Input(ids.design_store(ids.DEV), "data"))
 def update(design):
     try:
         result, _ = analyses.run("devices", design)
@@ -71,8 +72,9 @@ def _metric(label: str, value: str) -> html.Div:
     return html.Div([html.Div(value, className="value"), html.Div(label, className="label")], className="metric")
 
 
-@dash.callback(Output("dev-download", "data"), Input("dev-csv", "n_clicks"), Input("dev-json", "n_clicks"),
-               State(design_id("dev"), "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.DEV_GROUP.download, "data"), Input(ids.DEV_GROUP.csv, "n_clicks"), Input(ids.DEV_GROUP.json,
+                                                                                                   "n_clicks"),
+               State(ids.design_store(ids.DEV), "data"), prevent_initial_call=True)
 def download(_csv, _json, design):
     try:
         result = analyses.cached("devices", design)  # drawn by update() above: a download never computes
@@ -80,7 +82,7 @@ def download(_csv, _json, design):
         return no_update
     if result is None:
         return no_update
-    if dash.ctx.triggered_id == "dev-json":
+    if dash.ctx.triggered_id == ids.DEV_GROUP.json:
         return {"content": ui.json_text(result), "filename": "devices.json"}
     nes = result["nes"]
     rows = zip(nes["angle"], nes["torque_exact"], nes["torque_cubic"], nes["stiffness_exact"], nes["stiffness_cubic"],

@@ -9,14 +9,14 @@ from plotly.subplots import make_subplots
 from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
-from ui import fields, jobs
+from ui import fields, formats, ids, jobs
 from ui.fields import Quantity
 from ui import style
-from ui.layout import design_id, page
+from ui.layout import page
 
 dash.register_page(__name__, path="/ground-run", name="Ground run", order=4.5)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
+CONFIGS = ui.CONFIGS
 PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi"}
 SERIES_DT = 0.02  # s: the envelopes are smooth; 1500 points per configuration for a 30 s take-off
 TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overflowX": "auto"},
@@ -37,62 +37,59 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
     lat_value, bad_lat = LAT_THR.from_url("lat_thr", lat_thr, 1.0)
     address = " ".join(m for m in (bad_preset, bad_config, bad_psi, bad_lat) if m)
     return page(
-        query, "gr",
+        query, ids.GR,
         ui.header("Ground run", "The gear through a take-off, a landing roll or a taxi: forward speed and nose-gear "
                   "load change with time along a profile (a preset with its stated assumptions, or your own table, "
                   "linearly interpolated). Envelopes of the torsional and lateral amplitudes, time in shimmy, peaks, "
                   "where the run crosses the Hopf curves, and how long shimmy takes to build up after it does, for "
                   "the four configurations."),
         html.Div([
-            ui.field("Profile preset", dcc.Dropdown(id="gr-preset", value=preset, clearable=False,
+            ui.field("Profile preset", dcc.Dropdown(id=ids.GR_PRESET, value=preset, clearable=False,
                                                     style={"width": "160px"},
                                                     options=[{"label": v, "value": k}
                                                              for k, v in PRESET_LABELS.items()])),
-            ui.field("Map and curves of", dcc.Dropdown(id="gr-config", value=config, clearable=False,
-                                                       style={"width": "150px"},
-                                                       options=[{"label": style.CONFIG_LABELS[c], "value": c}
-                                                                for c in CONFIGS])),
-            ui.field("Shimmy threshold |psi| (rad)", PSI_THR.box("gr-psi-thr", psi_value)),
-            ui.field("Shimmy threshold |l_g delta| (mm)", LAT_THR.box("gr-lat-thr", lat_value)),
-            *jobs.controls("gr", "Run"),
+            ui.field("Map and curves of", ui.configurations(ids.GR_CONFIG, config)),
+            ui.field("Shimmy threshold |psi| (rad)", PSI_THR.box(ids.GR_PSI_THR, psi_value)),
+            ui.field("Shimmy threshold |l_g delta| (mm)", LAT_THR.box(ids.GR_LAT_THR, lat_value)),
+            *jobs.controls(ids.GR_GROUP, "Run"),
         ], className="controls"),
         html.Div([
             html.Div([
                 html.H2("Preset settings"),
-                dash_table.DataTable(id="gr-settings", editable=True, **TABLE_STYLE, columns=[
+                dash_table.DataTable(id=ids.GR_SETTINGS, editable=True, **TABLE_STYLE, columns=[
                     {"name": "setting", "id": "name", "editable": False},
                     {"name": "value", "id": "value", "type": "numeric"},
                     {"name": "unit", "id": "unit", "editable": False},
                     {"name": "range", "id": "range", "editable": False},
                     {"name": "meaning", "id": "description", "editable": False}]),
-                html.Div(id="gr-settings-error", className="error", role="alert"),  # at the settings
-                html.P(id="gr-assumptions", className="hint"),
+                html.Div(id=ids.GR_SETTINGS_ERROR, className="error", role="alert"),  # at the settings
+                html.P(id=ids.GR_ASSUMPTIONS, className="hint"),
             ]),
             html.Div([
                 html.H2("Profile table"),
-                dash_table.DataTable(id="gr-table", editable=True, row_deletable=True, **TABLE_STYLE, columns=[
+                dash_table.DataTable(id=ids.GR_TABLE, editable=True, row_deletable=True, **TABLE_STYLE, columns=[
                     {"name": "t (s)", "id": "t", "type": "numeric"},
                     {"name": "V (m/s)", "id": "V", "type": "numeric"},
                     {"name": "Fz (kN)", "id": "Fz", "type": "numeric"}]),
-                html.Div([html.Button("Add row", id="gr-add-row", className="secondary"),
-                          html.Button("Back to the preset", id="gr-reset", className="secondary")],
+                html.Div([html.Button("Add row", id=ids.GR_ADD_ROW, className="secondary"),
+                          html.Button("Back to the preset", id=ids.GR_RESET, className="secondary")],
                          className="downloads"),
-                html.P(id="gr-source", className="hint"),
+                html.P(id=ids.GR_SOURCE, className="hint"),
             ]),
         ], style={"display": "grid", "gridTemplateColumns": "minmax(0, 3fr) minmax(15em, 2fr)", "gap": "16px"}),
-        html.Div(address, id="gr-address", className="error", role="alert"),  # what of the address is unusable
-        html.Div(id="gr-error", className="error", role="alert"),
-        html.Div(id="gr-summary"),
-        ui.graph("gr-plane", figure=style.message_figure("Computing the take-off for the four configurations…")),
-        ui.graph("gr-time"),
-        ui.graph("gr-speed"),
-        ui.downloads("gr"),
-        *jobs.stores("gr"),
-        dcc.Store(id="gr-preset-rows"),
+        html.Div(address, id=ids.GR_ADDRESS, className="error", role="alert"),  # what of the address is unusable
+        html.Div(id=ids.GR_GROUP.error, className="error", role="alert"),
+        html.Div(id=ids.GR_SUMMARY),
+        ui.graph(ids.GR_PLANE, figure=style.message_figure("Computing the take-off for the four configurations…")),
+        ui.graph(ids.GR_TIME),
+        ui.graph(ids.GR_SPEED),
+        ui.downloads(ids.GR_GROUP),
+        *jobs.stores(ids.GR_GROUP),
+        dcc.Store(id=ids.GR_PRESET_ROWS),
     )
 
 
-@dash.callback(Output("gr-settings", "data"), Input("gr-preset", "value"))
+@dash.callback(Output(ids.GR_SETTINGS, "data"), Input(ids.GR_PRESET, "value"))
 def preset_settings(name):
     """The preset's settings at their defaults (a new preset starts from its documented defaults)."""
     fields = analyses.preset_profile(name)["fields"]
@@ -100,9 +97,9 @@ def preset_settings(name):
              "description": f["description"]} for f in fields]
 
 
-@dash.callback(Output("gr-table", "data"), Output("gr-preset-rows", "data"), Output("gr-assumptions", "children"),
-               Output("gr-settings-error", "children"),
-               Input("gr-settings", "data"), Input("gr-reset", "n_clicks"), State("gr-preset", "value"))
+@dash.callback(Output(ids.GR_TABLE, "data"), Output(ids.GR_PRESET_ROWS, "data"), Output(ids.GR_ASSUMPTIONS, "children"),
+               Output(ids.GR_SETTINGS_ERROR, "children"),
+               Input(ids.GR_SETTINGS, "data"), Input(ids.GR_RESET, "n_clicks"), State(ids.GR_PRESET, "value"))
 def preset_table(settings, _reset, name):
     """The preset's table for its settings (shown in the profile table, which may then be edited)."""
     if not settings:
@@ -115,8 +112,8 @@ def preset_table(settings, _reset, name):
     return rows, rows, profile["assumptions"], ""
 
 
-@dash.callback(Output("gr-table", "data", allow_duplicate=True), Input("gr-add-row", "n_clicks"),
-               State("gr-table", "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.GR_TABLE, "data", allow_duplicate=True), Input(ids.GR_ADD_ROW, "n_clicks"),
+               State(ids.GR_TABLE, "data"), prevent_initial_call=True)
 def add_row(_n, rows):
     rows = list(rows or [])
     last = rows[-1] if rows else {"t": 0.0, "V": 10.0, "Fz": 150.0}
@@ -124,8 +121,8 @@ def add_row(_n, rows):
     return [*rows, {"t": t + 1.0, "V": last.get("V"), "Fz": last.get("Fz")}]
 
 
-@dash.callback(Output("gr-source", "children"), Input("gr-table", "data"), State("gr-preset-rows", "data"),
-               State("gr-preset", "value"))
+@dash.callback(Output(ids.GR_SOURCE, "children"), Input(ids.GR_TABLE, "data"), State(ids.GR_PRESET_ROWS, "data"),
+               State(ids.GR_PRESET, "value"))
 def source(rows, preset_rows, name):
     if rows and preset_rows and _same(rows, preset_rows):
         return f"Runs the {PRESET_LABELS[name].lower()} preset ({len(rows)} points). Edit a cell to run your own table."
@@ -179,16 +176,16 @@ def _notice(results):
 
 
 jobs.register(
-    "gr", "ground_run", requests=_requests, initial=True, notice=_notice,
+    ids.GR_GROUP, "ground_run", requests=_requests, initial=True, notice=_notice,
     render=lambda results: (plane(results[0]), envelopes(results, "t"), envelopes(results, "V"), summary(results)),
-    outputs=[Output("gr-plane", "figure"), Output("gr-time", "figure"), Output("gr-speed", "figure"),
-             Output("gr-summary", "children")],
-    triggers=[Input("gr-config", "value")],
-    states=[State("gr-preset", "value"), State("gr-settings", "data"), State("gr-table", "data"),
-            State("gr-preset-rows", "data"), State("gr-psi-thr", "value"), State("gr-lat-thr", "value"),
-            State(design_id("gr"), "data")],
-    lock=["gr-preset"],
-    download=jobs.Download("gr", "ground_run", _csv_rows, filename=_file_stem))
+    outputs=[Output(ids.GR_PLANE, "figure"), Output(ids.GR_TIME, "figure"), Output(ids.GR_SPEED, "figure"),
+             Output(ids.GR_SUMMARY, "children")],
+    triggers=[Input(ids.GR_CONFIG, "value")],
+    states=[State(ids.GR_PRESET, "value"), State(ids.GR_SETTINGS, "data"), State(ids.GR_TABLE, "data"),
+            State(ids.GR_PRESET_ROWS, "data"), State(ids.GR_PSI_THR, "value"), State(ids.GR_LAT_THR, "value"),
+            State(ids.design_store(ids.GR), "data")],
+    lock=[ids.GR_PRESET],
+    download=jobs.Download(ids.GR_GROUP, "ground_run", _csv_rows, filename=_file_stem))
 
 
 def _ordered(results):
@@ -277,15 +274,15 @@ def summary(results):
             if base["peak_psi"]["value"] > 0:
                 psi += f" (×{p['value'] / base['peak_psi']['value']:.2f})"
         crossings = ", ".join(f"{c['V']:.4g} m/s" for c in r["boundary_crossings"]) or "none"
-        delay = ui.fmt(r["onset_delay_s"], 3)
+        delay = formats.significant(r["onset_delay_s"], 3)
         rows.append([style.CONFIG_LABELS[r["config"]], time_in, speeds, psi, lat, crossings, delay])
     return ui.table(["configuration", "time in shimmy (s, against original)", "speed range in shimmy (m/s)",
                      "peak |psi| (rad)", "peak |l_g delta| (mm)", "crosses the Hopf curves at", "onset delay (s)"],
-                    rows, "gr-summary-table")
+                    rows, ids.GR_SUMMARY_TABLE)
 
 
-@dash.callback(Output("url-update", "data", allow_duplicate=True), Input("gr-preset", "value"),
-               Input("gr-config", "value"), Input("gr-psi-thr", "value"), Input("gr-lat-thr", "value"),
+@dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True), Input(ids.GR_PRESET, "value"),
+               Input(ids.GR_CONFIG, "value"), Input(ids.GR_PSI_THR, "value"), Input(ids.GR_LAT_THR, "value"),
                prevent_initial_call=True)
 def remember(preset, config, psi_thr, lat_thr):
     return {"preset": preset, "config": config, "psi_thr": psi_thr, "lat_thr": lat_thr}

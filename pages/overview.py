@@ -9,15 +9,15 @@ from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from plotly.subplots import make_subplots
 
-from ui import compare, designs, jobs
+from ui import compare, designs, formats, ids, jobs
 from ui import components as ui
 from ui.fields import Quantity
-from ui.layout import design_id, page
+from ui.layout import page
 from ui import style
 
 dash.register_page(__name__, path="/", name="Overview", order=0)
 
-CONFIGS = ("original", "nes", "pd", "nes_pd")
+CONFIGS = ui.CONFIGS
 
 
 FZ = Quantity("stability", "Fz", "Fz", "kN", 1e3)
@@ -32,61 +32,57 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
                   "design: the largest eigenvalue real part against speed (shimmy grows where it is positive), the "
                   "Hopf speed interval of each, and the (V, Fz) stability boundary."),
         html.Div([
-            ui.field("Vertical load Fz (kN)", FZ.box("ov-fz", fz, debounce=True)),
-            ui.field("Highest speed (m/s)", V_MAX.box("ov-vmax", v_max, debounce=True)),
+            ui.field("Vertical load Fz (kN)", FZ.box(ids.OV_FZ, fz, debounce=True)),
+            ui.field("Highest speed (m/s)", V_MAX.box(ids.OV_VMAX, v_max, debounce=True)),
         ], className="controls"),
-        html.Div(" ".join(p for p in (p_fz, p_v) if p), id="ov-error", className="error", role="alert"),
-        ui.graph("ov-growth"),
+        html.Div(" ".join(p for p in (p_fz, p_v) if p), id=ids.OV_GROUP.error, className="error", role="alert"),
+        ui.graph(ids.OV_GROWTH),
         html.H2("Hopf speed interval at this load"),
-        html.Div(id="ov-table"),
-        ui.downloads("ov"),
-        dcc.Store(id="ov-data"),
+        html.Div(id=ids.OV_TABLE),
+        ui.downloads(ids.OV_GROUP),
+        dcc.Store(id=ids.OV_DATA),
         html.H2("Hopf speed intervals of the compared designs"),
         html.P("The designs ticked under Compare in the design panel (2 to 4; the current one may be one of them) "
                "at this load: where straight rolling is unstable for each configuration, one colour per design, "
                "with the change of the onset speed against the first design.", className="hint"),
-        html.Div(id="ov-cmp-designs", className="compare-designs"),
-        html.Div(id="ov-cmp-error", className="error", role="alert"),
-        ui.graph("ov-cmp-graph", figure=style.message_figure(
+        html.Div(id=ids.OV_CMP.designs, className="compare-designs"),
+        html.Div(id=ids.OV_CMP.error, className="error", role="alert"),
+        ui.graph(ids.OV_CMP_GRAPH, figure=style.message_figure(
             f"Tick {designs.COMPARE[0]} to {designs.COMPARE[1]} designs under Compare in the design panel "
             "(instant: linear stability)", 200)),
-        html.Div(id="ov-cmp-table", className="table-wrap"),
+        html.Div(id=ids.OV_CMP_TABLE, className="table-wrap"),
         html.H2("Stability boundary in (V, Fz)"),
         html.P("Hopf curves of straight rolling: inside a closed curve, or above the lateral one, x = 0 is "
                "unstable. Computed by two-parameter continuation; runs in the background.", className="hint"),
-        html.Div(jobs.controls("ov-boundary", "Compute boundary"), className="controls"),
-        html.Div(id="ov-boundary-error", className="error", role="alert"),
-        ui.graph("ov-boundary-graph", figure=style.message_figure("Press 'Compute boundary' (about 3 s cold, "
+        html.Div(jobs.controls(ids.OV_BOUNDARY, "Compute boundary"), className="controls"),
+        html.Div(id=ids.OV_BOUNDARY.error, className="error", role="alert"),
+        ui.graph(ids.OV_BOUNDARY_GRAPH, figure=style.message_figure("Press 'Compute boundary' (about 3 s cold, "
                                                                    "instant when cached)")),
-        html.Div([html.Button("Download boundary CSV", id="ovb-csv", className="secondary", disabled=True),
-                  html.Button("Download boundary JSON", id="ovb-json", className="secondary", disabled=True),
-                  dcc.Download(id="ovb-download")], className="downloads"),
-        *jobs.stores("ov-boundary", "ovb-requests"),
+        ui.downloads(ids.OV_BOUNDARY_FILES, "Download boundary CSV", "Download boundary JSON"),
+        *jobs.stores(ids.OV_BOUNDARY),
         html.H2("Regions and curves of cycles in (V, Fz)"),
         html.P("The stability maps of the four configurations: the regions of original shaded by shimmy type, "
                "bounded by its Hopf, fold-of-cycles and torus curves; every configuration's curves in its colour "
                "(the same maps as on the Stability map page, shared through the cache).", className="hint"),
-        html.Div(jobs.controls("ov-regions", "Compute maps"), className="controls"),
-        html.Div(id="ov-regions-error", className="error", role="alert"),
-        ui.graph("ov-regions-graph", figure=style.message_figure("Press 'Compute maps' (about 15-25 s per "
+        html.Div(jobs.controls(ids.OV_REGIONS, "Compute maps"), className="controls"),
+        html.Div(id=ids.OV_REGIONS.error, className="error", role="alert"),
+        ui.graph(ids.OV_REGIONS_GRAPH, figure=style.message_figure("Press 'Compute maps' (about 15-25 s per "
                                                                   "configuration cold, instant when cached)")),
-        html.Div([html.Button("Download regions CSV", id="ovr-csv", className="secondary", disabled=True),
-                  html.Button("Download maps JSON", id="ovr-json", className="secondary", disabled=True),
-                  dcc.Download(id="ovr-download")], className="downloads"),
-        *jobs.stores("ov-regions", "ovr-requests"),
+        ui.downloads(ids.OV_REGIONS_FILES, "Download regions CSV", "Download maps JSON"),
+        *jobs.stores(ids.OV_REGIONS),
     ])
 
 
 def layout_page(query, children):
-    return page(query, "ov", *children)
+    return page(query, ids.OV, *children)
 
 
 
 @dash.callback(
-    Output("ov-growth", "figure"), Output("ov-table", "children"), Output("ov-data", "data"),
-    Output("ov-error", "children"), Output("ov-csv", "disabled"), Output("ov-json", "disabled"),
-    Output("url-update", "data", allow_duplicate=True),
-    Input(design_id("ov"), "data"), Input("ov-fz", "value"), Input("ov-vmax", "value"),
+    Output(ids.OV_GROWTH, "figure"), Output(ids.OV_TABLE, "children"), Output(ids.OV_DATA, "data"),
+    Output(ids.OV_GROUP.error, "children"), Output(ids.OV_GROUP.csv, "disabled"), Output(ids.OV_GROUP.json, "disabled"),
+    Output(ids.URL_UPDATE, "data", allow_duplicate=True),
+    Input(ids.design_store(ids.OV), "data"), Input(ids.OV_FZ, "value"), Input(ids.OV_VMAX, "value"),
     prevent_initial_call="initial_duplicate",
 )
 def update(design, fz_kn, v_max):
@@ -117,7 +113,8 @@ def update(design, fz_kn, v_max):
         freq = data["hopf_points"][0]["frequency_hz"] if data["hopf_points"] else None
         rows.append([style.CONFIG_LABELS[config],
                      ", ".join(f"{a:.4g}–{b:.4g}" for a, b in intervals) or "stable",
-                     ui.fmt(onset), ui.fmt(end), ui.signed(d_onset), ui.fmt(freq),
+                     formats.significant(onset), formats.significant(end), formats.signed(d_onset),
+                     formats.significant(freq),
                      ", ".join(h["criticality"] for h in data["hopf_points"]) or "–"])
     lay = style.layout(f"Growth rate of straight rolling at Fz = {fz_kn:g} kN", "forward speed V (m/s)",
                        "largest eigenvalue real part (1/s)", x_log=True)
@@ -126,24 +123,26 @@ def update(design, fz_kn, v_max):
     fig = {"data": traces, "layout": lay}
     columns = ["configuration", "unstable for V in (m/s)", "onset (m/s)", "end (m/s)", "onset vs original (m/s)",
                "onset frequency (Hz)", "criticality"]
-    table = ui.table(columns, rows, "ov-hopf-table")
+    table = ui.table(columns, rows, ids.OV_HOPF_TABLE)
     return (fig, table, {"columns": columns, "rows": rows, "result": result}, "", False, False,
             {"Fz": f"{float(fz_kn):g}", "vmax": f"{float(v_max):g}"})
 
 
-@dash.callback(Output("ov-download", "data"), Input("ov-csv", "n_clicks"), Input("ov-json", "n_clicks"),
-               State("ov-data", "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.OV_GROUP.download, "data"), Input(ids.OV_GROUP.csv, "n_clicks"), Input(ids.OV_GROUP.json,
+                                                                                                 "n_clicks"),
+               State(ids.OV_DATA, "data"), prevent_initial_call=True)
 def download(_csv, _json, data):
     if not data:
         return no_update
-    if dash.ctx.triggered_id == "ov-csv":
+    if dash.ctx.triggered_id == ids.OV_GROUP.csv:
         return {"content": ui.csv_text(data["columns"], data["rows"]), "filename": "overview_hopf.csv"}
     return {"content": ui.json_text(data["result"]), "filename": "overview_stability.json"}
 
 
-@dash.callback(Output("ov-cmp-designs", "children"), Output("ov-cmp-graph", "figure"),
-               Output("ov-cmp-table", "children"), Output("ov-cmp-error", "children"),
-               *compare.SELECTION, Input(design_id("ov"), "data"), Input("ov-fz", "value"), Input("ov-vmax", "value"))
+@dash.callback(Output(ids.OV_CMP.designs, "children"), Output(ids.OV_CMP_GRAPH, "figure"),
+               Output(ids.OV_CMP_TABLE, "children"), Output(ids.OV_CMP.error, "children"),
+               *compare.SELECTION, Input(ids.design_store(ids.OV), "data"), Input(ids.OV_FZ,
+                                                                                  "value"), Input(ids.OV_VMAX, "value"))
 def compare_designs(selection, saved, current, fz_kn, v_max):
     """Linear stability of each compared design (quick: asked of the service at once, the current
     design's answer shared with the figure above through the cache)."""
@@ -160,7 +159,7 @@ def compare_designs(selection, saved, current, fz_kn, v_max):
         return compare.swatches(names), no_update, no_update, str(exc)
     table = designs.comparison(names, results, designs.hopf_figures(CONFIGS, style.CONFIG_LABELS))
     shown = [name for name, _ in compare.series(names)]
-    return compare.swatches(names), intervals_figure(results, shown), compare.table(table, "ov-cmp-summary"), ""
+    return compare.swatches(names), intervals_figure(results, shown), compare.table(table, ids.OV_CMP_SUMMARY), ""
 
 
 def intervals_figure(results, names):
@@ -235,9 +234,9 @@ def _boundary_rows(results):
 
 
 jobs.register(
-    "ov-boundary", "hopf_curves", requests=_boundary_requests, render=lambda results: (boundary_figure(results),),
-    outputs=[Output("ov-boundary-graph", "figure")], states=[State(design_id("ov"), "data")],
-    store="ovb-requests", download=jobs.Download("ovb", "hopf_curves", _boundary_rows))
+    ids.OV_BOUNDARY, "hopf_curves", requests=_boundary_requests, render=lambda results: (boundary_figure(results),),
+    outputs=[Output(ids.OV_BOUNDARY_GRAPH, "figure")], states=[State(ids.design_store(ids.OV), "data")],
+    download=jobs.Download(ids.OV_BOUNDARY_FILES, "hopf_curves", _boundary_rows))
 
 
 def _regions_requests(design):
@@ -257,6 +256,6 @@ def _region_rows(results):
 
 
 jobs.register(
-    "ov-regions", "map", requests=_regions_requests, render=lambda results: (_regions_figure(results),),
-    outputs=[Output("ov-regions-graph", "figure")], states=[State(design_id("ov"), "data")],
-    store="ovr-requests", download=jobs.Download("ovr", "stability_maps", _region_rows))
+    ids.OV_REGIONS, "map", requests=_regions_requests, render=lambda results: (_regions_figure(results),),
+    outputs=[Output(ids.OV_REGIONS_GRAPH, "figure")], states=[State(ids.design_store(ids.OV), "data")],
+    download=jobs.Download(ids.OV_REGIONS_FILES, "stability_maps", _region_rows))

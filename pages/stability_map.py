@@ -7,17 +7,17 @@ from urllib.parse import urlencode
 import dash
 from dash import Input, Output, State, dcc, html, no_update
 
+from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from ui import compare, designs, fields, jobs
+from ui import compare, designs, fields, formats, ids, jobs, merits
 from ui import components as ui
 from ui import style
 from ui.fields import Quantity
-from ui.layout import design_id, page
-from ui.sessions import LOCAL
+from ui.layout import page
 
 dash.register_page(__name__, path="/stability-map", name="Stability map", order=4)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
+CONFIGS = ui.CONFIGS
 TYPES = tuple(style.SHIMMY_TYPE_COLOURS)
 CURVE_STYLES = {"hopf_curves": ("Hopf", "solid", 2.6), "fold_curves": ("fold of cycles", "dash", 2.2),
                 "torus_curves": ("torus", "dot", 2.2)}
@@ -48,52 +48,46 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
         values[key], problem = q.from_url(key, raw, default)
         problems.append(problem)
     return page(
-        query, "map",
+        query, ids.MAP,
         ui.header("Stability map", "The (V, Fz) plane shaded by shimmy type, from the stable attractors on each load "
                   "slice (equilibrium, torsional and lateral limit cycles, including those reached from large "
                   "torsional and lateral starts; simulation where none is stable). Hopf, fold-of-cycles and torus "
                   "curves, GH and double-Hopf points by two-parameter continuation; the operating points A-I "
                   "marked. Click a point to open its time history."),
         html.Div([
-            ui.field("Shade by", dcc.Dropdown(id="map-shade", value=shade, clearable=False, style={"width": "150px"},
-                                              options=[{"label": style.CONFIG_LABELS[c], "value": c}
-                                                       for c in CONFIGS])),
-            ui.field("Overlay curves of", dcc.Checklist(id="map-overlay", value=others, inline=True, options=[
-                {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
-            html.Div([ui.field("Fz from (kN)", FZ_MIN.box("map-fzmin", values["fz_min"])),
-                      ui.field("to (kN)", FZ_MAX.box("map-fzmax", values["fz_max"]))], className="pair"),
-            html.Div([ui.field("V from (m/s)", V_MIN.box("map-vmin", values["v_min"])),
-                      ui.field("to (m/s)", V_MAX.box("map-vmax", values["v_max"]))], className="pair"),
-            ui.field(f"Fz slices ({SLICES.low:g}-{SLICES.high:g})", SLICES.box("map-res", values["resolution"])),
-            *jobs.controls("map"),
+            ui.field("Shade by", ui.configurations(ids.MAP_SHADE, shade)),
+            ui.field("Overlay curves of", ui.configurations(ids.MAP_OVERLAY, others, multi=True)),
+            html.Div([ui.field("Fz from (kN)", FZ_MIN.box(ids.MAP_FZMIN, values["fz_min"])),
+                      ui.field("to (kN)", FZ_MAX.box(ids.MAP_FZMAX, values["fz_max"]))], className="pair"),
+            html.Div([ui.field("V from (m/s)", V_MIN.box(ids.MAP_VMIN, values["v_min"])),
+                      ui.field("to (m/s)", V_MAX.box(ids.MAP_VMAX, values["v_max"]))], className="pair"),
+            ui.field(f"Fz slices ({SLICES.low:g}-{SLICES.high:g})", SLICES.box(ids.MAP_RES, values["resolution"])),
+            *jobs.controls(ids.MAP_GROUP),
         ], className="controls"),
-        html.Div(" ".join(p for p in problems if p), id="map-error", className="error", role="alert"),
-        ui.graph("map-graph", figure=style.message_figure(WAITING, 600)),
-        html.Div(id="map-hint", className="hint"),
-        html.Div(id="map-table", className="table-wrap"),
-        ui.downloads("map"),
-        *jobs.stores("map"),
-        dcc.Location(id="map-nav", refresh="callback-nav"),
+        html.Div(" ".join(p for p in problems if p), id=ids.MAP_GROUP.error, className="error", role="alert"),
+        ui.graph(ids.MAP_GRAPH, figure=style.message_figure(WAITING, 600)),
+        html.Div(id=ids.MAP_HINT, className="hint"),
+        html.Div(id=ids.MAP_TABLE, className="table-wrap"),
+        ui.downloads(ids.MAP_GROUP),
+        *jobs.stores(ids.MAP_GROUP),
+        dcc.Location(id=ids.MAP_NAV, refresh="callback-nav"),
         html.H2("Compare saved designs"),
         html.P("The designs ticked under Compare in the design panel (2 to 4; the current one may be one of them) "
                "over this page's Fz and V ranges and slices, for one configuration: the Hopf, fold and torus curves "
                "of each design in its colour, the shading of the first; their figures of merit below, each with "
                "its change against the first.", className="hint"),
-        html.Div([ui.field("Configuration", dcc.Dropdown(id="mapc-config", value=compared, clearable=False,
-                                                         style={"width": "150px"},
-                                                         options=[{"label": style.CONFIG_LABELS[c], "value": c}
-                                                                  for c in CONFIGS])),
-                  ui.field("Figures at Fz (kN)", METRICS_FZ.box("mapc-fz", merit_fz)),
-                  *jobs.controls("mapc", "Compare")], className="controls"),
-        html.Div(id="mapc-designs", className="compare-designs"),
-        html.Div(" ".join(p for p in (bad_compared, bad_merit_fz) if p), id="mapc-error", className="error",
+        html.Div([ui.field("Configuration", ui.configurations(ids.MAPC_CONFIG, compared)),
+                  ui.field("Figures at Fz (kN)", METRICS_FZ.box(ids.MAPC_FZ, merit_fz)),
+                  *jobs.controls(ids.MAPC, "Compare")], className="controls"),
+        html.Div(id=ids.MAPC.designs, className="compare-designs"),
+        html.Div(" ".join(p for p in (bad_compared, bad_merit_fz) if p), id=ids.MAPC.error, className="error",
                  role="alert"),
-        ui.graph("mapc-graph", figure=style.message_figure(compare.waiting_text(
+        ui.graph(ids.MAPC_GRAPH, figure=style.message_figure(compare.waiting_text(
             "tens of seconds per design cold on 2 cores, instant from the cache"), 360)),
         html.H3("Figures of merit"),
-        html.Div(id="mapc-table", className="table-wrap"),
-        ui.downloads("mapc"),
-        *jobs.stores("mapc"),
+        html.Div(id=ids.MAPC_TABLE, className="table-wrap"),
+        ui.downloads(ids.MAPC),
+        *jobs.stores(ids.MAPC),
     )
 
 
@@ -112,9 +106,9 @@ def _requests(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, design):
             for c in configs]
 
 
-CONTROLS = (State("map-shade", "value"), State("map-overlay", "value"), State("map-fzmin", "value"),
-            State("map-fzmax", "value"), State("map-vmin", "value"), State("map-vmax", "value"),
-            State("map-res", "value"), State(design_id("map"), "data"))
+CONTROLS = (State(ids.MAP_SHADE, "value"), State(ids.MAP_OVERLAY, "value"), State(ids.MAP_FZMIN, "value"),
+            State(ids.MAP_FZMAX, "value"), State(ids.MAP_VMIN, "value"), State(ids.MAP_VMAX, "value"),
+            State(ids.MAP_RES, "value"), State(ids.design_store(ids.MAP), "data"))
 
 
 def _csv_rows(results):
@@ -124,10 +118,10 @@ def _csv_rows(results):
 
 
 jobs.register(
-    "map", "map", requests=_requests, render=lambda results: (figure(results), summary(results)),
-    outputs=[Output("map-graph", "figure"), Output("map-table", "children")], states=CONTROLS,
-    lock=["map-shade", "map-res", "map-fzmin", "map-fzmax", "map-vmin", "map-vmax"],
-    download=jobs.Download("map", "stability_map", _csv_rows),
+    ids.MAP_GROUP, "map", requests=_requests, render=lambda results: (figure(results), summary(results)),
+    outputs=[Output(ids.MAP_GRAPH, "figure"), Output(ids.MAP_TABLE, "children")], states=CONTROLS,
+    lock=[ids.MAP_SHADE, ids.MAP_RES, ids.MAP_FZMIN, ids.MAP_FZMAX, ids.MAP_VMIN, ids.MAP_VMAX],
+    download=jobs.Download(ids.MAP_GROUP, "stability_map", _csv_rows),
     blank=lambda: (style.message_figure("Refused: see the message above", 600), None))
 
 
@@ -150,24 +144,24 @@ def _merits(results, names):
 
 def _compare_render(results, names):
     series = compare.series(names)
-    return figure(results, series, what="design"), compare.table(_merits(results, names), "mapc-summary")
+    return figure(results, series, what="design"), compare.table(_merits(results, names), ids.MAPC_SUMMARY)
 
 
 jobs.register(
-    "mapc", "map", requests=_compare_requests, labels=_compare_names, render=_compare_render,
-    outputs=[Output("mapc-graph", "figure"), Output("mapc-table", "children")],
-    states=[State("map-fzmin", "value"), State("map-fzmax", "value"), State("map-vmin", "value"),
-            State("map-vmax", "value"), State("map-res", "value"), State("mapc-config", "value"),
-            State("mapc-fz", "value"), State("design-compare", "value"), State(LOCAL, "data"),
-            State(design_id("map"), "data")],
-    lock=["mapc-config", "mapc-fz"],
-    download=jobs.Download("mapc", "figures_of_merit", lambda results, names: designs.comparison_csv(
+    ids.MAPC, "map", requests=_compare_requests, labels=_compare_names, render=_compare_render,
+    outputs=[Output(ids.MAPC_GRAPH, "figure"), Output(ids.MAPC_TABLE, "children")],
+    states=[State(ids.MAP_FZMIN, "value"), State(ids.MAP_FZMAX, "value"), State(ids.MAP_VMIN, "value"),
+            State(ids.MAP_VMAX, "value"), State(ids.MAP_RES, "value"), State(ids.MAPC_CONFIG, "value"),
+            State(ids.MAPC_FZ, "value"), State(ids.DESIGN_COMPARE, "value"), State(ids.SAVED, "data"),
+            State(ids.design_store(ids.MAP), "data")],
+    lock=[ids.MAPC_CONFIG, ids.MAPC_FZ],
+    download=jobs.Download(ids.MAPC, "figures_of_merit", lambda results, names: designs.comparison_csv(
         _merits(results, names))),
     blank=lambda: (style.message_figure("Refused: see the message above", 360), None))
-compare.register_selection("mapc", "map")
+compare.register_selection(ids.MAPC, ids.MAP)
 
 
-MARKERS = {"gh_points": ("GH", "diamond", 12), "double_hopf_points": ("double Hopf", "star", 13)}
+MARKERS = {"gh_points": (PointKind.GENERALISED_HOPF, "diamond", 12), "double_hopf_points": ("double Hopf", "star", 13)}
 
 
 def figure(results, series=None, what="configuration"):
@@ -249,7 +243,7 @@ def figure(results, series=None, what="configuration"):
 
 def _pct(value, base):
     """Relative change against original, for the table."""
-    return "–" if value is None or not base else ui.pct(100 * (value - base) / base, 1)
+    return "–" if value is None or not base else formats.signed_percent(100 * (value - base) / base, 1)
 
 
 def summary(results):
@@ -261,8 +255,9 @@ def summary(results):
         hull = at["shimmy_speed_range"]
         low = None if r["min_shimmy_Fz"] is None else r["min_shimmy_Fz"] / 1e3
         speeds = "–" if hull is None else f"{hull[0]:.4g} – {hull[1]:.4g}"
-        row = [style.CONFIG_LABELS[r["config"]], ui.fmt(low), ui.fmt(m["torsion_area"], 5), speeds,
-               ui.fmt(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]), len(r["torus_curves"])]
+        row = [style.CONFIG_LABELS[r["config"]], formats.significant(low), formats.significant(m["torsion_area"], 5),
+               speeds, formats.significant(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]),
+               len(r["torus_curves"])]
         if base is not None and r is not base:
             b = base["metrics"]
             row[1] += f" ({_pct(r['min_shimmy_Fz'], base['min_shimmy_Fz'])})"
@@ -270,13 +265,14 @@ def summary(results):
             row[4] += f" ({_pct(at['max_psi'], b['at_Fz']['max_psi'])})"
         rows.append(row)
     fz = results[0]["metrics"]["at_Fz"]["Fz"] / 1e3
-    return ui.table(["configuration", "min shimmy Fz (kN)", "pure-torsion area, Fz ≤ 250 kN ((m/s) kN)",
-                     f"shimmy V at {fz:g} kN (m/s)", f"max stable |psi| at {fz:g} kN (rad)", "GH points",
-                     "fold curves", "torus curves"], rows, "map-summary")
+    area = f"{merits.label('torsion_area')} ({merits.unit('torsion_area')})"
+    return ui.table(["configuration", "min shimmy Fz (kN)", area, f"shimmy V at {fz:g} kN (m/s)",
+                     f"max stable |psi| at {fz:g} kN (rad)", f"{PointKind.GENERALISED_HOPF} points",
+                     "fold curves", "torus curves"], rows, ids.MAP_SUMMARY)
 
 
-@dash.callback(Output("map-nav", "href"), Output("map-hint", "children"),
-               Input("map-graph", "clickData"), State("map-requests", "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.MAP_NAV, "href"), Output(ids.MAP_HINT, "children"),
+               Input(ids.MAP_GRAPH, "clickData"), State(ids.MAP_GROUP.requests, "data"), prevent_initial_call=True)
 def open_time_history(click, requests):
     """A click on the map opens the time history at that point (same configuration and design)."""
     if not click or not requests or not click.get("points"):
@@ -291,10 +287,10 @@ def open_time_history(click, requests):
     return "/time-history?" + urlencode(query), f"Opening the time history at V = {V:.4g} m/s, Fz = {fz_kn:.4g} kN"
 
 
-@dash.callback(Output("url-update", "data", allow_duplicate=True),
-               Input("map-shade", "value"), Input("map-overlay", "value"), Input("map-fzmin", "value"),
-               Input("map-fzmax", "value"), Input("map-vmin", "value"), Input("map-vmax", "value"),
-               Input("map-res", "value"), Input("mapc-config", "value"), Input("mapc-fz", "value"),
+@dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),
+               Input(ids.MAP_SHADE, "value"), Input(ids.MAP_OVERLAY, "value"), Input(ids.MAP_FZMIN, "value"),
+               Input(ids.MAP_FZMAX, "value"), Input(ids.MAP_VMIN, "value"), Input(ids.MAP_VMAX, "value"),
+               Input(ids.MAP_RES, "value"), Input(ids.MAPC_CONFIG, "value"), Input(ids.MAPC_FZ, "value"),
                prevent_initial_call=True)
 def remember(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, compared, merit_fz):
     return {"shade": shade, "overlay": ",".join(overlay or []), "fz_min": fz_min, "fz_max": fz_max, "v_min": v_min,

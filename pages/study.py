@@ -10,14 +10,14 @@ from shimmy.errors import InvalidParameterError
 from shimmy.model.configurations import affects
 from shimmy.model.parameters import PARAMETER_SPECS
 from ui import components as ui
-from ui import fields, jobs
+from ui import fields, formats, ids, jobs
 from ui import style
 from ui.fields import Quantity
-from ui.layout import design_id, page
+from ui.layout import page
 
 dash.register_page(__name__, path="/study", name="Parametric study", order=5)
 
-CONFIGS = tuple(style.CONFIG_COLOURS)
+CONFIGS = ui.CONFIGS
 DEFAULT_VALUES = "0.0005, 0.001, 0.002, 0.003, 0.004, 0.005"
 
 
@@ -39,45 +39,45 @@ def layout(parameter: str | None = None, values: str = DEFAULT_VALUES, configs: 
     view, bad_view = fields.choice("table", table, list(TABLE_VIEWS), "long", "a table layout")
     problems = " ".join(p for p in (bad_parameter, bad_configs, bad_fz, bad_view) if p)
     return page(
-        query, "study",
+        query, ids.STUDY,
         ui.header("Parametric study", "Sweep one design parameter (the others at the current design) and tabulate, "
                   "per configuration, the first and last Hopf speed of straight rolling (shimmy onset and end of the "
                   "linear instability) and the largest torsional amplitude of a stable limit cycle, from a "
                   "bifurcation diagram per design. A device's parameter is studied only in the configurations that "
                   "have the device. Two-parameter grids: API and command line."),
         html.Div([
-            ui.field("Parameter", dcc.Dropdown(id="study-param", value=parameter, clearable=False,
+            ui.field("Parameter", dcc.Dropdown(id=ids.STUDY_PARAM, value=parameter, clearable=False,
                                                style={"width": "170px"},
                                                options=[{"label": f"{n}{_unit(n)}", "value": n}
                                                         for n in PARAMETER_SPECS])),
-            html.Div(ui.field("Values (comma-separated)", dcc.Input(id="study-values", type="text", value=values,
+            html.Div(ui.field("Values (comma-separated)", dcc.Input(id=ids.STUDY_VALUES, type="text", value=values,
                                                                     debounce=True)), className="wide"),
-            ui.field("Fz (kN)", FZ.box("study-fz", fz)),
-            ui.field("Configurations", dcc.Checklist(id="study-configs", value=chosen, inline=True, options=[
-                {"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS])),
-            *jobs.controls("study"),
+            ui.field("Fz (kN)", FZ.box(ids.STUDY_FZ, fz)),
+            ui.field("Configurations", ui.configurations(ids.STUDY_CONFIGS, chosen, multi=True)),
+            *jobs.controls(ids.STUDY_GROUP),
         ], className="controls"),
-        html.Div(id="study-range", className="hint"),
-        html.Div(problems, id="study-error", className="error", role="alert"),
-        html.Div(id="study-skipped", className="hint", role="status"),
-        html.Div([ui.field("Amplitude axis", dcc.Checklist(id="study-log", value=[], inline=True,
+        html.Div(id=ids.STUDY_RANGE, className="hint"),
+        html.Div(problems, id=ids.STUDY_GROUP.error, className="error", role="alert"),
+        html.Div(id=ids.STUDY_SKIPPED, className="hint", role="status"),
+        html.Div([ui.field("Amplitude axis", dcc.Checklist(id=ids.STUDY_LOG, value=[], inline=True,
                                                            options=[{"label": "logarithmic", "value": "log"}])),
-                  ui.field("Table", dcc.RadioItems(id="study-view", value=view, inline=True, options=[
+                  ui.field("Table", dcc.RadioItems(id=ids.STUDY_VIEW, value=view, inline=True, options=[
                       {"label": label, "value": k} for k, label in TABLE_VIEWS.items()]))], className="controls"),
-        ui.graph("study-graph", figure=style.message_figure(WAITING, 560)),
-        html.Div(id="study-table", className=f"table-wrap view-{view}"),
-        ui.downloads("study"),
-        *jobs.stores("study", "study-request"),
+        ui.graph(ids.STUDY_GRAPH, figure=style.message_figure(WAITING, 560)),
+        html.Div(id=ids.STUDY_TABLE, className=f"table-wrap view-{view}"),
+        ui.downloads(ids.STUDY_GROUP),
+        *jobs.stores(ids.STUDY_GROUP),
     )
 
 
-@dash.callback(Output("study-range", "children"), Input("study-param", "value"))
+@dash.callback(Output(ids.STUDY_RANGE, "children"), Input(ids.STUDY_PARAM, "value"))
 def allowed(name):
     spec = PARAMETER_SPECS[name]
     return f"{name}: {spec.description}; {spec.allowed}; current default {spec.default:g}"
 
 
-@dash.callback(Output("study-skipped", "children"), Input("study-param", "value"), Input("study-configs", "value"))
+@dash.callback(Output(ids.STUDY_SKIPPED, "children"), Input(ids.STUDY_PARAM, "value"), Input(ids.STUDY_CONFIGS,
+                                                                                             "value"))
 def skipped(name, configs):
     """Which chosen configurations the parameter cannot affect (they are left out of the study)."""
     out = [c for c in configs or [] if not affects(name, c)]
@@ -122,8 +122,8 @@ def _request(parameter, text, fz_kn, configs, design):
     return {"parameter": parameter, "values": values, "configs": studied, "Fz": FZ.read(fz_kn), **design}
 
 
-CONTROLS = (State("study-param", "value"), State("study-values", "value"), State("study-fz", "value"),
-            State("study-configs", "value"), State(design_id("study"), "data"))
+CONTROLS = (State(ids.STUDY_PARAM, "value"), State(ids.STUDY_VALUES, "value"), State(ids.STUDY_FZ, "value"),
+            State(ids.STUDY_CONFIGS, "value"), State(ids.design_store(ids.STUDY), "data"))
 
 
 def _csv_rows(results):
@@ -135,11 +135,11 @@ def _csv_rows(results):
 
 
 jobs.register(
-    "study", "study", requests=lambda *controls: [_request(*controls)],
+    ids.STUDY_GROUP, "study", requests=lambda *controls: [_request(*controls)],
     render=lambda results: (figure(results[0]), summary(results[0])),
-    outputs=[Output("study-graph", "figure"), Output("study-table", "children")], states=CONTROLS,
-    lock=["study-param", "study-values", "study-fz"], store="study-request",
-    download=jobs.Download("study", "study", _csv_rows, single=True),
+    outputs=[Output(ids.STUDY_GRAPH, "figure"), Output(ids.STUDY_TABLE, "children")], states=CONTROLS,
+    lock=[ids.STUDY_PARAM, ids.STUDY_VALUES, ids.STUDY_FZ],
+    download=jobs.Download(ids.STUDY_GROUP, "study", _csv_rows, single=True),
     blank=lambda: (style.message_figure("Refused: see the message above", 560), None))
 
 
@@ -168,11 +168,12 @@ def summary(result):
     """Both layouts of the table (the page shows the one chosen): long, and pivoted by configuration."""
     name = result["parameters"][0]
     ordered = sorted(result["rows"], key=lambda r: (r[name], CONFIGS.index(r["config"])))
-    rows = [[f"{r[name]:.6g}", style.CONFIG_LABELS[r["config"]], ui.fmt(r["hopf_start"], 6), ui.fmt(r["hopf_end"], 6),
-             ui.fmt(r["max_psi"], 5), ui.fmt(r["max_psi_V"], 4), "; ".join(r["warnings"]) or "–"]
+    rows = [[f"{r[name]:.6g}", style.CONFIG_LABELS[r["config"]], formats.significant(r["hopf_start"], 6),
+             formats.significant(r["hopf_end"], 6), formats.significant(r["max_psi"], 5),
+             formats.significant(r["max_psi_V"], 4), "; ".join(r["warnings"]) or "–"]
             for r in ordered]
     long = ui.table([f"{name}{_unit(name)}", "configuration", "first Hopf V (m/s)", "last Hopf V (m/s)",
-                     "max stable |psi| (rad)", "at V (m/s)", "warnings"], rows, "study-summary")
+                     "max stable |psi| (rad)", "at V (m/s)", "warnings"], rows, ids.STUDY_SUMMARY)
     configs = [c for c in CONFIGS if c in result["configs"]]
     by_value: dict[float, dict[str, dict]] = {}
     for r in ordered:
@@ -184,16 +185,16 @@ def summary(result):
     for value, per in by_value.items():
         row = [f"{value:.6g}"]
         for key, digits in (("hopf_start", 6), ("hopf_end", 6), ("max_psi", 5)):
-            row += [ui.fmt(per[c][key], digits) if c in per else "–" for c in configs]
+            row += [formats.significant(per[c][key], digits) if c in per else "–" for c in configs]
         pivot_rows.append(row)
-    pivot = ui.table(columns, pivot_rows, "study-pivot")
-    return [html.Div(long, className="study-long"), html.Div(pivot, className="study-pivot")]
+    pivot = ui.table(columns, pivot_rows, ids.STUDY_PIVOT)
+    return [html.Div(long, className="study-long"), html.Div(pivot, className=ids.STUDY_PIVOT)]
 
 
 # The table layout and the amplitude axis are views of the shown result: switched in the browser.
 dash.clientside_callback(
     """function(view) { return "table-wrap view-" + (view || "long"); }""",
-    Output("study-table", "className"), Input("study-view", "value"))
+    Output(ids.STUDY_TABLE, "className"), Input(ids.STUDY_VIEW, "value"))
 
 dash.clientside_callback(
     """
@@ -207,13 +208,14 @@ dash.clientside_callback(
         return Object.assign({}, fig, {layout: layout});
     }
     """,
-    Output("study-graph", "figure", allow_duplicate=True), Input("study-log", "value"), Input("study-graph", "figure"),
+    Output(ids.STUDY_GRAPH, "figure", allow_duplicate=True), Input(ids.STUDY_LOG, "value"), Input(ids.STUDY_GRAPH,
+                                                                                                  "figure"),
     prevent_initial_call=True)
 
 
-@dash.callback(Output("url-update", "data", allow_duplicate=True),
-               Input("study-param", "value"), Input("study-values", "value"), Input("study-fz", "value"),
-               Input("study-configs", "value"), Input("study-view", "value"), prevent_initial_call=True)
+@dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),
+               Input(ids.STUDY_PARAM, "value"), Input(ids.STUDY_VALUES, "value"), Input(ids.STUDY_FZ, "value"),
+               Input(ids.STUDY_CONFIGS, "value"), Input(ids.STUDY_VIEW, "value"), prevent_initial_call=True)
 def remember(parameter, values, fz, configs, view):
     return {"parameter": parameter, "values": values, "Fz": fz, "configs": ",".join(configs or []),
             "table": None if view == "long" else view}

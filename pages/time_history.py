@@ -11,15 +11,14 @@ from plotly.subplots import make_subplots
 
 from shimmy.service import settings
 from ui import components as ui
-from ui import fields, jobs
+from ui import fields, ids, jobs
 from ui import style
 from ui.series import envelope
 from ui.fields import Quantity
-from ui.layout import design_id, page
+from ui.layout import page
 
 dash.register_page(__name__, path="/time-history", name="Time history", order=2)
 
-CONFIG_OPTIONS = [{"label": style.CONFIG_LABELS[c], "value": c} for c in style.CONFIG_COLOURS]
 SPEED = Quantity("simulate", "V", "V", "m/s")
 FZ = Quantity("simulate", "Fz", "Fz", "kN", 1e3)
 T_END = Quantity("simulate", "t_end", "simulated time", "s")
@@ -45,7 +44,7 @@ def _start_of(psi0, lateral0) -> str:
 
 def layout(config: str | None = None, V: str | None = None, Fz: str | None = None, t_end: str | None = None,
            psi0: str | None = None, lateral0: str | None = None, run: str | None = None, **query):
-    config, bad_config = fields.choice("config", config, list(style.CONFIG_COLOURS), "nes_pd", "a configuration")
+    config, bad_config = fields.choice("config", config, list(ui.CONFIGS), "nes_pd", "a configuration")
     problems = [bad_config]
     v, problem_v = SPEED.from_url("V", V, 30)
     fz, problem_fz = FZ.from_url("Fz", Fz, 150)
@@ -55,42 +54,42 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
     problems += [problem_v, problem_fz, problem_t, problem_p, problem_l]
     series, spectrum, phase, _ = _placeholders()
     return page(
-        query, "th",
+        query, ids.TH,
         ui.header("Time history", "The gear at one operating point, from a start you choose (the standard "
                   "start is psi = 0.001 rad, the rest at rest): torsion and lateral bending against time, the "
                   "spectrum of the steady window with its dominant frequency, and the torsional phase portrait. A "
                   "bistable point settles on a different limit cycle from a large torsional or a large lateral "
                   "start. Runs in the background; repeated questions come from the cache."),
         html.Div([
-            ui.field("Configuration", dcc.Dropdown(id="th-config", options=CONFIG_OPTIONS, value=config,
-                                                   clearable=False, style={"width": "160px"})),
-            ui.field("V (m/s)", SPEED.box("th-v", v, debounce=True)),
-            ui.field("Fz (kN)", FZ.box("th-fz", fz, debounce=True)),
-            ui.field("Simulated time (s)", T_END.box("th-tend", t)),
-            ui.field("Start", dcc.Dropdown(id="th-start", value=_start_of(p0, l0), clearable=False,
+            ui.field("Configuration", ui.configurations(ids.TH_CONFIG, config, width="160px")),
+            ui.field("V (m/s)", SPEED.box(ids.TH_V, v, debounce=True)),
+            ui.field("Fz (kN)", FZ.box(ids.TH_FZ, fz, debounce=True)),
+            ui.field("Simulated time (s)", T_END.box(ids.TH_TEND, t)),
+            ui.field("Start", dcc.Dropdown(id=ids.TH_START, value=_start_of(p0, l0), clearable=False,
                                            style={"width": "250px"}, options=[
                                                {"label": label, "value": k} for k, (label, _, _) in STARTS.items()])),
-            html.Div([ui.field("psi0 (rad)", PSI0.box("th-psi0", p0)),
-                      ui.field("l_g delta0 (m)", LATERAL0.box("th-lat0", l0))], className="pair"),
-            *jobs.controls("th", "Run"),
+            html.Div([ui.field("psi0 (rad)", PSI0.box(ids.TH_PSI0, p0)),
+                      ui.field("l_g delta0 (m)", LATERAL0.box(ids.TH_LAT0, l0))], className="pair"),
+            *jobs.controls(ids.TH_GROUP, "Run"),
         ], className="controls"),
         html.Div([html.Span("Operating points: ", className="hint"),
-                  *[html.Button(f"{name} ({v} m/s, {f} kN)", id={"type": "th-op", "name": name}, className="secondary")
+                  *[html.Button(f"{name} ({v} m/s, {f} kN)", id=ids.th_op(name), className="secondary")
                     for name, (v, f) in ui.OPERATING_POINTS.items()]], className="op-buttons"),
-        html.Div(" ".join(p for p in problems if p), id="th-error", className="error", role="alert"),
-        html.Div(id="th-settled", className="settled", role="status"),
-        html.Div(id="th-metrics", className="metrics"),
-        ui.graph("th-series", figure=series),
-        html.Div([ui.graph("th-spectrum", figure=spectrum), ui.graph("th-phase", figure=phase)], className="grid-2"),
-        ui.downloads("th"),
-        *jobs.stores("th", "th-request"),
+        html.Div(" ".join(p for p in problems if p), id=ids.TH_GROUP.error, className="error", role="alert"),
+        html.Div(id=ids.TH_SETTLED, className="settled", role="status"),
+        html.Div(id=ids.TH_METRICS, className="metrics"),
+        ui.graph(ids.TH_SERIES, figure=series),
+        html.Div([ui.graph(ids.TH_SPECTRUM, figure=spectrum), ui.graph(ids.TH_PHASE, figure=phase)],
+                 className="grid-2"),
+        ui.downloads(ids.TH_GROUP),
+        *jobs.stores(ids.TH_GROUP),
         # ?run=1 (a click on a map point): run once the page is drawn, as if Run had been pressed.
-        dcc.Interval(id="th-autorun", interval=200, max_intervals=1, disabled=run != "1"),
+        dcc.Interval(id=ids.TH_AUTORUN, interval=200, max_intervals=1, disabled=run != "1"),
     )
 
 
-@dash.callback(Output("th-v", "value"), Output("th-fz", "value"),
-               Input({"type": "th-op", "name": dash.ALL}, "n_clicks"), prevent_initial_call=True)
+@dash.callback(Output(ids.TH_V, "value"), Output(ids.TH_FZ, "value"),
+               Input(ids.th_op(dash.ALL), "n_clicks"), prevent_initial_call=True)
 def operating_point(_clicks):
     trigger = dash.ctx.triggered_id
     if not trigger or not any(_clicks):
@@ -99,12 +98,12 @@ def operating_point(_clicks):
     return v, f
 
 
-@dash.callback(Output("th-start", "value"), Output("th-psi0", "value"), Output("th-lat0", "value"),
-               Input("th-start", "value"), Input("th-psi0", "value"), Input("th-lat0", "value"),
+@dash.callback(Output(ids.TH_START, "value"), Output(ids.TH_PSI0, "value"), Output(ids.TH_LAT0, "value"),
+               Input(ids.TH_START, "value"), Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"),
                prevent_initial_call=True)
 def start(choice, psi0, lateral0):
     """A start chosen fills its values in; values typed in make the choice "typed" (unless they are a preset's)."""
-    if dash.ctx.triggered_id == "th-start":
+    if dash.ctx.triggered_id == ids.TH_START:
         _, p, q = STARTS.get(choice, STARTS["typed"])
         return no_update, (psi0 if p is None else p), (lateral0 if q is None else q)
     return _start_of(psi0, lateral0), no_update, no_update
@@ -130,16 +129,16 @@ def _file_stem(results):
 
 
 jobs.register(
-    "th", "simulate", requests=_requests, blank=lambda: (*_placeholders("Refused: see the message above"), ""),
+    ids.TH_GROUP, "simulate", requests=_requests, blank=lambda: (*_placeholders("Refused: see the message above"), ""),
     running=lambda: (*_placeholders("Running the time history…"), ""),
     render=lambda results: (*_figures(results[0]), _metrics(results[0]), settled(results[0])),
     notice=lambda results: "" if results[0]["success"] else results[0]["message"],
-    outputs=[Output("th-series", "figure"), Output("th-spectrum", "figure"), Output("th-phase", "figure"),
-             Output("th-metrics", "children"), Output("th-settled", "children")],
-    triggers=[Input("th-v", "value"), Input("th-fz", "value"), Input("th-autorun", "n_intervals")],
-    states=[State("th-config", "value"), State("th-tend", "value"), State("th-psi0", "value"),
-            State("th-lat0", "value"), State(design_id("th"), "data")],
-    store="th-request", download=jobs.Download("th", "time_history", _csv_rows, single=True, filename=_file_stem))
+    outputs=[Output(ids.TH_SERIES, "figure"), Output(ids.TH_SPECTRUM, "figure"), Output(ids.TH_PHASE, "figure"),
+             Output(ids.TH_METRICS, "children"), Output(ids.TH_SETTLED, "children")],
+    triggers=[Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_AUTORUN, "n_intervals")],
+    states=[State(ids.TH_CONFIG, "value"), State(ids.TH_TEND, "value"), State(ids.TH_PSI0, "value"),
+            State(ids.TH_LAT0, "value"), State(ids.design_store(ids.TH), "data")],
+    download=jobs.Download(ids.TH_GROUP, "time_history", _csv_rows, single=True, filename=_file_stem))
 
 
 def _figures(result):
@@ -219,9 +218,10 @@ def _metrics(result):
             for k, v in items]
 
 
-@dash.callback(Output("url-update", "data", allow_duplicate=True),
-               Input("th-config", "value"), Input("th-v", "value"), Input("th-fz", "value"), Input("th-tend", "value"),
-               Input("th-psi0", "value"), Input("th-lat0", "value"), prevent_initial_call=True)
+@dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),
+               Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_TEND,
+                                                                                                         "value"),
+               Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"), prevent_initial_call=True)
 def remember(config, V, fz, t_end, psi0, lateral0):
     standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,

@@ -7,6 +7,7 @@ from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.service import analyses
 from ui import components as ui
+from ui import formats, ids
 from ui.layout import page
 
 dash.register_page(__name__, path="/validation", name="Validation", order=6)
@@ -18,15 +19,15 @@ PUBLISHED_AMPLITUDE = 0.017  # rad, nes_pd at V = 30 m/s, Fz = 150 kN
 
 def layout(**query):
     return page(
-        query, "val",
+        query, ids.VAL,
         ui.header("Validation", "The calibrated defaults against the published study (docs/validation.md in the "
                   "repository describes the fit and the disagreement), at "
                   "Fz = 150 kN. These use the default design, whatever the panel says: they check the model, "
                   "not a design."),
-        html.Div(id="val-content", children=html.P("computing…", className="hint")),
-        html.Button("Recompute", id="val-run", className="secondary"),
-        ui.downloads("val"),
-        dcc.Store(id="val-data"),
+        html.Div(id=ids.VAL_CONTENT, children=html.P("computing…", className="hint")),
+        html.Button("Recompute", id=ids.VAL_RUN, className="secondary"),
+        ui.downloads(ids.VAL_GROUP),
+        dcc.Store(id=ids.VAL_DATA),
         design=False,
     )
 
@@ -44,27 +45,27 @@ def _amplitude(config, V, params=None, material=None):
     return result["amplitude"]["psi"]
 
 
-@dash.callback(Output("val-content", "children"), Output("val-data", "data"), Output("val-csv", "disabled"),
-               Output("val-json", "disabled"), Input("val-run", "n_clicks"))
+@dash.callback(Output(ids.VAL_CONTENT, "children"), Output(ids.VAL_DATA, "data"), Output(ids.VAL_GROUP.csv, "disabled"),
+               Output(ids.VAL_GROUP.json, "disabled"), Input(ids.VAL_RUN, "n_clicks"))
 def build(_n):
     rows = []
     for config, published in PUBLISHED_HOPF.items():
         computed = _hopf(config)
         for p, c in zip(published, computed, strict=False):
-            rows.append([config, f"{p:g}", f"{c:.4f}", ui.pct(100 * (c / p - 1), 3)])
+            rows.append([config, f"{p:g}", f"{c:.4f}", formats.signed_percent(100 * (c / p - 1), 3)])
     hopf_table = ui.table(["configuration", "published Hopf V (m/s)", "computed (m/s)", "difference"], rows,
-                          "val-hopf")
+                          ids.VAL_HOPF)
     amp = _amplitude("nes_pd", 30.0)
     amp_table = ui.table(["quantity", "published", "computed", "difference"], [
         ["nes_pd torsional amplitude at V = 30 m/s (rad)", f"{PUBLISHED_AMPLITUDE:g}", f"{amp:.4f}",
-         ui.pct(100 * (amp / PUBLISHED_AMPLITUDE - 1), 1)]], "val-amplitude")
+         formats.signed_percent(100 * (amp / PUBLISHED_AMPLITUDE - 1), 1)]], ids.VAL_AMPLITUDE)
     a08, a09 = _amplitude("nes_pd", 30.0, {"a_p": 0.8}), _amplitude("nes_pd", 30.0, {"a_p": 0.9})
     tungsten = _amplitude("nes_pd", 30.0, material="tungsten")
     sanity = ui.table(["sanity check (not a target)", "expected", "computed"], [
-        ["a_p 0.8 -> 0.9 lowers the nes_pd amplitude", "about -10 %", ui.pct(100 * (a09 / a08 - 1), 1)],
+        ["a_p 0.8 -> 0.9 lowers the nes_pd amplitude", "about -10 %", formats.signed_percent(100 * (a09 / a08 - 1), 1)],
         ["tungsten powder damps more than steel shot", "tungsten < steel",
          f"{tungsten:.4f} < {amp:.4f} rad" if tungsten < amp else f"{tungsten:.4f} >= {amp:.4f} rad (FAILS)"]],
-        "val-sanity")
+        ids.VAL_SANITY)
     pd_hopf = _hopf("pd")
     original = _hopf("original")
     disagreement = html.Div([
@@ -73,7 +74,7 @@ def build(_n):
             ["shimmy onset (m/s)", "about 14.2", f"{pd_hopf[0]:.4g}" if pd_hopf else "–"],
             ["upper Hopf point (m/s)", "about 1500", f"{pd_hopf[-1]:.4g}" if len(pd_hopf) > 1 else "–"],
             ["original, for comparison (m/s)", "5.61, 93.43", ", ".join(f"{v:.4g}" for v in original)]],
-            "val-disagreement"),
+            ids.VAL_DISAGREEMENT),
         html.P(["The study reports that the particle damper alone moves the onset up to about 14.2 m/s and the "
                 "upper Hopf point to about 1500 m/s. With the published equations this cannot happen: the damper "
                 "torque M_pd = n r^2 c*(r|dpsi|) dpsi has zero slope at dpsi = 0, so the damper changes the "
@@ -95,12 +96,13 @@ def build(_n):
     return content, data, False, False
 
 
-@dash.callback(Output("val-download", "data"), Input("val-csv", "n_clicks"), Input("val-json", "n_clicks"),
-               State("val-data", "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.VAL_GROUP.download, "data"), Input(ids.VAL_GROUP.csv, "n_clicks"), Input(ids.VAL_GROUP.json,
+                                                                                                   "n_clicks"),
+               State(ids.VAL_DATA, "data"), prevent_initial_call=True)
 def download(_csv, _json, data):
     if not data:
         return no_update
-    if dash.ctx.triggered_id == "val-json":
+    if dash.ctx.triggered_id == ids.VAL_GROUP.json:
         return {"content": ui.json_text(data), "filename": "validation.json"}
     rows = [["hopf_V", h["config"], h["published"], h["computed"]] for h in data["hopf"]]
     rows.append(["amplitude_nes_pd_A", "nes_pd", data["amplitude"]["published"], data["amplitude"]["computed"]])

@@ -14,12 +14,11 @@ from dash import Input, Output, html
 
 from shimmy.errors import InvalidParameterError
 
-from . import designs, style
-from .layout import design_id
-from .sessions import LOCAL
+from . import designs, ids, style
+from .ids import Group
 
 #: The inputs that say which designs are compared (the panel's, on every page).
-SELECTION = (Input("design-compare", "value"), Input(LOCAL, "data"))
+SELECTION = (Input(ids.DESIGN_COMPARE, "value"), Input(ids.SAVED, "data"))
 
 
 def chosen(selection: Any, saved: Any, current: Any) -> list[designs.Design]:
@@ -50,10 +49,10 @@ def swatches(names: list[str]) -> list:
     return out
 
 
-def register_selection(prefix: str, page_id: str) -> None:
+def register_selection(group: Group, page_id: str) -> None:
     """The line that says which designs the page's comparison would show (or what to tick)."""
 
-    @dash.callback(Output(f"{prefix}-designs", "children"), *SELECTION, Input(design_id(page_id), "data"))
+    @dash.callback(Output(group.designs, "children"), *SELECTION, Input(ids.design_store(page_id), "data"))
     def _designs(selection, saved, current):
         try:
             return swatches([d.name for d in chosen(selection, saved, current)])

@@ -11,6 +11,9 @@ from dash import dcc, html
 
 from shimmy.model.configurations import OPERATING_POINTS as _OPERATING_POINTS_N
 
+from . import style
+from .ids import Group
+
 
 def _whole(x: float) -> float | int:
     return int(x) if float(x).is_integer() else x
@@ -20,6 +23,8 @@ def _whole(x: float) -> float | int:
 OPERATING_POINTS = {name: (_whole(v), _whole(fz / 1e3)) for name, (v, fz) in _OPERATING_POINTS_N.items()}
 
 GRAPH_CONFIG = {"displaylogo": False, "toImageButtonOptions": {"format": "png", "scale": 2}}
+#: The four configurations in the order the pages list them (original, NES, PD, NES + PD).
+CONFIGS = tuple(style.CONFIG_LABELS)
 
 
 def header(title: str, lead: str) -> html.Div:
@@ -30,18 +35,27 @@ def graph(graph_id: str, **kwargs) -> dcc.Graph:
     return dcc.Graph(id=graph_id, config=GRAPH_CONFIG, **kwargs)
 
 
-def downloads(prefix: str) -> html.Div:
-    """CSV and JSON download buttons (ids PREFIX-csv, PREFIX-json) and their dcc.Download."""
+def downloads(group: Group, csv_label: str = "Download CSV", json_label: str = "Download JSON") -> html.Div:
+    """CSV and JSON download buttons (the group's csv and json ids) and their dcc.Download."""
     return html.Div([
-        html.Button("Download CSV", id=f"{prefix}-csv", className="secondary", disabled=True),
-        html.Button("Download JSON", id=f"{prefix}-json", className="secondary", disabled=True),
-        dcc.Download(id=f"{prefix}-download"),
+        html.Button(csv_label, id=group.csv, className="secondary", disabled=True),
+        html.Button(json_label, id=group.json, className="secondary", disabled=True),
+        dcc.Download(id=group.download),
     ], className="downloads")
 
 
-def progress_bar(prefix: str) -> html.Div:
-    return html.Div([html.Progress(id=f"{prefix}-progress", value="0", max="100"),
-                     html.Span(id=f"{prefix}-status", className="status")], className="progress-row")
+def progress_bar(group: Group) -> html.Div:
+    return html.Div([html.Progress(id=group.progress, value="0", max="100"),
+                     html.Span(id=group.status, className="status")], className="progress-row")
+
+
+def configurations(component_id: str, value, multi: bool = False, width: str = "150px") -> dcc.Dropdown | dcc.Checklist:
+    """The configuration picker, labelled as the pages name the configurations: a dropdown of one
+    (``value`` a configuration) or, ``multi``, a row of check boxes (``value`` a list of them)."""
+    options = [{"label": style.CONFIG_LABELS[c], "value": c} for c in CONFIGS]
+    if multi:
+        return dcc.Checklist(id=component_id, value=value, inline=True, options=options)
+    return dcc.Dropdown(id=component_id, value=value, clearable=False, style={"width": width}, options=options)
 
 
 def field(label: str, control, hint: str | None = None) -> html.Div:
@@ -75,24 +89,3 @@ def number(raw, default: float) -> float:
     except (TypeError, ValueError):
         return default
 
-
-def pct(x: float | None, digits: int = 1) -> str:
-    """A signed percentage with ``digits`` decimals; one that rounds to zero is "0.0 %", never "-0.0 %"."""
-    if x is None:
-        return "–"
-    text = f"{x:+.{digits}f}"
-    if float(text) == 0:
-        text = f"{0:.{digits}f}"
-    return f"{text} %"
-
-
-def signed(x: float | None, digits: int = 3) -> str:
-    """A signed number to ``digits`` significant digits; zero without a sign (no "-0")."""
-    if x is None:
-        return "–"
-    text = f"{x:+.{digits}g}"
-    return "0" if float(text) == 0 else text
-
-
-def fmt(x: float | None, digits: int = 4) -> str:
-    return "–" if x is None else f"{x:.{digits}g}"

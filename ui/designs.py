@@ -18,12 +18,14 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 from urllib.parse import parse_qs
 
+from shimmy.continuation.kinds import CYCLE_BIFURCATIONS, PointKind
 from shimmy.errors import InvalidParameterError
 from shimmy.model.configurations import Configuration
 from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters, check_number
 from shimmy.version import __version__ as SHIMMY_VERSION
 
-from . import state
+from . import merits, state
+from .formats import significant, significant_or_whole, signed_or_whole, signed_percent
 
 FORMAT = "shimmy design"
 FORMAT_VERSION = 1
@@ -45,13 +47,9 @@ class DesignError(ValueError):
         super().__init__(f"{what}: " + "; ".join(self.problems))
 
 
-def _g(x: float) -> str:
-    return f"{x:.6g}"
-
-
 def _with_unit(name: str, value: Any) -> str:
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return f"{name} = {_g(value)} {PARAMETER_SPECS[name].unit}".rstrip()
+        return f"{name} = {significant(value, 6)} {PARAMETER_SPECS[name].unit}".rstrip()
     return f"{name} = {json.dumps(value)}"
 
 
@@ -437,26 +435,9 @@ class Figure:
     relative: bool = True  # also the change in per cent
 
 
-def fmt(x: float | None, digits: int = 4) -> str:
-    """4 significant digits; whole numbers from 10 000 up to 1e9 written out (11300, not 1.13e+04)."""
-    if x is None:
-        return "–"
-    return f"{x:.0f}" if 1e4 <= abs(x) < 1e9 else f"{x:.{digits}g}"
-
-
 def _zero(d: float, *values: float) -> bool:
     """A change that is rounding noise of the computation (1e-9 of the values), shown as "same"."""
     return abs(d) <= 1e-9 * max([1e-300, *(abs(v) for v in values)])
-
-
-def _signed(x: float, digits: int = 3) -> str:
-    text = f"{x:+.0f}" if 1e3 <= abs(x) < 1e9 else f"{x:+.{digits}g}"
-    return "0" if float(text) == 0 else text
-
-
-def _pct(x: float) -> str:
-    text = f"{x:+.1f}"
-    return "0.0 %" if float(text) == 0 else f"{text} %"
 
 
 def _shown(f: Figure, value: Any) -> Any:
@@ -475,13 +456,13 @@ def _shown(f: Figure, value: Any) -> Any:
 
 def _text(f: Figure, v: Any) -> str:
     if f.kind == "number":
-        return fmt(v)
+        return significant_or_whole(v)
     if f.kind == "list":
-        return ", ".join(fmt(x) for x in v) if v else "none"
+        return ", ".join(significant_or_whole(x) for x in v) if v else "none"
     if f.kind == "range":
-        return "none" if v is None else f"{fmt(v[0])} – {fmt(v[1])}"
+        return "none" if v is None else f"{significant_or_whole(v[0])} – {significant_or_whole(v[1])}"
     if f.kind == "ranges":
-        return "; ".join(f"{fmt(a)} – {fmt(b)}" for a, b in v) if v else "none"
+        return "; ".join(f"{significant_or_whole(a)} – {significant_or_whole(b)}" for a, b in v) if v else "none"
     return "–" if v in (None, "") else str(v)
 
 
@@ -495,15 +476,17 @@ def _change(f: Figure, v: Any, b: Any) -> tuple[str, Any]:
         d = v - b
         if _zero(d, v, b):
             return "same", 0.0
-        text = f"{_signed(d)}{unit}"
+        text = f"{signed_or_whole(d)}{unit}"
         if f.relative and b != 0:
-            text += f" ({_pct(100 * d / b)})"
+            text += f" ({signed_percent(100 * d / b)})"
         return text, d
     if f.kind == "range":
         if v is None or b is None:
             return ("same" if v == b else f"{_text(f, b)} → {_text(f, v)}"), None
         d = [v[0] - b[0], v[1] - b[1]]
-        return ("same" if all(_zero(x, *v, *b) for x in d) else f"onset {_signed(d[0])}, end {_signed(d[1])}{unit}"), d
+        if all(_zero(x, *v, *b) for x in d):
+            return "same", d
+        return f"onset {signed_or_whole(d[0])}, end {signed_or_whole(d[1])}{unit}", d
     if f.kind == "ranges":
         v, b = v or [], b or []
         if len(v) != len(b):
@@ -512,7 +495,7 @@ def _change(f: Figure, v: Any, b: Any) -> tuple[str, Any]:
         bounds = [x for pair in v + b for x in pair]
         if all(_zero(x, *bounds) for pair in d for x in pair):
             return "same", d
-        return "; ".join(f"onset {_signed(x)}, end {_signed(y)}" for x, y in d) + unit, d
+        return "; ".join(f"onset {signed_or_whole(x)}, end {signed_or_whole(y)}" for x, y in d) + unit, d
     # lists: element by element when they have as many entries
     v, b = v or [], b or []
     if len(v) != len(b):
@@ -520,7 +503,7 @@ def _change(f: Figure, v: Any, b: Any) -> tuple[str, Any]:
     d = [x - y for x, y in zip(v, b, strict=True)]
     if all(_zero(x, p, q) for x, p, q in zip(d, v, b, strict=True)):
         return "same", d
-    return ", ".join(_signed(x) for x in d) + unit, d
+    return ", ".join(signed_or_whole(x) for x in d) + unit, d
 
 
 def comparison(names: Sequence[str], results: Sequence[dict[str, Any]], figures: Sequence[Figure]
@@ -560,7 +543,7 @@ def merit_figures(fz: float) -> list[Figure]:
         Figure("lowest shimmy load, min_shimmy_Fz (kN)", lambda m: m["min_shimmy_Fz"], scale=1e3, unit="kN"),
         Figure("lateral Hopf curve's lowest load, lateral_min_Fz (kN)", lambda m: m["lateral_min_Fz"], scale=1e3,
                unit="kN"),
-        Figure("pure-torsion area, Fz ≤ 250 kN ((m/s) kN)", lambda m: m["torsion_area"]),
+        Figure(f"{merits.label('torsion_area')} ({merits.unit('torsion_area')})", lambda m: m["torsion_area"]),
         Figure(f"Hopf speeds {at} (m/s)", lambda m: m["at_Fz"]["hopf_points"], "list", unit="m/s"),
         Figure(f"shimmy speed range {at} (m/s)", lambda m: m["at_Fz"]["shimmy_speed_range"], "range", unit="m/s"),
         Figure(f"largest stable |psi| {at} (rad)", lambda m: m["at_Fz"]["max_psi"], unit="rad"),
@@ -571,17 +554,18 @@ def merit_figures(fz: float) -> list[Figure]:
 
 def bifurcation_figures() -> list[Figure]:
     """What a bifurcation diagram says of a design: its Hopf points and its largest stable cycle."""
-    def special(r, kinds=("LPC", "NS", "PD")):
+    def special(r, kinds=CYCLE_BIFURCATIONS):
         return sorted(sp["V"] for b in r["branches"] if b["kind"] == "periodic" for sp in b["special_points"]
                       if sp["kind"] in kinds)
 
+    fold, torus, flip = PointKind.FOLD_OF_CYCLES, PointKind.TORUS, PointKind.PERIOD_DOUBLING
     return [
         Figure("Hopf points V (m/s)", lambda r: [h["V"] for h in r["hopf_points"]], "list", unit="m/s"),
         Figure("their criticality", lambda r: ", ".join(h["criticality"] for h in r["hopf_points"]) or "–", "text"),
         Figure("largest stable |psi| (rad)", lambda r: r["max_psi"], unit="rad"),
         Figure("speed of that largest |psi| (m/s)", lambda r: r["max_psi_V"], unit="m/s", relative=False),
-        Figure("folds of cycles (LPC) V (m/s)", lambda r: special(r, ("LPC",)), "list", unit="m/s"),
-        Figure("torus (NS) and period-doubling (PD) V (m/s)", lambda r: special(r, ("NS", "PD")), "list",
+        Figure(f"folds of cycles ({fold}) V (m/s)", lambda r: special(r, (fold,)), "list", unit="m/s"),
+        Figure(f"torus ({torus}) and period-doubling ({flip}) V (m/s)", lambda r: special(r, (torus, flip)), "list",
                unit="m/s"),
         Figure("warnings", lambda r: "; ".join(r["warnings"]) or "–", "text"),
     ]

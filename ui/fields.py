@@ -17,9 +17,7 @@ from dash import dcc
 from shimmy.errors import InvalidParameterError
 from shimmy.service import schemas
 
-
-def _g(x: float) -> str:
-    return f"{x:g}"
+from .formats import significant
 
 
 @dataclass(frozen=True)
@@ -51,7 +49,7 @@ class Quantity:
     @property
     def allowed(self) -> str:
         kind = "an integer" if self.integer else "a number"
-        return f"{kind} in [{_g(self.low)}, {_g(self.high)}] {self.unit}".rstrip()
+        return f"{kind} in [{significant(self.low, 6)}, {significant(self.high, 6)}] {self.unit}".rstrip()
 
     def _refuse(self, value: Any, why: str) -> InvalidParameterError:
         return InvalidParameterError(self.name, value, self.allowed, message=why)
@@ -75,7 +73,8 @@ class Quantity:
         if self.integer and number != round(number):
             raise self._refuse(value, f"{self.shown(number)} is not a whole number; enter {self.allowed}")
         if not self.low <= number <= self.high:
-            raise self._refuse(value, f"{self.shown(number)} is outside [{_g(self.low)}, {_g(self.high)}] "
+            raise self._refuse(value, f"{self.shown(number)} is outside [{significant(self.low, 6)}, "
+                                      f"{significant(self.high, 6)}] "
                                       f"{self.unit}".rstrip())
         si = number * self.scale
         return int(round(si)) if self.integer else si

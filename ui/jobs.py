@@ -1,8 +1,8 @@
 """One component for a page's long computation: Compute and Cancel buttons, a progress bar,
 an answer at once from the cache, jobs of the service otherwise, and CSV/JSON downloads.
 
-A page lays out :func:`controls` (ids PREFIX-run, PREFIX-cancel, PREFIX-progress, PREFIX-status,
-PREFIX-poll) and :func:`ui.components.downloads`, then calls :func:`register` with what is
+A page lays out :func:`controls` (the run and cancel buttons, progress and poll of an
+:class:`ui.ids.Group`) and :func:`ui.components.downloads`, then calls :func:`register` with what is
 particular to it: how its controls become requests, how results become its outputs, and how
 results become CSV rows.
 
@@ -32,28 +32,28 @@ from shimmy.errors import InvalidParameterError
 from shimmy.service import cache, jobs, schemas, settings
 
 from . import components
+from .ids import Group
 
 
-def controls(prefix: str, label: str = "Compute", interval: int = 400) -> list:
+def controls(group: Group, label: str = "Compute", interval: int = 400) -> list:
     """The run and cancel buttons, the progress bar of a job and the interval that reads it."""
-    return [html.Button(label, id=f"{prefix}-run"),
-            html.Button("Cancel", id=f"{prefix}-cancel", className="secondary", disabled=True),
-            components.progress_bar(prefix),
-            dcc.Interval(id=f"{prefix}-poll", interval=interval, disabled=True)]
+    return [html.Button(label, id=group.run),
+            html.Button("Cancel", id=group.cancel, className="secondary", disabled=True),
+            components.progress_bar(group),
+            dcc.Interval(id=group.poll, interval=interval, disabled=True)]
 
 
-def stores(prefix: str, store: str | None = None) -> list:
+def stores(group: Group) -> list:
     """The store of the shown results' requests, the ids of the jobs being waited for and the
     jobs whose results are ready to be drawn."""
-    return [dcc.Store(id=store or f"{prefix}-requests"), dcc.Store(id=f"{prefix}-go"),
-            dcc.Store(id=f"{prefix}-ready")]
+    return [dcc.Store(id=group.requests), dcc.Store(id=group.go), dcc.Store(id=group.ready)]
 
 
 @dataclass(frozen=True)
 class Download:
     """How a page's results become files: ``rows(results)`` -> (columns, rows) for the CSV."""
 
-    prefix: str  # ids PREFIX-csv, PREFIX-json, PREFIX-download
+    files: Group  # the buttons and the dcc.Download (its csv, json and download ids)
     name: str  # file stem
     rows: Callable[[list[dict[str, Any]]], tuple[list[str], list[list[Any]]]]
     single: bool = False  # the page shows one result: its JSON is that result, not a list of one
@@ -78,10 +78,10 @@ def canonical(analysis: str, wanted: Any) -> list[dict[str, Any]]:
     return out
 
 
-def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[str, Any]]],
+def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[str, Any]]],
              render: Callable[[list[dict[str, Any]]], tuple], outputs: Sequence[Output], states: Sequence[State],
-             download: Download, lock: Sequence[str] = (), store: str | None = None,
-             error: str | None = None, triggers: Sequence[Input] = (), initial: bool | str = "cached",
+             download: Download, lock: Sequence[str] = (), error: str | None = None,
+             triggers: Sequence[Input] = (), initial: bool | str = "cached",
              notice: Callable[[list[dict[str, Any]]], str] | None = None,
              blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None,
              labels: Callable[..., list[str]] | None = None) -> None:
@@ -90,7 +90,7 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
     ``requests(*trigger values, *state values)`` -> the analysis requests (may raise
     InvalidParameterError); ``render(results)`` -> one value per entry of ``outputs``;
     ``lock`` are ids of controls disabled while the jobs run; ``error`` the id of the element
-    that shows a refusal (PREFIX-error by default), ``notice(results)`` what it shows with a
+    that shows a refusal (the group's error line by default), ``notice(results)`` what it shows with a
     result; ``triggers`` inputs that start a computation besides the run button. When the page
     loads, ``initial="cached"`` shows the answer to the page's controls if the cache has it (and
     computes nothing otherwise), ``True`` computes it, ``False`` does nothing. ``blank()`` -> the
@@ -100,14 +100,14 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
     drawn by ``render(results, names)`` and tabulated by ``download.rows(results, names)``, and the
     requests store holds {"requests", "labels"}.
     """
-    store = store or f"{prefix}-requests"
-    error = error or f"{prefix}-error"
+    store, files = group.requests, download.files
+    error = error or group.error
     n_out = len(outputs)
-    tail = [Output(error, "children"), Output(store, "data"), Output(f"{download.prefix}-csv", "disabled"),
-            Output(f"{download.prefix}-json", "disabled")]
-    state = [Output(f"{prefix}-go", "data"), Output(f"{prefix}-poll", "disabled"), Output(f"{prefix}-run", "disabled"),
-             Output(f"{prefix}-cancel", "disabled"), *(Output(name, "disabled") for name in lock),
-             Output(f"{prefix}-progress", "value"), Output(f"{prefix}-status", "children")]
+    tail = [Output(error, "children"), Output(store, "data"), Output(files.csv, "disabled"), Output(files.json,
+                                                                                                    "disabled")]
+    state = [Output(group.go, "data"), Output(group.poll, "disabled"), Output(group.run, "disabled"),
+             Output(group.cancel, "disabled"), *(Output(name, "disabled") for name in lock),
+             Output(group.progress, "value"), Output(group.status, "children")]
     idle = (None, True, False, True, *(False for _ in lock))
 
     def refused(message: str, status: str = "", clear: bool = False) -> tuple:
@@ -120,7 +120,7 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         kept = wanted if labels is None else {"requests": wanted, "labels": names}
         return (*drawn, notice(results) if notice else "", kept, False, False) + idle + ("100", "")
 
-    @dash.callback(*outputs, *tail, *state, Input(f"{prefix}-run", "n_clicks"), *triggers, *states,
+    @dash.callback(*outputs, *tail, *state, Input(group.run, "n_clicks"), *triggers, *states,
                    prevent_initial_call=not initial)
     def dispatch(_n, *values):
         """Answer at once when every result is cached; otherwise submit jobs and start reading them."""
@@ -147,8 +147,8 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         return (tuple(busy) + (no_update,) * len(tail) + (go, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
-    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Output(f"{prefix}-ready", "data"),
-                   Input(f"{prefix}-poll", "n_intervals"), State(f"{prefix}-go", "data"), prevent_initial_call=True)
+    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Output(group.ready, "data"),
+                   Input(group.poll, "n_intervals"), State(group.go, "data"), prevent_initial_call=True)
     def poll(_n, go):
         """Progress of the page's jobs; once every result is in the cache, the interval stops and
         the ready store tells :func:`show` to draw them."""
@@ -173,7 +173,7 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
                   else f"{label}: queued ({jobs.counts()['running']} analyses running){of}")
         return (no_update,) * (n_out + len(tail) + len(state) - 2) + (str(int(100 * fraction)), status, no_update)
 
-    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(f"{prefix}-ready", "data"),
+    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(group.ready, "data"),
                    prevent_initial_call=True)
     def show(ready):
         """The results of the jobs the poll found done, drawn (once per ready signal)."""
@@ -190,9 +190,9 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
             return refused("A result left the cache before it could be shown; press Compute again.")
         return shown(results, wanted, names)
 
-    @dash.callback(Output(f"{prefix}-cancel", "disabled", allow_duplicate=True),
-                   Output(f"{prefix}-status", "children", allow_duplicate=True),
-                   Input(f"{prefix}-cancel", "n_clicks"), State(f"{prefix}-go", "data"), prevent_initial_call=True)
+    @dash.callback(Output(group.cancel, "disabled", allow_duplicate=True),
+                   Output(group.status, "children", allow_duplicate=True),
+                   Input(group.cancel, "n_clicks"), State(group.go, "data"), prevent_initial_call=True)
     def cancel(_n, go):
         """Cancel the jobs; the poll, the one writer of the page's job state, then says "cancelled" (a
         poll already on its way cannot overwrite it with a progress line)."""
@@ -201,8 +201,8 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
             jobs.cancel(job_id, remove=False)
         return True, "cancelling…" if ids else "cancelled"
 
-    @dash.callback(Output(f"{download.prefix}-download", "data"), Input(f"{download.prefix}-csv", "n_clicks"),
-                   Input(f"{download.prefix}-json", "n_clicks"), State(store, "data"), prevent_initial_call=True)
+    @dash.callback(Output(files.download, "data"), Input(files.csv, "n_clicks"), Input(files.json, "n_clicks"),
+                   State(store, "data"), prevent_initial_call=True)
     def save(_csv, _json, kept):
         wanted, names = (kept.get("requests"), kept.get("labels")) if isinstance(kept, dict) else (kept, None)
         if not wanted:
@@ -216,7 +216,7 @@ def register(prefix: str, analysis: str, *, requests: Callable[..., list[dict[st
         if any(r is None for r in results):  # evicted from the cache since it was drawn: compute again first
             return no_update
         name = download.filename(results) if download.filename else download.name
-        if dash.ctx.triggered_id == f"{download.prefix}-json":
+        if dash.ctx.triggered_id == files.json:
             return {"content": components.json_text(results[0] if download.single else results),
                     "filename": f"{name}.json"}
         columns, rows = download.rows(results) if labels is None else download.rows(results, names)

@@ -10,7 +10,7 @@ from dash import ALL, Input, Output, State, dcc, html
 from shimmy.errors import InvalidParameterError
 from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
 
-from . import sessions, state
+from . import formats, ids, sessions, state
 
 #: The design parameters with sliders (the six a device design moves); every other one is in the advanced panel.
 DESIGN = ("r2", "e_p", "k_s", "r3", "a_p", "rho_p")
@@ -25,18 +25,13 @@ def _label(name: str) -> html.Label:
                       title=f"{spec.description}; {spec.allowed}; {spec.provenance}", htmlFor=f"param-{name}")
 
 
-def _short(x: float) -> str:
-    """1.4e+06 -> 1.4e6: slider end labels that fit the panel."""
-    return f"{x:g}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
-
-
 def _field_error(name: str, problem: str | None) -> html.Div:
-    return html.Div(problem, id={"type": "param-error", "name": name}, className="error field-error", role="alert")
+    return html.Div(problem, id=ids.param_error(name), className="error field-error", role="alert")
 
 
 def _box(name: str, value: float) -> dcc.Input:
     spec = PARAMETER_SPECS[name]
-    return html.Div(dcc.Input(id={"type": "param-box", "name": name}, type="number", value=value, step="any",
+    return html.Div(dcc.Input(id=ids.param_box(name), type="number", value=value, step="any",
                               debounce=True, className="param-box"), title=f"{name}: {spec.allowed}",
                     className="param-box-wrap")
 
@@ -46,9 +41,9 @@ def _slider(name: str, value: float, problem: str | None = None) -> html.Div:
     return html.Div([
         _label(name),
         html.Div([
-            html.Div(dcc.Slider(id={"type": "param", "name": name}, min=spec.low, max=spec.high,
+            html.Div(dcc.Slider(id=ids.param(name), min=spec.low, max=spec.high,
                                 step=(spec.high - spec.low) / SLIDER_STEPS, value=value, updatemode="drag",
-                                marks={spec.low: _short(spec.low), spec.high: _short(spec.high)},
+                                marks={spec.low: formats.compact(spec.low), spec.high: formats.compact(spec.high)},
                                 tooltip={"placement": "bottom", "always_visible": False}), className="slider-track"),
             _box(name, value),
         ], className="slider-line"),
@@ -59,7 +54,7 @@ def _slider(name: str, value: float, problem: str | None = None) -> html.Div:
 def _number(name: str, value: float, problem: str | None = None) -> html.Div:
     return html.Div([
         html.Div([_label(name),
-                  html.Div(dcc.Input(id={"type": "param", "name": name}, type="number", value=value, step="any",
+                  html.Div(dcc.Input(id=ids.param(name), type="number", value=value, step="any",
                                      debounce=True, className="number-input"), title=PARAMETER_SPECS[name].allowed)],
                  className="number-line"),
         _field_error(name, problem),
@@ -82,12 +77,6 @@ def _url_problems(query: dict[str, str]) -> dict[str, str]:
     return out
 
 
-def design_id(page_id: str) -> dict[str, str]:
-    """Id of a page's design store. Each page has its own so that its callbacks' inputs all live
-    on that page (a callback with an input missing from the layout is an error in the browser)."""
-    return {"type": "design", "page": page_id}
-
-
 def design_panel(query: dict[str, str], page_id: str, shown: bool = True) -> html.Aside:
     material, values, problems = state.design_from_query(query)
     at_field = _url_problems(query)
@@ -95,22 +84,22 @@ def design_panel(query: dict[str, str], page_id: str, shown: bool = True) -> htm
     summary = "" if not at_field else ("Some values of the address were not applied: see the fields marked below."
                                        if shown else "; ".join(problems))
     return html.Aside([
-        dcc.Store(id=design_id(page_id), data=state.design_request(material, values)),
-        dcc.Store(id="url-update"), html.Div(id="url-sink", hidden=True),
+        dcc.Store(id=ids.design_store(page_id), data=state.design_request(material, values)),
+        dcc.Store(id=ids.URL_UPDATE), html.Div(id=ids.URL_SINK, hidden=True),
         html.H2("Design"),
-        html.Div(summary, id="design-error", className="error", role="alert"),
-        html.Div([html.Label("PD material", htmlFor="material"),
-                  dcc.Dropdown(id="material", options=[{"label": m, "value": m} for m in MATERIALS],
+        html.Div(summary, id=ids.DESIGN_ERROR, className="error", role="alert"),
+        html.Div([html.Label("PD material", htmlFor=ids.MATERIAL),
+                  dcc.Dropdown(id=ids.MATERIAL, options=[{"label": m, "value": m} for m in MATERIALS],
                                value=material, clearable=False),
                   html.Div(at_field.get("material"), className="error field-error", role="alert")],
                  className="slider-row"),
         *[_slider(n, values[n], at_field.get(n)) for n in DESIGN],
         html.Details([html.Summary("Advanced parameters"),
                       html.Div([_number(n, values[n], at_field.get(n)) for n in ADVANCED], className="advanced-grid")],
-                     id="advanced", open=advanced_problem),
-        html.Button("Reset design", id="reset-design", className="secondary"),
+                     id=ids.ADVANCED, open=advanced_problem),
+        html.Button("Reset design", id=ids.RESET_DESIGN, className="secondary"),
         sessions.section(),
-    ], className="design-panel", id="design-panel", hidden=not shown)
+    ], className="design-panel", id=ids.DESIGN_PANEL, hidden=not shown)
 
 
 def page(query: dict[str, str], page_id: str, *children, design: bool = True) -> html.Div:
@@ -129,7 +118,7 @@ def navigation() -> html.Nav:
     # Plain links: their href is kept carrying the design by the clientside URL updater below.
     links = [html.A(p["name"], href=p["relative_path"], className="nav-link")
              for p in dash.page_registry.values()]
-    toggle = html.Button("Design", id="design-toggle", className="nav-toggle",
+    toggle = html.Button("Design", id=ids.DESIGN_TOGGLE, className="nav-toggle",
                          title="Hide or show the design panel", **{"aria-pressed": "true"})
     return html.Nav([toggle, html.Span("shimmy", className="brand"), html.Span("workbench", className="brand-sub"),
                      *links], className="navbar")
@@ -163,8 +152,8 @@ dash.clientside_callback(
         return s;
     }
     """ % json.dumps([*PARAMETER_SPECS, "material"]),
-    Output("url-sink", "children"),
-    Input("url-update", "data"),
+    Output(ids.URL_SINK, "children"),
+    Input(ids.URL_UPDATE, "data"),
 )
 
 
@@ -179,8 +168,8 @@ dash.clientside_callback(
         return hidden ? "false" : "true";
     }
     """,
-    Output("design-toggle", "aria-pressed"),
-    Input("design-toggle", "n_clicks"),
+    Output(ids.DESIGN_TOGGLE, "aria-pressed"),
+    Input(ids.DESIGN_TOGGLE, "n_clicks"),
 )
 
 
@@ -195,6 +184,7 @@ dash.clientside_callback(
     function(values, boxes, material, reset, ids, boxIds, errorIds, stores) {
         const C = window.dash_clientside, trig = C.callback_context.triggered_id;
         const SPEC = %(spec)s, PRESET = %(preset)s, BASE = %(base)s, DEFAULT = %(default)s, ADVANCED = %(advanced)s;
+        const ID = %(ids)s;
         const names = ids.map(i => i.name), boxNames = boxIds.map(i => i.name);
         const previous = Object.assign({}, BASE[DEFAULT], ((stores || [])[0] || {}).params || {});
         let cur = {};
@@ -203,16 +193,16 @@ dash.clientside_callback(
         boxNames.forEach((n, i) => { boxOf[n] = boxes[i]; });
         let outValues = names.map(() => C.no_update), outBoxes = boxNames.map(() => C.no_update);
         let outMaterial = C.no_update;
-        const typed = trig && typeof trig === "object" && trig.type === "param-box" ? trig.name : null;
-        if (trig === "reset-design") {
+        const typed = trig && typeof trig === "object" && trig.type === ID.box ? trig.name : null;
+        if (trig === ID.reset) {
             material = DEFAULT; cur = Object.assign({}, BASE[DEFAULT]); outMaterial = DEFAULT;
             outValues = names.map(n => cur[n]); outBoxes = boxNames.map(n => cur[n]);
-        } else if (trig === "material") {
+        } else if (trig === ID.material) {
             Object.assign(cur, PRESET[material]); outValues = names.map(n => cur[n]);
             outBoxes = boxNames.map(n => cur[n]);
         } else if (typed) {
             cur[typed] = boxOf[typed];
-        } else if (trig && typeof trig === "object" && trig.type === "param") {
+        } else if (trig && typeof trig === "object" && trig.type === ID.param) {
             if (boxNames.includes(trig.name)) { outBoxes[boxNames.indexOf(trig.name)] = cur[trig.name]; }
         }
         const base = BASE[material], full = Object.assign({}, base), problems = {};
@@ -253,22 +243,24 @@ dash.clientside_callback(
                                for n, s in PARAMETER_SPECS.items()}),
            "preset": json.dumps(MATERIALS),
            "base": json.dumps({m: state.material_params(m) for m in MATERIALS}),
-           "default": json.dumps(state.DEFAULT_MATERIAL), "advanced": json.dumps(list(ADVANCED))},
-    Output({"type": "param", "name": ALL}, "value"),
-    Output({"type": "param-box", "name": ALL}, "value"),
-    Output("material", "value"),
-    Output("url-update", "data", allow_duplicate=True),
-    Output({"type": "design", "page": ALL}, "data"),
-    Output("design-error", "children"),
-    Output({"type": "param-error", "name": ALL}, "children"),
-    Output("advanced", "open"),
-    Input({"type": "param", "name": ALL}, "value"),
-    Input({"type": "param-box", "name": ALL}, "value"),
-    Input("material", "value"),
-    Input("reset-design", "n_clicks"),
-    State({"type": "param", "name": ALL}, "id"),
-    State({"type": "param-box", "name": ALL}, "id"),
-    State({"type": "param-error", "name": ALL}, "id"),
-    State({"type": "design", "page": ALL}, "data"),
+           "default": json.dumps(state.DEFAULT_MATERIAL), "advanced": json.dumps(list(ADVANCED)),
+           "ids": json.dumps({"box": ids.PARAM_BOX_TYPE, "param": ids.PARAM_TYPE, "reset": ids.RESET_DESIGN,
+                              "material": ids.MATERIAL})},
+    Output(ids.param(ALL), "value"),
+    Output(ids.param_box(ALL), "value"),
+    Output(ids.MATERIAL, "value"),
+    Output(ids.URL_UPDATE, "data", allow_duplicate=True),
+    Output(ids.design_store(ALL), "data"),
+    Output(ids.DESIGN_ERROR, "children"),
+    Output(ids.param_error(ALL), "children"),
+    Output(ids.ADVANCED, "open"),
+    Input(ids.param(ALL), "value"),
+    Input(ids.param_box(ALL), "value"),
+    Input(ids.MATERIAL, "value"),
+    Input(ids.RESET_DESIGN, "n_clicks"),
+    State(ids.param(ALL), "id"),
+    State(ids.param_box(ALL), "id"),
+    State(ids.param_error(ALL), "id"),
+    State(ids.design_store(ALL), "data"),
     prevent_initial_call=True,
 )

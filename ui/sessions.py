@@ -11,44 +11,43 @@ from __future__ import annotations
 
 import base64
 import binascii
+import json
 
 import dash
 from dash import ALL, Input, Output, State, dcc, html, no_update
 
-from . import designs
-
-LOCAL = "designs-saved"  # localStorage key of the saved designs (shared by every page and tab)
+from . import designs, ids
 
 
 def section() -> html.Details:
     """The panel's block of saved designs (the ids are the same on every page: one panel at a time)."""
     return html.Details([
         html.Summary("Saved designs"),
-        dcc.Store(id=LOCAL, storage_type="local"),
-        dcc.Store(id="design-ask"), dcc.Store(id="design-upload-ask"), dcc.Store(id="design-open"),
-        html.Div(id="design-open-sink", hidden=True),
-        html.Div([dcc.Input(id="design-name", type="text", placeholder="name this design", maxLength=designs.MAX_NAME,
+        dcc.Store(id=ids.SAVED, storage_type="local"),
+        dcc.Store(id=ids.DESIGN_ASK), dcc.Store(id=ids.DESIGN_UPLOAD_ASK), dcc.Store(id=ids.DESIGN_OPEN),
+        html.Div(id=ids.DESIGN_OPEN_SINK, hidden=True),
+        html.Div([dcc.Input(id=ids.DESIGN_NAME, type="text", placeholder="name this design", maxLength=designs.MAX_NAME,
                             className="design-name", debounce=False),
-                  html.Button("Save design", id="design-save", title="Save the design in this browser")],
+                  html.Button("Save design", id=ids.DESIGN_SAVE, title="Save the design in this browser")],
                  className="save-line"),
-        html.Div(id="designs-message", className="designs-message", role="status"),
-        html.Div(id="designs-list", className="saved-list"),
-        html.Div([html.Label("Compare (tick 2 to 4)", htmlFor="design-compare"),
-                  dcc.Checklist(id="design-compare", value=[], className="compare-list",
+        html.Div(id=ids.DESIGNS_MESSAGE, className="designs-message", role="status"),
+        html.Div(id=ids.DESIGNS_LIST, className="saved-list"),
+        html.Div([html.Label("Compare (tick 2 to 4)", htmlFor=ids.DESIGN_COMPARE),
+                  dcc.Checklist(id=ids.DESIGN_COMPARE, value=[], className="compare-list",
                                 options=[{"label": designs.CURRENT_NAME, "value": designs.CURRENT}],
                                 persistence=True, persistence_type="local"),
                   html.Small("The Overview, Bifurcation and Stability map pages overlay the ticked designs "
                              "(changes against the first).", className="hint")], className="compare-block"),
-        html.Div([html.Button("Download JSON", id="design-download-json", className="secondary",
+        html.Div([html.Button("Download JSON", id=ids.DESIGN_DOWNLOAD_JSON, className="secondary",
                               title="This design as a JSON file (name, material, every parameter value)"),
                   dcc.Upload(html.Button("Open JSON…", className="secondary", title="Open a design file"),
-                             id="design-upload", accept=".json,application/json"),
-                  dcc.Download(id="design-download")], className="file-line"),
-        html.Label("Link to this design", htmlFor="design-link"),
-        html.Div([dcc.Input(id="design-link", type="text", readOnly=True, className="design-link"),
-                  dcc.Clipboard(target_id="design-link", title="Copy the link", className="copy-link")],
+                             id=ids.DESIGN_UPLOAD, accept=".json,application/json"),
+                  dcc.Download(id=ids.DESIGN_DOWNLOAD)], className="file-line"),
+        html.Label("Link to this design", htmlFor=ids.DESIGN_LINK),
+        html.Div([dcc.Input(id=ids.DESIGN_LINK, type="text", readOnly=True, className="design-link"),
+                  dcc.Clipboard(target_id=ids.DESIGN_LINK, title="Copy the link", className="copy-link")],
                  className="link-line"),
-    ], open=True, id="designs", className="designs")
+    ], open=True, id=ids.DESIGNS, className="designs")
 
 
 def _message(text: str, notes: list[str] | None = None) -> list:
@@ -79,18 +78,18 @@ def _current(stores) -> object:
     return (stores or [None])[0]
 
 
-@dash.callback(Output(LOCAL, "data"), Output("design-open", "data"), Output("designs-message", "children"),
-               Input("design-ask", "data"), Input("design-upload-ask", "data"),
-               Input({"type": "saved-open", "id": ALL}, "n_clicks"),
-               Input({"type": "saved-delete", "id": ALL}, "n_clicks"),
-               Input({"type": "saved-name", "id": ALL}, "value"),
-               State(LOCAL, "data"), State({"type": "design", "page": ALL}, "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.SAVED, "data"), Output(ids.DESIGN_OPEN, "data"), Output(ids.DESIGNS_MESSAGE, "children"),
+               Input(ids.DESIGN_ASK, "data"), Input(ids.DESIGN_UPLOAD_ASK, "data"),
+               Input(ids.saved(ids.SAVED_OPEN_TYPE, ALL), "n_clicks"),
+               Input(ids.saved(ids.SAVED_DELETE_TYPE, ALL), "n_clicks"),
+               Input(ids.saved(ids.SAVED_NAME_TYPE, ALL), "value"),
+               State(ids.SAVED, "data"), State(ids.design_store(ALL), "data"), prevent_initial_call=True)
 def act(ask, upload, _opens, _deletes, _names, saved, stores):
     """Save, open, rename, delete, open a file: the store, the design to open, what was done."""
     trig = dash.ctx.triggered_id
     value = dash.ctx.triggered[0]["value"] if dash.ctx.triggered else None
     try:
-        if trig == "design-ask":
+        if trig == ids.DESIGN_ASK:
             if not isinstance(ask, dict) or ask.get("action") != "save":
                 return no_update, no_update, no_update
             design = designs.current_design(_current(stores), ask.get("name"))
@@ -98,7 +97,7 @@ def act(ask, upload, _opens, _deletes, _names, saved, stores):
                                     designs.config_from_search(ask.get("search")))
             new, _, text = designs.save(saved, design)
             return new, no_update, _message(text)
-        if trig == "design-upload-ask":
+        if trig == ids.DESIGN_UPLOAD_ASK:
             if not isinstance(upload, dict) or not isinstance(upload.get("contents"), str):
                 return no_update, no_update, no_update
             design, notes = designs.from_file(_decode(upload["contents"]), str(upload.get("filename") or "the file"))
@@ -108,16 +107,16 @@ def act(ask, upload, _opens, _deletes, _names, saved, stores):
         if not isinstance(trig, dict):
             return no_update, no_update, no_update
         entry_id = str(trig.get("id"))
-        if trig.get("type") == "saved-open" and value:
+        if trig.get("type") == ids.SAVED_OPEN_TYPE and value:
             entry = designs.find(saved, entry_id)
             if entry is None:
                 return no_update, no_update, _message("That design is no longer saved.")
             design = designs.from_entry(entry)
             return no_update, _open(design, f"Opened {design.name!r}."), _message(f"Opening {design.name!r}…")
-        if trig.get("type") == "saved-delete" and value:
+        if trig.get("type") == ids.SAVED_DELETE_TYPE and value:
             new, text = designs.delete(saved, entry_id)
             return new, no_update, _message(text)
-        if trig.get("type") == "saved-name":
+        if trig.get("type") == ids.SAVED_NAME_TYPE:
             entry = designs.find(saved, entry_id)
             if entry is None or value == entry.get("name"):  # a list drawn again, not a rename
                 return no_update, no_update, no_update
@@ -128,8 +127,8 @@ def act(ask, upload, _opens, _deletes, _names, saved, stores):
     return no_update, no_update, no_update
 
 
-@dash.callback(Output("design-download", "data"), Input("design-ask", "data"),
-               State({"type": "design", "page": ALL}, "data"), prevent_initial_call=True)
+@dash.callback(Output(ids.DESIGN_DOWNLOAD, "data"), Input(ids.DESIGN_ASK, "data"),
+               State(ids.design_store(ALL), "data"), prevent_initial_call=True)
 def download(ask, stores):
     """The design in the panel as a file, named by the name box (the page's configuration with it)."""
     if not isinstance(ask, dict) or ask.get("action") != "download":
@@ -143,9 +142,9 @@ def download(ask, stores):
     return {"content": design.text(), "filename": design.filename(), "type": "application/json"}
 
 
-@dash.callback(Output("designs-list", "children"), Output("design-compare", "options"),
-               Output("design-name", "value"),
-               Input(LOCAL, "data"), Input({"type": "design", "page": ALL}, "data"), State("design-name", "value"))
+@dash.callback(Output(ids.DESIGNS_LIST, "children"), Output(ids.DESIGN_COMPARE, "options"),
+               Output(ids.DESIGN_NAME, "value"),
+               Input(ids.SAVED, "data"), Input(ids.design_store(ALL), "data"), State(ids.DESIGN_NAME, "value"))
 def show(saved, stores, name):
     """The saved designs (the current one marked, one that can no longer be used says why) and the
     compare choices; an empty name box takes the name of the saved design shown."""
@@ -160,12 +159,12 @@ def show(saved, stores, name):
         is_current = match is not None and e["id"] == match["id"]
         detail = (f"not usable: {problem}" if problem else designs.from_entry(e).summary())
         rows.append(html.Div([
-            html.Div([html.Div(dcc.Input(id={"type": "saved-name", "id": e["id"]}, type="text", value=e.get("name"),
+            html.Div([html.Div(dcc.Input(id=ids.saved(ids.SAVED_NAME_TYPE, e["id"]), type="text", value=e.get("name"),
                                          debounce=True, maxLength=designs.MAX_NAME, className="saved-name"),
                                title="Type a new name and press Enter to rename", className="saved-name-wrap"),
-                      html.Button("Open", id={"type": "saved-open", "id": e["id"]}, className="secondary small",
+                      html.Button("Open", id=ids.saved(ids.SAVED_OPEN_TYPE, e["id"]), className="secondary small",
                                   disabled=bool(problem), title=f"Open {e.get('name')!r} on this page"),
-                      html.Button("Delete", id={"type": "saved-delete", "id": e["id"]}, className="secondary small",
+                      html.Button("Delete", id=ids.saved(ids.SAVED_DELETE_TYPE, e["id"]), className="secondary small",
                                   title=f"Delete {e.get('name')!r} from this browser")], className="saved-line"),
             html.Div(("● shown now · " if is_current else "") + detail,
                      className="saved-detail error" if problem else "saved-detail"),
@@ -185,12 +184,12 @@ dash.clientside_callback(
     function(save, down, name) {
         const trig = window.dash_clientside.callback_context.triggered_id;
         if (!trig) { return window.dash_clientside.no_update; }
-        return {action: trig === "design-save" ? "save" : "download", name: name || "",
+        return {action: trig === %s ? "save" : "download", name: name || "",
                 search: window.location.search, t: Date.now()};
     }
-    """,
-    Output("design-ask", "data"),
-    Input("design-save", "n_clicks"), Input("design-download-json", "n_clicks"), State("design-name", "value"),
+    """ % json.dumps(ids.DESIGN_SAVE),
+    Output(ids.DESIGN_ASK, "data"),
+    Input(ids.DESIGN_SAVE, "n_clicks"), Input(ids.DESIGN_DOWNLOAD_JSON, "n_clicks"), State(ids.DESIGN_NAME, "value"),
     prevent_initial_call=True,
 )
 
@@ -200,7 +199,7 @@ dash.clientside_callback(
     function(contents, filename) {
         const C = window.dash_clientside;
         if (!contents) { return [C.no_update, C.no_update, C.no_update]; }
-        const input = document.querySelector("#design-upload input[type=file]");
+        const input = document.querySelector("#%s input[type=file]");
         if (input) { input.value = ""; }  // the same file chosen again (edited) is read again
         const bytes = Math.floor((contents.length - contents.indexOf(",") - 1) * 3 / 4);
         if (bytes > %d) {  // emptied again, so that choosing the same file once more is seen
@@ -209,10 +208,10 @@ dash.clientside_callback(
         }
         return [{contents: contents, filename: filename, t: Date.now()}, C.no_update, null];
     }
-    """ % (designs.MAX_FILE_BYTES, designs.MAX_FILE_BYTES // 1024),
-    Output("design-upload-ask", "data"), Output("designs-message", "children", allow_duplicate=True),
-    Output("design-upload", "contents"),
-    Input("design-upload", "contents"), State("design-upload", "filename"),
+    """ % (ids.DESIGN_UPLOAD, designs.MAX_FILE_BYTES, designs.MAX_FILE_BYTES // 1024),
+    Output(ids.DESIGN_UPLOAD_ASK, "data"), Output(ids.DESIGNS_MESSAGE, "children", allow_duplicate=True),
+    Output(ids.DESIGN_UPLOAD, "contents"),
+    Input(ids.DESIGN_UPLOAD, "contents"), State(ids.DESIGN_UPLOAD, "filename"),
     prevent_initial_call=True,
 )
 
@@ -233,8 +232,8 @@ dash.clientside_callback(
         return url;
     }
     """,
-    Output("design-open-sink", "children"),
-    Input("design-open", "data"),
+    Output(ids.DESIGN_OPEN_SINK, "children"),
+    Input(ids.DESIGN_OPEN, "data"),
     prevent_initial_call=True,
 )
 
@@ -244,8 +243,8 @@ dash.clientside_callback(
 LINK = """
     function(_s) { return window.location.href; }
 """
-dash.clientside_callback(LINK, Output("design-link", "value"), Input("design-link", "id"))
-dash.clientside_callback(LINK, Output("design-link", "value", allow_duplicate=True), Input("url-sink", "children"),
+dash.clientside_callback(LINK, Output(ids.DESIGN_LINK, "value"), Input(ids.DESIGN_LINK, "id"))
+dash.clientside_callback(LINK, Output(ids.DESIGN_LINK, "value", allow_duplicate=True), Input(ids.URL_SINK, "children"),
                          prevent_initial_call=True)
 
 # After an open, the page that loaded says what was opened (and what the file left to the preset).
@@ -258,7 +257,7 @@ dash.clientside_callback(
         return text || window.dash_clientside.no_update;
     }
     """,
-    Output("designs-message", "children", allow_duplicate=True),
-    Input("design-open-sink", "id"),
+    Output(ids.DESIGNS_MESSAGE, "children", allow_duplicate=True),
+    Input(ids.DESIGN_OPEN_SINK, "id"),
     prevent_initial_call="initial_duplicate",
 )

@@ -296,6 +296,9 @@ def _check_ground_run(out: dict[str, Any]) -> None:
 #: The optimiser's figures of merit: unit, whether taken at a load, the range a constraint value may take.
 FIGURE_LIMITS: dict[str, tuple[str, bool, float, float]] = {
     name: (f.unit, f.at_load, f.low, f.high) for name, f in design_space.FIGURES.items()}
+#: The figures of merit themselves (label, unit, sense, ...), re-exported for the workbench, which names them by
+#: these labels and imports no analysis.
+FIGURES = design_space.FIGURES
 #: Figures with derivatives (the gradient method needs the objective and every constraint among them).
 DIFFERENTIABLE = design_space.DIFFERENTIABLE
 #: The optimiser's default search parameters (those of them the configuration has).

@@ -16,8 +16,10 @@ from shimmy.model.parameters import PARAMETER_SPECS
 pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
 
-from test_browser import DOWNLOADS, SHOTS, _idle, _severe, _trace_count, _wait_for, browser  # noqa: E402,F401
-from test_browser_workbench import _by_id, _open, _text, _type  # noqa: E402
+from browser import (DOWNLOADS, SHOTS, browser_fixture, by_id, idle, open_page, severe, text_of,  # noqa: E402
+                     trace_count, type_into, wait_for)
+
+browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)  # the profile of test_browser.py
 
 A = ("A wide track", "/?r2=0.085")
 B = ("B stiff spring", "/?r2=0.075&k_s=1300000")
@@ -25,7 +27,7 @@ B = ("B stiff spring", "/?r2=0.075&k_s=1300000")
 
 def _figures(driver):
     """What the Overview shows of a design: its Hopf table and its NES growth-rate curve."""
-    return _wait_for(lambda: driver.execute_script("""
+    return wait_for(lambda: driver.execute_script("""
         const rows = [...document.querySelectorAll('#ov-hopf-table tbody tr')].map(r => r.innerText);
         const g = document.querySelector('#ov-growth .js-plotly-plot');
         const t = g && g.data ? g.data.find(t => t.name === 'NES') : null;
@@ -41,8 +43,8 @@ def _saved(driver):
 def _click_row(driver, name: str, label: str) -> None:
     """Press a saved design's button, found and clicked in one script (the list is redrawn after
     every change: an element found earlier may be gone)."""
-    _idle(driver)
-    _wait_for(lambda: driver.execute_script("""
+    idle(driver)
+    wait_for(lambda: driver.execute_script("""
         const row = [...document.querySelectorAll('#designs-list .saved-row')]
             .find(r => r.querySelector('input').value === arguments[0]);
         const button = row ? [...row.querySelectorAll('button')].find(b => b.innerText === arguments[1]) : null;
@@ -52,8 +54,8 @@ def _click_row(driver, name: str, label: str) -> None:
 
 def _tick(driver, *names: str) -> None:
     """Tick designs under Compare (found and clicked in one script; done once each is ticked)."""
-    _idle(driver)
-    _wait_for(lambda: driver.execute_script("""
+    idle(driver)
+    wait_for(lambda: driver.execute_script("""
         const labels = [...document.querySelectorAll('#design-compare label')];
         let done = true;
         for (const name of arguments[0]) {
@@ -65,10 +67,10 @@ def _tick(driver, *names: str) -> None:
 
 
 def _save(driver, server, name: str, path: str) -> None:
-    _open(driver, server, path)
-    _type(driver, _by_id(driver, "design-name"), name)
-    _by_id(driver, "design-save").click()
-    _wait_for(lambda: any(n == name for n, _ in _saved(driver)), timeout=10, what=f"{name!r} in the saved list")
+    open_page(driver, server, path)
+    type_into(by_id(driver, "design-name"), name)
+    by_id(driver, "design-save").click()
+    wait_for(lambda: any(n == name for n, _ in _saved(driver)), timeout=10, what=f"{name!r} in the saved list")
 
 
 def _reopened(driver, path: str, **design: str) -> None:
@@ -78,15 +80,15 @@ def _reopened(driver, path: str, **design: str) -> None:
         url = urlsplit(driver.current_url)
         query = {k: v[-1] for k, v in parse_qs(url.query).items()}
         keys = {k: v for k, v in query.items() if k in PARAMETER_SPECS or k == "material"}
-        return (url.path == path and keys == design and _text(driver, "designs-message").startswith("Opened"))
+        return (url.path == path and keys == design and text_of(driver, "designs-message").startswith("Opened"))
 
-    _wait_for(loaded, timeout=20, what=f"the page to load {path} with {design}")
-    _idle(driver)
+    wait_for(loaded, timeout=20, what=f"the page to load {path} with {design}")
+    idle(driver)
 
 
 def _fresh(driver, server) -> None:
     """No saved designs and nothing ticked (the profile outlives a run)."""
-    _open(driver, server, "/")
+    open_page(driver, server, "/")
     driver.execute_script("localStorage.clear(); sessionStorage.clear();")
 
 
@@ -94,17 +96,17 @@ def _upload(driver, path) -> None:
     driver.find_element(By.CSS_SELECTOR, "#design-upload input[type=file]").send_keys(str(path))
 
 
-def test_a_saved_design_reopens_to_the_same_figures(server, browser, tmp_path):  # noqa: F811
+def test_a_saved_design_reopens_to_the_same_figures(server, browser, tmp_path):
     _fresh(browser, server)
     _save(browser, server, *A)
-    assert _text(browser, "designs-message") == "Saved 'A wide track' in this browser (1 saved)."
+    assert text_of(browser, "designs-message") == "Saved 'A wide track' in this browser (1 saved)."
     shown_a = _figures(browser)
-    link = _wait_for(lambda: _by_id(browser, "design-link").get_attribute("value"), what="the link")
+    link = wait_for(lambda: by_id(browser, "design-link").get_attribute("value"), what="the link")
     assert link == server.base + "/?r2=0.085&Fz=150&vmax=200"
     (DOWNLOADS / "A_wide_track.json").unlink(missing_ok=True)
-    _by_id(browser, "design-download-json").click()
+    by_id(browser, "design-download-json").click()
     file_a = DOWNLOADS / "A_wide_track.json"
-    _wait_for(file_a.exists, timeout=20, what="the design file")
+    wait_for(file_a.exists, timeout=20, what="the design file")
     data = json.loads(file_a.read_text())
     assert data["name"] == "A wide track" and data["parameters"]["r2"] == 0.085 and len(data["parameters"]) == 38
     _save(browser, server, *B)
@@ -118,20 +120,20 @@ def test_a_saved_design_reopens_to_the_same_figures(server, browser, tmp_path): 
     _click_row(browser, "A wide track", "Open")
     _reopened(browser, "/", r2="0.085")
     assert _figures(browser) == shown_a
-    assert _by_id(browser, "design-name").get_attribute("value") == "A wide track"
+    assert by_id(browser, "design-name").get_attribute("value") == "A wide track"
     assert _saved(browser)[0][1].startswith("● shown now")
 
     # from its file (on a page showing B)
-    _open(browser, server, B[1])
+    open_page(browser, server, B[1])
     _upload(browser, file_a)
     _reopened(browser, "/", r2="0.085")
     assert _figures(browser) == shown_a
-    assert "Opened 'A wide track' from A_wide_track.json" in _text(browser, "designs-message")
+    assert "Opened 'A wide track' from A_wide_track.json" in text_of(browser, "designs-message")
 
     # from its link
-    _open(browser, server, B[1])
+    open_page(browser, server, B[1])
     browser.get(link)
-    _idle(browser)
+    idle(browser)
     assert _figures(browser) == shown_a
 
     # a bad file is refused naming the field, the value and the range; nothing of it is applied
@@ -140,25 +142,25 @@ def test_a_saved_design_reopens_to_the_same_figures(server, browser, tmp_path): 
     bad.write_text(json.dumps(data))
     url = browser.current_url
     _upload(browser, bad)
-    _wait_for(lambda: "Refused (bad.json)" in _text(browser, "designs-message"), timeout=10, what="the refusal")
-    message = _text(browser, "designs-message")
+    wait_for(lambda: "Refused (bad.json)" in text_of(browser, "designs-message"), timeout=10, what="the refusal")
+    message = text_of(browser, "designs-message")
     assert "r2 = 0.5 m is out of range; allowed: a number in [0.07, 0.09] m" in message
     assert "unknown parameter 'k_sx' (did you mean k_s, k_psi?)" in message
     assert browser.current_url == url and len(_saved(browser)) == 2
     browser.set_window_size(1024, 768)
-    _wait_for(lambda: browser.execute_script("return document.documentElement.scrollWidth <= "
-                                             "document.documentElement.clientWidth"), timeout=10,
-              what="the page to fit 1024 px")
+    wait_for(lambda: browser.execute_script("return document.documentElement.scrollWidth <= "
+                                            "document.documentElement.clientWidth"), timeout=10,
+             what="the page to fit 1024 px")
     browser.execute_script("document.getElementById('designs-message').scrollIntoView({block: 'center'})")
     browser.save_screenshot(str(SHOTS / "designs-refused-file-1024x768.png"))
 
     # rename, delete
-    _type(browser, _by_id(browser, '{"id":"d2","type":"saved-name"}'), "B renamed")
-    _wait_for(lambda: [n for n, _ in _saved(browser)] == ["A wide track", "B renamed"], timeout=10,
-              what="the rename")
+    type_into(by_id(browser, '{"id":"d2","type":"saved-name"}'), "B renamed")
+    wait_for(lambda: [n for n, _ in _saved(browser)] == ["A wide track", "B renamed"], timeout=10,
+             what="the rename")
     _click_row(browser, "B renamed", "Delete")
-    _wait_for(lambda: [n for n, _ in _saved(browser)] == ["A wide track"], timeout=10, what="the deletion")
-    assert _text(browser, "designs-message") == "Deleted 'B renamed'."
+    wait_for(lambda: [n for n, _ in _saved(browser)] == ["A wide track"], timeout=10, what="the deletion")
+    assert text_of(browser, "designs-message") == "Deleted 'B renamed'."
 
     # the refused file, corrected and chosen again, is read again
     del data["parameters"]["k_sx"]
@@ -166,8 +168,8 @@ def test_a_saved_design_reopens_to_the_same_figures(server, browser, tmp_path): 
     bad.write_text(json.dumps(data))
     _upload(browser, bad)
     _reopened(browser, "/", r2="0.0855")
-    assert "Replaced the saved design 'A wide track'" in _text(browser, "designs-message")
-    assert _severe(browser) == []
+    assert "Replaced the saved design 'A wide track'" in text_of(browser, "designs-message")
+    assert severe(browser) == []
 
 
 def _compare_names(driver) -> list[list[str]]:
@@ -189,18 +191,18 @@ def _cycles(driver, graph: str, name: str):
                      .map(t => t.y);""", graph, name)
 
 
-def test_two_designs_compared_on_the_bifurcation_page_both_show(server, browser):  # noqa: F811
+def test_two_designs_compared_on_the_bifurcation_page_both_show(server, browser):
     _fresh(browser, server)
     page = "/bifurcation?configs=nes&compare_config=nes"
     _save(browser, server, A[0], page + "&r2=0.085")
     _save(browser, server, B[0], page + "&r2=0.075&k_s=1300000")
     _tick(browser, A[0], B[0])
-    _wait_for(lambda: _text(browser, "bifc-designs").startswith("Comparing: ■ A wide track (reference) ■ B stiff"),
-              timeout=10, what="the designs to compare")
-    _by_id(browser, "bifc-run").click()
-    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#bifc-summary tbody tr"), timeout=120,
-              what="the comparison")
-    _wait_for(lambda: _trace_count(browser, "bifc-graph") > 6, what="the comparison's traces")
+    wait_for(lambda: text_of(browser, "bifc-designs").startswith("Comparing: ■ A wide track (reference) ■ B stiff"),
+             timeout=10, what="the designs to compare")
+    by_id(browser, "bifc-run").click()
+    wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#bifc-summary tbody tr"), timeout=120,
+             what="the comparison")
+    wait_for(lambda: trace_count(browser, "bifc-graph") > 6, what="the comparison's traces")
     assert _compare_names(browser) == [[A[0], B[0]], [A[0], B[0]]]
     strip = browser.execute_script("return document.querySelector('#bifc-graph .js-plotly-plot')"
                                    ".layout.yaxis3.categoryarray")
@@ -216,16 +218,16 @@ def test_two_designs_compared_on_the_bifurcation_page_both_show(server, browser)
     compared_a = _cycles(browser, "bifc-graph", A[0])
     _click_row(browser, A[0], "Open")
     _reopened(browser, "/bifurcation", r2="0.085")
-    _wait_for(lambda: _trace_count(browser, "bif-graph") > 4, timeout=20, what="A's cached diagram")
+    wait_for(lambda: trace_count(browser, "bif-graph") > 4, timeout=20, what="A's cached diagram")
     assert _cycles(browser, "bif-graph", "NES") == compared_a
-    _wait_for(lambda: _trace_count(browser, "bifc-graph") > 6, timeout=20, what="the cached comparison")
+    wait_for(lambda: trace_count(browser, "bifc-graph") > 6, timeout=20, what="the cached comparison")
 
     # The Overview compares the same two at once: their Hopf intervals side by side.
-    _open(browser, server, "/")
-    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#ov-cmp-summary tbody tr"), timeout=20,
-              what="the Overview's comparison")
+    open_page(browser, server, "/")
+    wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#ov-cmp-summary tbody tr"), timeout=20,
+             what="the Overview's comparison")
     columns = browser.execute_script("return [...document.querySelectorAll('#ov-cmp-summary thead th')]"
                                      ".map(th => th.innerText)")
     assert columns == ["figure", "■ A wide track (reference)", "■ B stiff spring"]
-    assert _trace_count(browser, "ov-cmp-graph") > 8
-    assert _severe(browser) == []
+    assert trace_count(browser, "ov-cmp-graph") > 8
+    assert severe(browser) == []

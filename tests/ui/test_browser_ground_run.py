@@ -12,7 +12,9 @@ from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
-from test_browser import DOWNLOADS, SHOTS, _idle, _severe, _trace_count, _wait_for, browser  # noqa: E402,F401
+from browser import DOWNLOADS, SHOTS, browser_fixture, idle, severe, text_of, trace_count, wait_for  # noqa: E402
+
+browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)  # the profile of test_browser.py
 
 NAMES = ["original", "NES", "PD", "NES + PD"]
 
@@ -23,10 +25,6 @@ def _summary(driver) -> list[list[str]]:
         "return Array.from(document.querySelectorAll('#gr-summary-table tbody tr'))"
         ".map(r => Array.from(r.cells).map(c => c.innerText));")
 
-
-def _text(driver, element_id: str) -> str:
-    """The text of an element, empty until the page has rendered it."""
-    return driver.execute_script(f"const e = document.getElementById('{element_id}'); return e ? e.innerText : '';")
 
 
 JOB_WAIT = 400  # s: the longest wait for the page's four ground-run jobs
@@ -39,32 +37,32 @@ def _edit_cell(driver, row: int, column: str, text: str) -> None:
     ActionChains(driver).send_keys(text).send_keys(Keys.ENTER).perform()
 
 
-def test_ground_run_page_runs_the_presets_and_a_table(server, browser):  # noqa: F811
+def test_ground_run_page_runs_the_presets_and_a_table(server, browser):
     browser.get_log("browser")
     browser.set_window_size(1440, 900)
     browser.get(server.base + "/ground-run")
     # Four ground runs as background jobs on the shared server's two job slots: bounded generously
     # for a loaded machine, not timed.
-    rows = _wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=JOB_WAIT,
-                     what="the take-off of the four configurations")
+    rows = wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=JOB_WAIT,
+                    what="the take-off of the four configurations")
     assert [r[0] for r in rows] == NAMES
     assert float(rows[0][1]) > float(rows[3][1].split()[0]) > 0  # NES + PD spends less time in shimmy
-    _wait_for(lambda: _trace_count(browser, "gr-time") == 8 and _trace_count(browser, "gr-speed") == 8,
-              what="two envelopes of four configurations against t and V")
-    assert _trace_count(browser, "gr-plane") >= 4  # Hopf curve(s), trajectory, shimmy stretch, start, crossings
+    wait_for(lambda: trace_count(browser, "gr-time") == 8 and trace_count(browser, "gr-speed") == 8,
+             what="two envelopes of four configurations against t and V")
+    assert trace_count(browser, "gr-plane") >= 4  # Hopf curve(s), trajectory, shimmy stretch, start, crossings
     assert "take-off preset" in browser.find_element(By.ID, "gr-source").text
-    _idle(browser)
+    idle(browser)
     browser.save_screenshot(str(SHOTS / "ground-run-1440.png"))
     origins = browser.execute_script("return performance.getEntriesByType('resource').map(e => e.name);")
     assert all(u.startswith(server.base) for u in origins)
-    assert _severe(browser) == []
+    assert severe(browser) == []
 
     # The downloads serialise what is drawn.
     for f in DOWNLOADS.glob("ground_run_*"):
         f.unlink()
     browser.find_element(By.ID, "gr-csv").click()
     path = DOWNLOADS / "ground_run_takeoff.csv"
-    _wait_for(lambda: path.exists() and path.stat().st_size > 0, timeout=20, what="the CSV download")
+    wait_for(lambda: path.exists() and path.stat().st_size > 0, timeout=20, what="the CSV download")
     table = list(csv.reader(io.StringIO(path.read_text())))
     assert table[0][:4] == ["config", "t_s", "V_m_s", "Fz_N"]
     assert {r[0] for r in table[1:]} == {"original", "nes", "pd", "nes_pd"}
@@ -72,43 +70,43 @@ def test_ground_run_page_runs_the_presets_and_a_table(server, browser):  # noqa:
     # An edited table runs instead of the preset: start at 30 m/s (inside the unstable region).
     before = _summary(browser)
     _edit_cell(browser, 0, "V", "30")
-    _wait_for(lambda: "your table" in _text(browser, "gr-source"), timeout=10, what="the table to be the profile")
+    wait_for(lambda: "your table" in text_of(browser, "gr-source"), timeout=10, what="the table to be the profile")
     browser.find_element(By.ID, "gr-run").click()
-    _wait_for(lambda: (s := _summary(browser)) and s != before and s, timeout=JOB_WAIT, what="the run of the table")
-    assert _severe(browser) == []
+    wait_for(lambda: (s := _summary(browser)) and s != before and s, timeout=JOB_WAIT, what="the run of the table")
+    assert severe(browser) == []
 
     # A bad row is refused, naming its row and column.
     _edit_cell(browser, 1, "V", "600")
     browser.find_element(By.ID, "gr-run").click()
-    message = _wait_for(lambda: _text(browser, "gr-error"), timeout=20, what="the refusal")
+    message = wait_for(lambda: text_of(browser, "gr-error"), timeout=20, what="the refusal")
     assert "profile[1].V=600" in message and "row 2 of the table" in message and "[1, 500] m/s" in message
 
     # The landing roll from the URL, at the smaller window.
     browser.set_window_size(1024, 768)
     browser.get(server.base + "/ground-run?preset=landing&config=nes")
-    _wait_for(lambda: "landing roll preset" in _text(browser, "gr-source"), timeout=30, what="the landing preset")
-    rows = _wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=JOB_WAIT, what="the landing roll")
+    wait_for(lambda: "landing roll preset" in text_of(browser, "gr-source"), timeout=30, what="the landing preset")
+    rows = wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=JOB_WAIT, what="the landing roll")
     assert "Hopf curves of NES" in browser.find_element(By.CSS_SELECTOR, "#gr-plane .gtitle").text
-    _idle(browser)
+    idle(browser)
     browser.save_screenshot(str(SHOTS / "ground-run-1024.png"))
-    assert _severe(browser) == []
+    assert severe(browser) == []
     browser.set_window_size(1500, 1100)
 
 
-def test_ground_run_address_values_are_refused_not_replaced(server, browser):  # noqa: F811
+def test_ground_run_address_values_are_refused_not_replaced(server, browser):
     """Values from the address that are not usable are named where the user looks, in the
     field's unit; a threshold that is not a number leaves its box empty and nothing runs from it."""
     browser.get(server.base + "/ground-run?preset=cruise&psi_thr=abc&lat_thr=5000")
-    error = _wait_for(lambda: "".join(e.text for e in browser.find_elements(By.ID, "gr-address")) or None,
-                      what="the refusal")
+    error = wait_for(lambda: "".join(e.text for e in browser.find_elements(By.ID, "gr-address")) or None,
+                     what="the refusal")
     assert "preset=cruise" in error and "psi_thr=abc" in error and "not a number" in error
     assert "lat_thr=5000" in error and "mm" in error
     # nothing is run on load from what the address could not give (the line above says why) ...
-    _idle(browser)
+    idle(browser)
     assert not browser.find_elements(By.CSS_SELECTOR, "#gr-summary tbody tr")
     # ... and Run refuses it in the box's unit
     browser.find_element(By.ID, "gr-run").click()
-    refusal = _wait_for(lambda: "".join(e.text for e in browser.find_elements(By.ID, "gr-error")) or None,
-                        what="the refused run")
+    refusal = wait_for(lambda: "".join(e.text for e in browser.find_elements(By.ID, "gr-error")) or None,
+                       what="the refused run")
     assert "threshold |psi|" in refusal and "rad" in refusal
     assert browser.find_element(By.ID, "gr-psi-thr").get_attribute("value") == ""

@@ -14,114 +14,80 @@ import pytest
 pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
-from test_browser import (PAGES, SHOTS, _idle, chromium,  # noqa: E402
-                          _severe, _trace_count, _wait_for)
+from browser import (PAGES, SHOTS, browser_fixture, by_id, idle, open_page, pattern, severe,  # noqa: E402
+                     text_of, trace_count, type_into, wait_for)
 
+#: Headless Chromium as in test_browser.py, with a profile of its own.
+browser = browser_fixture("chromium-profile-workbench", "1440,900")
 
-@pytest.fixture(scope="module")
-def browser():
-    """Headless Chromium as in test_browser.py, with a profile of its own."""
-    driver = chromium("chromium-profile-workbench", "1440,900")
-    yield driver
-    driver.quit()
 
 
 SIZES = ((1440, 900), (1024, 768))
 
 
-def _by_id(driver, element_id):
-    """An element by id (pattern-matching ids are JSON, not valid CSS)."""
-    return driver.execute_script("return document.getElementById(arguments[0])", element_id)
-
-
-def _pattern(name: str, kind: str) -> str:
-    return '{"name":"%s","type":"%s"}' % (name, kind)
-
-
-def _type(driver, element, text: str) -> None:
-    """Replace a box's content and leave it (a debounced box sends its value on blur)."""
-    element.click()
-    element.send_keys(Keys.CONTROL, "a")
-    element.send_keys(Keys.BACKSPACE)
-    if text:
-        element.send_keys(text)
-    element.send_keys(Keys.TAB)
-
-
-def _text(driver, element_id: str) -> str:
-    return driver.execute_script("const e = document.getElementById(arguments[0]); return e ? e.innerText : '';",
-                                 element_id)
-
-
-def _open(driver, server, path, size=(1440, 900)):
-    driver.set_window_size(*size)
-    driver.get(server.base + path)
-    _wait_for(lambda: driver.find_elements(By.CSS_SELECTOR, ".page-header h1"), what="the page header")
-    _idle(driver)
-
 
 def test_design_box_slider_and_url_stay_in_sync(server, browser):
-    _open(browser, server, "/")
-    box = _wait_for(lambda: _by_id(browser, _pattern("r2", "param-box")), what="the r2 box")
+    open_page(browser, server, "/")
+    box = wait_for(lambda: by_id(browser, pattern("r2", "param-box")), what="the r2 box")
     assert box.get_attribute("value") == "0.08"  # the value is visible before any drag
-    _type(browser, box, "0.0853")
-    _wait_for(lambda: "r2=0.0853" in browser.current_url, timeout=10, what="the URL to carry the typed r2")
+    type_into(box, "0.0853")
+    wait_for(lambda: "r2=0.0853" in browser.current_url, timeout=10, what="the URL to carry the typed r2")
     slider = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]
     assert float(slider.get_attribute("aria-valuenow")) == pytest.approx(0.0853)
     slider.click()
     slider.send_keys(Keys.HOME)
-    _wait_for(lambda: _by_id(browser, _pattern("r2", "param-box")).get_attribute("value") == "0.07", timeout=10,
-              what="the box to follow the slider")
-    _wait_for(lambda: "r2=0.07" in browser.current_url, timeout=10, what="the URL to follow the slider")
+    wait_for(lambda: by_id(browser, pattern("r2", "param-box")).get_attribute("value") == "0.07", timeout=10,
+             what="the box to follow the slider")
+    wait_for(lambda: "r2=0.07" in browser.current_url, timeout=10, what="the URL to follow the slider")
     browser.get(server.base + "/?k_s=1234567")  # the URL sets the box and the slider
-    _idle(browser)
-    k_s = _wait_for(lambda: _by_id(browser, _pattern("k_s", "param-box")), what="the k_s box")
+    idle(browser)
+    k_s = wait_for(lambda: by_id(browser, pattern("k_s", "param-box")), what="the k_s box")
     assert k_s.get_attribute("value") == "1234567"
-    assert _severe(browser) == []
+    assert severe(browser) == []
 
 
 def test_refusals_are_at_the_field_in_its_unit_quoting_what_was_typed(server, browser):
-    _open(browser, server, "/")
+    open_page(browser, server, "/")
     browser.find_element(By.CSS_SELECTOR, "#advanced summary").click()
-    _type(browser, _by_id(browser, _pattern("k_psi", "param")), "-5")
-    _wait_for(lambda: _text(browser, _pattern("k_psi", "param-error")), timeout=10, what="the error at k_psi")
-    assert _text(browser, _pattern("k_psi", "param-error")).startswith(
+    type_into(by_id(browser, pattern("k_psi", "param")), "-5")
+    wait_for(lambda: text_of(browser, pattern("k_psi", "param-error")), timeout=10, what="the error at k_psi")
+    assert text_of(browser, pattern("k_psi", "param-error")).startswith(
         "k_psi = -5 N m/rad is outside [10000, 1e+07] N m/rad (kept 380000")
     # The advanced inputs are wide enough for their values.
-    k_delta = _by_id(browser, _pattern("k_delta", "param"))
+    k_delta = by_id(browser, pattern("k_delta", "param"))
     assert browser.execute_script("return arguments[0].scrollWidth <= arguments[0].clientWidth", k_delta)
-    _type(browser, _by_id(browser, _pattern("r2", "param-box")), "0.2")
-    _wait_for(lambda: _text(browser, _pattern("r2", "param-error")), timeout=10, what="the error at r2")
-    assert _text(browser, _pattern("r2", "param-error")).startswith("r2 = 0.2 m is outside [0.07, 0.09] m")
+    type_into(by_id(browser, pattern("r2", "param-box")), "0.2")
+    wait_for(lambda: text_of(browser, pattern("r2", "param-error")), timeout=10, what="the error at r2")
+    assert text_of(browser, pattern("r2", "param-error")).startswith("r2 = 0.2 m is outside [0.07, 0.09] m")
     assert "r2=0.2" not in browser.current_url
     browser.save_screenshot(str(SHOTS / "design-errors-at-the-field.png"))
 
-    _open(browser, server, "/bifurcation?configs=original")
-    _type(browser, browser.find_element(By.ID, "bif-fz"), "5")
+    open_page(browser, server, "/bifurcation?configs=original")
+    type_into(browser.find_element(By.ID, "bif-fz"), "5")
     browser.find_element(By.ID, "bif-run").click()
-    _wait_for(lambda: _text(browser, "bif-error"), timeout=10, what="the bifurcation refusal")
-    assert _text(browser, "bif-error") == "Fz = 5 kN is outside [10, 900] kN"
+    wait_for(lambda: text_of(browser, "bif-error"), timeout=10, what="the bifurcation refusal")
+    assert text_of(browser, "bif-error") == "Fz = 5 kN is outside [10, 900] kN"
 
-    _open(browser, server, "/time-history?Fz=5000")
-    assert _text(browser, "th-error") == "The address gives Fz=5000: Fz = 5000 kN is outside [10, 900] kN."
-    _type(browser, browser.find_element(By.ID, "th-fz"), "150")
-    _type(browser, browser.find_element(By.ID, "th-v"), "600")
-    _wait_for(lambda: "V = 600" in _text(browser, "th-error"), timeout=10, what="the V refusal")
-    assert _text(browser, "th-error") == "V = 600 m/s is outside [1, 500] m/s"
-    assert _severe(browser) == []
+    open_page(browser, server, "/time-history?Fz=5000")
+    assert text_of(browser, "th-error") == "The address gives Fz=5000: Fz = 5000 kN is outside [10, 900] kN."
+    type_into(browser.find_element(By.ID, "th-fz"), "150")
+    type_into(browser.find_element(By.ID, "th-v"), "600")
+    wait_for(lambda: "V = 600" in text_of(browser, "th-error"), timeout=10, what="the V refusal")
+    assert text_of(browser, "th-error") == "V = 600 m/s is outside [1, 500] m/s"
+    assert severe(browser) == []
 
 
 @pytest.mark.parametrize("slices, why", [("1", "Fz slices = 1 is outside [2, 80]"),
                                          ("2.5", "Fz slices = 2.5 is not a whole number"),
                                          ("1000", "Fz slices = 1000 is outside [2, 80]")])
 def test_map_slices_out_of_range_are_refused_not_replaced(server, browser, slices, why):
-    _open(browser, server, "/stability-map?fz_min=100&fz_max=400")
+    open_page(browser, server, "/stability-map?fz_min=100&fz_max=400")
     assert "Fz slices (2-80)" in browser.find_element(By.CSS_SELECTOR, ".controls").text  # the shared limit
-    _type(browser, browser.find_element(By.ID, "map-res"), slices)
+    type_into(browser.find_element(By.ID, "map-res"), slices)
     browser.find_element(By.ID, "map-run").click()
-    _wait_for(lambda: _text(browser, "map-error"), timeout=10, what="the refusal")
-    assert _text(browser, "map-error").startswith(why)
-    assert _text(browser, "map-status") == ""  # nothing was submitted
+    wait_for(lambda: text_of(browser, "map-error"), timeout=10, what="the refusal")
+    assert text_of(browser, "map-error").startswith(why)
+    assert text_of(browser, "map-status") == ""  # nothing was submitted
     # The API and the page refuse the same value by the same limit.
     status, _, body = server.request("POST", "/api/v1/jobs", {"analysis": "map", "config": "original",
                                                               "resolution": 81})
@@ -129,66 +95,66 @@ def test_map_slices_out_of_range_are_refused_not_replaced(server, browser, slice
 
 
 def test_nothing_falls_back_silently(server, browser):
-    _open(browser, server, "/time-history?V=abc&config=foo")
-    text = _text(browser, "th-error")
+    open_page(browser, server, "/time-history?V=abc&config=foo")
+    text = text_of(browser, "th-error")
     assert "config=foo, which is not a configuration" in text and "V=abc, which is not a number" in text
     assert browser.find_element(By.ID, "th-v").get_attribute("value") == ""  # not a silent 30
     for t_end, why in (("0", "simulated time = 0 s is outside [0.1, 600] s"),
                        ("100000", "simulated time = 100000 s is outside [0.1, 600] s")):
-        _type(browser, browser.find_element(By.ID, "th-v"), "30")
-        _type(browser, browser.find_element(By.ID, "th-tend"), t_end)
+        type_into(browser.find_element(By.ID, "th-v"), "30")
+        type_into(browser.find_element(By.ID, "th-tend"), t_end)
         browser.find_element(By.ID, "th-run").click()
-        _wait_for(lambda w=why: _text(browser, "th-error") == w, timeout=10, what=f"the t_end refusal {why}")
-    _open(browser, server, "/bifurcation?configs=original")
-    _type(browser, browser.find_element(By.ID, "bif-vmax"), "")
+        wait_for(lambda w=why: text_of(browser, "th-error") == w, timeout=10, what=f"the t_end refusal {why}")
+    open_page(browser, server, "/bifurcation?configs=original")
+    type_into(browser.find_element(By.ID, "bif-vmax"), "")
     browser.find_element(By.ID, "bif-run").click()
-    _wait_for(lambda: _text(browser, "bif-error"), timeout=10, what="the empty v_max refusal")
-    assert _text(browser, "bif-error") == "highest V is empty or not a number; enter a number in [1, 500] m/s"
-    _open(browser, server, "/stability-map?shade=foo&overlay=nes,bar")
-    assert "shade=foo, which is not a configuration" in _text(browser, "map-error")
-    assert "bar is not a configuration" in _text(browser, "map-error")
-    assert _severe(browser) == []
+    wait_for(lambda: text_of(browser, "bif-error"), timeout=10, what="the empty v_max refusal")
+    assert text_of(browser, "bif-error") == "highest V is empty or not a number; enter a number in [1, 500] m/s"
+    open_page(browser, server, "/stability-map?shade=foo&overlay=nes,bar")
+    assert "shade=foo, which is not a configuration" in text_of(browser, "map-error")
+    assert "bar is not a configuration" in text_of(browser, "map-error")
+    assert severe(browser) == []
 
 
 def test_time_history_waits_for_run_and_a_large_start_reaches_the_second_attractor(server, browser):
-    _open(browser, server, "/time-history?config=original&V=50&Fz=850")
+    open_page(browser, server, "/time-history?config=original&V=50&Fz=850")
     time.sleep(1.5)
     assert browser.find_elements(By.CSS_SELECTOR, "#th-metrics .metric") == []  # no run on load
-    assert _trace_count(browser, "th-spectrum") == 0  # a message, not bare axes
-    assert "appears here" in _text(browser, "th-spectrum")
+    assert trace_count(browser, "th-spectrum") == 0  # a message, not bare axes
+    assert "appears here" in text_of(browser, "th-spectrum")
     browser.find_element(By.ID, "th-run").click()
-    _wait_for(lambda: "lateral limit cycle" in _text(browser, "th-settled"), timeout=120,
-              what="the standard start to settle on the lateral cycle")
-    assert "psi0 = 0.001 rad" in _text(browser, "th-settled")
+    wait_for(lambda: "lateral limit cycle" in text_of(browser, "th-settled"), timeout=120,
+             what="the standard start to settle on the lateral cycle")
+    assert "psi0 = 0.001 rad" in text_of(browser, "th-settled")
     ticks = browser.execute_script("const g = document.querySelector('#th-spectrum .js-plotly-plot');"
                                    "return g.layout.yaxis.range;")
     assert ticks[0] == pytest.approx(-6) and ticks[1] < 1  # six decades, not twenty
     start = browser.find_element(By.ID, "th-start")
     start.click()
-    _wait_for(lambda: [o for o in browser.find_elements(By.CSS_SELECTOR, "[role='option']")
-                       if "large torsional" in o.text], what="the start options")[0].click()
-    _wait_for(lambda: browser.find_element(By.ID, "th-psi0").get_attribute("value") == "0.2", timeout=10,
-              what="psi0 = 0.2 rad")
+    wait_for(lambda: [o for o in browser.find_elements(By.CSS_SELECTOR, "[role='option']")
+                      if "large torsional" in o.text], what="the start options")[0].click()
+    wait_for(lambda: browser.find_element(By.ID, "th-psi0").get_attribute("value") == "0.2", timeout=10,
+             what="psi0 = 0.2 rad")
     browser.find_element(By.ID, "th-run").click()
-    _wait_for(lambda: "torsional limit cycle" in _text(browser, "th-settled"), timeout=120,
-              what="the large torsional start to settle on the torsional cycle")
-    settled = _text(browser, "th-settled")
+    wait_for(lambda: "torsional limit cycle" in text_of(browser, "th-settled"), timeout=120,
+             what="the large torsional start to settle on the torsional cycle")
+    settled = text_of(browser, "th-settled")
     amplitude = float(settled.split("max |psi| ")[1].split(" rad")[0])
     assert amplitude == pytest.approx(0.20, abs=0.02)
     assert "psi0=0.2" in browser.current_url
     browser.save_screenshot(str(SHOTS / "time-history-second-attractor.png"))
     # Typed values make the choice "typed".
-    _type(browser, browser.find_element(By.ID, "th-lat0"), "0.05")
-    _wait_for(lambda: "typed" in browser.find_element(By.ID, "th-start").text, timeout=10, what="the typed start")
-    assert _severe(browser) == []
+    type_into(browser.find_element(By.ID, "th-lat0"), "0.05")
+    wait_for(lambda: "typed" in browser.find_element(By.ID, "th-start").text, timeout=10, what="the typed start")
+    assert severe(browser) == []
 
 
 def test_bifurcation_labels_special_points_with_separate_legends(server, browser):
-    _open(browser, server, "/bifurcation?configs=original,nes&Fz=850")
+    open_page(browser, server, "/bifurcation?configs=original,nes&Fz=850")
     browser.find_element(By.ID, "bif-run").click()
-    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#bif-summary tbody tr"), timeout=180,
-              what="the diagram")
-    _wait_for(lambda: _trace_count(browser, "bif-graph") > 10, what="the traces")
+    wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#bif-summary tbody tr"), timeout=180,
+             what="the diagram")
+    wait_for(lambda: trace_count(browser, "bif-graph") > 10, what="the traces")
     info = browser.execute_script("""
         const g = document.querySelector('#bif-graph .js-plotly-plot');
         const labels = g.data.filter(t => t.meta && t.meta.special_point).map(t => t.text[0]);
@@ -213,18 +179,18 @@ def test_bifurcation_labels_special_points_with_separate_legends(server, browser
     assert strip == ["NES", "original"]
     assert "LPC1" in browser.find_element(By.ID, "bif-summary").text
     browser.save_screenshot(str(SHOTS / "bifurcation-labelled.png"))
-    assert _severe(browser) == []
+    assert severe(browser) == []
 
 
 def test_map_operating_points_colours_cancel_progress_and_cached_return(server, browser):
     path = "/stability-map?shade=original&fz_min=100&fz_max=400&resolution=3"
-    _open(browser, server, path)
+    open_page(browser, server, path)
     browser.find_element(By.ID, "map-run").click()
-    _wait_for(lambda: "3 Fz slices" in _text(browser, "map-status") or "/3 slices" in _text(browser, "map-status"),
-              timeout=60, interval=0.05, what="progress counted in the slices asked")
-    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"), timeout=240,
-              what="the map")
-    _wait_for(lambda: _trace_count(browser, "map-graph") > 5, what="the map's traces")
+    wait_for(lambda: "3 Fz slices" in text_of(browser, "map-status") or "/3 slices" in text_of(browser, "map-status"),
+             timeout=60, interval=0.05, what="progress counted in the slices asked")
+    wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"), timeout=240,
+             what="the map")
+    wait_for(lambda: trace_count(browser, "map-graph") > 5, what="the map's traces")
     info = browser.execute_script("""
         const g = document.querySelector('#map-graph .js-plotly-plot');
         const op = g.data.find(t => t.name === 'points A-I');
@@ -236,51 +202,51 @@ def test_map_operating_points_colours_cancel_progress_and_cached_return(server, 
     assert info["legends"][0] == "configuration (colour):"
     browser.save_screenshot(str(SHOTS / "stability-map-operating-points.png"))
     # Back on the page later: the cached map is shown without pressing Compute.
-    _open(browser, server, "/")
-    _open(browser, server, path)
-    _wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"), timeout=20,
-              what="the cached map on return")
-    assert _text(browser, "map-status") == ""
+    open_page(browser, server, "/")
+    open_page(browser, server, path)
+    wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"), timeout=20,
+             what="the cached map on return")
+    assert text_of(browser, "map-status") == ""
     # Cancel says "cancelled".
-    _type(browser, browser.find_element(By.ID, "map-res"), "5")
+    type_into(browser.find_element(By.ID, "map-res"), "5")
     browser.find_element(By.ID, "map-run").click()
-    _wait_for(lambda: browser.find_element(By.ID, "map-cancel").is_enabled(), timeout=20, what="Cancel enabled")
+    wait_for(lambda: browser.find_element(By.ID, "map-cancel").is_enabled(), timeout=20, what="Cancel enabled")
     browser.find_element(By.ID, "map-cancel").click()
-    _wait_for(lambda: _text(browser, "map-status") == "cancelled", timeout=20, what='"cancelled"')
+    wait_for(lambda: text_of(browser, "map-status") == "cancelled", timeout=20, what='"cancelled"')
     time.sleep(1.5)
-    assert _text(browser, "map-status") == "cancelled"  # no late progress line overwrites it
+    assert text_of(browser, "map-status") == "cancelled"  # no late progress line overwrites it
     assert not browser.find_element(By.ID, "map-run").get_attribute("disabled")
-    assert _severe(browser) == []
+    assert severe(browser) == []
 
 
 def test_study_skips_what_a_parameter_cannot_affect_and_refuses_empty_values(server, browser):
-    _open(browser, server, "/study?parameter=e_p&values=0.0005,0.005&configs=original,nes")
-    assert "Skipped: original" in _text(browser, "study-skipped")
+    open_page(browser, server, "/study?parameter=e_p&values=0.0005,0.005&configs=original,nes")
+    assert "Skipped: original" in text_of(browser, "study-skipped")
     values = browser.find_element(By.ID, "study-values")
     assert browser.execute_script("return arguments[0].scrollWidth <= arguments[0].clientWidth", values)
     browser.find_element(By.ID, "study-run").click()
     configs = ("return [...document.querySelectorAll('#study-summary tbody tr')].map(r => r.cells[1].innerText);")
-    _wait_for(lambda: browser.execute_script(configs), timeout=120, what="the study table")
-    _idle(browser)
+    wait_for(lambda: browser.execute_script(configs), timeout=120, what="the study table")
+    idle(browser)
     assert browser.execute_script(configs) == ["NES", "NES"]  # original skipped
     browser.find_elements(By.CSS_SELECTOR, "#study-view input")[1].click()
-    _wait_for(lambda: browser.find_element(By.ID, "study-pivot").is_displayed(), timeout=10, what="the pivot")
+    wait_for(lambda: browser.find_element(By.ID, "study-pivot").is_displayed(), timeout=10, what="the pivot")
     assert not browser.find_element(By.ID, "study-summary").is_displayed()
     assert len(browser.find_elements(By.CSS_SELECTOR, "#study-pivot tbody tr")) == 2
     browser.find_element(By.CSS_SELECTOR, "#study-log input").click()
-    _wait_for(lambda: browser.execute_script("return document.querySelector('#study-graph .js-plotly-plot')"
-                                             ".layout.yaxis3.type") == "log", timeout=10, what="the log axis")
-    _type(browser, browser.find_element(By.ID, "study-values"), "")
+    wait_for(lambda: browser.execute_script("return document.querySelector('#study-graph .js-plotly-plot')"
+                                            ".layout.yaxis3.type") == "log", timeout=10, what="the log axis")
+    type_into(browser.find_element(By.ID, "study-values"), "")
     browser.find_element(By.ID, "study-run").click()
-    _wait_for(lambda: _text(browser, "study-error").startswith("Values is empty"), timeout=10, what="the refusal")
+    wait_for(lambda: text_of(browser, "study-error").startswith("Values is empty"), timeout=10, what="the refusal")
     assert browser.find_elements(By.CSS_SELECTOR, "#study-summary tbody tr") == []  # the old table is gone
-    assert _text(browser, "study-status") == ""
-    assert _severe(browser) == []
+    assert text_of(browser, "study-status") == ""
+    assert severe(browser) == []
 
 
 def test_devices_current_design_does_not_hide_the_steel_preset(server, browser):
-    _open(browser, server, "/devices")
-    _wait_for(lambda: _trace_count(browser, "dev-pd") >= 3, what="the damper curves")
+    open_page(browser, server, "/devices")
+    wait_for(lambda: trace_count(browser, "dev-pd") >= 3, what="the damper curves")
     names = browser.execute_script("return document.querySelector('#dev-pd .js-plotly-plot').data"
                                    ".map(t => [t.name, t.line.width]);")
     assert names[0] == ["current design (= steel preset)", 7] and ["steel preset", 2] in names
@@ -289,7 +255,7 @@ def test_devices_current_design_does_not_hide_the_steel_preset(server, browser):
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 def test_every_page_fits_the_window_and_is_photographed(server, browser, size):
     for name, path in {**PAGES, "ground-run": "/ground-run"}.items():
-        _open(browser, server, path, size)
+        open_page(browser, server, path, size)
         time.sleep(0.8)
         browser.save_screenshot(str(SHOTS / f"{name}-{size[0]}x{size[1]}.png"))
         widths = browser.execute_script("return [document.documentElement.scrollWidth, "
@@ -309,40 +275,40 @@ def test_every_page_fits_the_window_and_is_photographed(server, browser, size):
                 return a.left < b.right && b.left < a.right && a.top < b.bottom && b.top < a.bottom; });""")
         assert not any(overlaps), name
         assert not re.search(r"-0(\.0+)?(?![\d.])", browser.find_element(By.TAG_NAME, "main").text), name
-    assert _severe(browser) == []
+    assert severe(browser) == []
 
 
 def test_plots_shrink_when_the_window_narrows(server, browser):
-    _open(browser, server, "/devices", (1440, 900))
-    _wait_for(lambda: _trace_count(browser, "dev-pd") >= 3, what="the damper curves")
+    open_page(browser, server, "/devices", (1440, 900))
+    wait_for(lambda: trace_count(browser, "dev-pd") >= 3, what="the damper curves")
     wide = browser.execute_script("return +document.querySelector('#dev-pd .main-svg').getAttribute('width')")
     browser.set_window_size(1024, 768)
-    _wait_for(lambda: browser.execute_script("return +document.querySelector('#dev-pd .main-svg')"
-                                             ".getAttribute('width')") < wide - 300, timeout=10,
-              what="the figure to shrink")
+    wait_for(lambda: browser.execute_script("return +document.querySelector('#dev-pd .main-svg')"
+                                            ".getAttribute('width')") < wide - 300, timeout=10,
+             what="the figure to shrink")
     widths = browser.execute_script("return [document.documentElement.scrollWidth, "
                                     "document.documentElement.clientWidth]")
     assert widths[0] <= widths[1]
 
 
 def test_paired_fields_share_a_row_and_the_sidebar_collapses(server, browser):
-    _open(browser, server, "/stability-map", (1024, 768))
+    open_page(browser, server, "/stability-map", (1024, 768))
     tops = [browser.find_element(By.ID, i).location["y"] for i in ("map-fzmin", "map-fzmax")]
     assert tops[0] == tops[1]
     tops = [browser.find_element(By.ID, i).location["y"] for i in ("map-vmin", "map-vmax")]
     assert tops[0] == tops[1]
     width = browser.find_element(By.CSS_SELECTOR, "main.page").size["width"]
     browser.find_element(By.ID, "design-toggle").click()
-    _wait_for(lambda: not browser.find_element(By.ID, "design-panel").is_displayed(), timeout=5,
-              what="the panel to hide")
+    wait_for(lambda: not browser.find_element(By.ID, "design-panel").is_displayed(), timeout=5,
+             what="the panel to hide")
     assert browser.find_element(By.CSS_SELECTOR, "main.page").size["width"] > width + 200
     browser.save_screenshot(str(SHOTS / "stability-map-1024-panel-hidden.png"))
     browser.find_element(By.ID, "design-toggle").click()
-    _wait_for(lambda: browser.find_element(By.ID, "design-panel").is_displayed(), timeout=5,
-              what="the panel to show again")
+    wait_for(lambda: browser.find_element(By.ID, "design-panel").is_displayed(), timeout=5,
+             what="the panel to show again")
     # The panel's white column runs the full height of a long page.
-    _open(browser, server, "/api", (1024, 768))
-    _open(browser, server, "/bifurcation", (1024, 768))
+    open_page(browser, server, "/api", (1024, 768))
+    open_page(browser, server, "/bifurcation", (1024, 768))
     image = browser.execute_script("return getComputedStyle(document.querySelector('.body')).backgroundImage")
     assert "linear-gradient" in image
-    assert _severe(browser) == []
+    assert severe(browser) == []

@@ -8,7 +8,8 @@ import pytest
 
 from shimmy.errors import InvalidParameterError
 from shimmy.model.parameters import PARAMETER_SPECS, Parameters
-from shimmy.service import __version__, schemas
+from shimmy.service import schemas
+from shimmy.version import __version__
 from ui import designs, state
 from ui.designs import Design, DesignError
 

@@ -6,7 +6,7 @@ import pytest
 from shimmy.errors import InvalidParameterError
 from shimmy.model.configurations import affects
 from shimmy.service import schemas
-from ui import components, fields
+from ui import fields, formats
 from ui.fields import Quantity
 
 FZ = Quantity("bifurcation", "Fz", "Fz", "kN", 1e3)
@@ -56,9 +56,17 @@ def test_address_values_are_refused_with_a_reason_never_replaced_silently():
 
 
 def test_percentages_and_signed_numbers_never_read_minus_zero():
-    assert components.pct(-0.0001, 3) == "0.000 %" and components.pct(-0.04, 1) == "0.0 %"
-    assert components.pct(1.23456, 1) == "+1.2 %" and components.pct(-9.8, 1) == "-9.8 %"
-    assert components.signed(-0.0) == "0" and components.signed(1.1234) == "+1.12"
+    assert formats.signed_percent(-0.0001, 3) == "0.000 %" and formats.signed_percent(-0.04, 1) == "0.0 %"
+    assert formats.signed_percent(1.23456, 1) == "+1.2 %" and formats.signed_percent(-9.8, 1) == "-9.8 %"
+    assert formats.signed(-0.0) == "0" and formats.signed(1.1234) == "+1.12"
+
+
+def test_each_number_format_is_one_named_function():
+    """The tables' significant digits, the comparisons' whole numbers, the short exponents of the slider ends."""
+    assert formats.significant(11300.0) == "1.13e+04" and formats.significant(None) == "–"
+    assert formats.significant_or_whole(11300.0) == "11300" and formats.significant_or_whole(0.012345) == "0.01235"
+    assert formats.signed_or_whole(1250.4) == "+1250" and formats.signed_or_whole(-0.0001234) == "-0.000123"
+    assert formats.compact(1.4e6) == "1.4e6" and formats.compact(2.5e-7) == "2.5e-7" and formats.compact(0.08) == "0.08"
 
 
 def test_a_device_parameter_affects_only_the_configurations_with_that_device():

@@ -1,0 +1,146 @@
+"""What the browser tests share: headless Chromium (Debian chromium + chromedriver, installed by the
+set-up when missing and allowed: CI runs as root), its fixtures, and the waits and reads the tests
+make of a page. The test modules import it (pytest puts their folder on sys.path).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("selenium")
+from selenium import webdriver  # noqa: E402
+from selenium.webdriver.chrome.service import Service  # noqa: E402
+from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.webdriver.common.keys import Keys  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+SHOTS = ROOT / "screenshots"  # screenshots for a person to look at (not committed)
+DOWNLOADS = ROOT / ".pytest_cache" / "downloads"
+CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
+PAGES = {"overview": "/", "devices": "/devices", "time-history": "/time-history", "bifurcation": "/bifurcation",
+         "stability-map": "/stability-map", "study": "/study", "design": "/design", "validation": "/validation",
+         "api": "/api"}
+
+
+def _ensure_chromium() -> None:
+    if os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER):
+        return
+    if os.geteuid() != 0 or not shutil.which("apt-get"):
+        pytest.fail("Debian chromium and chromium-driver are needed and cannot be installed here (not root)")
+    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
+    subprocess.run(["apt-get", "update", "-qq"], check=True, env=env)
+    subprocess.run(["apt-get", "install", "-y", "-qq", "chromium", "chromium-driver"], check=True, env=env)
+
+
+def chromium(profile: str, window: str, downloads: Path | None = None):
+    """Headless Chromium on a profile of its own (``profile`` under .pytest_cache), started once
+    for a module: a second browser on the same profile, started while the first is still closing,
+    would hand its pages to that one."""
+    _ensure_chromium()
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = CHROMIUM
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                "--disable-dev-shm-usage", f"--window-size={window}"):
+        opts.add_argument(arg)
+    opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / profile}")
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    if downloads is not None:
+        downloads.mkdir(parents=True, exist_ok=True)
+        opts.add_experimental_option("prefs", {"download.default_directory": str(downloads),
+                                               "download.prompt_for_download": False})
+    driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
+    driver.set_page_load_timeout(60)
+    SHOTS.mkdir(exist_ok=True)
+    return driver
+
+
+def browser_fixture(profile: str, window: str, downloads: Path | None = None):
+    """A module's ``browser`` fixture: Chromium on ``profile`` at ``window`` ("W,H"), quit after the module."""
+
+    @pytest.fixture(scope="module")
+    def browser():
+        driver = chromium(profile, window, downloads)
+        yield driver
+        driver.quit()
+
+    return browser
+
+
+def severe(driver) -> list[str]:
+    """The console's errors since it was last read."""
+    return [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+
+
+def wait_for(predicate, timeout=60.0, interval=0.1, what="condition"):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(interval)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def idle(driver, timeout=60.0):
+    """Dash has no callback in flight (the renderer sets data-dash-is-loading on busy components)."""
+    wait_for(lambda: not driver.find_elements(By.CSS_SELECTOR, "[data-dash-is-loading='true']"), timeout,
+             what="Dash to be idle")
+
+
+def open_page(driver, server, path, size=(1440, 900), *, clear_log=False, wait_idle=True):
+    """Load ``path`` (at the window ``size``, unless None) and wait for its header and, unless told
+    not to, for Dash to be idle; ``clear_log``: drop the console's messages first (those the page
+    then logs are its own)."""
+    if clear_log:
+        driver.get_log("browser")
+    if size is not None:
+        driver.set_window_size(*size)
+    driver.get(server.base + path)
+    wait_for(lambda: driver.find_elements(By.CSS_SELECTOR, ".page-header h1"), what="the page header")
+    if wait_idle:
+        idle(driver)
+
+
+def by_id(driver, element_id):
+    """An element by id (pattern-matching ids are JSON, not valid CSS)."""
+    return driver.execute_script("return document.getElementById(arguments[0])", element_id)
+
+
+def pattern(name: str, kind: str) -> str:
+    """The DOM id of a pattern-matching component {"type": kind, "name": name}."""
+    return '{"name":"%s","type":"%s"}' % (name, kind)
+
+
+def text_of(driver, element_id: str) -> str:
+    """The text of an element, empty until the page has rendered it."""
+    return driver.execute_script("const e = document.getElementById(arguments[0]); return e ? e.innerText : '';",
+                                 element_id)
+
+
+def type_into(element, value: str) -> None:
+    """Replace a box's content and leave it (a debounced box sends its value on blur)."""
+    element.click()
+    element.send_keys(Keys.CONTROL, "a")
+    element.send_keys(Keys.BACKSPACE)
+    if value:
+        element.send_keys(value)
+    element.send_keys(Keys.TAB)
+
+
+def trace_count(driver, graph_id: str) -> int:
+    """Traces Plotly has drawn in a dcc.Graph (0 until it has drawn: the figure can lag the tables)."""
+    return driver.execute_script(f"const g = document.querySelector('#{graph_id} .js-plotly-plot');"
+                                 "return g && g.data ? g.data.length : 0;")
+
+
+def on_figure(driver, graph_id: str, script: str):
+    """``script`` on the drawn figure ``g`` of a dcc.Graph (null until Plotly has drawn it)."""
+    return driver.execute_script(f"const g = document.querySelector('#{graph_id} .js-plotly-plot');"
+                                 f"if (!g || !g.data) {{ return null; }} {script}")
