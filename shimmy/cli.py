@@ -20,6 +20,7 @@ import numpy as np
 
 from .model.configurations import Configuration
 from .continuation.errors import InvalidInputError
+from .continuation.kinds import PointKind
 from .errors import EXPECTED_ERRORS, GeometryError, InvalidParameterError
 from .model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters,
                                check_number)
@@ -300,7 +301,7 @@ def _cmd_bifurcation(args) -> int:
                      f"V {b.V.min():.4g}..{b.V.max():.4g} m/s, max |psi| {b.max_psi.max():.5g} rad; "
                      f"modes {', '.join(sorted({m for m in b.mode if m}))}")
         for s in b.special_points:
-            if s["kind"] != "EP":
+            if s["kind"] != PointKind.END:
                 lines.append(f"      {s['kind']:<4} V = {s['V']:.6g} m/s")
         lines.append(f"      ends: {b.stop_reason}")
     where = "" if result.max_psi_V is None else f" at V = {result.max_psi_V:.5g} m/s"
@@ -359,7 +360,7 @@ def _cmd_curves(args) -> int:
     lines = [f"{result.config.value}: cycle-bifurcation curves in V {result.v_range[0]:g}..{result.v_range[1]:g} m/s, "
              f"Fz {result.fz_range[0]:g}..{result.fz_range[1]:g} N ({result.elapsed_s:.2f} s, "
              f"{result.starts_tried} curve starts)"]
-    names = {"LPC": "fold", "NS": "torus", "PD": "period-doubling"}
+    names = {PointKind.FOLD_OF_CYCLES: "fold", PointKind.TORUS: "torus", PointKind.PERIOD_DOUBLING: "period-doubling"}
     for kind in kinds:
         lines.append(f"  {names[kind]} curves: {len(data[KEY_OF_KIND[kind]])}")
     for i, c in enumerate(data["curves"], start=1):

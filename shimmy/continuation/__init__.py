@@ -3,6 +3,7 @@
 Generic: numpy and scipy only (numba compiles the condensed LU), nothing of the landing gear; tested on
 textbook systems.
 
+* :mod:`.kinds`: :class:`PointKind`, the kinds of special point (H, LP, LPC, NS, PD, GH, ...).
 * :mod:`.core`: pseudo-arclength continuation of F(u) = 0 (predictor, bordered Newton
   corrector, step control, location of special points), the :class:`VectorField` every
   curve type continues and the one :class:`SpecialPoint` type.
@@ -21,7 +22,7 @@ y' = x + p y - y r^2 has x = 0 stable for p < 0, a Hopf point at p = 0 and the s
 cycle r = sqrt(p) with period 2 pi for p > 0::
 
     import numpy as np
-    from shimmy.continuation import (Mesh, PeriodicOptions, VectorField, equilibrium_branch,
+    from shimmy.continuation import (Mesh, PeriodicOptions, PointKind, VectorField, equilibrium_branch,
                                      hopf_eigenvectors, hopf_guess, periodic_branch)
 
     def f(x, p):
@@ -39,7 +40,7 @@ cycle r = sqrt(p) with period 2 pi for p > 0::
 
     hopf_normal_form = VectorField(2, f, dfdx, lambda x, p: x.copy(), "hopf")
     eq = equilibrium_branch(hopf_normal_form, np.zeros(2), -0.5, -0.5, 0.5)
-    H = next(s for s in eq.special_points if s.kind == "H")       # H.p ~ 0, H.data["omega"] ~ 1
+    H = next(s for s in eq.special_points if s.kind == PointKind.HOPF)  # H.p ~ 0, H.data["omega"] ~ 1
     omega, q, _ = hopf_eigenvectors(dfdx(np.array(H.data["x"]), H.p))
     options = PeriodicOptions(ntst=20, ncol=4)
     guess, shape = hopf_guess(np.array(H.data["x"]), H.p, omega, q,
@@ -54,23 +55,24 @@ early says why in its ``stop_reason``.
 """
 
 from .collocation import Mesh, PeriodicProblem
-from .cycle_curves import (CODIM2_KINDS, CycleBifurcation, CycleCurve, CycleCurveOptions, CycleCurveProblem,
+from .cycle_curves import (CODIM2_KINDS, CycleCurve, CycleCurveOptions, CycleCurveProblem,
                            TwoParameterVectorField, cycle_curve, start_beside)
 from .core import (ContinuationOptions, CurvePoint, CurveProblem, SpecialPoint, Tracer, VectorField, correct,
                    locate, point_at, step, tangent, weighted_norm)
 from .equilibria import EquilibriumBranch, equilibrium_branch
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
+from .kinds import CYCLE_BIFURCATIONS, PointKind
 from .hopf import HopfCurve, HopfCurveProblem, TwoParameterField, hopf_curve, hopf_start
 from .lyapunov import first_lyapunov_coefficient, hopf_eigenvectors
 from .periodic_orbits import (OrbitGuess, PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
                               periodic_branch)
 
 __all__ = [
-    "CODIM2_KINDS", "CycleBifurcation", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem",
+    "CODIM2_KINDS", "CYCLE_BIFURCATIONS", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem",
     "TwoParameterVectorField", "cycle_curve", "start_beside",
     "ContinuationError", "ContinuationOptions", "ConvergenceError", "CurvePoint", "CurveProblem",
     "EquilibriumBranch", "HopfCurve", "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess",
-    "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "SpecialPoint", "Tracer", "TwoParameterField",
+    "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "PointKind", "SpecialPoint", "Tracer", "TwoParameterField",
     "VectorField", "correct", "equilibrium_branch", "first_lyapunov_coefficient", "hopf_curve",
     "hopf_eigenvectors", "hopf_guess", "hopf_start", "locate", "orbit_from_samples", "periodic_branch",
     "point_at", "step", "tangent", "weighted_norm",

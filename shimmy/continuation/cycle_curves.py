@@ -43,7 +43,6 @@ describes neutral saddle cycles, not tori), the period limit, step underflow, th
 
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -58,22 +57,21 @@ from .condensed_lu import ChainLayout, CondensedLU, collocation_layout
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, condensed_factors,
                    locate_between, point_at, refine, step, tangent, weighted_norm)
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
+from .kinds import CYCLE_BIFURCATIONS, PointKind
 from .lyapunov import hopf_eigenvectors
 from .periodic_orbits import PeriodicOptions, hopf_guess, multiplier_crossing_test, periodic_branch
 
 
-class CycleBifurcation(str, enum.Enum):
-    """The curve types: the defining condition held along the curve."""
-
-    LPC = "LPC"
-    PD = "PD"
-    NS = "NS"
-
+LPC, PD, NS = PointKind.FOLD_OF_CYCLES, PointKind.PERIOD_DOUBLING, PointKind.TORUS
 
 #: Codimension-2 points reported on each curve type.
-CODIM2_KINDS = {"LPC": ("CPC", "LPNS", "LPPD"), "PD": ("LPPD", "PDNS", "R2"),
-                "NS": ("R1", "R2", "R3", "R4", "LPNS", "PDNS")}
-RESONANCES = {"R1": 1.0, "R4": 0.0, "R3": -0.5, "R2": -1.0}  # kappa = cos(theta) at 1:k
+CODIM2_KINDS = {LPC: (PointKind.CUSP_OF_CYCLES, PointKind.FOLD_TORUS, PointKind.FOLD_FLIP),
+                PD: (PointKind.FOLD_FLIP, PointKind.FLIP_TORUS, PointKind.RESONANCE_1_2),
+                NS: (PointKind.RESONANCE_1_1, PointKind.RESONANCE_1_2, PointKind.RESONANCE_1_3,
+                     PointKind.RESONANCE_1_4, PointKind.FOLD_TORUS, PointKind.FLIP_TORUS)}
+#: kappa = cos(theta) at the strong resonances 1:k
+RESONANCES = {PointKind.RESONANCE_1_1: 1.0, PointKind.RESONANCE_1_4: 0.0, PointKind.RESONANCE_1_3: -0.5,
+              PointKind.RESONANCE_1_2: -1.0}
 COMPLEX_TOL = 1e-7
 #: |test function| accepted at a located point: tangent slopes and kappa to 1e-8 (the tangent
 #: carries the finite-difference error of the Newton matrix, ~1e-10); ln |mu| to 1e-5: where a
@@ -154,7 +152,7 @@ class CycleCurveOptions:
 class CycleCurve:
     """Points of a curve of cycle bifurcations (one row per point) and its special points."""
 
-    kind: str
+    kind: PointKind
     p: np.ndarray  # (points, 2)
     period: np.ndarray
     x_max: np.ndarray  # (points, n)
@@ -183,16 +181,16 @@ class CycleCurve:
 #: curves with the condensed LU (a factorisation ~2.5 solves): NS (two periods, two right-hand
 #: sides) is fastest with 2 (nes curves 5.9 -> 5.4 s); LPC with 6 (with fewer, one of original's fold
 #: curves took shorter steps: 28 points with 2 or 3 sweeps, 42 with 1, 26 with 6).
-REFINE_SWEEPS = {CycleBifurcation.LPC: 6, CycleBifurcation.PD: 6, CycleBifurcation.NS: 2}
+REFINE_SWEEPS = {LPC: 6, PD: 6, NS: 2}
 FRESH_SWEEPS = 3
 
 
 class CycleCurveProblem:
     """The minimally augmented system of one curve type on one mesh, as a curve problem."""
 
-    def __init__(self, system: TwoParameterVectorField, kind: CycleBifurcation | str, mesh: Mesh,
+    def __init__(self, system: TwoParameterVectorField, kind: PointKind | str, mesh: Mesh,
                  scale: np.ndarray, T_scale: float, p_scale: np.ndarray, kappa_weight: float = 1.0):
-        self.kind = CycleBifurcation(kind)
+        self.kind = _cycle_bifurcation(kind)
         self.system = system
         self.slice = _Slice(system, 0.0)
         self.p_scale = np.asarray(p_scale, float)
@@ -200,12 +198,12 @@ class CycleCurveProblem:
         self.mesh, self.n = mesh, system.n
         self.n_x = self.cycle.n_x
         self.n_coll = mesh.ntst * mesh.ncol * self.n
-        extra = [1.0 / self.p_scale[1] ** 2] + ([kappa_weight] if self.kind is CycleBifurcation.NS else [])
+        extra = [1.0 / self.p_scale[1] ** 2] + ([kappa_weight] if self.kind is NS else [])
         self.weights = np.concatenate([self.cycle.weights, extra])
         self.size = self.weights.size
-        self.k = 2 if self.kind is CycleBifurcation.NS else 1  # kernel dimension
-        self.m = {CycleBifurcation.LPC: self.n_x + 1, CycleBifurcation.PD: self.n_x,
-                  CycleBifurcation.NS: 2 * self.n_x}[self.kind]  # size of A
+        self.k = 2 if self.kind is NS else 1  # kernel dimension
+        self.m = {LPC: self.n_x + 1, PD: self.n_x,
+                  NS: 2 * self.n_x}[self.kind]  # size of A
         rng = np.random.default_rng(12345)
         self.B = np.linalg.qr(rng.standard_normal((self.m, self.k)))[0]
         self.C = np.linalg.qr(rng.standard_normal((self.m, self.k)))[0]
@@ -224,7 +222,7 @@ class CycleCurveProblem:
         return u[:self.n_x + 2]
 
     def kappa(self, u: np.ndarray) -> float:
-        return float(u[self.n_x + 3]) if self.kind is CycleBifurcation.NS else math.nan
+        return float(u[self.n_x + 3]) if self.kind is NS else math.nan
 
     @cached_property
     def chain_layout(self) -> ChainLayout:
@@ -244,11 +242,11 @@ class CycleCurveProblem:
         n_x, n_coll, n, m, k = self.n_x, self.n_coll, self.n, self.m, self.k
         mesh = self.mesh
         borders_c, borders_r = m + np.arange(k), m + np.arange(k)
-        if self.kind is CycleBifurcation.NS:
+        if self.kind is NS:
             return collocation_layout(mesh.ntst, mesh.ncol, n, m + k, [(0, 0), (n_coll, n_x)],
                                       [2 * n_coll + np.arange(n)], borders_c,
                                       np.concatenate([2 * n_coll + n + np.arange(n), borders_r]))
-        extra = [n_x] if self.kind is CycleBifurcation.LPC else []  # the period's column
+        extra = [n_x] if self.kind is LPC else []  # the period's column
         return collocation_layout(mesh.ntst, mesh.ncol, n, m + k, [(0, 0)], [], np.concatenate([extra, borders_c]),
                                   np.concatenate([n_coll + np.arange(m - n_coll), borders_r]))
 
@@ -290,7 +288,7 @@ class CycleCurveProblem:
         col = np.zeros(J.shape[0])
         col[:self.n_coll] = (-(self.mesh.h * T)[:, None, None] * Fp2).ravel()
         cols = [J, sp.csr_matrix(col[:, None])]
-        if self.kind is CycleBifurcation.NS:
+        if self.kind is NS:
             cols.append(sp.csr_matrix((J.shape[0], 1)))
         return sp.hstack(cols, format="csr")
 
@@ -336,15 +334,15 @@ class CycleCurveProblem:
         cyc = self.cycle
         a = np.arange(n)
         rows, cols = [], []
-        copies = 2 if self.kind is CycleBifurcation.NS else 1
+        copies = 2 if self.kind is NS else 1
         for c in range(copies):
             rows.append(cyc._rows + c * n_coll)
             cols.append(cyc._cols + c * n_x)
-        if self.kind is CycleBifurcation.LPC:
+        if self.kind is LPC:
             idx = self.mesh.node_index[:, :, None] * n + a[None, None, :]
             rows += [np.arange(n_coll), n_coll + a, n_coll + a, np.full(idx.size, n_coll + n)]
             cols += [np.full(n_coll, n_x), a, n_x - n + a, idx.ravel()]
-        elif self.kind is CycleBifurcation.PD:
+        elif self.kind is PD:
             rows += [n_coll + a, n_coll + a]
             cols += [a, n_x - n + a]
         else:
@@ -367,13 +365,13 @@ class CycleCurveProblem:
         cu = self.cycle_u(u)
         n, mesh = self.n, self.mesh
         blocks, F, _, T = self.cycle.collocation_blocks(cu)
-        parts = [blocks.ravel()] * (2 if self.kind is CycleBifurcation.NS else 1)
+        parts = [blocks.ravel()] * (2 if self.kind is NS else 1)
         ones = np.ones(n)
-        if self.kind is CycleBifurcation.LPC:
+        if self.kind is LPC:
             coeff = np.einsum("j,k,kl,jkn->jln", mesh.h, self.cycle.basis.gauss[1], self.cycle.basis.L,
                               self.cycle.reference_derivative)
             parts += [(-mesh.h[:, None, None] * F).ravel(), ones, -ones, coeff.ravel()]
-        elif self.kind is CycleBifurcation.PD:
+        elif self.kind is PD:
             parts += [ones, ones]
         else:
             parts += [-ones, ones, ones, np.full(n, -2.0 * self.kappa(u)), ones]
@@ -444,11 +442,11 @@ class CycleCurveProblem:
         V, W = data["V"][:, j], data["W"][:, i]
         n_x, n_coll = self.n_x, self.n_coll
         grad = np.zeros(self.size)
-        if self.kind is CycleBifurcation.LPC:
+        if self.kind is LPC:
             d = np.zeros(self.size)
             d[:n_x + 1] = V
             grad -= self._second(u, d, W[:n_coll])
-        elif self.kind is CycleBifurcation.PD:
+        elif self.kind is PD:
             d = np.zeros(self.size)
             d[:n_x] = V
             grad -= self._second(u, d, W[:n_coll])
@@ -524,7 +522,7 @@ class CycleCurveProblem:
 
     def rebuilt(self, mesh: Mesh) -> "CycleCurveProblem":
         other = CycleCurveProblem(self.system, self.kind, mesh, self.cycle.scale, self.cycle.T_scale, self.p_scale,
-                                  float(self.weights[-1]) if self.kind is CycleBifurcation.NS else 1.0)
+                                  float(self.weights[-1]) if self.kind is NS else 1.0)
         other.entries = list(self.entries)
         return other
 
@@ -538,9 +536,9 @@ class CycleCurveProblem:
         def nodes(V):
             return np.column_stack([self.cycle.evaluate(V[:, c].reshape(self.mesh.n_nodes, self.n),
                                                         other.mesh.node_times).ravel() for c in range(V.shape[1])])
-        if self.kind is CycleBifurcation.LPC:
+        if self.kind is LPC:
             C = np.vstack([nodes(self.C[:self.n_x]), self.C[self.n_x:]])
-        elif self.kind is CycleBifurcation.PD:
+        elif self.kind is PD:
             C = nodes(self.C)
         else:
             C = np.vstack([nodes(self.C[:self.n_x]), nodes(self.C[self.n_x:])])
@@ -550,12 +548,12 @@ class CycleCurveProblem:
 # --------------------------------------------------------------------------- tracing a curve
 
 
-def _critical(kind: CycleBifurcation, mu: np.ndarray, kappa: float) -> list[int]:
+def _critical(kind: PointKind, mu: np.ndarray, kappa: float) -> list[int]:
     """Indices of the trivial multiplier (0) and of those the curve's condition holds at."""
     rest = np.arange(1, mu.size)
-    if kind is CycleBifurcation.LPC:
+    if kind is LPC:
         return [0, int(rest[np.argmin(np.abs(mu[1:] - 1.0))])]
-    if kind is CycleBifurcation.PD:
+    if kind is PD:
         return [0, int(rest[np.argmin(np.abs(mu[1:] + 1.0))])]
     target = kappa + 1j * math.sqrt(max(0.0, 1.0 - kappa ** 2))
     d = np.minimum(np.abs(mu[1:] - target), np.abs(mu[1:] - np.conj(target)))
@@ -568,22 +566,23 @@ def _monitors(problem: CycleCurveProblem, point: CurvePoint, mu: np.ndarray, ref
     kind = problem.kind
     kappa = problem.kappa(point.u)
     out: dict[str, float] = {}
-    if kind is CycleBifurcation.LPC:
+    if kind is LPC:
         t_p = point.tangent[problem.n_x + 1:problem.n_x + 3] * np.sqrt(problem.weights[problem.n_x + 1:problem.n_x + 3])
-        out["CPC"] = float(t_p @ reference_direction) if reference_direction is not None else 1.0
-    elif kind is CycleBifurcation.NS:
+        out[PointKind.CUSP_OF_CYCLES] = float(t_p @ reference_direction) if reference_direction is not None else 1.0
+    elif kind is NS:
         for name, value in RESONANCES.items():
             out[name] = kappa - value
-    for name, which in _CROSSINGS[kind.value].items():
+    for name, which in _CROSSINGS[kind].items():
         out[name] = _crossing_value(problem, which, mu, kappa)
     return out
 
 
 #: Codimension-2 points where a further multiplier crosses the unit circle: which kind of
 #: multiplier (real positive, real negative, complex) crosses, per curve type.
-_CROSSINGS = {"LPC": {"LPNS": "complex", "LPPD": "negative"},
-              "PD": {"LPPD": "positive", "PDNS": "complex", "R2": "negative"},
-              "NS": {"LPNS": "positive", "PDNS": "negative"}}
+_CROSSINGS = {LPC: {PointKind.FOLD_TORUS: "complex", PointKind.FOLD_FLIP: "negative"},
+              PD: {PointKind.FOLD_FLIP: "positive", PointKind.FLIP_TORUS: "complex",
+                   PointKind.RESONANCE_1_2: "negative"},
+              NS: {PointKind.FOLD_TORUS: "positive", PointKind.FLIP_TORUS: "negative"}}
 
 
 def _crossing_value(problem: "CycleCurveProblem", which: str, mu: np.ndarray, kappa: float,
@@ -606,7 +605,7 @@ def _crossing_test(problem: "CycleCurveProblem", which: str) -> Callable[[CurveP
     return g
 
 
-def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, start: tuple[np.ndarray, np.ndarray],
+def cycle_curve(system: TwoParameterVectorField, kind: PointKind | str, start: tuple[np.ndarray, np.ndarray],
                 p2: float, box: tuple[tuple[float, float], tuple[float, float]], scale: np.ndarray,
                 p_scale: tuple[float, float], kappa: float | None = None, options: CycleCurveOptions | None = None,
                 ncol: int = 4, directions: tuple[int, ...] = (1, -1), p2_marks: tuple[float, ...] = (),
@@ -620,9 +619,9 @@ def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, s
     curve turns in p2 a ``P2_TURN`` point is located, and where it crosses a value of ``p2_marks``
     a ``P2_MARK`` point (both with the cycle's period and extremes).
     """
-    kind = CycleBifurcation(kind)
+    kind = _cycle_bifurcation(kind)
     options = options or CycleCurveOptions()
-    if kind is CycleBifurcation.NS and (kappa is None or not -1.0 < kappa < 1.0):
+    if kind is NS and (kappa is None or not -1.0 < kappa < 1.0):
         raise InvalidInputError("kappa", kappa, "cos of the torus angle, in (-1, 1)")
     for name, (low, high) in zip(("p1 range", "p2 range"), box, strict=True):
         if not (math.isfinite(low) and math.isfinite(high) and low < high):
@@ -631,7 +630,7 @@ def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, s
     mesh = Mesh(np.asarray(mesh_points, float), ncol)
     problem = CycleCurveProblem(system, kind, mesh, scale, float(cu[-2]), np.asarray(p_scale, float),
                                 options.kappa_weight)
-    u0 = np.concatenate([cu, [p2]] + ([[kappa]] if kind is CycleBifurcation.NS else []))
+    u0 = np.concatenate([cu, [p2]] + ([[kappa]] if kind is NS else []))
     problem.cycle.accept(problem.cycle_u(u0))
     problem.update_borders(u0, sweeps=3)
     problem.choose_entries(u0)
@@ -641,7 +640,7 @@ def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, s
     e2[problem.n_x + 2] = 1.0
     first = step(problem, CurvePoint(u0, e2 / weighted_norm(e2, problem.weights)), 0.0, copts)
     if first is None:
-        raise ConvergenceError(f"no {kind.value} point converged near the start (p = ({cu[-1]:g}, {p2:g}))")
+        raise ConvergenceError(f"no {kind} point converged near the start (p = ({cu[-1]:g}, {p2:g}))")
     halves, reasons, steps_total = [], [], 0
     for direction in directions:
         half_problem = problem if not halves else _fresh(problem, first.u)
@@ -656,7 +655,7 @@ def cycle_curve(system: TwoParameterVectorField, kind: CycleBifurcation | str, s
     return _join(kind, halves, reasons, steps_total)
 
 
-def start_beside(system: TwoParameterVectorField, kind: CycleBifurcation | str, x_star: np.ndarray,
+def start_beside(system: TwoParameterVectorField, kind: PointKind | str, x_star: np.ndarray,
                  p: np.ndarray, p1_range: tuple[float, float], scale: np.ndarray, p1_scale: float,
                  options: PeriodicOptions | None = None, limits=None) -> tuple[SpecialPoint | None, int]:
     """A start for :func:`cycle_curve` near a codimension-2 point of an equilibrium: the first
@@ -664,8 +663,8 @@ def start_beside(system: TwoParameterVectorField, kind: CycleBifurcation | str, 
     p2 = p[1]). Beside a generalised Hopf point that is the small-amplitude fold of the fold curve
     born there; beside a double-Hopf point, the torus point of a torus curve born there. Returns
     (the located point with its solution, or None; the collocation degree of its mesh)."""
-    kind = CycleBifurcation(kind)
-    options = replace(options or PeriodicOptions(), stop_at=(kind.value,))
+    kind = _cycle_bifurcation(kind)
+    options = replace(options or PeriodicOptions(), stop_at=(kind,))
     field_ = system.at(float(p[1]))
     x_star = np.asarray(x_star, float)
     omega, q, _ = hopf_eigenvectors(field_.dfdx(x_star, float(p[0])))
@@ -675,8 +674,16 @@ def start_beside(system: TwoParameterVectorField, kind: CycleBifurcation | str, 
                                  direction=shape, limits=limits)
     except ContinuationError:
         return None, options.ncol
-    found = [s for s in branch.special_points if s.kind == kind.value]
+    found = [s for s in branch.special_points if s.kind == kind]
     return (found[0] if found else None), branch.ncol
+
+
+def _cycle_bifurcation(kind: PointKind | str) -> PointKind:
+    """The curve type ``kind`` names: one of :data:`~.kinds.CYCLE_BIFURCATIONS`."""
+    kind = PointKind(kind)
+    if kind not in CYCLE_BIFURCATIONS:
+        raise InvalidInputError("kind", kind.value, ", ".join(CYCLE_BIFURCATIONS), "is not a bifurcation of cycles")
+    return kind
 
 
 def _fresh(problem: CycleCurveProblem, u: np.ndarray) -> CycleCurveProblem:
@@ -744,7 +751,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
                 special.extend(_p2_points(problem, prev, hit[0], marks, rows, copts))
                 problem.accept(hit[0].u)
                 _record(problem, rows, hit[0])
-                special.append(SpecialPoint("EP", float(hit[0].u[n_x + 1]), len(rows["p"]) - 1,
+                special.append(SpecialPoint(PointKind.END, float(hit[0].u[n_x + 1]), len(rows["p"]) - 1,
                                             {"p2": float(hit[0].u[n_x + 2])}))
             reason = f"left the parameter box at p{c + 1} = {bound:g}"
             break
@@ -755,7 +762,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
             reason = "period became non-positive: the continuation left the curve"
             break
         kappa = problem.kappa(new.u)
-        if problem.kind is CycleBifurcation.NS and not -1.0 <= kappa <= 1.0:
+        if problem.kind is NS and not -1.0 <= kappa <= 1.0:
             reason = (f"kappa = {kappa:.4g} left [-1, 1] near p = ({p_new[0]:.6g}, {p_new[1]:.6g}): past a strong "
                       "resonance the condition describes neutral saddle cycles, not tori")
             break
@@ -765,8 +772,8 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         special.extend(_codim2(problem, prev, new, h, monitors, new_monitors, reference, rows, copts))
         monitors = new_monitors
         reference = p_direction(new)
-        if problem.kind is CycleBifurcation.LPC:  # the cusp test at `new` against its own direction
-            monitors["CPC"] = _monitors(problem, new, mu, reference)["CPC"]
+        if problem.kind is LPC:  # the cusp test at `new` against its own direction
+            monitors[PointKind.CUSP_OF_CYCLES] = _monitors(problem, new, mu, reference)[PointKind.CUSP_OF_CYCLES]
         if progress is not None:
             progress(min(1.0, steps / copts.max_steps))
         if _closed(rows):
@@ -778,7 +785,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         if amp < options.amplitude_min * amp_peak and amp < amp_last:
             reason = (f"amplitude shrank to zero near p = ({p_new[0]:.6g}, {p_new[1]:.6g}): the curve ends at a "
                       "codimension-2 point of the equilibrium")
-            special.append(SpecialPoint("ZA", float(p_new[0]), len(rows["p"]) - 1,
+            special.append(SpecialPoint(PointKind.ZERO_AMPLITUDE, float(p_new[0]), len(rows["p"]) - 1,
                                         {"p2": float(p_new[1]), "amplitude": amp}))
             break
         if amp < amp_last:
@@ -820,13 +827,13 @@ def _remesh(problem: CycleCurveProblem, tracer: Tracer, copts: ContinuationOptio
     return other
 
 
-def _located(problem: CycleCurveProblem, kind: str, at: CurvePoint, rows, extra=None) -> SpecialPoint:
+def _located(problem: CycleCurveProblem, kind: PointKind, at: CurvePoint, rows, extra=None) -> SpecialPoint:
     n_x = problem.n_x
     mu = problem.multipliers(at.u)
     xmax, xmin = problem.extremes(at.u)
     data = {"p2": float(at.u[n_x + 2]), "period": float(at.u[n_x]), "x_max": xmax.tolist(), "x_min": xmin.tolist(),
             "multipliers_abs": np.abs(mu[1:]).tolist(), **(extra or {})}
-    if problem.kind is CycleBifurcation.NS:
+    if problem.kind is NS:
         data["kappa"] = problem.kappa(at.u)
     return SpecialPoint(kind, float(at.u[n_x + 1]), len(rows["p"]) - 1, data)
 
@@ -843,12 +850,12 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
     if prev.tangent[i2] * new.tangent[i2] < 0:
         hit = locate_between(problem, prev, new, slope, slope(prev), slope(new), copts, LOCATE_TOL)
         at = hit[0] if hit is not None else new
-        found.append(_located(problem, "P2_TURN", at, rows,
+        found.append(_located(problem, PointKind.P2_TURN, at, rows,
                               {"turn": "max" if prev.tangent[i2] > 0 else "min", "located": hit is not None}))
     for mark in marks:
         a, b = prev.u[i2] - mark, new.u[i2] - mark
         if abs(b) <= 1e-9 * problem.p_scale[1]:  # the step ends on the mark (a box edge)
-            found.append(_located(problem, "P2_MARK", new, rows))
+            found.append(_located(problem, PointKind.P2_MARK, new, rows))
         elif a * b < 0:
             at = point_at(problem, prev, new, i2, mark, copts)  # p2 held at the mark: one Newton solve
             if at is None:
@@ -856,7 +863,7 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
                                      1e-9 * problem.p_scale[1], with_tangent=False)
                 at = None if hit is None else hit[0]
             if at is not None:
-                found.append(_located(problem, "P2_MARK", at, rows))
+                found.append(_located(problem, PointKind.P2_MARK, at, rows))
     problem.cycle_u(new.u)
     return found
 
@@ -869,9 +876,9 @@ def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: fl
         b = after[name]
         if not (np.isfinite(a) and np.isfinite(b)) or a * b > 0 or a == b:
             continue
-        if name in _CROSSINGS[problem.kind.value]:
-            g = _crossing_test(problem, _CROSSINGS[problem.kind.value][name])
-        elif name == "CPC":
+        if name in _CROSSINGS[problem.kind]:
+            g = _crossing_test(problem, _CROSSINGS[problem.kind][name])
+        elif name is PointKind.CUSP_OF_CYCLES:
             def g(q):
                 t_p = q.tangent[n_x + 1:n_x + 3] * np.sqrt(problem.weights[n_x + 1:n_x + 3])
                 return float(t_p @ reference)
@@ -879,8 +886,8 @@ def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: fl
             def g(q, target=RESONANCES[name]):
                 return problem.kappa(q.u) - target
         hit = locate_between(problem, prev, new, g, a, b, copts,
-                             MULTIPLIER_TOL if name in _CROSSINGS[problem.kind.value] else LOCATE_TOL,
-                             with_tangent=name == "CPC")
+                             MULTIPLIER_TOL if name in _CROSSINGS[problem.kind] else LOCATE_TOL,
+                             with_tangent=name is PointKind.CUSP_OF_CYCLES)
         at = hit[0] if hit is not None else new
         found.append(_located(problem, name, at, rows, {"located": hit is not None}))
     problem.cycle_u(new.u)
@@ -910,7 +917,7 @@ def _closed(rows: dict) -> bool:
     return float(np.linalg.norm(prev + s * seg - first)) < length / 3.0
 
 
-def _join(kind: CycleBifurcation, halves, reasons, steps) -> CycleCurve:
+def _join(kind: PointKind, halves, reasons, steps) -> CycleCurve:
     """One curve: the second half reversed, then the first (they share the start point)."""
     parts = []
     special: list[SpecialPoint] = []
@@ -935,6 +942,6 @@ def _join(kind: CycleBifurcation, halves, reasons, steps) -> CycleCurve:
 
     mu = gather("mu")
     special.sort(key=lambda s: s.index)
-    return CycleCurve(kind.value, np.array(gather("p")), np.array(gather("T")), np.array(gather("xmax")),
+    return CycleCurve(kind, np.array(gather("p")), np.array(gather("T")), np.array(gather("xmax")),
                       np.array(gather("xmin")), np.array(gather("kappa"), float), np.array(mu), special, reasons,
                       steps, gather("solutions"), closed=any(c for _, _, c in halves))

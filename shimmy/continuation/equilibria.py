@@ -16,6 +16,7 @@ import scipy.linalg as la
 
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, correct, locate, step, tangent,
                    weighted_norm)
+from .kinds import PointKind
 
 
 @dataclass
@@ -93,7 +94,7 @@ def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, p_min: fl
             _append_equilibrium(system, points, eigs, special, prev, new, problem, options)
         if bound is not None:
             if new is not None:
-                special.append(SpecialPoint("EP", float(new.u[-1]), len(points) - 1))
+                special.append(SpecialPoint(PointKind.END, float(new.u[-1]), len(points) - 1))
             stop = f"reached the parameter bound p = {bound:g}"
             break
     u = np.array([q.u for q in points])
@@ -174,7 +175,8 @@ def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: Cu
         hit = locate(problem, prev, h, lambda q: q.tangent[-1], prev.tangent[-1], new.tangent[-1], options)
         at = hit[0] if hit is not None else (prev if abs(prev.tangent[-1]) < abs(new.tangent[-1]) else new)
         found.append((weighted_norm(at.u - prev.u, problem.weights),
-                      SpecialPoint("LP", float(at.u[-1]), -1, {"x": at.u[:-1].tolist(), "located": hit is not None})))
+                      SpecialPoint(PointKind.FOLD, float(at.u[-1]), -1,
+                                   {"x": at.u[:-1].tolist(), "located": hit is not None})))
     # The j-th largest real part changes sign for every j between the two counts: one located
     # point per real eigenvalue or complex pair (several pairs can cross within one step).
     j = min(count_old, count_new)
@@ -189,13 +191,13 @@ def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: Cu
         scale = max(np.abs(ev).max(), 1e-300)
         where = weighted_norm(q.u - prev.u, problem.weights)
         if abs(crit.imag) > 1e-6 * scale:
-            found.append((where, SpecialPoint("H", float(q.u[-1]), -1,
+            found.append((where, SpecialPoint(PointKind.HOPF, float(q.u[-1]), -1,
                                               {"omega": float(abs(crit.imag)), "x": q.u[:-1].tolist(),
                                                "located": hit is not None})))
             j += 2  # its conjugate crosses with it
             continue
-        if not any(s.kind == "LP" for _, s in found):
-            found.append((where, SpecialPoint("BP", float(q.u[-1]), -1,
+        if not any(s.kind is PointKind.FOLD for _, s in found):
+            found.append((where, SpecialPoint(PointKind.BRANCH_POINT, float(q.u[-1]), -1,
                                               {"x": q.u[:-1].tolist(), "located": hit is not None})))
         j += 1
     points.append(new)

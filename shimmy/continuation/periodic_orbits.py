@@ -33,6 +33,7 @@ from .collocation import Mesh, PeriodicProblem
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step,
                            tangent, weighted_norm)
 from .errors import ConvergenceError, InvalidInputError
+from .kinds import PointKind
 
 COMPLEX_TOL = 1e-7  # |Im mu| below this (relative) counts as a real multiplier
 
@@ -45,7 +46,7 @@ class PeriodicOptions:
     period_max: float = math.inf
     amplitude_min: float = 0.05  # end at x*: amplitude below this fraction of the first orbit's (Hopf starts)
     continuation: ContinuationOptions = field(default_factory=ContinuationOptions)
-    stop_at: tuple[str, ...] = ()  # kinds of special point at which to end the branch (e.g. the first LPC)
+    stop_at: tuple[PointKind, ...] = ()  # kinds of special point at which to end the branch (e.g. the first LPC)
 
     def __post_init__(self):
         if not (isinstance(self.ntst, int) and 4 <= self.ntst <= 2000):
@@ -121,16 +122,16 @@ def _count_unstable(mu: np.ndarray) -> int:
     return int((np.abs(mu[1:]) > 1.0).sum())
 
 
-def _kind_of_crossing(mu_a: np.ndarray, mu_b: np.ndarray) -> str:
+def _kind_of_crossing(mu_a: np.ndarray, mu_b: np.ndarray) -> PointKind:
     """The kind of the multiplier that crossed the unit circle between a and b, from which kind's
     count outside changed (complex pair -> NS, real negative -> PD, real positive -> BPC)."""
     ra, na, ca = _outside_by_kind(mu_a)
     rb, nb, cb = _outside_by_kind(mu_b)
     if cb != ca:
-        return "NS"
+        return PointKind.TORUS
     if nb != na:
-        return "PD"
-    return "BPC"
+        return PointKind.PERIOD_DOUBLING
+    return PointKind.BRANCH_POINT_OF_CYCLES
 
 
 def multiplier_crossing_test(mu: np.ndarray, which: str, accuracy: float = 0.0) -> float:
@@ -153,8 +154,8 @@ def multiplier_crossing_test(mu: np.ndarray, which: str, accuracy: float = 0.0) 
     return (-1.0) ** int((log_abs > 0).sum()) * nearest
 
 
-def _crossing_test(kind: str) -> Callable[[np.ndarray], float]:
-    which = {"NS": "complex", "PD": "negative"}.get(kind, "positive")
+def _crossing_test(kind: PointKind) -> Callable[[np.ndarray], float]:
+    which = {PointKind.TORUS: "complex", PointKind.PERIOD_DOUBLING: "negative"}.get(kind, "positive")
 
     def g(mu: np.ndarray) -> float:
         return multiplier_crossing_test(mu[1:], which)
@@ -237,7 +238,7 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
             if new is not None:
                 _record(problem, rows, solutions, new)
                 special.extend(_detect(problem, rows, prev, new, copts))
-                special.append(_special(problem, "EP", new, rows))
+                special.append(_special(problem, PointKind.END, new, rows))
             stop = f"reached the parameter bound p = {bound:g}"
             break
         p_new, T_new = new.u[-1], new.u[-2]
@@ -253,14 +254,14 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
         _record(problem, rows, solutions, new)
         found = _detect(problem, rows, prev, new, copts)
         zero = amp_first if hopf_start else 1e-3 * amp_peak  # below this a cycle's amplitude counts as zero
-        ends = [s for s in found if s.kind == "LPC"
+        ends = [s for s in found if s.kind == PointKind.FOLD_OF_CYCLES
                 and _amplitude(problem, np.array(s.data["x_max"]), np.array(s.data["x_min"])) < zero]
         if ends:  # a 'fold' at zero amplitude: the branch passed through the equilibrium
             for key in rows:
                 rows[key].pop()
             solutions.pop()
             p_end = float(rows["p"][-1])
-            special.append(SpecialPoint("H", p_end, len(rows["p"]) - 1, {"amplitude": amp_last}))
+            special.append(SpecialPoint(PointKind.HOPF, p_end, len(rows["p"]) - 1, {"amplitude": amp_last}))
             stop = f"amplitude returned to zero near p = {p_end:.6g}: the branch ends at a Hopf point"
             break
         special.extend(found)
@@ -283,7 +284,7 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
         # from an orbit may start at its largest one)
         if amp < amp_last and (amp_peak > 2.0 * amp_first or not hopf_start):
             if amp < amp_stop:
-                special.append(SpecialPoint("H", float(p_new), len(rows["p"]) - 1, {"amplitude": amp}))
+                special.append(SpecialPoint(PointKind.HOPF, float(p_new), len(rows["p"]) - 1, {"amplitude": amp}))
                 stop = f"amplitude returned to zero near p = {p_new:.6g}: the branch ends at a Hopf point"
                 break
             tracer.limit_step(0.7 * amp * h / (amp_last - amp))  # do not jump through zero amplitude
@@ -355,12 +356,12 @@ def _record(problem: PeriodicProblem, rows, solutions, point: CurvePoint) -> Non
     solutions.append((problem.mesh.points.copy(), point.u.copy()))
 
 
-def _special(problem: PeriodicProblem, kind: str, point: CurvePoint, rows, mu=None) -> SpecialPoint:
+def _special(problem: PeriodicProblem, kind: PointKind, point: CurvePoint, rows, mu=None) -> SpecialPoint:
     xmax, xmin = _orbit_measures(problem, point.u)
     mu = problem.multipliers(point.u) if mu is None else mu
     data: dict[str, Any] = {"period": float(point.u[-2]), "x_max": xmax.tolist(), "x_min": xmin.tolist(),
                             "multipliers_abs": np.abs(mu[1:]).tolist()}
-    if kind == "NS":
+    if kind is PointKind.TORUS:
         rest = mu[1:]
         cand = rest[np.abs(rest.imag) > COMPLEX_TOL * np.abs(rest)]
         if cand.size:
@@ -421,10 +422,11 @@ def _events(problem: PeriodicProblem, rows, a: CurvePoint, b: CurvePoint, mu_a: 
     if fold:
         hit = locate(problem, a, h, lambda q: q.tangent[-1], a.tangent[-1], b.tangent[-1], copts)
         at = hit[0] if hit is not None else b
-        found.append((offset + weighted_norm(at.u - a.u, problem.weights), _special(problem, "LPC", at, rows)))
+        found.append((offset + weighted_norm(at.u - a.u, problem.weights),
+                      _special(problem, PointKind.FOLD_OF_CYCLES, at, rows)))
     if _count_unstable(mu_a) != _count_unstable(mu_b):
         kind = _kind_of_crossing(mu_a, mu_b)
-        if not (kind == "BPC" and fold):
+        if not (kind is PointKind.BRANCH_POINT_OF_CYCLES and fold):
             g_mu = _crossing_test(kind)
             ga, gb = g_mu(mu_a), g_mu(mu_b)
             at = b

@@ -56,11 +56,6 @@ class Criticality(str, Enum):
     DEGENERATE = "degenerate"
 
 
-class CrossingKind(str, Enum):
-    HOPF = "H"
-    BRANCH_POINT = "BP"
-
-
 class Linearisation:
     """J(V) = J0 + V J1 + J2 / V at x = 0 for one model and load Fz."""
 

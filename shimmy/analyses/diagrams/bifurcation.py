@@ -49,7 +49,7 @@ from ...continuation.errors import ConvergenceError as EngineConvergenceError
 from ...continuation.errors import InvalidInputError as EngineInvalidInputError
 from ...continuation.collocation import Mesh, PeriodicProblem
 from ...model.configurations import Configuration
-from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, SpecialPoint, VectorField,
+from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, PointKind, SpecialPoint, VectorField,
                            equilibrium_branch, locate, step, tangent, weighted_norm)
 from ...model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...errors import ConvergenceError, InvalidParameterError
@@ -207,7 +207,7 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
     eq = equilibrium_branch(system, np.zeros(n), v_min, v_min, v_max,
                             ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000), scale=scale,
                             p_scale=V_SCALE)
-    engine_h = [s.p for s in eq.special_points if s.kind == "H"]
+    engine_h = [s.p for s in eq.special_points if s.kind == PointKind.HOPF]
     scan_h = [h.V for h in hopf.hopf_points]
     starts = sorted(scan_h)
     for v in scan_h:
@@ -244,7 +244,7 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
             continue
         done.append(v_h)
         for s in raw.special_points:
-            if s.kind == "H":  # ended on another Hopf point: the located one it approaches
+            if s.kind == PointKind.HOPF:  # ended on another Hopf point: the located one it approaches
                 near = _hopf_reached(starts, raw)
                 if near is not None:
                     done.append(near)
@@ -334,9 +334,9 @@ def _equilibrium_output(eq: EquilibriumBranch, hopf: HopfResult) -> Branch:
         stable.insert(k, False)
     V_arr = np.array(V)
     zeros = np.zeros_like(V_arr)
-    special = [{"kind": "H", "V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value,
+    special = [{"kind": PointKind.HOPF, "V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value,
                 "lyapunov": h.lyapunov} for h in hopf.hopf_points]
-    special += [{"kind": "BP", "V": v} for v in hopf.branch_points]
+    special += [{"kind": PointKind.BRANCH_POINT, "V": v} for v in hopf.branch_points]
     return Branch("equilibrium", V_arr, np.full_like(V_arr, np.nan), zeros, zeros.copy(), np.array(stable),
                   [None] * V_arr.size, special, "x = 0", eq.stop_reason, eq.steps)
 
@@ -352,7 +352,7 @@ def _periodic_output(raw: PeriodicBranch, params: Parameters, origin: str, hopf_
     special = []
     for s in raw.special_points:
         d = {"kind": s.kind, "V": s.p}
-        if s.kind == "H" and hopf_speeds:
+        if s.kind == PointKind.HOPF and hopf_speeds:
             near = _hopf_reached(hopf_speeds, raw)
             if near is not None:
                 d.update({"V": near, "V_last_point": s.p})
@@ -376,7 +376,7 @@ def _with_hopf_ends(branch: Branch, v_start: float, omega: dict[float, float]) -
         return V, 2.0 * math.pi / omega[V]
 
     head = [point(v_start)]
-    tail = [point(s["V"]) for s in branch.special_points if s["kind"] == "H" and s["V"] in omega]
+    tail = [point(s["V"]) for s in branch.special_points if s["kind"] == PointKind.HOPF and s["V"] in omega]
     V = np.concatenate([[v for v, _ in head], branch.V, [v for v, _ in tail]])
     T = np.concatenate([[t for _, t in head], branch.period, [t for _, t in tail]])
     zeros_h, zeros_t = np.zeros(len(head)), np.zeros(len(tail))

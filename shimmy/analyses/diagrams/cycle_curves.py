@@ -30,8 +30,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ...version import __version__
-from ...continuation import (ContinuationOptions, CycleCurve, CycleCurveOptions, SpecialPoint,
-                            TwoParameterVectorField, cycle_curve, start_beside)
+from ...continuation import (CYCLE_BIFURCATIONS, ContinuationOptions, CycleCurve, CycleCurveOptions, PointKind,
+                             SpecialPoint, TwoParameterVectorField, cycle_curve, start_beside)
 from ...continuation.errors import ContinuationError
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
@@ -43,8 +43,12 @@ from ..core.polylines import near_polyline
 from ..core.executors import open_executor, run_dynamic
 from ..core.stability import hopf_points
 
-KINDS = ("LPC", "NS", "PD")
-KEY_OF_KIND = {"LPC": "fold_curves", "NS": "torus_curves", "PD": "pd_curves"}
+KINDS = CYCLE_BIFURCATIONS
+KEY_OF_KIND = {PointKind.FOLD_OF_CYCLES: "fold_curves", PointKind.TORUS: "torus_curves",
+               PointKind.PERIOD_DOUBLING: "pd_curves"}
+#: Marks on a cycle curve that are not codimension-2 points: its ends, its turns and crossings in Fz
+MARKS = (PointKind.END, PointKind.ZERO_AMPLITUDE, PointKind.P2_TURN, PointKind.P2_MARK)
+ENDS = (PointKind.END, PointKind.ZERO_AMPLITUDE)
 FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 kN
 CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400,
                                                                    max_angle=0.3))
@@ -68,7 +72,7 @@ def gear_cycle_field(config: Configuration, params: Parameters) -> TwoParameterV
 
 @dataclass(eq=False)  # compared by identity: list.remove takes the very start
 class Start:
-    kind: str
+    kind: PointKind
     point: SpecialPoint  # located on a branch in V, with its solution
     Fz: float
     ncol: int
@@ -81,7 +85,7 @@ class Start:
 
 @dataclass
 class GearCycleCurve:
-    kind: str
+    kind: PointKind
     curve: CycleCurve
     origin: str
 
@@ -110,7 +114,7 @@ class CycleCurvesResult:
     params: Parameters
     v_range: tuple[float, float]
     fz_range: tuple[float, float]
-    kinds: tuple[str, ...]
+    kinds: tuple[PointKind, ...]
     curves: list[GearCycleCurve]
     gh_points: list[dict[str, float]]
     double_hopf_points: list[dict[str, float]]
@@ -119,17 +123,17 @@ class CycleCurvesResult:
     starts_tried: int
     warnings: list[str] = field(default_factory=list)
 
-    def of_kind(self, kind: str) -> list[GearCycleCurve]:
+    def of_kind(self, kind: PointKind) -> list[GearCycleCurve]:
         return [c for c in self.curves if c.kind == kind]
 
     def codim2_points(self) -> list[dict[str, Any]]:
         """GH and double-Hopf points of the Hopf curves, and those located on the cycle curves
         (one entry per point: the same point found on two curves is listed once)."""
-        out = [{"kind": "GH", "V": g["V"], "Fz": g["Fz"]} for g in self.gh_points]
-        out += [{"kind": "HH", "V": g["V"], "Fz": g["Fz"]} for g in self.double_hopf_points]
+        out = [{"kind": PointKind.GENERALISED_HOPF, "V": g["V"], "Fz": g["Fz"]} for g in self.gh_points]
+        out += [{"kind": PointKind.DOUBLE_HOPF, "V": g["V"], "Fz": g["Fz"]} for g in self.double_hopf_points]
         for c in self.curves:
             for s in c.curve.special_points:
-                if s.kind in ("EP", "ZA", "P2_TURN", "P2_MARK") or not s.data.get("located", True):
+                if s.kind in MARKS or not s.data.get("located", True):
                     continue  # ends and load marks are not codimension-2 points; unlocated ones stay in "curves"
                 entry = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
                 # the same point on two curves (LPNS on a fold and a torus curve) agrees to the
@@ -148,7 +152,7 @@ class CycleCurvesResult:
         details = []
         for c in self.curves:
             special = c.curve.special_points
-            turns = [_located_point(s, l_g) | {"turn": s.data["turn"]} for s in special if s.kind == "P2_TURN"]
+            turns = [_located_point(s, l_g) | {"turn": s.data["turn"]} for s in special if s.kind == PointKind.P2_TURN]
             fz = c.curve.p[:, 1]
             lowest = min([{"V": float(c.curve.p[int(np.argmin(fz)), 0]), "Fz": float(fz.min())}]
                          + [t for t in turns if t["turn"] == "min"], key=lambda e: e["Fz"])
@@ -159,11 +163,11 @@ class CycleCurvesResult:
                 "stop_reasons": c.curve.stop_reasons, "steps": c.curve.steps,
                 "fz_min": {"V": lowest["V"], "Fz": lowest["Fz"]}, "fz_max": {"V": highest["V"], "Fz": highest["Fz"]},
                 "turning_points": turns,
-                "crossings": sorted((_located_point(s, l_g) for s in special if s.kind == "P2_MARK"),
+                "crossings": sorted((_located_point(s, l_g) for s in special if s.kind == PointKind.P2_MARK),
                                     key=lambda e: (e["Fz"], e["V"])),
-                "ends": [_located_point(s, l_g) for s in special if s.kind in ("EP", "ZA")],
+                "ends": [_located_point(s, l_g) for s in special if s.kind in ENDS],
                 "codim2_points": [_located_point(s, l_g) for s in special
-                                  if s.kind not in ("EP", "ZA", "P2_TURN", "P2_MARK")],
+                                  if s.kind not in MARKS],
             })
         out.update({"curves": details, "codim2_points": self.codim2_points(), "gh_points": self.gh_points,
                     "double_hopf_points": self.double_hopf_points, "loads": list(self.loads),
@@ -197,7 +201,7 @@ class CurveSearch:
     units finish: a map or a set of curves is the same on any executor.
     :func:`cycle_curves` and the stability maps both drive it."""
 
-    def __init__(self, config: Configuration, params: Parameters, box, kinds: tuple[str, ...],
+    def __init__(self, config: Configuration, params: Parameters, box, kinds: tuple[PointKind, ...],
                  loads: tuple[float, ...]):
         self.config, self.params, self.box, self.kinds, self.loads = config, params, box, kinds, loads
         self.gh: list[dict[str, float]] = []
@@ -222,12 +226,12 @@ class CurveSearch:
                 entry = {"V": g["p"][0], "Fz": g["p"][1], "omega": g["omega"], "omega2": g["omega2"]}
                 if not any(_close(entry, e, 1e-4) for e in self.hh):
                     self.hh.append(entry)
-        units = [("beside", self.config, self.params, g, "LPC", self.box,
+        units = [("beside", self.config, self.params, g, PointKind.FOLD_OF_CYCLES, self.box,
                   f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
-                 for g in self.gh if "LPC" in self.kinds]
-        units += [("beside", self.config, self.params, g, "NS", self.box,
+                 for g in self.gh if PointKind.FOLD_OF_CYCLES in self.kinds]
+        units += [("beside", self.config, self.params, g, PointKind.TORUS, self.box,
                    f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
-                  for g in self.hh if "NS" in self.kinds]
+                  for g in self.hh if PointKind.TORUS in self.kinds]
         self.hopf_pending = False
         self.beside_order += units
         return units
@@ -331,7 +335,7 @@ def search_done(search: CurveSearch, task: tuple, result: Any) -> list[tuple]:
 
 def cycle_curves(config: Configuration | str, params: Parameters | None = None,
                  v_range: tuple[float, float] = (V_RANGE[0], 200.0), fz_range: tuple[float, float] = FZ_RANGE,
-                 kinds: tuple[str, ...] = KINDS, loads: tuple[float, ...] = (),
+                 kinds: tuple[PointKind | str, ...] = KINDS, loads: tuple[float, ...] = (),
                  progress: Callable[[float, str], None] | None = None,
                  executor: Executor | None = None) -> CycleCurvesResult:
     """Every fold, torus and period-doubling curve of cycles in the box (m/s, N); ``loads``: the
@@ -352,6 +356,7 @@ def cycle_curves(config: Configuration | str, params: Parameters | None = None,
     for k in kinds:
         if k not in KINDS:
             raise InvalidParameterError("kinds", k, ", ".join(KINDS), "is not a kind of cycle curve")
+    kinds = tuple(PointKind(k) for k in kinds)
     if not kinds:
         raise InvalidParameterError("kinds", "", ", ".join(KINDS), "is empty")
     loads = tuple(float(check_number(f"loads[{i}]", f, f_lo, f_hi, "N")) for i, f in enumerate(loads))
@@ -405,7 +410,7 @@ def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
     """One curve continued from one start (a unit of :func:`cycle_curves`)."""
     config, params, start, box, loads = task
     system = gear_cycle_field(config, params)
-    kappa = math.cos(start.point.data["torus_angle"]) if start.kind == "NS" else None
+    kappa = math.cos(start.point.data["torus_angle"]) if start.kind == PointKind.TORUS else None
     if kappa is not None and not -1.0 < kappa < 1.0:
         return None, None
     about = f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin})"
@@ -442,7 +447,7 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
         if not fz_range[0] <= Fz <= fz_range[1]:
             continue
         hopf = hopf_points(config, Fz, params, v_min=v_range[0], v_max=v_range[1]).hopf_points
-        near = sorted(hopf, key=lambda h: abs(math.log(h.V / point["V"])))[:2 if kind == "NS" else 1]
+        near = sorted(hopf, key=lambda h: abs(math.log(h.V / point["V"])))[:2 if kind == PointKind.TORUS else 1]
         for h in near:
             if abs(math.log(h.V / point["V"])) > 0.2:
                 continue
