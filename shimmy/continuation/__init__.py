@@ -61,19 +61,18 @@ from .core import (ContinuationOptions, CurvePoint, CurveProblem, SpecialPoint, 
                    locate, point_at, step, tangent, weighted_norm)
 from .equilibria import EquilibriumBranch, equilibrium_branch
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
-from .kinds import CYCLE_BIFURCATIONS, PointKind
+from .kinds import CYCLE_BIFURCATIONS, PointKind, Stop, StopReason
 from .hopf import HopfCurve, HopfCurveProblem, TwoParameterField, hopf_curve, hopf_start
 from .lyapunov import first_lyapunov_coefficient, hopf_eigenvectors
 from .periodic_orbits import (OrbitGuess, PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
                               periodic_branch)
 
 __all__ = [
-    "CODIM2_KINDS", "CYCLE_BIFURCATIONS", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem",
-    "TwoParameterVectorField", "cycle_curve", "start_beside",
-    "ContinuationError", "ContinuationOptions", "ConvergenceError", "CurvePoint", "CurveProblem",
-    "EquilibriumBranch", "HopfCurve", "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess",
-    "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "PointKind", "SpecialPoint", "Tracer", "TwoParameterField",
-    "VectorField", "correct", "equilibrium_branch", "first_lyapunov_coefficient", "hopf_curve",
-    "hopf_eigenvectors", "hopf_guess", "hopf_start", "locate", "orbit_from_samples", "periodic_branch",
-    "point_at", "step", "tangent", "weighted_norm",
+    "CODIM2_KINDS", "CYCLE_BIFURCATIONS", "ContinuationError", "ContinuationOptions", "ConvergenceError", "CurvePoint",
+    "CurveProblem", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem", "EquilibriumBranch", "HopfCurve",
+    "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess", "PeriodicBranch", "PeriodicOptions",
+    "PeriodicProblem", "PointKind", "SpecialPoint", "Stop", "StopReason", "Tracer", "TwoParameterField",
+    "TwoParameterVectorField", "VectorField", "correct", "cycle_curve", "equilibrium_branch",
+    "first_lyapunov_coefficient", "hopf_curve", "hopf_eigenvectors", "hopf_guess", "hopf_start", "locate",
+    "orbit_from_samples", "periodic_branch", "point_at", "start_beside", "step", "tangent", "weighted_norm",
 ]

@@ -42,6 +42,7 @@ from scipy.sparse.linalg import splu
 
 from .condensed_lu import CondensedLU
 from .errors import InvalidInputError
+from .kinds import PointKind, Stop, StopReason
 
 
 @dataclass(frozen=True)
@@ -322,7 +323,7 @@ class Tracer:
         self.chord = chord
         self.point = start
         self.h = options.ds
-        self.failed: str | None = None
+        self.failed: Stop | None = None
         #: (problem, point, previous tangent, step between them) after an accepted step: the
         #: curvature estimate's data, valid while the problem and the point are those
         self._last: tuple | None = None
@@ -375,8 +376,8 @@ class Tracer:
             else:
                 self.h *= opts.shrink
             if self.h < opts.ds_min:
-                self.failed = (f"Newton did not converge with step {self.h / opts.shrink:.2g} "
-                               f"(minimum {opts.ds_min:g})")
+                self.failed = Stop(StopReason.NEWTON_FAILED, f"Newton did not converge with step "
+                                   f"{self.h / opts.shrink:.2g} (minimum {opts.ds_min:g})")
                 return None
 
     def _turn(self, new: CurvePoint) -> float:
@@ -542,13 +543,21 @@ class VectorField:
 class SpecialPoint:
     """A bifurcation point located on a branch."""
 
-    kind: str  # H, LP, BP (equilibria); LPC, NS, PD, BPC (cycles); EP end point
+    kind: PointKind
     p: float
     index: int  # position in the branch's point list
     data: dict[str, Any] = field(default_factory=dict)
+    #: Whether the search for the point reached its tolerance (False: the point is the nearest the
+    #: search got, or an end of the step it lies in); None where no search was made (an end point).
+    located: bool | None = None
     #: The located point's full solution where a follow-on analysis needs it (cycles:
     #: (mesh points, u)); not part of :meth:`to_dict`.
     solution: Any = field(default=None, repr=False, compare=False)
 
     def to_dict(self, parameter: str = "p") -> dict[str, Any]:
-        return {"kind": self.kind, parameter: self.p, **self.data}
+        """kind, the parameter, the data and ``located`` (where a search was made), in the key order
+        of the JSON written when ``located`` was a data key: last, but before a torus curve's kappa."""
+        data = dict(self.data)
+        kappa = {"kappa": data.pop("kappa")} if "kappa" in data else {}
+        located = {} if self.located is None else {"located": self.located}
+        return {"kind": self.kind, parameter: self.p, **data, **located, **kappa}

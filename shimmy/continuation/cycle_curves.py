@@ -57,7 +57,7 @@ from .condensed_lu import ChainLayout, CondensedLU, collocation_layout
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, condensed_factors,
                    locate_between, point_at, refine, step, tangent, weighted_norm)
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
-from .kinds import CYCLE_BIFURCATIONS, PointKind
+from .kinds import CYCLE_BIFURCATIONS, PointKind, Stop, StopReason
 from .lyapunov import hopf_eigenvectors
 from .periodic_orbits import PeriodicOptions, hopf_guess, multiplier_crossing_test, periodic_branch
 
@@ -160,10 +160,14 @@ class CycleCurve:
     kappa: np.ndarray  # NS: cos of the torus angle; nan otherwise
     multipliers: np.ndarray  # (points, n), trivial first, then by decreasing modulus
     special_points: list[SpecialPoint]
-    stop_reasons: list[str]  # one per direction traced
+    stops: list[Stop]  # one per direction traced
     steps: int
     solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, cycle u = (x, T, p1)) per point
     closed: bool = False
+
+    @property
+    def stop_reasons(self) -> list[str]:
+        return [s.message for s in self.stops]
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "p": self.p.tolist(), "period": self.period.tolist(),
@@ -641,18 +645,18 @@ def cycle_curve(system: TwoParameterVectorField, kind: PointKind | str, start: t
     first = step(problem, CurvePoint(u0, e2 / weighted_norm(e2, problem.weights)), 0.0, copts)
     if first is None:
         raise ConvergenceError(f"no {kind} point converged near the start (p = ({cu[-1]:g}, {p2:g}))")
-    halves, reasons, steps_total = [], [], 0
+    halves, stops, steps_total = [], [], 0
     for direction in directions:
         half_problem = problem if not halves else _fresh(problem, first.u)
         t = first.tangent if first.tangent[problem.n_x + 2] * direction >= 0 else -first.tangent
-        rows, special, reason, steps, closed = _trace(half_problem, CurvePoint(first.u.copy(), t), box, options,
+        rows, special, stop, steps = _trace(half_problem, CurvePoint(first.u.copy(), t), box, options,
                                                       tuple(p2_marks), progress)
-        halves.append((rows, special, closed))
-        reasons.append(reason)
+        halves.append((rows, special))
+        stops.append(stop)
         steps_total += steps
-        if closed:
+        if stop.reason is StopReason.CLOSED:
             break
-    return _join(kind, halves, reasons, steps_total)
+    return _join(kind, halves, stops, steps_total)
 
 
 def start_beside(system: TwoParameterVectorField, kind: PointKind | str, x_star: np.ndarray,
@@ -729,14 +733,13 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
     monitors = _monitors(problem, start, mu, reference)
     amp_peak = _amplitude(problem, rows["xmax"][0], rows["xmin"][0])
     amp_last = amp_peak
-    reason = f"step budget of {copts.max_steps} steps used"
-    closed = False
+    stop = Stop(StopReason.STEP_BUDGET, f"step budget of {copts.max_steps} steps used")
     steps = 0
     for steps in range(1, copts.max_steps + 1):  # noqa: B007
         prev = tracer.point
         adv = tracer.advance()
         if adv is None:
-            reason = tracer.failed or "Newton failed"
+            stop = tracer.failed
             break
         new, h = adv
         p_new = new.u[n_x + 1:n_x + 3]
@@ -753,18 +756,19 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
                 _record(problem, rows, hit[0])
                 special.append(SpecialPoint(PointKind.END, float(hit[0].u[n_x + 1]), len(rows["p"]) - 1,
                                             {"p2": float(hit[0].u[n_x + 2])}))
-            reason = f"left the parameter box at p{c + 1} = {bound:g}"
+            stop = Stop(StopReason.BOUND, f"left the parameter box at p{c + 1} = {bound:g}")
             break
         if new.u[n_x] > options.period_max:
-            reason = f"period {new.u[n_x]:.4g} above the limit {options.period_max:.4g}"
+            stop = Stop(StopReason.PERIOD_LIMIT, f"period {new.u[n_x]:.4g} above the limit {options.period_max:.4g}")
             break
         if new.u[n_x] <= 0:
-            reason = "period became non-positive: the continuation left the curve"
+            stop = Stop(StopReason.NONPOSITIVE_PERIOD, "period became non-positive: the continuation left the curve")
             break
         kappa = problem.kappa(new.u)
         if problem.kind is NS and not -1.0 <= kappa <= 1.0:
-            reason = (f"kappa = {kappa:.4g} left [-1, 1] near p = ({p_new[0]:.6g}, {p_new[1]:.6g}): past a strong "
-                      "resonance the condition describes neutral saddle cycles, not tori")
+            stop = Stop(StopReason.PAST_RESONANCE, f"kappa = {kappa:.4g} left [-1, 1] near p = ({p_new[0]:.6g}, "
+                        f"{p_new[1]:.6g}): past a strong resonance the condition describes neutral saddle cycles, "
+                        "not tori")
             break
         mu = _record(problem, rows, new)
         special.extend(_p2_points(problem, prev, new, marks, rows, copts))
@@ -777,14 +781,13 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         if progress is not None:
             progress(min(1.0, steps / copts.max_steps))
         if _closed(rows):
-            reason = "closed curve: returned to its first point"
-            closed = True
+            stop = Stop(StopReason.CLOSED, "closed curve: returned to its first point")
             break
         amp = _amplitude(problem, rows["xmax"][-1], rows["xmin"][-1])
         amp_peak = max(amp_peak, amp)
         if amp < options.amplitude_min * amp_peak and amp < amp_last:
-            reason = (f"amplitude shrank to zero near p = ({p_new[0]:.6g}, {p_new[1]:.6g}): the curve ends at a "
-                      "codimension-2 point of the equilibrium")
+            stop = Stop(StopReason.ZERO_AMPLITUDE, f"amplitude shrank to zero near p = ({p_new[0]:.6g}, "
+                        f"{p_new[1]:.6g}): the curve ends at a codimension-2 point of the equilibrium")
             special.append(SpecialPoint(PointKind.ZERO_AMPLITUDE, float(p_new[0]), len(rows["p"]) - 1,
                                         {"p2": float(p_new[1]), "amplitude": amp}))
             break
@@ -793,7 +796,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         amp_last = amp
         if options.adapt_every and steps % options.adapt_every == 0:
             problem = _remesh(problem, tracer, copts)
-    return rows, special, reason, steps, closed
+    return rows, special, stop, steps
 
 
 def _chord_ratio(problem: CycleCurveProblem, a: CurvePoint, b: CurvePoint, h: float, tol: float) -> float:
@@ -827,7 +830,8 @@ def _remesh(problem: CycleCurveProblem, tracer: Tracer, copts: ContinuationOptio
     return other
 
 
-def _located(problem: CycleCurveProblem, kind: PointKind, at: CurvePoint, rows, extra=None) -> SpecialPoint:
+def _located(problem: CycleCurveProblem, kind: PointKind, at: CurvePoint, rows, extra=None,
+             located: bool | None = None) -> SpecialPoint:
     n_x = problem.n_x
     mu = problem.multipliers(at.u)
     xmax, xmin = problem.extremes(at.u)
@@ -835,7 +839,7 @@ def _located(problem: CycleCurveProblem, kind: PointKind, at: CurvePoint, rows, 
             "multipliers_abs": np.abs(mu[1:]).tolist(), **(extra or {})}
     if problem.kind is NS:
         data["kappa"] = problem.kappa(at.u)
-    return SpecialPoint(kind, float(at.u[n_x + 1]), len(rows["p"]) - 1, data)
+    return SpecialPoint(kind, float(at.u[n_x + 1]), len(rows["p"]) - 1, data, located)
 
 
 def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, marks, rows, copts) -> list[SpecialPoint]:
@@ -851,7 +855,7 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
         hit = locate_between(problem, prev, new, slope, slope(prev), slope(new), copts, LOCATE_TOL)
         at = hit[0] if hit is not None else new
         found.append(_located(problem, PointKind.P2_TURN, at, rows,
-                              {"turn": "max" if prev.tangent[i2] > 0 else "min", "located": hit is not None}))
+                              {"turn": "max" if prev.tangent[i2] > 0 else "min"}, hit is not None))
     for mark in marks:
         a, b = prev.u[i2] - mark, new.u[i2] - mark
         if abs(b) <= 1e-9 * problem.p_scale[1]:  # the step ends on the mark (a box edge)
@@ -889,7 +893,7 @@ def _codim2(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, h: fl
                              MULTIPLIER_TOL if name in _CROSSINGS[problem.kind] else LOCATE_TOL,
                              with_tangent=name is PointKind.CUSP_OF_CYCLES)
         at = hit[0] if hit is not None else new
-        found.append(_located(problem, name, at, rows, {"located": hit is not None}))
+        found.append(_located(problem, name, at, rows, located=hit is not None))
     problem.cycle_u(new.u)
     return found
 
@@ -917,23 +921,23 @@ def _closed(rows: dict) -> bool:
     return float(np.linalg.norm(prev + s * seg - first)) < length / 3.0
 
 
-def _join(kind: PointKind, halves, reasons, steps) -> CycleCurve:
+def _join(kind: PointKind, halves, stops, steps) -> CycleCurve:
     """One curve: the second half reversed, then the first (they share the start point)."""
     parts = []
     special: list[SpecialPoint] = []
     offset = 0
     ordered = [halves[1], halves[0]] if len(halves) == 2 else halves
-    for h_index, (rows, pts, _) in enumerate(ordered):
+    for h_index, (rows, pts) in enumerate(ordered):
         count = len(rows["p"])
         if len(halves) == 2 and h_index == 0:
             order = list(range(count - 1, 0, -1))  # reversed, without the shared start point
             position = {i: k for k, i in enumerate(order)}
             for s in pts:
-                special.append(SpecialPoint(s.kind, s.p, position.get(s.index, 0), s.data))
+                special.append(replace(s, index=position.get(s.index, 0)))
         else:
             order = list(range(count))
             for s in pts:
-                special.append(SpecialPoint(s.kind, s.p, offset + s.index, s.data))
+                special.append(replace(s, index=offset + s.index))
         parts.append((rows, order))
         offset += len(order)
 
@@ -943,5 +947,5 @@ def _join(kind: PointKind, halves, reasons, steps) -> CycleCurve:
     mu = gather("mu")
     special.sort(key=lambda s: s.index)
     return CycleCurve(kind, np.array(gather("p")), np.array(gather("T")), np.array(gather("xmax")),
-                      np.array(gather("xmin")), np.array(gather("kappa"), float), np.array(mu), special, reasons,
-                      steps, gather("solutions"), closed=any(c for _, _, c in halves))
+                      np.array(gather("xmin")), np.array(gather("kappa"), float), np.array(mu), special, stops,
+                      steps, gather("solutions"), closed=any(s.reason is StopReason.CLOSED for s in stops))

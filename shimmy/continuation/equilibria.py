@@ -9,14 +9,14 @@ sign) or a branch point BP (real eigenvalue, no fold). Each is located to
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg as la
 
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, correct, locate, step, tangent,
                    weighted_norm)
-from .kinds import PointKind
+from .kinds import PointKind, Stop, StopReason
 
 
 @dataclass
@@ -42,8 +42,13 @@ class EquilibriumBranch:
     eigenvalues: np.ndarray  # (points, n), sorted by decreasing real part
     stable: np.ndarray
     special_points: list[SpecialPoint]
-    stop_reason: str
+    stops: list[Stop]  # one: the branch is traced one way
     steps: int
+    closed: bool = False  # never: the branch is traced until it leaves the range
+
+    @property
+    def stop_reason(self) -> str:
+        return "; ".join(s.message for s in self.stops)
 
     @property
     def n_unstable(self) -> np.ndarray:
@@ -82,12 +87,12 @@ def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, p_min: fl
     points = [tracer.point]
     eigs = [_sorted_eigenvalues(system.dfdx(u0[:-1], u0[-1]))]
     special: list[SpecialPoint] = []
-    stop = f"step budget of {options.max_steps} steps used"
+    stop = Stop(StopReason.STEP_BUDGET, f"step budget of {options.max_steps} steps used")
     steps = 0
     for steps in range(1, options.max_steps + 1):  # noqa: B007 (steps is reported)
         out = tracer.advance_within(p_min, p_max)
         if out is None:
-            stop = tracer.failed or "failed"
+            stop = tracer.failed
             break
         prev, new, _, bound = out
         if new is not None:
@@ -95,11 +100,11 @@ def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, p_min: fl
         if bound is not None:
             if new is not None:
                 special.append(SpecialPoint(PointKind.END, float(new.u[-1]), len(points) - 1))
-            stop = f"reached the parameter bound p = {bound:g}"
+            stop = Stop(StopReason.BOUND, f"reached the parameter bound p = {bound:g}")
             break
     u = np.array([q.u for q in points])
     ev = np.array(eigs)
-    return EquilibriumBranch(u[:, -1], u[:, :-1], ev, ev[:, 0].real < 0, special, stop, steps)
+    return EquilibriumBranch(u[:, -1], u[:, :-1], ev, ev[:, 0].real < 0, special, [stop], steps)
 
 
 def _eigen_slopes(A: np.ndarray, dA: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -175,8 +180,8 @@ def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: Cu
         hit = locate(problem, prev, h, lambda q: q.tangent[-1], prev.tangent[-1], new.tangent[-1], options)
         at = hit[0] if hit is not None else (prev if abs(prev.tangent[-1]) < abs(new.tangent[-1]) else new)
         found.append((weighted_norm(at.u - prev.u, problem.weights),
-                      SpecialPoint(PointKind.FOLD, float(at.u[-1]), -1,
-                                   {"x": at.u[:-1].tolist(), "located": hit is not None})))
+                      SpecialPoint(PointKind.FOLD, float(at.u[-1]), -1, {"x": at.u[:-1].tolist()},
+                                   located=hit is not None)))
     # The j-th largest real part changes sign for every j between the two counts: one located
     # point per real eigenvalue or complex pair (several pairs can cross within one step).
     j = min(count_old, count_new)
@@ -192,15 +197,15 @@ def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: Cu
         where = weighted_norm(q.u - prev.u, problem.weights)
         if abs(crit.imag) > 1e-6 * scale:
             found.append((where, SpecialPoint(PointKind.HOPF, float(q.u[-1]), -1,
-                                              {"omega": float(abs(crit.imag)), "x": q.u[:-1].tolist(),
-                                               "located": hit is not None})))
+                                              {"omega": float(abs(crit.imag)), "x": q.u[:-1].tolist()},
+                                              located=hit is not None)))
             j += 2  # its conjugate crosses with it
             continue
         if not any(s.kind is PointKind.FOLD for _, s in found):
             found.append((where, SpecialPoint(PointKind.BRANCH_POINT, float(q.u[-1]), -1,
-                                              {"x": q.u[:-1].tolist(), "located": hit is not None})))
+                                              {"x": q.u[:-1].tolist()}, located=hit is not None)))
         j += 1
     points.append(new)
     eigs.append(ev_new)
     for _, sp_ in sorted(found, key=lambda item: item[0]):
-        special.append(SpecialPoint(sp_.kind, sp_.p, len(points) - 1, sp_.data))
+        special.append(replace(sp_, index=len(points) - 1))

@@ -32,6 +32,7 @@ import numpy as np
 
 from . import lyapunov
 from .core import ContinuationOptions, CurvePoint, Tracer, correct, locate, tangent, weighted_norm
+from .kinds import Stop, StopReason
 
 
 @dataclass(frozen=True)
@@ -126,12 +127,16 @@ class HopfCurve:
     lyapunov: np.ndarray  # nan where the field is not smooth
     gh_points: list[dict]  # {"p": (p1, p2), "omega": ...}
     extrema: list[dict]  # turning points in p2 (dp2/ds = 0): {"p": (p1, p2), "omega": ...}
-    stop_reasons: list[str]  # one per direction
+    stops: list[Stop]  # one per direction traced
     steps: int
     closed: bool = False
     warnings: list[str] = field(default_factory=list)
     double_hopf: list[dict] = field(default_factory=list)  # {"p", "omega", "omega2", "located"}
     zero_hopf: list[dict] = field(default_factory=list)  # {"p", "omega", "located"}
+
+    @property
+    def stop_reasons(self) -> list[str]:
+        return [s.message for s in self.stops]
 
 
 def hopf_start(x: np.ndarray, p: np.ndarray, J: np.ndarray) -> tuple[np.ndarray, float]:
@@ -161,14 +166,14 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
     u0 = out[0]
     problem.accept(u0)
     t0 = tangent(problem, u0, guess)
-    halves, reasons, warnings, steps, closed = [], [], [], 0, False
+    halves, stops, warnings, steps, closed = [], [], [], 0, False
     for sign in (1.0, -1.0):
         problem.accept(u0)
-        part, reason, n_steps, is_closed = _trace(problem, CurvePoint(u0, sign * t0), box, options, u0)
+        part, stop, n_steps = _trace(problem, CurvePoint(u0, sign * t0), box, options, u0)
         halves.append(part)
-        reasons.append(reason)
+        stops.append(stop)
         steps += n_steps
-        if is_closed:
+        if stop.reason is StopReason.CLOSED:
             closed = True
             break
     points = halves[-1] if closed else halves[1][::-1] + halves[0][1:]  # the half that closed is the loop
@@ -192,7 +197,7 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
             hit = locate(problem, a, h, lambda q: q.tangent[-1], sign * ta, sign * tb, options)
             at = hit[0] if hit is not None else points[i]
             extrema.append({"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n])})
-    return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, gh, extrema, reasons, steps, closed, warnings,
+    return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, gh, extrema, stops, steps, closed, warnings,
                      double_hopf, zero_hopf)
 
 
@@ -251,13 +256,12 @@ def _trace(problem: HopfCurveProblem, start: CurvePoint, box, options: Continuat
     points = [start]
     n = problem.n
     (lo1, hi1), (lo2, hi2) = box
-    reason = f"step budget of {options.max_steps} steps used"
     travelled = 0.0
     for k in range(1, options.max_steps + 1):
         prev = tracer.point
         adv = tracer.advance()
         if adv is None:
-            return points, tracer.failed or "Newton failed", k, False
+            return points, tracer.failed, k
         new, h = adv
         travelled += h
         p1, p2 = new.u[3 * n + 1], new.u[3 * n + 2]
@@ -269,17 +273,19 @@ def _trace(problem: HopfCurveProblem, start: CurvePoint, box, options: Continuat
                              value - bound, options)
                 if hit is not None:
                     points.append(hit[0])
-                return points, f"left the parameter box at p{1 if idx == 3 * n + 1 else 2} = {bound:g}", k, False
+                return points, Stop(StopReason.BOUND,
+                                    f"left the parameter box at p{1 if idx == 3 * n + 1 else 2} = {bound:g}"), k
         if new.u[3 * n] <= 1e-6 * max(abs(start.u[3 * n]), 1.0):
             points.append(new)
-            return points, f"omega fell to zero at p = ({p1:.6g}, {p2:.6g}): Bogdanov-Takens point", k, False
+            return points, Stop(StopReason.ZERO_FREQUENCY,
+                                f"omega fell to zero at p = ({p1:.6g}, {p2:.6g}): Bogdanov-Takens point"), k
         points.append(new)
         # Closed curve: back at the start, heading the same way.
         if travelled > 4 * options.ds_max and weighted_norm(new.u - u0, problem.weights) < 0.5 * h \
                 and new.tangent @ (problem.weights * start.tangent) > 0:
             points.append(CurvePoint(u0, start.tangent))
-            return points, "closed curve: returned to its start", k, True
-    return points, reason, options.max_steps, False
+            return points, Stop(StopReason.CLOSED, "closed curve: returned to its start"), k
+    return points, Stop(StopReason.STEP_BUDGET, f"step budget of {options.max_steps} steps used"), options.max_steps
 
 
 def _toward(problem: HopfCurveProblem, a: CurvePoint, b: CurvePoint) -> CurvePoint:

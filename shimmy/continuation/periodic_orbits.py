@@ -33,7 +33,7 @@ from .collocation import Mesh, PeriodicProblem
 from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step,
                            tangent, weighted_norm)
 from .errors import ConvergenceError, InvalidInputError
-from .kinds import PointKind
+from .kinds import PointKind, Stop, StopReason
 
 COMPLEX_TOL = 1e-7  # |Im mu| below this (relative) counts as a real multiplier
 
@@ -66,12 +66,17 @@ class PeriodicBranch:
     stable: np.ndarray
     multipliers: np.ndarray  # (points, n) trivial first, then by decreasing modulus
     special_points: list[SpecialPoint]
-    stop_reason: str
+    stops: list[Stop]  # one per direction traced (one here; two where a caller joins two)
     steps: int
     ntst: int
     ncol: int
     solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, u) per point
     trivial_error: float  # max |mu_trivial - 1| over the branch: accuracy check
+    closed: bool = False  # a loop of orbits: its last point joins its first
+
+    @property
+    def stop_reason(self) -> str:
+        return "; ".join(s.message for s in self.stops)
 
     def orbit(self, i: int, system: VectorField, per_interval: int = 12) -> tuple[np.ndarray, np.ndarray]:
         """t (s) and x (k, n) of point i over one period."""
@@ -225,13 +230,13 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
     special: list[SpecialPoint] = []
     amp_first = _amplitude(problem, xmax0, xmin0)
     amp_peak = amp_last = amp_first
-    stop = f"step budget of {copts.max_steps} steps used"
+    stop = Stop(StopReason.STEP_BUDGET, f"step budget of {copts.max_steps} steps used")
     steps = 0
     span = p_max - p_min
     for steps in range(1, copts.max_steps + 1):  # noqa: B007 (steps is reported)
         out = tracer.advance_within(p_min, p_max)
         if out is None:
-            stop = tracer.failed or "Newton failed"
+            stop = tracer.failed
             break
         prev, new, h, bound = out
         if bound is not None:
@@ -239,17 +244,17 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
                 _record(problem, rows, solutions, new)
                 special.extend(_detect(problem, rows, prev, new, copts))
                 special.append(_special(problem, PointKind.END, new, rows))
-            stop = f"reached the parameter bound p = {bound:g}"
+            stop = Stop(StopReason.BOUND, f"reached the parameter bound p = {bound:g}")
             break
         p_new, T_new = new.u[-1], new.u[-2]
         if progress is not None:
             progress(min(1.0, abs(p_new - guess.p) / span))
         if T_new > options.period_max:
-            stop = (f"period {T_new:.4g} at p = {p_new:.6g} above the limit {options.period_max:.4g} "
-                    "(homoclinic approach?); the branch ends at the last orbit below it")
+            stop = Stop(StopReason.PERIOD_LIMIT, f"period {T_new:.4g} at p = {p_new:.6g} above the limit "
+                        f"{options.period_max:.4g} (homoclinic approach?); the branch ends at the last orbit below it")
             break
         if T_new <= 0:
-            stop = "period became non-positive: the continuation left the branch"
+            stop = Stop(StopReason.NONPOSITIVE_PERIOD, "period became non-positive: the continuation left the branch")
             break
         _record(problem, rows, solutions, new)
         found = _detect(problem, rows, prev, new, copts)
@@ -262,15 +267,17 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
             solutions.pop()
             p_end = float(rows["p"][-1])
             special.append(SpecialPoint(PointKind.HOPF, p_end, len(rows["p"]) - 1, {"amplitude": amp_last}))
-            stop = f"amplitude returned to zero near p = {p_end:.6g}: the branch ends at a Hopf point"
+            stop = Stop(StopReason.ZERO_AMPLITUDE,
+                        f"amplitude returned to zero near p = {p_end:.6g}: the branch ends at a Hopf point")
             break
         special.extend(found)
         wanted = [s.kind for s in found if s.kind in options.stop_at]
         if wanted:
-            stop = f"stopped at the first {wanted[0]} point, as asked"
+            stop = Stop(StopReason.REQUESTED_POINT, f"stopped at the first {wanted[0]} point, as asked")
             break
         if _closed(problem, rows):
-            stop = "closed branch: the orbits returned to the first one (a loop of periodic orbits, traversed once)"
+            stop = Stop(StopReason.CLOSED, "closed branch: the orbits returned to the first one (a loop of periodic "
+                        "orbits, traversed once)")
             break
         amp = _amplitude(problem, rows["xmax"][-1], rows["xmin"][-1])
         amp_peak = max(amp_peak, amp)
@@ -278,14 +285,15 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
         if limits is not None:
             message = limits(rows["xmax"][-1], rows["xmin"][-1], T_new, p_new)
             if message:
-                stop = message
+                stop = Stop(StopReason.LIMITS, message)
                 break
         # Shrinking: approach x* with care (a Hopf start only once it has grown; a branch started
         # from an orbit may start at its largest one)
         if amp < amp_last and (amp_peak > 2.0 * amp_first or not hopf_start):
             if amp < amp_stop:
                 special.append(SpecialPoint(PointKind.HOPF, float(p_new), len(rows["p"]) - 1, {"amplitude": amp}))
-                stop = f"amplitude returned to zero near p = {p_new:.6g}: the branch ends at a Hopf point"
+                stop = Stop(StopReason.ZERO_AMPLITUDE,
+                            f"amplitude returned to zero near p = {p_new:.6g}: the branch ends at a Hopf point")
                 break
             tracer.limit_step(0.7 * amp * h / (amp_last - amp))  # do not jump through zero amplitude
         amp_last = amp
@@ -308,7 +316,8 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
     trivial = float(np.max(np.abs(mu[:, 0] - 1.0)))
     return PeriodicBranch(np.array(rows["p"]), np.array(rows["T"]), np.array(rows["xmax"]),
                           np.array(rows["xmin"]), np.abs(mu[:, 1:]).max(axis=1, initial=0.0) < 1.0, mu, special,
-                          stop, steps, problem.mesh.ntst, problem.mesh.ncol, solutions, trivial)
+                          [stop], steps, problem.mesh.ntst, problem.mesh.ncol, solutions, trivial,
+                          closed=stop.reason is StopReason.CLOSED)
 
 
 def _measures(problem: PeriodicProblem, rows) -> np.ndarray:

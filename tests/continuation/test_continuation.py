@@ -329,7 +329,7 @@ def test_two_hopf_points_inside_one_step_are_both_found(delta):
     p_h = np.array([s.p for s in br.special_points[:2]])
     assert np.all(np.abs((p_h - 0.5) ** 2 - delta ** 2) <= options.locate_tol)
     np.testing.assert_allclose(p_h, [0.5 - delta, 0.5 + delta], atol=options.locate_tol / delta)
-    assert all(s.data["located"] for s in br.special_points[:2])
+    assert all(s.located for s in br.special_points[:2])
 
 
 def test_two_pairs_crossing_within_one_step_give_two_hopf_points():

@@ -49,8 +49,8 @@ from ...continuation.errors import ConvergenceError as EngineConvergenceError
 from ...continuation.errors import InvalidInputError as EngineInvalidInputError
 from ...continuation.collocation import Mesh, PeriodicProblem
 from ...model.configurations import Configuration
-from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, PointKind, SpecialPoint, VectorField,
-                           equilibrium_branch, locate, step, tangent, weighted_norm)
+from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, PointKind, Stop, VectorField,
+                             equilibrium_branch, locate, step, tangent, weighted_norm)
 from ...model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.nes import VALID_ANGLE
@@ -132,6 +132,7 @@ class Branch:
     stop_reason: str
     steps: int
     raw: PeriodicBranch | None = None
+    closed: bool = False  # a loop of orbits: its last point joins its first
 
     def to_dict(self) -> dict[str, Any]:
         points = [{"V": float(v), "period": None if math.isnan(T) else float(T), "max_psi": float(a),
@@ -365,7 +366,7 @@ def _periodic_output(raw: PeriodicBranch, params: Parameters, origin: str, hopf_
             d["torus_angle"] = s.data["torus_angle"]
         special.append(d)
     return Branch("periodic", raw.p, raw.period, psi_amp, l_g * delta_amp, raw.stable, modes, special, origin,
-                  raw.stop_reason, raw.steps, raw)
+                  raw.stop_reason, raw.steps, raw, raw.closed)
 
 
 def _with_hopf_ends(branch: Branch, v_start: float, omega: dict[float, float]) -> Branch:
@@ -384,7 +385,7 @@ def _with_hopf_ends(branch: Branch, v_start: float, omega: dict[float, float]) -
     mode = branch.mode[:1] + branch.mode + branch.mode[-1:][:len(tail)]
     return Branch(branch.kind, V, T, np.concatenate([zeros_h, branch.max_psi, zeros_t]),
                   np.concatenate([zeros_h, branch.max_lateral, zeros_t]), stable, mode, branch.special_points,
-                  branch.origin, branch.stop_reason, branch.steps, branch.raw)
+                  branch.origin, branch.stop_reason, branch.steps, branch.raw, branch.closed)
 
 
 def _on_branch(branches: list[Branch], V: float, period: float, psi_amp: float, lat_amp: float) -> bool:
@@ -468,25 +469,28 @@ def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popt
         except EngineConvergenceError as exc:  # the engine's, or ours derived from it
             warnings.append(f"{label} at V = {v_seed:.6g} m/s: {exc}")
             return None
-        if halves[0].stop_reason.startswith("closed branch"):  # a loop: one way round covers it
+        if halves[0].closed:  # a loop: one way round covers it
             return _periodic_output(halves[0], params, f"{label} at V = {v_seed:.6g} m/s", [])
     joined = _join(halves[0], halves[1])
     return _periodic_output(joined, params, f"{label} at V = {v_seed:.6g} m/s", [])
 
 
 def _join(down: PeriodicBranch, up: PeriodicBranch) -> PeriodicBranch:
-    """One branch from two halves continued both ways from the same first point."""
+    """One branch from two halves continued both ways from the same first point (open: a loop is kept
+    from its first half alone)."""
     k = down.p.size
 
     def cat(a, b):
         return np.concatenate([a[::-1], b[1:]])
 
-    special = [SpecialPoint(s.kind, s.p, k - 1 - s.index, s.data, s.solution) for s in down.special_points][::-1]
-    special += [SpecialPoint(s.kind, s.p, k - 1 + s.index, s.data, s.solution) for s in up.special_points]
+    special = [replace(s, index=k - 1 - s.index) for s in down.special_points][::-1]
+    special += [replace(s, index=k - 1 + s.index) for s in up.special_points]
     return PeriodicBranch(cat(down.p, up.p), cat(down.period, up.period), cat(down.x_max, up.x_max),
                           cat(down.x_min, up.x_min), cat(down.stable, up.stable),
                           cat(down.multipliers, up.multipliers), special,
-                          f"decreasing V: {down.stop_reason}; increasing V: {up.stop_reason}",
+                          [Stop(s.reason, f"{way}: {s.message}") for way, half in (("decreasing V", down),
+                                                                                    ("increasing V", up))
+                           for s in half.stops],
                           down.steps + up.steps, up.ntst, up.ncol, down.solutions[::-1] + up.solutions[1:],
                           max(down.trivial_error, up.trivial_error))
 

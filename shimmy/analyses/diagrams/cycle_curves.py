@@ -99,8 +99,8 @@ class GearCycleCurve:
 
 def _located_point(s: SpecialPoint, l_g: float) -> dict[str, Any]:
     out: dict[str, Any] = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
-    if "located" in s.data:
-        out["located"] = bool(s.data["located"])
+    if s.located is not None:
+        out["located"] = s.located
     if "x_max" in s.data:
         xmax, xmin = np.array(s.data["x_max"]), np.array(s.data["x_min"])
         out.update({"period": s.data["period"], "max_psi": float(max(abs(xmax[0]), abs(xmin[0]))),
@@ -133,7 +133,7 @@ class CycleCurvesResult:
         out += [{"kind": PointKind.DOUBLE_HOPF, "V": g["V"], "Fz": g["Fz"]} for g in self.double_hopf_points]
         for c in self.curves:
             for s in c.curve.special_points:
-                if s.kind in MARKS or not s.data.get("located", True):
+                if s.kind in MARKS or s.located is False:
                     continue  # ends and load marks are not codimension-2 points; unlocated ones stay in "curves"
                 entry = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
                 # the same point on two curves (LPNS on a fold and a torus curve) agrees to the

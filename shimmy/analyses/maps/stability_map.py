@@ -110,7 +110,7 @@ def attractors_on(result: BifurcationResult, speeds: np.ndarray) -> list[list[di
         if b.kind != "periodic" or b.V.size < 2:
             continue
         first = np.arange(b.V.size - 1)
-        if b.stop_reason.startswith("closed branch"):  # a loop: its last orbit joins its first
+        if b.closed:  # a loop: its last orbit joins its first
             first = np.append(first, b.V.size - 1)
         second = (first + 1) % b.V.size
         v0s, v1s = b.V[first], b.V[second]
