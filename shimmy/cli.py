@@ -329,11 +329,11 @@ def _cmd_hopf_curves(args) -> int:
     for i, c in enumerate(result.curves, start=1):
         lines.append(f"  curve {i}: {len(c.p)} points, V {c.p[:, 0].min():.4g}..{c.p[:, 0].max():.4g} m/s, "
                      f"Fz {c.p[:, 1].min():.5g}..{c.p[:, 1].max():.5g} N, {'closed' if c.closed else 'open'}")
-        for g in c.gh_points:
-            lines.append(f"      GH  V = {g['p'][0]:.6g} m/s, Fz = {g['p'][1]:.6g} N")
-        for g in c.double_hopf:
-            lines.append(f"      HH  V = {g['p'][0]:.6g} m/s, Fz = {g['p'][1]:.6g} N "
-                         f"({g['omega'] / (2 * math.pi):.4g} and {g['omega2'] / (2 * math.pi):.4g} Hz)")
+        for g in c.points_of(PointKind.GENERALISED_HOPF):
+            lines.append(f"      GH  V = {g.p[0]:.6g} m/s, Fz = {g.p[1]:.6g} N")
+        for g in c.points_of(PointKind.DOUBLE_HOPF):
+            lines.append(f"      HH  V = {g.p[0]:.6g} m/s, Fz = {g.p[1]:.6g} N "
+                         f"({g.data['omega'] / (2 * math.pi):.4g} and {g.data['omega2'] / (2 * math.pi):.4g} Hz)")
     if result.fz_minimum:
         lines.append(f"  lowest load on a Hopf curve: Fz = {result.fz_minimum['Fz']:.6g} N "
                      f"at V = {result.fz_minimum['V']:.6g} m/s")

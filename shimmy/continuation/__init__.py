@@ -3,10 +3,14 @@
 Generic: numpy and scipy only (numba compiles the condensed LU), nothing of the landing gear; tested on
 textbook systems.
 
-* :mod:`.kinds`: :class:`PointKind`, the kinds of special point (H, LP, LPC, NS, PD, GH, ...).
+* :mod:`.kinds`: :class:`PointKind`, the kinds of special point (H, LP, LPC, NS, PD, GH, ...), and
+  :class:`Stop` / :class:`StopReason`, why a branch or curve ended.
+* :mod:`.fields`: the systems continued, :class:`VectorField` x' = f(x, p) and
+  :class:`TwoParameterField` x' = f(x, p1, p2).
+* :mod:`.results`: the one :class:`SpecialPoint` type and :class:`ContinuationResult`, the shape
+  every branch and curve shares (special points, stops, closed, steps, ``to_dict``).
 * :mod:`.core`: pseudo-arclength continuation of F(u) = 0 (predictor, bordered Newton
-  corrector, step control, location of special points), the :class:`VectorField` every
-  curve type continues and the one :class:`SpecialPoint` type.
+  corrector, step control, location of special points).
 * :mod:`.equilibria`: equilibrium branches with eigenvalues, Hopf (H), fold (LP) and branch
   (BP) points.
 * :mod:`.collocation` and :mod:`.periodic_orbits`: periodic orbits by orthogonal collocation
@@ -14,8 +18,8 @@ textbook systems.
   period-doubling (PD) and branch (BPC) points of cycles.
 * :mod:`.cycle_curves`: two-parameter curves of folds (LPC), period doublings (PD) and tori (NS)
   of cycles, with their codimension-2 points;
-* :mod:`.hopf`: two-parameter Hopf curves with generalised Hopf (GH) points;
-  :mod:`.lyapunov`: the first Lyapunov coefficient.
+* :mod:`.hopf`: two-parameter Hopf curves with generalised Hopf (GH), double-Hopf (HH) and
+  zero-Hopf (ZH) points; :mod:`.lyapunov`: the first Lyapunov coefficient.
 
 Continue any ``f(x, p)``: the supercritical Hopf normal form x' = p x - y - x r^2,
 y' = x + p y - y r^2 has x = 0 stable for p < 0, a Hopf point at p = 0 and the stable
@@ -55,24 +59,25 @@ early says why in its ``stop_reason``.
 """
 
 from .collocation import Mesh, PeriodicProblem
-from .cycle_curves import (CODIM2_KINDS, CycleCurve, CycleCurveOptions, CycleCurveProblem,
-                           TwoParameterVectorField, cycle_curve, start_beside)
-from .core import (ContinuationOptions, CurvePoint, CurveProblem, SpecialPoint, Tracer, VectorField, correct,
-                   locate, point_at, step, tangent, weighted_norm)
+from .cycle_curves import CODIM2_KINDS, CycleCurve, CycleCurveOptions, CycleCurveProblem, cycle_curve, start_beside
+from .core import (ContinuationOptions, CurvePoint, CurveProblem, Tracer, correct, locate, point_at, step, tangent,
+                   weighted_norm)
 from .equilibria import EquilibriumBranch, equilibrium_branch
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
+from .fields import TwoParameterField, VectorField
 from .kinds import CYCLE_BIFURCATIONS, PointKind, Stop, StopReason
-from .hopf import HopfCurve, HopfCurveProblem, TwoParameterField, hopf_curve, hopf_start
+from .hopf import HopfCurve, HopfCurveProblem, hopf_curve, hopf_start
 from .lyapunov import first_lyapunov_coefficient, hopf_eigenvectors
 from .periodic_orbits import (OrbitGuess, PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
                               periodic_branch)
+from .results import ContinuationResult, SpecialPoint
 
 __all__ = [
-    "CODIM2_KINDS", "CYCLE_BIFURCATIONS", "ContinuationError", "ContinuationOptions", "ConvergenceError", "CurvePoint",
-    "CurveProblem", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem", "EquilibriumBranch", "HopfCurve",
-    "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess", "PeriodicBranch", "PeriodicOptions",
-    "PeriodicProblem", "PointKind", "SpecialPoint", "Stop", "StopReason", "Tracer", "TwoParameterField",
-    "TwoParameterVectorField", "VectorField", "correct", "cycle_curve", "equilibrium_branch",
+    "CODIM2_KINDS", "CYCLE_BIFURCATIONS", "ContinuationError", "ContinuationOptions", "ContinuationResult",
+    "ConvergenceError", "CurvePoint", "CurveProblem", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem",
+    "EquilibriumBranch", "HopfCurve", "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess",
+    "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "PointKind", "SpecialPoint", "Stop", "StopReason",
+    "Tracer", "TwoParameterField", "VectorField", "correct", "cycle_curve", "equilibrium_branch",
     "first_lyapunov_coefficient", "hopf_curve", "hopf_eigenvectors", "hopf_guess", "hopf_start", "locate",
     "orbit_from_samples", "periodic_branch", "point_at", "start_beside", "step", "tangent", "weighted_norm",
 ]

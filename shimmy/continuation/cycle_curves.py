@@ -54,12 +54,14 @@ from scipy.sparse.linalg import splu
 
 from .collocation import Mesh, PeriodicProblem
 from .condensed_lu import ChainLayout, CondensedLU, collocation_layout
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, condensed_factors,
-                   locate_between, point_at, refine, step, tangent, weighted_norm)
+from .core import (ContinuationOptions, CurvePoint, Tracer, condensed_factors, locate_between, point_at, refine, step,
+                   tangent, weighted_norm)
 from .errors import ContinuationError, ConvergenceError, InvalidInputError
+from .fields import SliceInP1, TwoParameterField
 from .kinds import CYCLE_BIFURCATIONS, PointKind, Stop, StopReason
 from .lyapunov import hopf_eigenvectors
 from .periodic_orbits import PeriodicOptions, hopf_guess, multiplier_crossing_test, periodic_branch
+from .results import ContinuationResult, SpecialPoint
 
 
 LPC, PD, NS = PointKind.FOLD_OF_CYCLES, PointKind.PERIOD_DOUBLING, PointKind.TORUS
@@ -79,51 +81,6 @@ COMPLEX_TOL = 1e-7
 #: only accurate to the square root of the monodromy matrix's error (~1e-6 for the gear)
 LOCATE_TOL = 1e-8
 MULTIPLIER_TOL = 1e-5
-
-
-@dataclass(frozen=True)
-class TwoParameterVectorField:
-    """x' = f(x, p1, p2) with analytic first derivatives, vectorised over columns.
-
-    ``f(x, p)``: x (n,) or (n, m), p = (p1, p2) -> like x; ``dfdx(x, p)``: (n, n) or (m, n, n);
-    ``dfdp(x, p)``: (2, n) or (2, n, m), the derivatives in p1 and p2 stacked.
-    """
-
-    n: int
-    f: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    dfdx: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    dfdp: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    name: str = "system"
-    #: Optional ``evaluate(x, p) -> (f, dfdx, dfdp)`` in one pass (a compiled field's fast path).
-    evaluate: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None
-
-    def all_at(self, x: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(f, dfdx, dfdp with both parameters stacked) at columns x."""
-        if self.evaluate is not None:
-            return self.evaluate(x, p)
-        return self.f(x, p), self.dfdx(x, p), self.dfdp(x, p)
-
-    def at(self, p2: float) -> VectorField:
-        """The one-parameter field in p1 at fixed p2 (for one-parameter branches)."""
-        return _Slice(self, float(p2)).field
-
-
-class _Slice:
-    """The field in p1 at a p2 that can be moved (the curve problems move it every evaluation)."""
-
-    def __init__(self, system: TwoParameterVectorField, p2: float):
-        self.system, self.p2 = system, p2
-        self.field = VectorField(system.n, lambda x, p: system.f(x, np.array([p, self.p2])),
-                                 lambda x, p: system.dfdx(x, np.array([p, self.p2])),
-                                 lambda x, p: system.dfdp(x, np.array([p, self.p2]))[0], system.name,
-                                 self._evaluate if system.evaluate is not None else None)
-
-    def _evaluate(self, x: np.ndarray, p1: float):
-        f, J, fp = self.system.evaluate(x, np.array([p1, self.p2]))
-        return f, J, fp[0]
-
-    def dfdp2(self, x: np.ndarray, p1: float) -> np.ndarray:
-        return self.system.dfdp(x, np.array([p1, self.p2]))[1]
 
 
 @dataclass(frozen=True)
@@ -149,8 +106,9 @@ class CycleCurveOptions:
 
 
 @dataclass
-class CycleCurve:
-    """Points of a curve of cycle bifurcations (one row per point) and its special points."""
+class CycleCurve(ContinuationResult):
+    """Points of a curve of cycle bifurcations (one row per point) and its special points (p1 in
+    ``p``, p2 in their data)."""
 
     kind: PointKind
     p: np.ndarray  # (points, 2)
@@ -159,22 +117,12 @@ class CycleCurve:
     x_min: np.ndarray
     kappa: np.ndarray  # NS: cos of the torus angle; nan otherwise
     multipliers: np.ndarray  # (points, n), trivial first, then by decreasing modulus
-    special_points: list[SpecialPoint]
-    stops: list[Stop]  # one per direction traced
-    steps: int
     solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, cycle u = (x, T, p1)) per point
-    closed: bool = False
-
-    @property
-    def stop_reasons(self) -> list[str]:
-        return [s.message for s in self.stops]
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "p": self.p.tolist(), "period": self.period.tolist(),
                 "x_max": self.x_max.tolist(), "x_min": self.x_min.tolist(),
-                "kappa": [None if not np.isfinite(k) else float(k) for k in self.kappa],
-                "special_points": [s.to_dict() for s in self.special_points], "stop_reasons": self.stop_reasons,
-                "steps": self.steps, "closed": self.closed}
+                "kappa": [None if not np.isfinite(k) else float(k) for k in self.kappa], **super().to_dict()}
 
 
 # --------------------------------------------------------------------------- the defining systems
@@ -192,11 +140,11 @@ FRESH_SWEEPS = 3
 class CycleCurveProblem:
     """The minimally augmented system of one curve type on one mesh, as a curve problem."""
 
-    def __init__(self, system: TwoParameterVectorField, kind: PointKind | str, mesh: Mesh,
+    def __init__(self, system: TwoParameterField, kind: PointKind | str, mesh: Mesh,
                  scale: np.ndarray, T_scale: float, p_scale: np.ndarray, kappa_weight: float = 1.0):
         self.kind = _cycle_bifurcation(kind)
         self.system = system
-        self.slice = _Slice(system, 0.0)
+        self.slice = SliceInP1(system, 0.0)
         self.p_scale = np.asarray(p_scale, float)
         self.cycle = PeriodicProblem(self.slice.field, mesh, scale, T_scale, self.p_scale[0])
         self.mesh, self.n = mesh, system.n
@@ -609,7 +557,7 @@ def _crossing_test(problem: "CycleCurveProblem", which: str) -> Callable[[CurveP
     return g
 
 
-def cycle_curve(system: TwoParameterVectorField, kind: PointKind | str, start: tuple[np.ndarray, np.ndarray],
+def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[np.ndarray, np.ndarray],
                 p2: float, box: tuple[tuple[float, float], tuple[float, float]], scale: np.ndarray,
                 p_scale: tuple[float, float], kappa: float | None = None, options: CycleCurveOptions | None = None,
                 ncol: int = 4, directions: tuple[int, ...] = (1, -1), p2_marks: tuple[float, ...] = (),
@@ -659,7 +607,7 @@ def cycle_curve(system: TwoParameterVectorField, kind: PointKind | str, start: t
     return _join(kind, halves, stops, steps_total)
 
 
-def start_beside(system: TwoParameterVectorField, kind: PointKind | str, x_star: np.ndarray,
+def start_beside(system: TwoParameterField, kind: PointKind | str, x_star: np.ndarray,
                  p: np.ndarray, p1_range: tuple[float, float], scale: np.ndarray, p1_scale: float,
                  options: PeriodicOptions | None = None, limits=None) -> tuple[SpecialPoint | None, int]:
     """A start for :func:`cycle_curve` near a codimension-2 point of an equilibrium: the first
@@ -947,5 +895,6 @@ def _join(kind: PointKind, halves, stops, steps) -> CycleCurve:
     mu = gather("mu")
     special.sort(key=lambda s: s.index)
     return CycleCurve(kind, np.array(gather("p")), np.array(gather("T")), np.array(gather("xmax")),
-                      np.array(gather("xmin")), np.array(gather("kappa"), float), np.array(mu), special, stops,
-                      steps, gather("solutions"), closed=any(s.reason is StopReason.CLOSED for s in stops))
+                      np.array(gather("xmin")), np.array(gather("kappa"), float), np.array(mu), gather("solutions"),
+                      special_points=special, stops=stops, steps=steps,
+                      closed=any(s.reason is StopReason.CLOSED for s in stops))

@@ -10,13 +10,15 @@ sign) or a branch point BP (real eigenvalue, no fold). Each is located to
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import scipy.linalg as la
 
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, correct, locate, step, tangent,
-                   weighted_norm)
+from .core import ContinuationOptions, CurvePoint, Tracer, correct, locate, step, tangent, weighted_norm
+from .fields import VectorField
 from .kinds import PointKind, Stop, StopReason
+from .results import ContinuationResult, SpecialPoint
 
 
 @dataclass
@@ -36,23 +38,22 @@ class EquilibriumProblem:
 
 
 @dataclass
-class EquilibriumBranch:
+class EquilibriumBranch(ContinuationResult):
+    """Points of an equilibrium branch (one row per point), traced one way: one stop, never closed."""
+
     p: np.ndarray
     x: np.ndarray  # (points, n)
     eigenvalues: np.ndarray  # (points, n), sorted by decreasing real part
     stable: np.ndarray
-    special_points: list[SpecialPoint]
-    stops: list[Stop]  # one: the branch is traced one way
-    steps: int
-    closed: bool = False  # never: the branch is traced until it leaves the range
-
-    @property
-    def stop_reason(self) -> str:
-        return "; ".join(s.message for s in self.stops)
 
     @property
     def n_unstable(self) -> np.ndarray:
         return (self.eigenvalues.real > 0).sum(axis=1)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"p": self.p.tolist(), "x": self.x.tolist(), "eigenvalues_real": self.eigenvalues.real.tolist(),
+                "eigenvalues_imag": self.eigenvalues.imag.tolist(), "stable": self.stable.tolist(),
+                **super().to_dict()}
 
 
 def _sorted_eigenvalues(A: np.ndarray) -> np.ndarray:
@@ -104,7 +105,8 @@ def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, p_min: fl
             break
     u = np.array([q.u for q in points])
     ev = np.array(eigs)
-    return EquilibriumBranch(u[:, -1], u[:, :-1], ev, ev[:, 0].real < 0, special, [stop], steps)
+    return EquilibriumBranch(u[:, -1], u[:, :-1], ev, ev[:, 0].real < 0, special_points=special, stops=[stop],
+                             steps=steps)
 
 
 def _eigen_slopes(A: np.ndarray, dA: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,6 +1,6 @@
 """Two-parameter continuation of Hopf points of equilibria, with generalised Hopf (GH) points.
 
-Generic (any :class:`TwoParameterField`). Unknowns u = (x, a, b, omega, p1, p2) with
+Generic (any :class:`~.fields.TwoParameterField`). Unknowns u = (x, a, b, omega, p1, p2) with
 q = a + i b the critical eigenvector, and the 3n + 2 equations (the standard extended
 system, Kuznetsov 3rd ed., sec. 10.2.2):
 
@@ -25,29 +25,16 @@ leaves the parameter box (end point located on the boundary), returns to its sta
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import Callable
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from . import lyapunov
 from .core import ContinuationOptions, CurvePoint, Tracer, correct, locate, tangent, weighted_norm
-from .kinds import Stop, StopReason
-
-
-@dataclass(frozen=True)
-class TwoParameterField:
-    """x' = f(x, p) with p = (p1, p2); ``dfdx(x, p)`` (n, n) and ``dfdp(x, p)`` (n, 2), analytic.
-
-    ``dfdx`` must accept complex x for the Lyapunov coefficient (complex-analytic f);
-    ``smooth`` False (e.g. a |v|^(1/2) v term) skips l1 and GH detection.
-    """
-
-    n: int
-    f: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    dfdx: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    dfdp: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    smooth: bool = True
+from .fields import TwoParameterField
+from .kinds import PointKind, Stop, StopReason
+from .results import ContinuationResult, SpecialPoint
 
 
 class HopfCurveProblem:
@@ -94,7 +81,7 @@ class HopfCurveProblem:
 
         Ja, Jb = along(a), along(b)
         Jp = [in_p(0), in_p(1)]
-        fp = s.dfdp(x, p)
+        fp = s.dfdp(x, p).T  # (n, 2)
         out = np.zeros((3 * n + 2, 3 * n + 3))
         eye = np.eye(n)
         out[:n, :n], out[:n, 3 * n + 1:] = J, fp
@@ -120,23 +107,21 @@ class HopfCurveProblem:
 
 
 @dataclass
-class HopfCurve:
+class HopfCurve(ContinuationResult):
+    """Points of a Hopf curve (one row per point) and its special points, each at p = (p1, p2) with
+    the critical frequency ``omega`` in its data: generalised Hopf (GH, with its ``lyapunov``),
+    double Hopf (HH, with the other pair's ``omega2``), zero-Hopf (ZH) and the turning points in p2
+    (P2_TURN)."""
+
     p: np.ndarray  # (points, 2)
     x: np.ndarray  # (points, n)
     omega: np.ndarray
     lyapunov: np.ndarray  # nan where the field is not smooth
-    gh_points: list[dict]  # {"p": (p1, p2), "omega": ...}
-    extrema: list[dict]  # turning points in p2 (dp2/ds = 0): {"p": (p1, p2), "omega": ...}
-    stops: list[Stop]  # one per direction traced
-    steps: int
-    closed: bool = False
-    warnings: list[str] = field(default_factory=list)
-    double_hopf: list[dict] = field(default_factory=list)  # {"p", "omega", "omega2", "located"}
-    zero_hopf: list[dict] = field(default_factory=list)  # {"p", "omega", "located"}
 
-    @property
-    def stop_reasons(self) -> list[str]:
-        return [s.message for s in self.stops]
+    def to_dict(self) -> dict[str, Any]:
+        return {"p": self.p.tolist(), "x": self.x.tolist(), "omega": self.omega.tolist(),
+                "lyapunov": [None if not math.isfinite(v) else float(v) for v in self.lyapunov],
+                **super().to_dict()}
 
 
 def hopf_start(x: np.ndarray, p: np.ndarray, J: np.ndarray) -> tuple[np.ndarray, float]:
@@ -166,7 +151,7 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
     u0 = out[0]
     problem.accept(u0)
     t0 = tangent(problem, u0, guess)
-    halves, stops, warnings, steps, closed = [], [], [], 0, False
+    halves, stops, steps, closed = [], [], 0, False
     for sign in (1.0, -1.0):
         problem.accept(u0)
         part, stop, n_steps = _trace(problem, CurvePoint(u0, sign * t0), box, options, u0)
@@ -180,13 +165,12 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
     U = np.array([q.u for q in points])
     n = system.n
     l1 = np.array([problem.lyapunov(u) if system.smooth else math.nan for u in U])
-    gh = []
+    special = []
     if system.smooth:
         for i in range(len(points) - 1):
             if np.isfinite(l1[i]) and np.isfinite(l1[i + 1]) and l1[i] * l1[i + 1] < 0:
-                gh.append(_locate_gh(problem, points[i], points[i + 1], l1[i], l1[i + 1], options))
-    double_hopf, zero_hopf = _other_crossings(problem, points, options)
-    extrema = []
+                special.append(_locate_gh(problem, points[i], points[i + 1], l1[i], l1[i + 1], options, i + 1))
+    special += _other_crossings(problem, points, options)
     for i in range(len(points) - 1):
         ta, tb = points[i].tangent[-1], points[i + 1].tangent[-1]
         if ta * tb < 0 and np.dot(points[i].tangent, problem.weights * points[i + 1].tangent) > 0:
@@ -196,9 +180,18 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
             sign = 1.0 if a.tangent[-1] == ta else -1.0  # the test along the step's direction
             hit = locate(problem, a, h, lambda q: q.tangent[-1], sign * ta, sign * tb, options)
             at = hit[0] if hit is not None else points[i]
-            extrema.append({"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n])})
-    return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, gh, extrema, stops, steps, closed, warnings,
-                     double_hopf, zero_hopf)
+            special.append(_special(problem, PointKind.P2_TURN, at, i + 1, hit is not None))
+    special.sort(key=lambda s: s.index)
+    return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, special_points=special, stops=stops, steps=steps,
+                     closed=closed)
+
+
+def _special(problem: HopfCurveProblem, kind: PointKind, at: CurvePoint, index: int, located: bool,
+             **data: float) -> SpecialPoint:
+    """A special point of a Hopf curve at the curve point ``at``: p = (p1, p2), omega and ``data``."""
+    n = problem.n
+    return SpecialPoint(kind, tuple(at.u[3 * n + 1:].tolist()), index, {"omega": float(at.u[3 * n]), **data},
+                        located)
 
 
 def _other_eigenvalues(problem: HopfCurveProblem, u: np.ndarray) -> np.ndarray:
@@ -226,12 +219,12 @@ def _crossing_tests(problem: HopfCurveProblem, u: np.ndarray) -> tuple[float, fl
     return hh, zh
 
 
-def _other_crossings(problem: HopfCurveProblem, points: list[CurvePoint], options: ContinuationOptions):
+def _other_crossings(problem: HopfCurveProblem, points: list[CurvePoint],
+                     options: ContinuationOptions) -> list[SpecialPoint]:
     """Double-Hopf (a second pair on the imaginary axis) and zero-Hopf (a zero eigenvalue) points
     along the curve, each located by the secant method on its test function."""
     tests = np.array([_crossing_tests(problem, q.u) for q in points])
-    n = problem.n
-    found: tuple[list[dict], list[dict]] = ([], [])
+    found = []
     for which in (0, 1):
         g = tests[:, which]
         for i in range(len(points) - 1):
@@ -242,12 +235,13 @@ def _other_crossings(problem: HopfCurveProblem, points: list[CurvePoint], option
             h = weighted_norm(points[i + 1].u - a.u, problem.weights)
             hit = locate(problem, a, h, lambda q, w=which: _crossing_tests(problem, q.u)[w], g[i], g[i + 1], options)
             at = hit[0] if hit is not None else points[i + 1]
-            entry = {"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n]), "located": hit is not None}
             if which == 0:
                 ev = _other_eigenvalues(problem, at.u)
                 pair = ev[ev.imag > 0]
-                entry["omega2"] = float(pair[np.argmin(np.abs(pair.real))].imag) if pair.size else math.nan
-            found[which].append(entry)
+                omega2 = float(pair[np.argmin(np.abs(pair.real))].imag) if pair.size else math.nan
+                found.append(_special(problem, PointKind.DOUBLE_HOPF, at, i + 1, hit is not None, omega2=omega2))
+            else:
+                found.append(_special(problem, PointKind.ZERO_HOPF, at, i + 1, hit is not None))
     return found
 
 
@@ -297,12 +291,11 @@ def _toward(problem: HopfCurveProblem, a: CurvePoint, b: CurvePoint) -> CurvePoi
 
 
 def _locate_gh(problem: HopfCurveProblem, a: CurvePoint, b: CurvePoint, la: float, lb: float,
-               options: ContinuationOptions) -> dict:
+               options: ContinuationOptions, index: int) -> SpecialPoint:
     a = _toward(problem, a, b)
     problem.accept(a.u)
     h = weighted_norm(b.u - a.u, problem.weights)
     hit = locate(problem, a, h, lambda q: problem.lyapunov(q.u), la, lb, options)
     at = hit[0] if hit is not None else b
-    n = problem.n
-    return {"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n]),
-            "lyapunov": float(problem.lyapunov(at.u))}
+    return _special(problem, PointKind.GENERALISED_HOPF, at, index, hit is not None,
+                    lyapunov=float(problem.lyapunov(at.u)))

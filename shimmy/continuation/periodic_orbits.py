@@ -30,10 +30,11 @@ from typing import Any, Callable
 import numpy as np
 
 from .collocation import Mesh, PeriodicProblem
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step,
-                           tangent, weighted_norm)
+from .core import ContinuationOptions, CurvePoint, Tracer, locate, step, tangent, weighted_norm
 from .errors import ConvergenceError, InvalidInputError
+from .fields import VectorField
 from .kinds import PointKind, Stop, StopReason
+from .results import ContinuationResult, SpecialPoint
 
 COMPLEX_TOL = 1e-7  # |Im mu| below this (relative) counts as a real multiplier
 
@@ -56,8 +57,9 @@ class PeriodicOptions:
 
 
 @dataclass
-class PeriodicBranch:
-    """Points of a branch of periodic orbits (one row per point) and its special points."""
+class PeriodicBranch(ContinuationResult):
+    """Points of a branch of periodic orbits (one row per point) and its special points; one stop
+    (two where a caller joins the branches continued both ways)."""
 
     p: np.ndarray
     period: np.ndarray
@@ -65,18 +67,16 @@ class PeriodicBranch:
     x_min: np.ndarray
     stable: np.ndarray
     multipliers: np.ndarray  # (points, n) trivial first, then by decreasing modulus
-    special_points: list[SpecialPoint]
-    stops: list[Stop]  # one per direction traced (one here; two where a caller joins two)
-    steps: int
     ntst: int
     ncol: int
     solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, u) per point
     trivial_error: float  # max |mu_trivial - 1| over the branch: accuracy check
-    closed: bool = False  # a loop of orbits: its last point joins its first
 
-    @property
-    def stop_reason(self) -> str:
-        return "; ".join(s.message for s in self.stops)
+    def to_dict(self) -> dict[str, Any]:
+        return {"p": self.p.tolist(), "period": self.period.tolist(), "x_max": self.x_max.tolist(),
+                "x_min": self.x_min.tolist(), "stable": self.stable.tolist(),
+                "multipliers_abs": np.abs(self.multipliers).tolist(), "ntst": self.ntst, "ncol": self.ncol,
+                "trivial_error": self.trivial_error, **super().to_dict()}
 
     def orbit(self, i: int, system: VectorField, per_interval: int = 12) -> tuple[np.ndarray, np.ndarray]:
         """t (s) and x (k, n) of point i over one period."""
@@ -315,9 +315,9 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
     mu = np.array(rows["mu"])
     trivial = float(np.max(np.abs(mu[:, 0] - 1.0)))
     return PeriodicBranch(np.array(rows["p"]), np.array(rows["T"]), np.array(rows["xmax"]),
-                          np.array(rows["xmin"]), np.abs(mu[:, 1:]).max(axis=1, initial=0.0) < 1.0, mu, special,
-                          [stop], steps, problem.mesh.ntst, problem.mesh.ncol, solutions, trivial,
-                          closed=stop.reason is StopReason.CLOSED)
+                          np.array(rows["xmin"]), np.abs(mu[:, 1:]).max(axis=1, initial=0.0) < 1.0, mu,
+                          problem.mesh.ntst, problem.mesh.ncol, solutions, trivial, special_points=special,
+                          stops=[stop], steps=steps, closed=stop.reason is StopReason.CLOSED)
 
 
 def _measures(problem: PeriodicProblem, rows) -> np.ndarray:

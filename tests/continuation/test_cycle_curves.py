@@ -167,8 +167,8 @@ def test_a_fold_and_two_torus_points_in_one_step_are_all_found(ds_max):
 
 def swapped(system):
     """The same field with p1 and p2 exchanged."""
-    from shimmy.continuation import TwoParameterVectorField
-    return TwoParameterVectorField(system.n, lambda x, p: system.f(x, p[::-1]), lambda x, p: system.dfdx(x, p[::-1]),
+    from shimmy.continuation import TwoParameterField
+    return TwoParameterField(system.n, lambda x, p: system.f(x, p[::-1]), lambda x, p: system.dfdx(x, p[::-1]),
                                    lambda x, p: system.dfdp(x, p[::-1])[::-1], "swapped " + system.name)
 
 
@@ -189,7 +189,7 @@ def test_turning_points_in_p2_and_crossings_of_marked_loads_are_located():
 def test_double_hopf_point_of_two_uncoupled_oscillators_is_located_on_the_hopf_curve():
     """x' = (p1 + i) x - |x|^2 x, y' = (p2 + 2i) y - |y|^2 y (complex x, y): the Hopf curve p1 = 0 has
     a double-Hopf point at p2 = 0 with frequencies 1 and 2."""
-    from shimmy.continuation import TwoParameterField, hopf_curve
+    from shimmy.continuation import PointKind, TwoParameterField, hopf_curve
 
     def parts(z):
         return z[0] + 1j * z[1], z[2] + 1j * z[3]
@@ -209,15 +209,15 @@ def test_double_hopf_point_of_two_uncoupled_oscillators_is_located_on_the_hopf_c
         return J
 
     def dfdp(z, p):
-        return np.array([[z[0], 0.0], [z[1], 0.0], [0.0, z[2]], [0.0, z[3]]])
+        return np.array([[z[0], z[1], 0.0, 0.0], [0.0, 0.0, z[2], z[3]]])
 
     curve = hopf_curve(TwoParameterField(4, f, dfdx, dfdp), np.zeros(4), np.array([0.0, 0.5]), ((-1, 1), (-1, 1)),
                        np.ones(4), np.ones(2))
     np.testing.assert_allclose(curve.p[:, 0], 0.0, atol=1e-10)
-    assert len(curve.double_hopf) == 1
-    hh = curve.double_hopf[0]
-    assert abs(hh["p"][1]) < 1e-8 and hh["located"]
-    assert hh["omega"] == pytest.approx(1.0) and hh["omega2"] == pytest.approx(2.0)
+    assert len(curve.points_of(PointKind.DOUBLE_HOPF)) == 1
+    hh = curve.points_of(PointKind.DOUBLE_HOPF)[0]
+    assert abs(hh.p[1]) < 1e-8 and hh.located
+    assert hh.data["omega"] == pytest.approx(1.0) and hh.data["omega2"] == pytest.approx(2.0)
 
 
 def test_fold_curve_started_beside_the_generalised_hopf_point():
@@ -239,7 +239,7 @@ def coupled_oscillators(w2: float = 2.3):
     y' = (p2 + i w2) y + (|x|^2 - |y|^2) y. A double-Hopf point at (0, 0); the cycle |x|^2 = p1
     (T = 2 pi, y = 0) has the fibre multipliers exp(2 pi (p2 + p1)) exp(+-2 pi i w2): the torus curve
     p2 = -p1, p1 > 0, born at the double-Hopf point, kappa = cos(2 pi w2)."""
-    from shimmy.continuation import TwoParameterVectorField
+    from shimmy.continuation import TwoParameterField
 
     def f(z, p):
         x, y = z[0] + 1j * z[1], z[2] + 1j * z[3]
@@ -265,7 +265,7 @@ def coupled_oscillators(w2: float = 2.3):
         zero = 0.0 * z[0]
         return np.stack([np.stack([z[0], z[1], zero, zero]), np.stack([zero, zero, z[2], z[3]])])
 
-    return TwoParameterVectorField(4, f, dfdx, dfdp, "coupled_oscillators")
+    return TwoParameterField(4, f, dfdx, dfdp, "coupled_oscillators")
 
 
 def test_coupled_oscillators_have_exact_jacobians():

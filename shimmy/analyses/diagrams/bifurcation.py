@@ -487,12 +487,11 @@ def _join(down: PeriodicBranch, up: PeriodicBranch) -> PeriodicBranch:
     special += [replace(s, index=k - 1 + s.index) for s in up.special_points]
     return PeriodicBranch(cat(down.p, up.p), cat(down.period, up.period), cat(down.x_max, up.x_max),
                           cat(down.x_min, up.x_min), cat(down.stable, up.stable),
-                          cat(down.multipliers, up.multipliers), special,
-                          [Stop(s.reason, f"{way}: {s.message}") for way, half in (("decreasing V", down),
-                                                                                    ("increasing V", up))
-                           for s in half.stops],
-                          down.steps + up.steps, up.ntst, up.ncol, down.solutions[::-1] + up.solutions[1:],
-                          max(down.trivial_error, up.trivial_error))
+                          cat(down.multipliers, up.multipliers), up.ntst, up.ncol,
+                          down.solutions[::-1] + up.solutions[1:], max(down.trivial_error, up.trivial_error),
+                          special_points=special, steps=down.steps + up.steps,
+                          stops=[Stop(s.reason, f"{way}: {s.message}")
+                                 for way, half in (("decreasing V", down), ("increasing V", up)) for s in half.stops])
 
 
 def _restore(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray,

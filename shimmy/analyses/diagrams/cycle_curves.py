@@ -31,14 +31,14 @@ import numpy as np
 
 from ...version import __version__
 from ...continuation import (CYCLE_BIFURCATIONS, ContinuationOptions, CycleCurve, CycleCurveOptions, PointKind,
-                             SpecialPoint, TwoParameterVectorField, cycle_curve, start_beside)
+                             SpecialPoint, cycle_curve, start_beside)
 from ...continuation.errors import ContinuationError
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
-from ...model.equations import build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
+from ...model.equations import build_model
 from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, _limits, bifurcation
-from .hopf_curves import hopf_curves
+from .hopf_curves import gear_two_parameter_field, hopf_curves
 from ..core.polylines import near_polyline
 from ..core.executors import open_executor, run_dynamic
 from ..core.stability import hopf_points
@@ -55,19 +55,6 @@ CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_m
 BESIDE = 0.015  # relative offset in Fz from a GH / double-Hopf point to the Hopf point a start branch leaves
 START_STEPS = 80  # step budget of a start branch
 SCAN_FRACTIONS = (0.3, 0.6, 0.9)  # loads of the one-parameter diagrams, as fractions of the box in Fz
-
-
-def gear_cycle_field(config: Configuration, params: Parameters) -> TwoParameterVectorField:
-    """The gear's vector field in (V, Fz), vectorised over columns, analytic derivatives."""
-    model = build_model(config, params)
-
-    def evaluate(x, p):
-        f, J, dV, dFz = field_and_derivatives(model, x, p[0], p[1])
-        return f, J, np.stack([dV, dFz])
-    return TwoParameterVectorField(model.n_states, lambda x, p: rhs(model, x, p[0], p[1]),
-                                   lambda x, p: jacobian(model, x, p[0], p[1]),
-                                   lambda x, p: np.stack(parameter_jacobian(model, x, p[0], p[1])),
-                                   f"{config.value} in (V, Fz)", evaluate)
 
 
 @dataclass(eq=False)  # compared by identity: list.remove takes the very start
@@ -220,10 +207,10 @@ class CurveSearch:
 
     def start_units(self, hopf) -> list[tuple]:
         """The branches beside the GH points (fold curves) and double-Hopf points (torus curves)."""
-        self.gh = [{"V": g["p"][0], "Fz": g["p"][1]} for c in hopf.curves for g in c.gh_points]
+        self.gh = [{"V": g.p[0], "Fz": g.p[1]} for c in hopf.curves for g in c.points_of(PointKind.GENERALISED_HOPF)]
         for c in hopf.curves:
-            for g in c.double_hopf:
-                entry = {"V": g["p"][0], "Fz": g["p"][1], "omega": g["omega"], "omega2": g["omega2"]}
+            for g in c.points_of(PointKind.DOUBLE_HOPF):
+                entry = {"V": g.p[0], "Fz": g.p[1], "omega": g.data["omega"], "omega2": g.data["omega2"]}
                 if not any(_close(entry, e, 1e-4) for e in self.hh):
                     self.hh.append(entry)
         units = [("beside", self.config, self.params, g, PointKind.FOLD_OF_CYCLES, self.box,
@@ -409,7 +396,7 @@ def _find_starts(task: tuple) -> tuple[list[Start], list[str]]:
 def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
     """One curve continued from one start (a unit of :func:`cycle_curves`)."""
     config, params, start, box, loads = task
-    system = gear_cycle_field(config, params)
+    system = gear_two_parameter_field(config, params)
     kappa = math.cos(start.point.data["torus_angle"]) if start.kind == PointKind.TORUS else None
     if kappa is not None and not -1.0 < kappa < 1.0:
         return None, None
@@ -440,7 +427,7 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
     Hopf points just above and below the codimension-2 point's load."""
     out = []
     n = model.n_states
-    system = gear_cycle_field(config, params)
+    system = gear_two_parameter_field(config, params)
     options = BifurcationOptions(max_steps=START_STEPS).periodic()
     for side in (-1.0, 1.0):
         Fz = point["Fz"] * (1.0 + side * BESIDE)

@@ -7,7 +7,8 @@ import sys
 import numpy as np
 import pytest
 
-from shimmy.analyses.diagrams.bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, cycle_at, gear_field
+from shimmy.analyses.diagrams.bifurcation import (STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, cycle_at,
+                                                  gear_field)
 from shimmy.continuation import ContinuationOptions, equilibrium_branch
 from shimmy.model.equations import build_model
 from shimmy.errors import InvalidParameterError

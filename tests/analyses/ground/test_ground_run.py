@@ -7,7 +7,8 @@ import pytest
 
 import shimmy
 from shimmy.analyses.diagrams.bifurcation import bifurcation
-from shimmy.analyses.ground.ground_profiles import MAX_PROFILE_POINTS, PRESETS, preset, preset_fields, profile_from_table
+from shimmy.analyses.ground.ground_profiles import (MAX_PROFILE_POINTS, PRESETS, preset, preset_fields,
+                                                   profile_from_table)
 from shimmy.analyses.ground.ground_run import GroundRunOptions, _segment_hits, ground_run, ground_runs
 from shimmy.analyses.diagrams.hopf_curves import FZ_SCALE, V_SCALE, hopf_curves
 from shimmy.analyses.core.polylines import near_polyline
