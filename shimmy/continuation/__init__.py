@@ -43,19 +43,18 @@ cycle r = sqrt(p) with period 2 pi for p > 0::
         return J
 
     hopf_normal_form = VectorField(2, f, dfdx, lambda x, p: x.copy(), "hopf")
-    eq = equilibrium_branch(hopf_normal_form, np.zeros(2), -0.5, -0.5, 0.5)
+    eq = equilibrium_branch(hopf_normal_form, np.zeros(2), -0.5, p_range=(-0.5, 0.5))
     H = next(s for s in eq.special_points if s.kind == PointKind.HOPF)  # H.p ~ 0, H.data["omega"] ~ 1
     omega, q, _ = hopf_eigenvectors(dfdx(np.array(H.data["x"]), H.p))
     options = PeriodicOptions(ntst=20, ncol=4)
     guess, shape = hopf_guess(np.array(H.data["x"]), H.p, omega, q,
                               Mesh.uniform(options.ntst, options.ncol), 0.0)
-    cycles = periodic_branch(hopf_normal_form, guess, -0.5, 0.5, np.ones(2), 1.0, options,
-                             direction=shape)
+    cycles = periodic_branch(hopf_normal_form, guess, p_range=(-0.5, 0.5), options=options, direction=shape)
     # cycles.p, cycles.period (~2 pi), cycles.x_max[:, 0] (~ sqrt(p)), cycles.stable (True)
 
 Errors: :class:`InvalidInputError` for bad options or starts, :class:`ConvergenceError` when
-a start does not converge; both derive from :class:`ContinuationError`. A branch that stops
-early says why in its ``stop_reason``.
+a start does not converge; both derive from :class:`ContinuationError`. A branch or curve says
+why it ended in its ``stops``: a :class:`StopReason` and a message for each direction traced.
 """
 
 from .collocation import Mesh, PeriodicProblem

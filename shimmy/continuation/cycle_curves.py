@@ -558,15 +558,17 @@ def _crossing_test(problem: "CycleCurveProblem", which: str) -> Callable[[CurveP
 
 
 def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[np.ndarray, np.ndarray],
-                p2: float, box: tuple[tuple[float, float], tuple[float, float]], scale: np.ndarray,
-                p_scale: tuple[float, float], kappa: float | None = None, options: CycleCurveOptions | None = None,
-                ncol: int = 4, directions: tuple[int, ...] = (1, -1), p2_marks: tuple[float, ...] = (),
+                p2: float, *, box: tuple[tuple[float, float], tuple[float, float]],
+                options: CycleCurveOptions | None = None, scale: np.ndarray | None = None,
+                p_scale: tuple[float, float] = (1.0, 1.0), kappa: float | None = None, ncol: int = 4,
+                directions: tuple[int, ...] = (1, -1), p2_marks: tuple[float, ...] = (),
                 progress: Callable[[float], None] | None = None) -> CycleCurve:
     """Continue a fold (LPC), period doubling (PD) or torus (NS) point of a cycle in (p1, p2).
 
     ``start`` = (mesh points, cycle u = (x at the nodes, T, p1)): a located special point of a
     one-parameter branch in p1 at ``p2`` (``PeriodicBranch.solutions`` at its index); for NS,
-    ``kappa`` = cos of the torus angle there. ``box`` bounds (p1, p2). Traced in both directions
+    ``kappa`` = cos of the torus angle there. ``box`` bounds (p1, p2); ``scale`` (n,) and ``p_scale``
+    set the size of a unit step in the states and in (p1, p2). Traced in both directions
     (``directions``: +1 first increases p2); the two halves are joined into one curve. Where the
     curve turns in p2 a ``P2_TURN`` point is located, and where it crosses a value of ``p2_marks``
     a ``P2_MARK`` point (both with the cycle's period and extremes).
@@ -580,6 +582,7 @@ def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[n
             raise InvalidInputError(name, (low, high), "finite bounds, low < high")
     mesh_points, cu = start
     mesh = Mesh(np.asarray(mesh_points, float), ncol)
+    scale = np.ones(system.n) if scale is None else scale
     problem = CycleCurveProblem(system, kind, mesh, scale, float(cu[-2]), np.asarray(p_scale, float),
                                 options.kappa_weight)
     u0 = np.concatenate([cu, [p2]] + ([[kappa]] if kind is NS else []))
@@ -607,13 +610,15 @@ def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[n
     return _join(kind, halves, stops, steps_total)
 
 
-def start_beside(system: TwoParameterField, kind: PointKind | str, x_star: np.ndarray,
-                 p: np.ndarray, p1_range: tuple[float, float], scale: np.ndarray, p1_scale: float,
-                 options: PeriodicOptions | None = None, limits=None) -> tuple[SpecialPoint | None, int]:
+def start_beside(system: TwoParameterField, kind: PointKind | str, x_star: np.ndarray, p: np.ndarray, *,
+                 p_range: tuple[float, float], options: PeriodicOptions | None = None,
+                 scale: np.ndarray | None = None, p_scale: float = 1.0,
+                 limits=None) -> tuple[SpecialPoint | None, int]:
     """A start for :func:`cycle_curve` near a codimension-2 point of an equilibrium: the first
-    ``kind`` point of the cycle branch born at the Hopf point (x_star, p) (continued in p1 at
-    p2 = p[1]). Beside a generalised Hopf point that is the small-amplitude fold of the fold curve
-    born there; beside a double-Hopf point, the torus point of a torus curve born there. Returns
+    ``kind`` point of the cycle branch born at the Hopf point (x_star, p) (continued in p1 over
+    ``p_range`` at p2 = p[1], with :func:`~.periodic_orbits.periodic_branch`'s ``scale``,
+    ``p_scale`` and ``limits``). Beside a generalised Hopf point that is the small-amplitude fold
+    of the fold curve born there; beside a double-Hopf point, the torus point of a torus curve born there. Returns
     (the located point with its solution, or None; the collocation degree of its mesh)."""
     kind = _cycle_bifurcation(kind)
     options = replace(options or PeriodicOptions(), stop_at=(kind,))
@@ -622,7 +627,7 @@ def start_beside(system: TwoParameterField, kind: PointKind | str, x_star: np.nd
     omega, q, _ = hopf_eigenvectors(field_.dfdx(x_star, float(p[0])))
     guess, shape = hopf_guess(x_star, float(p[0]), omega, q, Mesh.uniform(options.ntst, options.ncol), 0.0)
     try:
-        branch = periodic_branch(field_, guess, p1_range[0], p1_range[1], scale, p1_scale, options,
+        branch = periodic_branch(field_, guess, p_range=p_range, options=options, scale=scale, p_scale=p_scale,
                                  direction=shape, limits=limits)
     except ContinuationError:
         return None, options.ncol

@@ -61,15 +61,16 @@ def _sorted_eigenvalues(A: np.ndarray) -> np.ndarray:
     return ev[np.argsort(-ev.real, kind="stable")]
 
 
-def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, p_min: float, p_max: float,
+def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, *, p_range: tuple[float, float],
                        options: ContinuationOptions | None = None, scale: np.ndarray | None = None,
                        p_scale: float = 1.0, direction: int = 1) -> EquilibriumBranch:
-    """Continue the equilibrium through (x0, p0) in p over [p_min, p_max].
+    """Continue the equilibrium through (x0, p0) in p over ``p_range`` = (p_min, p_max).
 
     ``scale`` (n,) and ``p_scale`` set the size of a unit step in each unknown; ``direction``
     +1 follows increasing p first. Stops at the parameter bounds (exactly, as an EP point),
     after ``max_steps`` or when the step size underflows.
     """
+    p_min, p_max = p_range
     options = options or ContinuationOptions()
     n = system.n
     scale = np.ones(n) if scale is None else np.asarray(scale, float)

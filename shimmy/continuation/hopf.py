@@ -133,12 +133,14 @@ def hopf_start(x: np.ndarray, p: np.ndarray, J: np.ndarray) -> tuple[np.ndarray,
     return np.concatenate([x, q.real, q.imag]), float(ev[i].imag)
 
 
-def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: tuple[tuple[float, float],
-               tuple[float, float]], x_scale: np.ndarray, p_scale: np.ndarray,
-               options: ContinuationOptions | None = None) -> HopfCurve:
-    """Continue the Hopf point (x0, p0) both ways until it leaves ``box`` ((p1 range), (p2 range))."""
+def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, *,
+               box: tuple[tuple[float, float], tuple[float, float]], options: ContinuationOptions | None = None,
+               scale: np.ndarray | None = None, p_scale: tuple[float, float] = (1.0, 1.0)) -> HopfCurve:
+    """Continue the Hopf point (x0, p0) both ways until it leaves ``box`` ((p1 range), (p2 range)).
+
+    ``scale`` (n,) and ``p_scale`` set the size of a unit step in the states and in (p1, p2)."""
     options = options or ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400)
-    problem = HopfCurveProblem(system, x_scale, p_scale)
+    problem = HopfCurveProblem(system, np.ones(system.n) if scale is None else scale, p_scale)
     p0 = np.asarray(p0, float)
     head, omega0 = hopf_start(np.asarray(x0, float), p0, system.dfdx(np.asarray(x0, float), p0))
     u0 = np.concatenate([head, [omega0], p0])

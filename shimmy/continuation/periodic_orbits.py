@@ -167,20 +167,23 @@ def _crossing_test(kind: PointKind) -> Callable[[np.ndarray], float]:
     return g
 
 
-def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max: float,
-                    scale: np.ndarray, p_scale: float, options: PeriodicOptions | None = None,
+def periodic_branch(system: VectorField, guess: OrbitGuess, *, p_range: tuple[float, float],
+                    options: PeriodicOptions | None = None, scale: np.ndarray | None = None, p_scale: float = 1.0,
                     direction: np.ndarray | None = None, p_direction: int = 1,
                     limits: Callable[[np.ndarray, np.ndarray, float, float], str | None] | None = None,
                     progress: Callable[[float], None] | None = None) -> PeriodicBranch:
-    """Continue the periodic orbit near ``guess`` in p over [p_min, p_max].
+    """Continue the periodic orbit near ``guess`` in p over ``p_range`` = (p_min, p_max).
 
-    ``direction`` (n_nodes, n): for a Hopf start, the emerging orbit shape (the first
-    step moves along it with p and T free, so the orbit grows away from the
+    ``scale`` (n,) and ``p_scale`` set the size of a unit step in the states and p (the period's is
+    the guess's period). ``direction`` (n_nodes, n): for a Hopf start, the emerging orbit shape
+    (the first step moves along it with p and T free, so the orbit grows away from the
     equilibrium); otherwise the first correction holds p fixed and the branch follows
     ``p_direction`` (+1 increasing p). ``limits(x_max, x_min, T, p)`` returns a message
     to stop the branch. ``progress`` receives the covered fraction of [p_min, p_max].
     """
+    p_min, p_max = p_range
     options = options or PeriodicOptions()
+    scale = np.ones(system.n) if scale is None else scale
     copts = options.continuation
     mesh = guess.mesh if guess.mesh.ncol == options.ncol and guess.mesh.ntst == options.ntst \
         else Mesh.uniform(options.ntst, options.ncol)

@@ -205,8 +205,8 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
 
     report(0.0, "equilibrium branch")
     hopf = hopf_points(config, Fz, params, v_min=v_min, v_max=v_max)
-    eq = equilibrium_branch(system, np.zeros(n), v_min, v_min, v_max,
-                            ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000), scale=scale,
+    eq = equilibrium_branch(system, np.zeros(n), v_min, p_range=(v_min, v_max),
+                            options=ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000), scale=scale,
                             p_scale=V_SCALE)
     engine_h = [s.p for s in eq.special_points if s.kind == PointKind.HOPF]
     scan_h = [h.V for h in hopf.hopf_points]
@@ -238,8 +238,8 @@ def bifurcation(config: Configuration | str, Fz: float, v_min: float = V_RANGE[0
         q = vecs[:, i] / vecs[np.argmax(np.abs(vecs[:, i] / scale)), i]
         guess, shape = hopf_guess(np.zeros(n), v_h, ev[i].imag, q, Mesh.uniform(popts.ntst, popts.ncol), 0.0)
         try:
-            raw = periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts, direction=shape,
-                                  limits=limits)
+            raw = periodic_branch(system, guess, p_range=(v_min, v_max), options=popts, scale=scale, p_scale=V_SCALE,
+                                  direction=shape, limits=limits)
         except EngineConvergenceError as exc:  # the engine's, or ours derived from it
             warnings.append(f"no periodic branch from the Hopf point at V = {v_h:.6g} m/s: {exc}")
             continue
@@ -464,8 +464,8 @@ def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popt
     halves = []
     for direction in (-1, +1):
         try:
-            halves.append(periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts,
-                                          p_direction=direction, limits=limits))
+            halves.append(periodic_branch(system, guess, p_range=(v_min, v_max), options=popts, scale=scale,
+                                          p_scale=V_SCALE, p_direction=direction, limits=limits))
         except EngineConvergenceError as exc:  # the engine's, or ours derived from it
             warnings.append(f"{label} at V = {v_seed:.6g} m/s: {exc}")
             return None

@@ -402,8 +402,9 @@ def _continue(task: tuple) -> tuple[GearCycleCurve | None, str | None]:
         return None, None
     about = f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin})"
     try:
-        curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box, STATE_SCALE[:system.n],
-                            (V_SCALE, FZ_SCALE), kappa=kappa, options=CURVE_OPTIONS, ncol=start.ncol, p2_marks=loads)
+        curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box=box, options=CURVE_OPTIONS,
+                            scale=STATE_SCALE[:system.n], p_scale=(V_SCALE, FZ_SCALE), kappa=kappa, ncol=start.ncol,
+                            p2_marks=loads)
     except ContinuationError as exc:
         return None, f"{about} not continued: {exc}"
     if len(curve.p) < 2:  # stopped at its start both ways (a start at a strong resonance): no curve to draw
@@ -438,8 +439,8 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
         for h in near:
             if abs(math.log(h.V / point["V"])) > 0.2:
                 continue
-            found, ncol = start_beside(system, kind, np.zeros(n), np.array([h.V, Fz]), v_range, STATE_SCALE[:n],
-                                       V_SCALE, options, limits=_limits(model))
+            found, ncol = start_beside(system, kind, np.zeros(n), np.array([h.V, Fz]), p_range=v_range, options=options,
+                                       scale=STATE_SCALE[:n], p_scale=V_SCALE, limits=_limits(model))
             if found is not None:
                 # eager when born at the point (a branch beside it may fold or lose stability
                 # first on another curve, far away: that start waits like a diagram's)

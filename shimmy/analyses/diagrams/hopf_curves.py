@@ -161,8 +161,8 @@ def hopf_curves(config: Configuration | str, params: Parameters | None = None,
             if any(_on_curve(c, h.V, float(Fz)) for c in curves):
                 continue
             try:
-                curve = hopf_curve(system, np.zeros(n), np.array([h.V, float(Fz)]), box, X_SCALE[:n],
-                                   np.array([V_SCALE, FZ_SCALE]), options)
+                curve = hopf_curve(system, np.zeros(n), np.array([h.V, float(Fz)]), box=box, options=options,
+                                   scale=X_SCALE[:n], p_scale=np.array([V_SCALE, FZ_SCALE]))
             except ValueError as exc:
                 warnings.append(f"Hopf point V = {h.V:.6g} m/s, Fz = {Fz:.6g} N not continued: {exc}")
                 continue
