@@ -17,7 +17,9 @@ textbook systems.
   (boundary-value problem in the period), Floquet multipliers, fold (LPC), torus (NS),
   period-doubling (PD) and branch (BPC) points of cycles.
 * :mod:`.cycle_curves`: two-parameter curves of folds (LPC), period doublings (PD) and tori (NS)
-  of cycles, with their codimension-2 points;
+  of cycles, with their codimension-2 points: a package, the shared bordered machinery
+  (``bordered``), one module per defining system (``fold_of_cycles``, ``period_doubling``,
+  ``torus``), the tracing driver (``tracing``) and the codimension-2 detection (``codim2``);
 * :mod:`.hopf`: two-parameter Hopf curves with generalised Hopf (GH), double-Hopf (HH) and
   zero-Hopf (ZH) points; :mod:`.lyapunov`: the first Lyapunov coefficient.
 
