@@ -2,8 +2,9 @@
 Neimark-Sacker / torus (NS) points of periodic orbits.
 
 Formulation: minimally augmented systems with bordered test functions on the collocation
-discretisation of :mod:`~..collocation` (Doedel, Govaerts, Kuznetsov, *Computation of periodic
-solution bifurcations in ODEs using bordered systems*, SIAM J. Numer. Anal. 41, 2003; the
+discretisation of :mod:`shimmy.continuation.collocation` (Doedel, Govaerts, Kuznetsov,
+*Computation of periodic solution bifurcations in ODEs using bordered systems*, SIAM J. Numer.
+Anal. 41, 2003; the
 formulation MATCONT's ``limitpointcycle``, ``perioddoubling`` and ``neimarksacker`` curves
 use). Chosen over the fully extended systems because the unknowns are the cycle's plus one
 parameter (plus kappa for NS) instead of doubling (PD, LPC) or tripling (NS) them; the cost per

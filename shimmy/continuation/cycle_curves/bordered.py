@@ -1,16 +1,16 @@
 """The bordered machinery every curve of cycle bifurcations shares: its minimally augmented system.
 
 Unknowns u = (x at the mesh nodes, T, p1, p2[, kappa]); equations: the cycle's collocation,
-periodicity and phase conditions (:class:`~..collocation.PeriodicProblem`) and the test functions
+periodicity and phase conditions (:class:`~shimmy.continuation.PeriodicProblem`) and the test functions
 G = 0 of the bordered matrix [[A, B], [C^T, 0]] [V; G] = [0; I], A the curve type's linearisation
-of the cycle (its :class:`~.defining_system.DefiningSystem`), singular on the curve.
+of the cycle (its ``DefiningSystem``, :mod:`.defining_system`), singular on the curve.
 
 Derivatives: g_u = -w^T A_u v, with w from the transposed bordered system; A_u v is the
 second derivative of the cycle equations along v, a central difference of the analytic
 Jacobian (step 1e-6 of v's size in the weighted norm: relative error ~1e-10, which only
 enters the Newton matrix; the residuals are exact). The borders are moved to the last kernel
 vectors at every accepted point. The bordered matrix is factored by the condensed LU of
-:mod:`~..condensed_lu` (SuperLU where that meets a zero pivot), and its solves are refined on the
+:mod:`shimmy.continuation.condensed_lu` (SuperLU where that meets a zero pivot), and its solves are refined on the
 last factors, so that most Newton iterates and trial points do not factor it.
 """
 
@@ -46,7 +46,7 @@ FRESH_SWEEPS = 3
 
 
 def defining_system(kind: PointKind | str) -> DefiningSystem:
-    """The defining system of the curves of ``kind``, one of :data:`~..kinds.CYCLE_BIFURCATIONS`."""
+    """The defining system of the curves of ``kind``, one of ``CYCLE_BIFURCATIONS``."""
     kind = PointKind(kind)
     if kind not in DEFINING_SYSTEMS:
         raise InvalidInputError("kind", kind.value, ", ".join(CYCLE_BIFURCATIONS), "is not a bifurcation of cycles")

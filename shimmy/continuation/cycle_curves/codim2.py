@@ -1,9 +1,10 @@
 """Codimension-2 points along a curve of cycle bifurcations: detected by sign changes of their test
-functions between consecutive points, located by the secant method (:func:`~..core.locate_between`).
+functions between consecutive points, located by the secant method (``locate_between`` of
+:mod:`shimmy.continuation.core`).
 
 Two families of test function: a further multiplier crossing the unit circle (every curve type;
-:func:`crossing_value`, which multipliers the curve's own condition holds at left out), and the
-curve type's own (:meth:`~.defining_system.DefiningSystem.own_monitors`: the fold's cusp, the
+``crossing_value``, which multipliers the curve's own condition holds at left out), and the
+curve type's own (``DefiningSystem.own_monitors``: the fold's cusp, the
 torus's strong resonances).
 """
 

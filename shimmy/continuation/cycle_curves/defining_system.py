@@ -1,9 +1,9 @@
 """What differs between the curve types: the interface of a defining system.
 
 A curve of cycle bifurcations is continued as a minimally augmented system
-(:class:`~.bordered.CycleCurveProblem`): the cycle's equations and the test functions G = 0 of the
+(``CycleCurveProblem``, :mod:`.bordered`): the cycle's equations and the test functions G = 0 of the
 bordered matrix [[A, B], [C^T, 0]], A a linearisation of the cycle that is singular on the curve.
-The bordered machinery is shared; a :class:`DefiningSystem` holds what is not: A's boundary rows
+The bordered machinery is shared; a ``DefiningSystem`` holds what is not: A's boundary rows
 and its size, the dimension of its kernel, the gradient of G, the multipliers the condition holds
 at and the codimension-2 points the curve reports. One subclass per curve type, as MATCONT has one
 curve type per defining system: :mod:`.fold_of_cycles`, :mod:`.period_doubling`, :mod:`.torus`.
@@ -34,7 +34,7 @@ class DefiningSystem:
     #: periods A spans: copies of the cycle's collocation blocks in it
     periods = 1
     #: refinement sweeps of the test matrix's solves on the last factors before it is factored
-    #: afresh (see :data:`~.bordered.FRESH_SWEEPS`)
+    #: afresh (see ``FRESH_SWEEPS`` in :mod:`.bordered`)
     refine_sweeps = 6
     #: codimension-2 points where a further multiplier crosses the unit circle, and which kind of
     #: multiplier crosses there ("positive", "negative" real, "complex")

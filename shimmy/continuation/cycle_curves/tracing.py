@@ -2,11 +2,11 @@
 one-parameter branch, both ways, and :func:`start_beside` for a start next to a codimension-2
 point of an equilibrium.
 
-Each direction is traced by the :class:`~..core.Tracer` on the curve's
-:class:`~.bordered.CycleCurveProblem`, the drawn polyline's chord held within ``chord_tol`` of
+Each direction is traced by the :class:`~shimmy.continuation.Tracer` on the curve's
+``CycleCurveProblem``, the drawn polyline's chord held within ``chord_tol`` of
 each parameter, the mesh re-adapted every ``adapt_every`` steps. Along the way: turning points
 in p2 and crossings of marked p2 values (P2_TURN, P2_MARK), and the codimension-2 points
-(:mod:`.codim2`). Stops, each a :class:`~..kinds.Stop`: the parameter box (end point located on
+(:mod:`.codim2`). Stops, each a :class:`~shimmy.continuation.Stop`: the parameter box (end point located on
 it), a closed curve, the amplitude shrinking to zero (the curve ends at a codimension-2 point of
 the equilibrium: GH for a fold curve, a double-Hopf or zero-Hopf point for a torus curve), kappa
 leaving [-1, 1] (past R1/R2 the torus condition describes neutral saddle cycles, not tori), the
