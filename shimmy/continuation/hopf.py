@@ -16,8 +16,10 @@ Along the curve: double-Hopf points (a second pair of eigenvalues crosses the im
 and zero-Hopf points (a real eigenvalue crosses zero), from sign changes of products of the
 other eigenvalues' real parts, located by the secant method; the first Lyapunov coefficient
 l1 (:mod:`shimmy.continuation.lyapunov`) at every point when the field is smooth; a sign
-change is a generalised Hopf (Bautin) point, located by the secant method on l1. omega falling to zero ends the curve (a
-Bogdanov-Takens point or a double zero eigenvalue). The curve also ends where it
+change is a generalised Hopf (Bautin) point, located by the secant method on l1; turning points
+in p2 are located too. Each is a :class:`~shimmy.continuation.SpecialPoint` (GH, HH, ZH, P2_TURN)
+at p = (p1, p2). omega falling to zero ends the curve (a Bogdanov-Takens point or a double zero
+eigenvalue). The curve also ends where it
 leaves the parameter box (end point located on the boundary), returns to its start
 (closed curve), or after the step budget.
 """

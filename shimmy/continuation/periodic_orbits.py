@@ -12,7 +12,7 @@ consecutive branch points:
   pair -> NS, real negative -> PD, real positive without a fold -> BPC. Located by the
   secant method on |mu| - 1 of the multipliers of that kind.
 
-Stop rules, each reported in ``stop_reason``: a parameter bound (the end point is
+Stop rules, each a :class:`~shimmy.continuation.Stop` in ``stops``: a parameter bound (the end point is
 located on the bound, kind EP); the step budget; the step size underflowing (Newton
 failure); the period above ``period_max`` (approach to a homoclinic orbit or a
 period blow-up); the caller's ``limits`` check (e.g. amplitude outside the model's
