@@ -20,6 +20,7 @@ import numpy as np
 
 from .model.configurations import Configuration
 from .continuation.errors import InvalidInputError
+from .continuation.kinds import PointKind
 from .errors import EXPECTED_ERRORS, GeometryError, InvalidParameterError
 from .model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters,
                                check_number)
@@ -301,7 +302,7 @@ def _cmd_bifurcation(args) -> int:
                      f"V {b.V.min():.4g}..{b.V.max():.4g} m/s, max |psi| {b.max_psi.max():.5g} rad; "
                      f"modes {', '.join(sorted({m for m in b.mode if m}))}")
         for s in b.special_points:
-            if s["kind"] != "EP":
+            if s["kind"] != PointKind.END:
                 lines.append(f"      {s['kind']:<4} V = {s['V']:.6g} m/s")
         lines.append(f"      ends: {b.stop_reason}")
     where = "" if result.max_psi_V is None else f" at V = {result.max_psi_V:.5g} m/s"
@@ -329,11 +330,11 @@ def _cmd_hopf_curves(args) -> int:
     for i, c in enumerate(result.curves, start=1):
         lines.append(f"  curve {i}: {len(c.p)} points, V {c.p[:, 0].min():.4g}..{c.p[:, 0].max():.4g} m/s, "
                      f"Fz {c.p[:, 1].min():.5g}..{c.p[:, 1].max():.5g} N, {'closed' if c.closed else 'open'}")
-        for g in c.gh_points:
-            lines.append(f"      GH  V = {g['p'][0]:.6g} m/s, Fz = {g['p'][1]:.6g} N")
-        for g in c.double_hopf:
-            lines.append(f"      HH  V = {g['p'][0]:.6g} m/s, Fz = {g['p'][1]:.6g} N "
-                         f"({g['omega'] / (2 * math.pi):.4g} and {g['omega2'] / (2 * math.pi):.4g} Hz)")
+        for g in c.points_of(PointKind.GENERALISED_HOPF):
+            lines.append(f"      GH  V = {g.p[0]:.6g} m/s, Fz = {g.p[1]:.6g} N")
+        for g in c.points_of(PointKind.DOUBLE_HOPF):
+            lines.append(f"      HH  V = {g.p[0]:.6g} m/s, Fz = {g.p[1]:.6g} N "
+                         f"({g.data['omega'] / (2 * math.pi):.4g} and {g.data['omega2'] / (2 * math.pi):.4g} Hz)")
     if result.fz_minimum:
         lines.append(f"  lowest load on a Hopf curve: Fz = {result.fz_minimum['Fz']:.6g} N "
                      f"at V = {result.fz_minimum['V']:.6g} m/s")
@@ -360,7 +361,7 @@ def _cmd_curves(args) -> int:
     lines = [f"{result.config.value}: cycle-bifurcation curves in V {result.v_range[0]:g}..{result.v_range[1]:g} m/s, "
              f"Fz {result.fz_range[0]:g}..{result.fz_range[1]:g} N ({result.elapsed_s:.2f} s, "
              f"{result.starts_tried} curve starts)"]
-    names = {"LPC": "fold", "NS": "torus", "PD": "period-doubling"}
+    names = {PointKind.FOLD_OF_CYCLES: "fold", PointKind.TORUS: "torus", PointKind.PERIOD_DOUBLING: "period-doubling"}
     for kind in kinds:
         lines.append(f"  {names[kind]} curves: {len(data[KEY_OF_KIND[kind]])}")
     for i, c in enumerate(data["curves"], start=1):

@@ -36,7 +36,8 @@ import scipy.sparse as sp
 from numba import njit
 
 from .condensed_lu import ChainLayout, CondensedLU, collocation_layout, monodromy
-from .core import VectorField, condensed_factors
+from .core import condensed_factors
+from .fields import VectorField
 
 
 @dataclass(frozen=True)

@@ -18,13 +18,10 @@ below ``tol`` and |F|_inf below ``residual_tol``; chord iterations, the Jacobian
 when a correction fails to halve, at most ``max_newton`` factorisations and 3 ``max_newton``
 iterations. Step control: h grows by ``grow`` after a step that converged in <= 4
 iterations with the tangent turned by at most half of ``max_angle``, shrinks by ``shrink``
-on failure, and the branch stops (with a message) when h would
+on failure, and the branch stops (with a :class:`~.kinds.Stop`) when h would
 fall below ``ds_min``. Special points are located by :func:`locate`: the secant
 (Illinois) method on the step length from the last point, every trial point being a
 converged point of the curve.
-
-:class:`VectorField` is the system x' = f(x, p) every curve type continues;
-:class:`SpecialPoint` is the one located-point type of every branch.
 """
 
 from __future__ import annotations
@@ -32,7 +29,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any, Callable, Protocol
 
 import numpy as np
@@ -42,6 +39,7 @@ from scipy.sparse.linalg import splu
 
 from .condensed_lu import CondensedLU
 from .errors import InvalidInputError
+from .kinds import Stop, StopReason
 
 
 @dataclass(frozen=True)
@@ -322,7 +320,7 @@ class Tracer:
         self.chord = chord
         self.point = start
         self.h = options.ds
-        self.failed: str | None = None
+        self.failed: Stop | None = None
         #: (problem, point, previous tangent, step between them) after an accepted step: the
         #: curvature estimate's data, valid while the problem and the point are those
         self._last: tuple | None = None
@@ -375,8 +373,8 @@ class Tracer:
             else:
                 self.h *= opts.shrink
             if self.h < opts.ds_min:
-                self.failed = (f"Newton did not converge with step {self.h / opts.shrink:.2g} "
-                               f"(minimum {opts.ds_min:g})")
+                self.failed = Stop(StopReason.NEWTON_FAILED, f"Newton did not converge with step "
+                                   f"{self.h / opts.shrink:.2g} (minimum {opts.ds_min:g})")
                 return None
 
     def _turn(self, new: CurvePoint) -> float:
@@ -512,43 +510,3 @@ def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Calla
     if g_a * g_mid < 0:
         return locate_between(problem, a, mid, g, g_a, g_mid, options, tolerance, splits - 1, with_tangent)
     return locate_between(problem, mid, b, g, g_mid, g_b, options, tolerance, splits - 1, with_tangent)
-
-
-@dataclass(frozen=True)
-class VectorField:
-    """x' = f(x, p) with analytic derivatives, vectorised over columns.
-
-    ``f(x, p)``: x (n,) or (n, m) -> same shape; ``dfdx(x, p)``: (n, n) or (m, n, n);
-    ``dfdp(x, p)``: like f. ``p`` is a scalar (the continuation parameter).
-    """
-
-    n: int
-    f: Callable[[np.ndarray, float], np.ndarray]
-    dfdx: Callable[[np.ndarray, float], np.ndarray]
-    dfdp: Callable[[np.ndarray, float], np.ndarray]
-    name: str = "system"
-    #: Optional ``evaluate(x, p) -> (f, dfdx, dfdp)`` in one pass (a compiled field's fast path);
-    #: must agree with the three functions.
-    evaluate: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None
-
-    def all_at(self, x: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(f, dfdx, dfdp) at columns x: one call of ``evaluate`` where the field has it."""
-        if self.evaluate is not None:
-            return self.evaluate(x, p)
-        return self.f(x, p), self.dfdx(x, p), self.dfdp(x, p)
-
-
-@dataclass(frozen=True)
-class SpecialPoint:
-    """A bifurcation point located on a branch."""
-
-    kind: str  # H, LP, BP (equilibria); LPC, NS, PD, BPC (cycles); EP end point
-    p: float
-    index: int  # position in the branch's point list
-    data: dict[str, Any] = field(default_factory=dict)
-    #: The located point's full solution where a follow-on analysis needs it (cycles:
-    #: (mesh points, u)); not part of :meth:`to_dict`.
-    solution: Any = field(default=None, repr=False, compare=False)
-
-    def to_dict(self, parameter: str = "p") -> dict[str, Any]:
-        return {"kind": self.kind, parameter: self.p, **self.data}

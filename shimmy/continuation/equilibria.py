@@ -9,13 +9,16 @@ sign) or a branch point BP (real eigenvalue, no fold). Each is located to
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import scipy.linalg as la
 
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, correct, locate, step, tangent,
-                   weighted_norm)
+from .core import ContinuationOptions, CurvePoint, Tracer, correct, locate, step, tangent, weighted_norm
+from .fields import VectorField
+from .kinds import PointKind, Stop, StopReason
+from .results import ContinuationResult, SpecialPoint
 
 
 @dataclass
@@ -35,18 +38,22 @@ class EquilibriumProblem:
 
 
 @dataclass
-class EquilibriumBranch:
+class EquilibriumBranch(ContinuationResult):
+    """Points of an equilibrium branch (one row per point), traced one way: one stop, never closed."""
+
     p: np.ndarray
     x: np.ndarray  # (points, n)
     eigenvalues: np.ndarray  # (points, n), sorted by decreasing real part
     stable: np.ndarray
-    special_points: list[SpecialPoint]
-    stop_reason: str
-    steps: int
 
     @property
     def n_unstable(self) -> np.ndarray:
         return (self.eigenvalues.real > 0).sum(axis=1)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"p": self.p.tolist(), "x": self.x.tolist(), "eigenvalues_real": self.eigenvalues.real.tolist(),
+                "eigenvalues_imag": self.eigenvalues.imag.tolist(), "stable": self.stable.tolist(),
+                **super().to_dict()}
 
 
 def _sorted_eigenvalues(A: np.ndarray) -> np.ndarray:
@@ -54,15 +61,16 @@ def _sorted_eigenvalues(A: np.ndarray) -> np.ndarray:
     return ev[np.argsort(-ev.real, kind="stable")]
 
 
-def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, p_min: float, p_max: float,
+def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, *, p_range: tuple[float, float],
                        options: ContinuationOptions | None = None, scale: np.ndarray | None = None,
                        p_scale: float = 1.0, direction: int = 1) -> EquilibriumBranch:
-    """Continue the equilibrium through (x0, p0) in p over [p_min, p_max].
+    """Continue the equilibrium through (x0, p0) in p over ``p_range`` = (p_min, p_max).
 
     ``scale`` (n,) and ``p_scale`` set the size of a unit step in each unknown; ``direction``
     +1 follows increasing p first. Stops at the parameter bounds (exactly, as an EP point),
     after ``max_steps`` or when the step size underflows.
     """
+    p_min, p_max = p_range
     options = options or ContinuationOptions()
     n = system.n
     scale = np.ones(n) if scale is None else np.asarray(scale, float)
@@ -81,24 +89,25 @@ def equilibrium_branch(system: VectorField, x0: np.ndarray, p0: float, p_min: fl
     points = [tracer.point]
     eigs = [_sorted_eigenvalues(system.dfdx(u0[:-1], u0[-1]))]
     special: list[SpecialPoint] = []
-    stop = f"step budget of {options.max_steps} steps used"
+    stop = Stop(StopReason.STEP_BUDGET, f"step budget of {options.max_steps} steps used")
     steps = 0
     for steps in range(1, options.max_steps + 1):  # noqa: B007 (steps is reported)
         out = tracer.advance_within(p_min, p_max)
         if out is None:
-            stop = tracer.failed or "failed"
+            stop = tracer.failed
             break
         prev, new, _, bound = out
         if new is not None:
             _append_equilibrium(system, points, eigs, special, prev, new, problem, options)
         if bound is not None:
             if new is not None:
-                special.append(SpecialPoint("EP", float(new.u[-1]), len(points) - 1))
-            stop = f"reached the parameter bound p = {bound:g}"
+                special.append(SpecialPoint(PointKind.END, float(new.u[-1]), len(points) - 1))
+            stop = Stop(StopReason.BOUND, f"reached the parameter bound p = {bound:g}")
             break
     u = np.array([q.u for q in points])
     ev = np.array(eigs)
-    return EquilibriumBranch(u[:, -1], u[:, :-1], ev, ev[:, 0].real < 0, special, stop, steps)
+    return EquilibriumBranch(u[:, -1], u[:, :-1], ev, ev[:, 0].real < 0, special_points=special, stops=[stop],
+                             steps=steps)
 
 
 def _eigen_slopes(A: np.ndarray, dA: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -174,7 +183,8 @@ def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: Cu
         hit = locate(problem, prev, h, lambda q: q.tangent[-1], prev.tangent[-1], new.tangent[-1], options)
         at = hit[0] if hit is not None else (prev if abs(prev.tangent[-1]) < abs(new.tangent[-1]) else new)
         found.append((weighted_norm(at.u - prev.u, problem.weights),
-                      SpecialPoint("LP", float(at.u[-1]), -1, {"x": at.u[:-1].tolist(), "located": hit is not None})))
+                      SpecialPoint(PointKind.FOLD, float(at.u[-1]), -1, {"x": at.u[:-1].tolist()},
+                                   located=hit is not None)))
     # The j-th largest real part changes sign for every j between the two counts: one located
     # point per real eigenvalue or complex pair (several pairs can cross within one step).
     j = min(count_old, count_new)
@@ -189,16 +199,16 @@ def _append_equilibrium(system, points, eigs, special, prev: CurvePoint, new: Cu
         scale = max(np.abs(ev).max(), 1e-300)
         where = weighted_norm(q.u - prev.u, problem.weights)
         if abs(crit.imag) > 1e-6 * scale:
-            found.append((where, SpecialPoint("H", float(q.u[-1]), -1,
-                                              {"omega": float(abs(crit.imag)), "x": q.u[:-1].tolist(),
-                                               "located": hit is not None})))
+            found.append((where, SpecialPoint(PointKind.HOPF, float(q.u[-1]), -1,
+                                              {"omega": float(abs(crit.imag)), "x": q.u[:-1].tolist()},
+                                              located=hit is not None)))
             j += 2  # its conjugate crosses with it
             continue
-        if not any(s.kind == "LP" for _, s in found):
-            found.append((where, SpecialPoint("BP", float(q.u[-1]), -1,
-                                              {"x": q.u[:-1].tolist(), "located": hit is not None})))
+        if not any(s.kind is PointKind.FOLD for _, s in found):
+            found.append((where, SpecialPoint(PointKind.BRANCH_POINT, float(q.u[-1]), -1,
+                                              {"x": q.u[:-1].tolist()}, located=hit is not None)))
         j += 1
     points.append(new)
     eigs.append(ev_new)
     for _, sp_ in sorted(found, key=lambda item: item[0]):
-        special.append(SpecialPoint(sp_.kind, sp_.p, len(points) - 1, sp_.data))
+        special.append(replace(sp_, index=len(points) - 1))

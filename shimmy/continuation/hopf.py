@@ -1,6 +1,6 @@
 """Two-parameter continuation of Hopf points of equilibria, with generalised Hopf (GH) points.
 
-Generic (any :class:`TwoParameterField`). Unknowns u = (x, a, b, omega, p1, p2) with
+Generic (any :class:`~.fields.TwoParameterField`). Unknowns u = (x, a, b, omega, p1, p2) with
 q = a + i b the critical eigenvector, and the 3n + 2 equations (the standard extended
 system, Kuznetsov 3rd ed., sec. 10.2.2):
 
@@ -16,8 +16,10 @@ Along the curve: double-Hopf points (a second pair of eigenvalues crosses the im
 and zero-Hopf points (a real eigenvalue crosses zero), from sign changes of products of the
 other eigenvalues' real parts, located by the secant method; the first Lyapunov coefficient
 l1 (:mod:`shimmy.continuation.lyapunov`) at every point when the field is smooth; a sign
-change is a generalised Hopf (Bautin) point, located by the secant method on l1. omega falling to zero ends the curve (a
-Bogdanov-Takens point or a double zero eigenvalue). The curve also ends where it
+change is a generalised Hopf (Bautin) point, located by the secant method on l1; turning points
+in p2 are located too. Each is a :class:`~shimmy.continuation.SpecialPoint` (GH, HH, ZH, P2_TURN)
+at p = (p1, p2). omega falling to zero ends the curve (a Bogdanov-Takens point or a double zero
+eigenvalue). The curve also ends where it
 leaves the parameter box (end point located on the boundary), returns to its start
 (closed curve), or after the step budget.
 """
@@ -25,28 +27,16 @@ leaves the parameter box (end point located on the boundary), returns to its sta
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import Callable
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from . import lyapunov
 from .core import ContinuationOptions, CurvePoint, Tracer, correct, locate, tangent, weighted_norm
-
-
-@dataclass(frozen=True)
-class TwoParameterField:
-    """x' = f(x, p) with p = (p1, p2); ``dfdx(x, p)`` (n, n) and ``dfdp(x, p)`` (n, 2), analytic.
-
-    ``dfdx`` must accept complex x for the Lyapunov coefficient (complex-analytic f);
-    ``smooth`` False (e.g. a |v|^(1/2) v term) skips l1 and GH detection.
-    """
-
-    n: int
-    f: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    dfdx: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    dfdp: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    smooth: bool = True
+from .fields import TwoParameterField
+from .kinds import PointKind, Stop, StopReason
+from .results import ContinuationResult, SpecialPoint
 
 
 class HopfCurveProblem:
@@ -93,7 +83,7 @@ class HopfCurveProblem:
 
         Ja, Jb = along(a), along(b)
         Jp = [in_p(0), in_p(1)]
-        fp = s.dfdp(x, p)
+        fp = s.dfdp(x, p).T  # (n, 2)
         out = np.zeros((3 * n + 2, 3 * n + 3))
         eye = np.eye(n)
         out[:n, :n], out[:n, 3 * n + 1:] = J, fp
@@ -119,19 +109,21 @@ class HopfCurveProblem:
 
 
 @dataclass
-class HopfCurve:
+class HopfCurve(ContinuationResult):
+    """Points of a Hopf curve (one row per point) and its special points, each at p = (p1, p2) with
+    the critical frequency ``omega`` in its data: generalised Hopf (GH, with its ``lyapunov``),
+    double Hopf (HH, with the other pair's ``omega2``), zero-Hopf (ZH) and the turning points in p2
+    (P2_TURN)."""
+
     p: np.ndarray  # (points, 2)
     x: np.ndarray  # (points, n)
     omega: np.ndarray
     lyapunov: np.ndarray  # nan where the field is not smooth
-    gh_points: list[dict]  # {"p": (p1, p2), "omega": ...}
-    extrema: list[dict]  # turning points in p2 (dp2/ds = 0): {"p": (p1, p2), "omega": ...}
-    stop_reasons: list[str]  # one per direction
-    steps: int
-    closed: bool = False
-    warnings: list[str] = field(default_factory=list)
-    double_hopf: list[dict] = field(default_factory=list)  # {"p", "omega", "omega2", "located"}
-    zero_hopf: list[dict] = field(default_factory=list)  # {"p", "omega", "located"}
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"p": self.p.tolist(), "x": self.x.tolist(), "omega": self.omega.tolist(),
+                "lyapunov": [None if not math.isfinite(v) else float(v) for v in self.lyapunov],
+                **super().to_dict()}
 
 
 def hopf_start(x: np.ndarray, p: np.ndarray, J: np.ndarray) -> tuple[np.ndarray, float]:
@@ -143,12 +135,14 @@ def hopf_start(x: np.ndarray, p: np.ndarray, J: np.ndarray) -> tuple[np.ndarray,
     return np.concatenate([x, q.real, q.imag]), float(ev[i].imag)
 
 
-def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: tuple[tuple[float, float],
-               tuple[float, float]], x_scale: np.ndarray, p_scale: np.ndarray,
-               options: ContinuationOptions | None = None) -> HopfCurve:
-    """Continue the Hopf point (x0, p0) both ways until it leaves ``box`` ((p1 range), (p2 range))."""
+def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, *,
+               box: tuple[tuple[float, float], tuple[float, float]], options: ContinuationOptions | None = None,
+               scale: np.ndarray | None = None, p_scale: tuple[float, float] = (1.0, 1.0)) -> HopfCurve:
+    """Continue the Hopf point (x0, p0) both ways until it leaves ``box`` ((p1 range), (p2 range)).
+
+    ``scale`` (n,) and ``p_scale`` set the size of a unit step in the states and in (p1, p2)."""
     options = options or ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400)
-    problem = HopfCurveProblem(system, x_scale, p_scale)
+    problem = HopfCurveProblem(system, np.ones(system.n) if scale is None else scale, p_scale)
     p0 = np.asarray(p0, float)
     head, omega0 = hopf_start(np.asarray(x0, float), p0, system.dfdx(np.asarray(x0, float), p0))
     u0 = np.concatenate([head, [omega0], p0])
@@ -161,27 +155,26 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
     u0 = out[0]
     problem.accept(u0)
     t0 = tangent(problem, u0, guess)
-    halves, reasons, warnings, steps, closed = [], [], [], 0, False
+    halves, stops, steps, closed = [], [], 0, False
     for sign in (1.0, -1.0):
         problem.accept(u0)
-        part, reason, n_steps, is_closed = _trace(problem, CurvePoint(u0, sign * t0), box, options, u0)
+        part, stop, n_steps = _trace(problem, CurvePoint(u0, sign * t0), box, options, u0)
         halves.append(part)
-        reasons.append(reason)
+        stops.append(stop)
         steps += n_steps
-        if is_closed:
+        if stop.reason is StopReason.CLOSED:
             closed = True
             break
     points = halves[-1] if closed else halves[1][::-1] + halves[0][1:]  # the half that closed is the loop
     U = np.array([q.u for q in points])
     n = system.n
     l1 = np.array([problem.lyapunov(u) if system.smooth else math.nan for u in U])
-    gh = []
+    special = []
     if system.smooth:
         for i in range(len(points) - 1):
             if np.isfinite(l1[i]) and np.isfinite(l1[i + 1]) and l1[i] * l1[i + 1] < 0:
-                gh.append(_locate_gh(problem, points[i], points[i + 1], l1[i], l1[i + 1], options))
-    double_hopf, zero_hopf = _other_crossings(problem, points, options)
-    extrema = []
+                special.append(_locate_gh(problem, points[i], points[i + 1], l1[i], l1[i + 1], options, i + 1))
+    special += _other_crossings(problem, points, options)
     for i in range(len(points) - 1):
         ta, tb = points[i].tangent[-1], points[i + 1].tangent[-1]
         if ta * tb < 0 and np.dot(points[i].tangent, problem.weights * points[i + 1].tangent) > 0:
@@ -191,9 +184,18 @@ def hopf_curve(system: TwoParameterField, x0: np.ndarray, p0: np.ndarray, box: t
             sign = 1.0 if a.tangent[-1] == ta else -1.0  # the test along the step's direction
             hit = locate(problem, a, h, lambda q: q.tangent[-1], sign * ta, sign * tb, options)
             at = hit[0] if hit is not None else points[i]
-            extrema.append({"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n])})
-    return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, gh, extrema, reasons, steps, closed, warnings,
-                     double_hopf, zero_hopf)
+            special.append(_special(problem, PointKind.P2_TURN, at, i + 1, hit is not None))
+    special.sort(key=lambda s: s.index)
+    return HopfCurve(U[:, 3 * n + 1:], U[:, :n], U[:, 3 * n], l1, special_points=special, stops=stops, steps=steps,
+                     closed=closed)
+
+
+def _special(problem: HopfCurveProblem, kind: PointKind, at: CurvePoint, index: int, located: bool,
+             **data: float) -> SpecialPoint:
+    """A special point of a Hopf curve at the curve point ``at``: p = (p1, p2), omega and ``data``."""
+    n = problem.n
+    return SpecialPoint(kind, tuple(at.u[3 * n + 1:].tolist()), index, {"omega": float(at.u[3 * n]), **data},
+                        located)
 
 
 def _other_eigenvalues(problem: HopfCurveProblem, u: np.ndarray) -> np.ndarray:
@@ -221,12 +223,12 @@ def _crossing_tests(problem: HopfCurveProblem, u: np.ndarray) -> tuple[float, fl
     return hh, zh
 
 
-def _other_crossings(problem: HopfCurveProblem, points: list[CurvePoint], options: ContinuationOptions):
+def _other_crossings(problem: HopfCurveProblem, points: list[CurvePoint],
+                     options: ContinuationOptions) -> list[SpecialPoint]:
     """Double-Hopf (a second pair on the imaginary axis) and zero-Hopf (a zero eigenvalue) points
     along the curve, each located by the secant method on its test function."""
     tests = np.array([_crossing_tests(problem, q.u) for q in points])
-    n = problem.n
-    found: tuple[list[dict], list[dict]] = ([], [])
+    found = []
     for which in (0, 1):
         g = tests[:, which]
         for i in range(len(points) - 1):
@@ -237,12 +239,13 @@ def _other_crossings(problem: HopfCurveProblem, points: list[CurvePoint], option
             h = weighted_norm(points[i + 1].u - a.u, problem.weights)
             hit = locate(problem, a, h, lambda q, w=which: _crossing_tests(problem, q.u)[w], g[i], g[i + 1], options)
             at = hit[0] if hit is not None else points[i + 1]
-            entry = {"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n]), "located": hit is not None}
             if which == 0:
                 ev = _other_eigenvalues(problem, at.u)
                 pair = ev[ev.imag > 0]
-                entry["omega2"] = float(pair[np.argmin(np.abs(pair.real))].imag) if pair.size else math.nan
-            found[which].append(entry)
+                omega2 = float(pair[np.argmin(np.abs(pair.real))].imag) if pair.size else math.nan
+                found.append(_special(problem, PointKind.DOUBLE_HOPF, at, i + 1, hit is not None, omega2=omega2))
+            else:
+                found.append(_special(problem, PointKind.ZERO_HOPF, at, i + 1, hit is not None))
     return found
 
 
@@ -251,13 +254,12 @@ def _trace(problem: HopfCurveProblem, start: CurvePoint, box, options: Continuat
     points = [start]
     n = problem.n
     (lo1, hi1), (lo2, hi2) = box
-    reason = f"step budget of {options.max_steps} steps used"
     travelled = 0.0
     for k in range(1, options.max_steps + 1):
         prev = tracer.point
         adv = tracer.advance()
         if adv is None:
-            return points, tracer.failed or "Newton failed", k, False
+            return points, tracer.failed, k
         new, h = adv
         travelled += h
         p1, p2 = new.u[3 * n + 1], new.u[3 * n + 2]
@@ -269,17 +271,19 @@ def _trace(problem: HopfCurveProblem, start: CurvePoint, box, options: Continuat
                              value - bound, options)
                 if hit is not None:
                     points.append(hit[0])
-                return points, f"left the parameter box at p{1 if idx == 3 * n + 1 else 2} = {bound:g}", k, False
+                return points, Stop(StopReason.BOUND,
+                                    f"left the parameter box at p{1 if idx == 3 * n + 1 else 2} = {bound:g}"), k
         if new.u[3 * n] <= 1e-6 * max(abs(start.u[3 * n]), 1.0):
             points.append(new)
-            return points, f"omega fell to zero at p = ({p1:.6g}, {p2:.6g}): Bogdanov-Takens point", k, False
+            return points, Stop(StopReason.ZERO_FREQUENCY,
+                                f"omega fell to zero at p = ({p1:.6g}, {p2:.6g}): Bogdanov-Takens point"), k
         points.append(new)
         # Closed curve: back at the start, heading the same way.
         if travelled > 4 * options.ds_max and weighted_norm(new.u - u0, problem.weights) < 0.5 * h \
                 and new.tangent @ (problem.weights * start.tangent) > 0:
             points.append(CurvePoint(u0, start.tangent))
-            return points, "closed curve: returned to its start", k, True
-    return points, reason, options.max_steps, False
+            return points, Stop(StopReason.CLOSED, "closed curve: returned to its start"), k
+    return points, Stop(StopReason.STEP_BUDGET, f"step budget of {options.max_steps} steps used"), options.max_steps
 
 
 def _toward(problem: HopfCurveProblem, a: CurvePoint, b: CurvePoint) -> CurvePoint:
@@ -291,12 +295,11 @@ def _toward(problem: HopfCurveProblem, a: CurvePoint, b: CurvePoint) -> CurvePoi
 
 
 def _locate_gh(problem: HopfCurveProblem, a: CurvePoint, b: CurvePoint, la: float, lb: float,
-               options: ContinuationOptions) -> dict:
+               options: ContinuationOptions, index: int) -> SpecialPoint:
     a = _toward(problem, a, b)
     problem.accept(a.u)
     h = weighted_norm(b.u - a.u, problem.weights)
     hit = locate(problem, a, h, lambda q: problem.lyapunov(q.u), la, lb, options)
     at = hit[0] if hit is not None else b
-    n = problem.n
-    return {"p": at.u[3 * n + 1:].tolist(), "omega": float(at.u[3 * n]),
-            "lyapunov": float(problem.lyapunov(at.u))}
+    return _special(problem, PointKind.GENERALISED_HOPF, at, index, hit is not None,
+                    lyapunov=float(problem.lyapunov(at.u)))

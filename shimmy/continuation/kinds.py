@@ -11,6 +11,7 @@ curves of cycles. "PD" is period doubling here, never the particle damper.
 from __future__ import annotations
 
 import enum
+from dataclasses import dataclass
 
 
 class PointKind(enum.StrEnum):
@@ -54,3 +55,28 @@ _MARKS = frozenset({PointKind.END, PointKind.ZERO_AMPLITUDE, PointKind.P2_TURN, 
 
 #: The bifurcations of cycles a one-parameter branch reports, and the curves that continue them.
 CYCLE_BIFURCATIONS = (PointKind.FOLD_OF_CYCLES, PointKind.TORUS, PointKind.PERIOD_DOUBLING)
+
+
+class StopReason(enum.StrEnum):
+    """Why a branch, or one direction of a curve, ended; its :class:`Stop`'s message says where."""
+
+    BOUND = "bound"  # reached a bound of the parameter range or box (the end located on it)
+    CLOSED = "closed"  # returned to its first point: a closed branch or curve, traversed once
+    STEP_BUDGET = "step_budget"  # ``max_steps`` used
+    NEWTON_FAILED = "newton_failed"  # the step fell below ``ds_min`` without a converged point
+    PERIOD_LIMIT = "period_limit"  # a cycle's period above ``period_max``
+    NONPOSITIVE_PERIOD = "nonpositive_period"  # the continuation left the curve
+    ZERO_AMPLITUDE = "zero_amplitude"  # cycles shrank onto an equilibrium (a Hopf or codimension-2 point)
+    ZERO_FREQUENCY = "zero_frequency"  # a Hopf curve's omega fell to zero (Bogdanov-Takens)
+    PAST_RESONANCE = "past_resonance"  # a torus curve's kappa left [-1, 1]: neutral saddle cycles, not tori
+    LIMITS = "limits"  # the caller's ``limits`` check (e.g. a model's range of validity)
+    REQUESTED_POINT = "requested_point"  # the first point of a kind in ``PeriodicOptions.stop_at``
+
+
+@dataclass(frozen=True)
+class Stop:
+    """Why a branch, or one direction of a curve, ended: ``reason`` to test, ``message`` to read
+    (and to write: results give the message, never the reason)."""
+
+    reason: StopReason
+    message: str

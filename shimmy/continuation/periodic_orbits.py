@@ -12,7 +12,7 @@ consecutive branch points:
   pair -> NS, real negative -> PD, real positive without a fold -> BPC. Located by the
   secant method on |mu| - 1 of the multipliers of that kind.
 
-Stop rules, each reported in ``stop_reason``: a parameter bound (the end point is
+Stop rules, each a :class:`~shimmy.continuation.Stop` in ``stops``: a parameter bound (the end point is
 located on the bound, kind EP); the step budget; the step size underflowing (Newton
 failure); the period above ``period_max`` (approach to a homoclinic orbit or a
 period blow-up); the caller's ``limits`` check (e.g. amplitude outside the model's
@@ -30,9 +30,11 @@ from typing import Any, Callable
 import numpy as np
 
 from .collocation import Mesh, PeriodicProblem
-from .core import (ContinuationOptions, CurvePoint, SpecialPoint, Tracer, VectorField, locate, step,
-                           tangent, weighted_norm)
+from .core import ContinuationOptions, CurvePoint, Tracer, locate, step, tangent, weighted_norm
 from .errors import ConvergenceError, InvalidInputError
+from .fields import VectorField
+from .kinds import PointKind, Stop, StopReason
+from .results import ContinuationResult, SpecialPoint
 
 COMPLEX_TOL = 1e-7  # |Im mu| below this (relative) counts as a real multiplier
 
@@ -45,7 +47,7 @@ class PeriodicOptions:
     period_max: float = math.inf
     amplitude_min: float = 0.05  # end at x*: amplitude below this fraction of the first orbit's (Hopf starts)
     continuation: ContinuationOptions = field(default_factory=ContinuationOptions)
-    stop_at: tuple[str, ...] = ()  # kinds of special point at which to end the branch (e.g. the first LPC)
+    stop_at: tuple[PointKind, ...] = ()  # kinds of special point at which to end the branch (e.g. the first LPC)
 
     def __post_init__(self):
         if not (isinstance(self.ntst, int) and 4 <= self.ntst <= 2000):
@@ -55,8 +57,9 @@ class PeriodicOptions:
 
 
 @dataclass
-class PeriodicBranch:
-    """Points of a branch of periodic orbits (one row per point) and its special points."""
+class PeriodicBranch(ContinuationResult):
+    """Points of a branch of periodic orbits (one row per point) and its special points; one stop
+    (two where a caller joins the branches continued both ways)."""
 
     p: np.ndarray
     period: np.ndarray
@@ -64,13 +67,16 @@ class PeriodicBranch:
     x_min: np.ndarray
     stable: np.ndarray
     multipliers: np.ndarray  # (points, n) trivial first, then by decreasing modulus
-    special_points: list[SpecialPoint]
-    stop_reason: str
-    steps: int
     ntst: int
     ncol: int
     solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, u) per point
     trivial_error: float  # max |mu_trivial - 1| over the branch: accuracy check
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"p": self.p.tolist(), "period": self.period.tolist(), "x_max": self.x_max.tolist(),
+                "x_min": self.x_min.tolist(), "stable": self.stable.tolist(),
+                "multipliers_abs": np.abs(self.multipliers).tolist(), "ntst": self.ntst, "ncol": self.ncol,
+                "trivial_error": self.trivial_error, **super().to_dict()}
 
     def orbit(self, i: int, system: VectorField, per_interval: int = 12) -> tuple[np.ndarray, np.ndarray]:
         """t (s) and x (k, n) of point i over one period."""
@@ -121,16 +127,16 @@ def _count_unstable(mu: np.ndarray) -> int:
     return int((np.abs(mu[1:]) > 1.0).sum())
 
 
-def _kind_of_crossing(mu_a: np.ndarray, mu_b: np.ndarray) -> str:
+def _kind_of_crossing(mu_a: np.ndarray, mu_b: np.ndarray) -> PointKind:
     """The kind of the multiplier that crossed the unit circle between a and b, from which kind's
     count outside changed (complex pair -> NS, real negative -> PD, real positive -> BPC)."""
     ra, na, ca = _outside_by_kind(mu_a)
     rb, nb, cb = _outside_by_kind(mu_b)
     if cb != ca:
-        return "NS"
+        return PointKind.TORUS
     if nb != na:
-        return "PD"
-    return "BPC"
+        return PointKind.PERIOD_DOUBLING
+    return PointKind.BRANCH_POINT_OF_CYCLES
 
 
 def multiplier_crossing_test(mu: np.ndarray, which: str, accuracy: float = 0.0) -> float:
@@ -153,28 +159,31 @@ def multiplier_crossing_test(mu: np.ndarray, which: str, accuracy: float = 0.0) 
     return (-1.0) ** int((log_abs > 0).sum()) * nearest
 
 
-def _crossing_test(kind: str) -> Callable[[np.ndarray], float]:
-    which = {"NS": "complex", "PD": "negative"}.get(kind, "positive")
+def _crossing_test(kind: PointKind) -> Callable[[np.ndarray], float]:
+    which = {PointKind.TORUS: "complex", PointKind.PERIOD_DOUBLING: "negative"}.get(kind, "positive")
 
     def g(mu: np.ndarray) -> float:
         return multiplier_crossing_test(mu[1:], which)
     return g
 
 
-def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max: float,
-                    scale: np.ndarray, p_scale: float, options: PeriodicOptions | None = None,
+def periodic_branch(system: VectorField, guess: OrbitGuess, *, p_range: tuple[float, float],
+                    options: PeriodicOptions | None = None, scale: np.ndarray | None = None, p_scale: float = 1.0,
                     direction: np.ndarray | None = None, p_direction: int = 1,
                     limits: Callable[[np.ndarray, np.ndarray, float, float], str | None] | None = None,
                     progress: Callable[[float], None] | None = None) -> PeriodicBranch:
-    """Continue the periodic orbit near ``guess`` in p over [p_min, p_max].
+    """Continue the periodic orbit near ``guess`` in p over ``p_range`` = (p_min, p_max).
 
-    ``direction`` (n_nodes, n): for a Hopf start, the emerging orbit shape (the first
-    step moves along it with p and T free, so the orbit grows away from the
+    ``scale`` (n,) and ``p_scale`` set the size of a unit step in the states and p (the period's is
+    the guess's period). ``direction`` (n_nodes, n): for a Hopf start, the emerging orbit shape
+    (the first step moves along it with p and T free, so the orbit grows away from the
     equilibrium); otherwise the first correction holds p fixed and the branch follows
     ``p_direction`` (+1 increasing p). ``limits(x_max, x_min, T, p)`` returns a message
     to stop the branch. ``progress`` receives the covered fraction of [p_min, p_max].
     """
+    p_min, p_max = p_range
     options = options or PeriodicOptions()
+    scale = np.ones(system.n) if scale is None else scale
     copts = options.continuation
     mesh = guess.mesh if guess.mesh.ncol == options.ncol and guess.mesh.ntst == options.ntst \
         else Mesh.uniform(options.ntst, options.ncol)
@@ -224,52 +233,54 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
     special: list[SpecialPoint] = []
     amp_first = _amplitude(problem, xmax0, xmin0)
     amp_peak = amp_last = amp_first
-    stop = f"step budget of {copts.max_steps} steps used"
+    stop = Stop(StopReason.STEP_BUDGET, f"step budget of {copts.max_steps} steps used")
     steps = 0
     span = p_max - p_min
     for steps in range(1, copts.max_steps + 1):  # noqa: B007 (steps is reported)
         out = tracer.advance_within(p_min, p_max)
         if out is None:
-            stop = tracer.failed or "Newton failed"
+            stop = tracer.failed
             break
         prev, new, h, bound = out
         if bound is not None:
             if new is not None:
                 _record(problem, rows, solutions, new)
                 special.extend(_detect(problem, rows, prev, new, copts))
-                special.append(_special(problem, "EP", new, rows))
-            stop = f"reached the parameter bound p = {bound:g}"
+                special.append(_special(problem, PointKind.END, new, rows))
+            stop = Stop(StopReason.BOUND, f"reached the parameter bound p = {bound:g}")
             break
         p_new, T_new = new.u[-1], new.u[-2]
         if progress is not None:
             progress(min(1.0, abs(p_new - guess.p) / span))
         if T_new > options.period_max:
-            stop = (f"period {T_new:.4g} at p = {p_new:.6g} above the limit {options.period_max:.4g} "
-                    "(homoclinic approach?); the branch ends at the last orbit below it")
+            stop = Stop(StopReason.PERIOD_LIMIT, f"period {T_new:.4g} at p = {p_new:.6g} above the limit "
+                        f"{options.period_max:.4g} (homoclinic approach?); the branch ends at the last orbit below it")
             break
         if T_new <= 0:
-            stop = "period became non-positive: the continuation left the branch"
+            stop = Stop(StopReason.NONPOSITIVE_PERIOD, "period became non-positive: the continuation left the branch")
             break
         _record(problem, rows, solutions, new)
         found = _detect(problem, rows, prev, new, copts)
         zero = amp_first if hopf_start else 1e-3 * amp_peak  # below this a cycle's amplitude counts as zero
-        ends = [s for s in found if s.kind == "LPC"
+        ends = [s for s in found if s.kind == PointKind.FOLD_OF_CYCLES
                 and _amplitude(problem, np.array(s.data["x_max"]), np.array(s.data["x_min"])) < zero]
         if ends:  # a 'fold' at zero amplitude: the branch passed through the equilibrium
             for key in rows:
                 rows[key].pop()
             solutions.pop()
             p_end = float(rows["p"][-1])
-            special.append(SpecialPoint("H", p_end, len(rows["p"]) - 1, {"amplitude": amp_last}))
-            stop = f"amplitude returned to zero near p = {p_end:.6g}: the branch ends at a Hopf point"
+            special.append(SpecialPoint(PointKind.HOPF, p_end, len(rows["p"]) - 1, {"amplitude": amp_last}))
+            stop = Stop(StopReason.ZERO_AMPLITUDE,
+                        f"amplitude returned to zero near p = {p_end:.6g}: the branch ends at a Hopf point")
             break
         special.extend(found)
         wanted = [s.kind for s in found if s.kind in options.stop_at]
         if wanted:
-            stop = f"stopped at the first {wanted[0]} point, as asked"
+            stop = Stop(StopReason.REQUESTED_POINT, f"stopped at the first {wanted[0]} point, as asked")
             break
         if _closed(problem, rows):
-            stop = "closed branch: the orbits returned to the first one (a loop of periodic orbits, traversed once)"
+            stop = Stop(StopReason.CLOSED, "closed branch: the orbits returned to the first one (a loop of periodic "
+                        "orbits, traversed once)")
             break
         amp = _amplitude(problem, rows["xmax"][-1], rows["xmin"][-1])
         amp_peak = max(amp_peak, amp)
@@ -277,14 +288,15 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
         if limits is not None:
             message = limits(rows["xmax"][-1], rows["xmin"][-1], T_new, p_new)
             if message:
-                stop = message
+                stop = Stop(StopReason.LIMITS, message)
                 break
         # Shrinking: approach x* with care (a Hopf start only once it has grown; a branch started
         # from an orbit may start at its largest one)
         if amp < amp_last and (amp_peak > 2.0 * amp_first or not hopf_start):
             if amp < amp_stop:
-                special.append(SpecialPoint("H", float(p_new), len(rows["p"]) - 1, {"amplitude": amp}))
-                stop = f"amplitude returned to zero near p = {p_new:.6g}: the branch ends at a Hopf point"
+                special.append(SpecialPoint(PointKind.HOPF, float(p_new), len(rows["p"]) - 1, {"amplitude": amp}))
+                stop = Stop(StopReason.ZERO_AMPLITUDE,
+                            f"amplitude returned to zero near p = {p_new:.6g}: the branch ends at a Hopf point")
                 break
             tracer.limit_step(0.7 * amp * h / (amp_last - amp))  # do not jump through zero amplitude
         amp_last = amp
@@ -306,8 +318,9 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, p_min: float, p_max:
     mu = np.array(rows["mu"])
     trivial = float(np.max(np.abs(mu[:, 0] - 1.0)))
     return PeriodicBranch(np.array(rows["p"]), np.array(rows["T"]), np.array(rows["xmax"]),
-                          np.array(rows["xmin"]), np.abs(mu[:, 1:]).max(axis=1, initial=0.0) < 1.0, mu, special,
-                          stop, steps, problem.mesh.ntst, problem.mesh.ncol, solutions, trivial)
+                          np.array(rows["xmin"]), np.abs(mu[:, 1:]).max(axis=1, initial=0.0) < 1.0, mu,
+                          problem.mesh.ntst, problem.mesh.ncol, solutions, trivial, special_points=special,
+                          stops=[stop], steps=steps, closed=stop.reason is StopReason.CLOSED)
 
 
 def _measures(problem: PeriodicProblem, rows) -> np.ndarray:
@@ -355,12 +368,12 @@ def _record(problem: PeriodicProblem, rows, solutions, point: CurvePoint) -> Non
     solutions.append((problem.mesh.points.copy(), point.u.copy()))
 
 
-def _special(problem: PeriodicProblem, kind: str, point: CurvePoint, rows, mu=None) -> SpecialPoint:
+def _special(problem: PeriodicProblem, kind: PointKind, point: CurvePoint, rows, mu=None) -> SpecialPoint:
     xmax, xmin = _orbit_measures(problem, point.u)
     mu = problem.multipliers(point.u) if mu is None else mu
     data: dict[str, Any] = {"period": float(point.u[-2]), "x_max": xmax.tolist(), "x_min": xmin.tolist(),
                             "multipliers_abs": np.abs(mu[1:]).tolist()}
-    if kind == "NS":
+    if kind is PointKind.TORUS:
         rest = mu[1:]
         cand = rest[np.abs(rest.imag) > COMPLEX_TOL * np.abs(rest)]
         if cand.size:
@@ -421,10 +434,11 @@ def _events(problem: PeriodicProblem, rows, a: CurvePoint, b: CurvePoint, mu_a: 
     if fold:
         hit = locate(problem, a, h, lambda q: q.tangent[-1], a.tangent[-1], b.tangent[-1], copts)
         at = hit[0] if hit is not None else b
-        found.append((offset + weighted_norm(at.u - a.u, problem.weights), _special(problem, "LPC", at, rows)))
+        found.append((offset + weighted_norm(at.u - a.u, problem.weights),
+                      _special(problem, PointKind.FOLD_OF_CYCLES, at, rows)))
     if _count_unstable(mu_a) != _count_unstable(mu_b):
         kind = _kind_of_crossing(mu_a, mu_b)
-        if not (kind == "BPC" and fold):
+        if not (kind is PointKind.BRANCH_POINT_OF_CYCLES and fold):
             g_mu = _crossing_test(kind)
             ga, gb = g_mu(mu_a), g_mu(mu_b)
             at = b

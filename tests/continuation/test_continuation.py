@@ -51,7 +51,8 @@ def hopf_branch(system, omega: float, p0: float, p_min: float, p_max: float, opt
     q = np.array([1.0, -1j])  # J q = i omega q for J = [[g, -omega], [omega, g]] at g = 0
     np.testing.assert_allclose(system.dfdx(np.zeros(2), p0) @ q, 1j * omega * q, atol=1e-12)
     guess, shape = hopf_guess(np.zeros(2), p0, omega, q, Mesh.uniform(options.ntst, options.ncol), 0.0)
-    return periodic_branch(system, guess, p_min, p_max, np.ones(2), 1.0, options, direction=shape, **kwargs)
+    return periodic_branch(system, guess, p_range=(p_min, p_max), options=options, scale=np.ones(2), p_scale=1.0,
+                           direction=shape, **kwargs)
 
 
 def node_radius(branch, i: int) -> np.ndarray:
@@ -271,7 +272,7 @@ def test_chord_control_bounds_how_far_each_drawn_step_strays_from_the_curve():
 
 
 def test_fold_1d_is_located_and_stability_changes_there():
-    br = equilibrium_branch(fold_1d(), np.array([1.0]), 1.0, -1.0, 1.0, direction=-1)
+    br = equilibrium_branch(fold_1d(), np.array([1.0]), 1.0, p_range=(-1.0, 1.0), direction=-1)
     lp = only(br, "LP")
     assert abs(lp.p) < 1e-7 and abs(lp.data["x"][0]) < 1e-7
     np.testing.assert_allclose(br.p, br.x[:, 0] ** 2, atol=1e-10)  # every point on p = x^2
@@ -288,7 +289,7 @@ def test_fold_1d_is_located_and_stability_changes_there():
 
 def test_fold_2d_is_located_at_the_analytic_point():
     c = 0.3
-    br = equilibrium_branch(fold_2d(c), np.array([1.0, 1.0]), 1.0 + c, -1.0, 1.3, direction=-1)
+    br = equilibrium_branch(fold_2d(c), np.array([1.0, 1.0]), 1.0 + c, p_range=(-1.0, 1.3), direction=-1)
     lp = only(br, "LP")
     assert abs(lp.p + c ** 2 / 4) < 1e-7
     np.testing.assert_allclose(lp.data["x"], [-c / 2, -c / 2], atol=1e-7)
@@ -300,7 +301,7 @@ def test_fold_2d_is_located_at_the_analytic_point():
 
 
 def test_hopf_point_of_the_normal_form():
-    br = equilibrium_branch(hopf_supercritical(omega=2.0), np.zeros(2), -1.0, -1.0, 1.0)
+    br = equilibrium_branch(hopf_supercritical(omega=2.0), np.zeros(2), -1.0, p_range=(-1.0, 1.0))
     h = only(br, "H")
     assert abs(h.p) < 1e-9 and abs(h.data["omega"] - 2.0) < 1e-9
     np.testing.assert_allclose(br.x, 0.0, atol=1e-14)
@@ -310,7 +311,7 @@ def test_hopf_point_of_the_normal_form():
 
 
 def test_two_hopf_points_of_a_growth_rate_mu_one_minus_mu():
-    br = equilibrium_branch(hopf_twice(), np.zeros(2), -1.0, -1.0, 2.0)
+    br = equilibrium_branch(hopf_twice(), np.zeros(2), -1.0, p_range=(-1.0, 2.0))
     assert kinds(br) == ["H", "H", "EP"]
     np.testing.assert_allclose([s.p for s in br.special_points[:2]], [0.0, 1.0], atol=1e-8)
     np.testing.assert_allclose([s.data["omega"] for s in br.special_points[:2]], 1.0, atol=1e-9)
@@ -322,20 +323,20 @@ def test_two_hopf_points_inside_one_step_are_both_found(delta):
     """Both crossings within one step: the unstable count agrees at the step's ends, yet the
     pair is detected (eigenvalue slopes at the ends) and each point located."""
     options = ContinuationOptions(ds=0.2, ds_max=0.5)
-    br = equilibrium_branch(hopf_close_pair(delta), np.zeros(2), 0.0, 0.0, 1.0, options)
+    br = equilibrium_branch(hopf_close_pair(delta), np.zeros(2), 0.0, p_range=(0.0, 1.0), options=options)
     assert np.diff(br.p).max() > 10 * delta  # the steps are much longer than the gap
     assert kinds(br) == ["H", "H", "EP"]
     # located to the test-function tolerance: |Re lambda| = |(p - 1/2)^2 - delta^2| <= locate_tol
     p_h = np.array([s.p for s in br.special_points[:2]])
     assert np.all(np.abs((p_h - 0.5) ** 2 - delta ** 2) <= options.locate_tol)
     np.testing.assert_allclose(p_h, [0.5 - delta, 0.5 + delta], atol=options.locate_tol / delta)
-    assert all(s.data["located"] for s in br.special_points[:2])
+    assert all(s.located for s in br.special_points[:2])
 
 
 def test_two_pairs_crossing_within_one_step_give_two_hopf_points():
     """The unstable count jumps by four in one step: each pair's crossing is located."""
     options = ContinuationOptions(ds=0.2, ds_max=0.5)
-    br = equilibrium_branch(two_pairs(1e-3), np.zeros(4), 0.0, 0.0, 1.0, options)
+    br = equilibrium_branch(two_pairs(1e-3), np.zeros(4), 0.0, p_range=(0.0, 1.0), options=options)
     assert kinds(br) == ["H", "H", "EP"]
     np.testing.assert_allclose([s.p for s in br.special_points[:2]], [0.5, 0.501], atol=1e-9)
     np.testing.assert_allclose([s.data["omega"] for s in br.special_points[:2]], [1.0, 2.0], atol=1e-9)
@@ -344,7 +345,7 @@ def test_two_pairs_crossing_within_one_step_give_two_hopf_points():
 @pytest.mark.parametrize("make, x0", [(pitchfork, np.zeros(2)), (transcritical, np.zeros(1))],
                          ids=["pitchfork", "transcritical"])
 def test_branch_point_on_the_trivial_branch(make, x0):
-    br = equilibrium_branch(make(), x0, -1.0, -1.0, 1.0)
+    br = equilibrium_branch(make(), x0, -1.0, p_range=(-1.0, 1.0))
     bp = only(br, "BP")
     assert abs(bp.p) < 1e-9
     assert kinds(br) == ["BP", "EP"]
@@ -358,7 +359,7 @@ def test_branch_point_on_the_trivial_branch(make, x0):
 
 def test_branch_point_on_the_nontrivial_transcritical_branch():
     # x' = p x - x^2 on x = p: eigenvalue -p changes sign at p = 0, where x = 0 crosses.
-    br = equilibrium_branch(transcritical(), np.array([-1.0]), -1.0, -1.0, 1.0)
+    br = equilibrium_branch(transcritical(), np.array([-1.0]), -1.0, p_range=(-1.0, 1.0))
     np.testing.assert_allclose(br.x[:, 0], br.p, atol=1e-10)  # stays on x = p (this part passes)
     assert np.all(br.stable == (br.p > 0))
     bp = only(br, "BP")
@@ -367,21 +368,22 @@ def test_branch_point_on_the_nontrivial_transcritical_branch():
 
 def test_branch_point_of_the_pitchfork_followed_downward():
     # The same trivial branch as above, from p = 0.5 towards p = -0.7: the secant hits p = 0.0 exactly.
-    br = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, -0.7, 1.0, direction=-1)
+    br = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, p_range=(-0.7, 1.0), direction=-1)
     assert np.all(br.stable == (br.p < 0))  # (passes)
     bp = only(br, "BP")
     assert abs(bp.p) < 1e-9
 
 
 def test_equilibrium_branch_downward_and_stop_rules():
-    br = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, -0.7, 1.0, direction=-1)
+    br = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, p_range=(-0.7, 1.0), direction=-1)
     assert np.all(np.diff(br.p) < 0)
     assert br.special_points[-1].kind == "EP" and abs(br.p[-1] + 0.7) <= 1e-9
     assert "p = -0.7" in br.stop_reason
-    short = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, -10.0, 10.0, ContinuationOptions(max_steps=3))
+    short = equilibrium_branch(pitchfork(), np.zeros(2), 0.5, p_range=(-10.0, 10.0),
+                               options=ContinuationOptions(max_steps=3))
     assert short.steps == 3 and len(short.p) == 4 and "step budget of 3" in short.stop_reason
     with pytest.raises(ValueError, match="no equilibrium"):
-        equilibrium_branch(fold_1d(), np.array([0.5]), -1.0, -2.0, 2.0)  # p - x^2 = 0 has no root at p = -1
+        equilibrium_branch(fold_1d(), np.array([0.5]), -1.0, p_range=(-2.0, 2.0))  # p - x^2 = 0 has no root at p = -1
 
 
 # --------------------------------------------------------------------------- Hopf normal forms
@@ -473,8 +475,8 @@ def test_van_der_pol_branch_to_mu_1(vdp_orbit_mu1):
     # The Hopf point of Van der Pol at mu = 0 is degenerate (the system is linear there: every circle is
     # an orbit), so the branch is started on the cycle near the circle of radius 2 at mu = 0.2.
     system = van_der_pol()
-    br = periodic_branch(system, unit_cycle_guess(40, 2, 0.2, radius=2.0, sign=-1.0), 0.1, 1.0, np.ones(2), 1.0,
-                         PeriodicOptions(ntst=40, ncol=4), p_direction=1)
+    br = periodic_branch(system, unit_cycle_guess(40, 2, 0.2, radius=2.0, sign=-1.0), p_range=(0.1, 1.0),
+                         options=PeriodicOptions(ntst=40, ncol=4), scale=np.ones(2), p_scale=1.0, p_direction=1)
     assert kinds(br) == ["EP"] and abs(br.p[-1] - 1.0) <= 1e-9 and "bound p = 1" in br.stop_reason
     assert abs(br.p[0] - 0.2) < 1e-14 and np.all(np.diff(br.p) > 0)
     # Lindstedt: omega = 1 - mu^2/16 + 17 mu^4/3072 + 35 mu^6/884736 + O(mu^8)
@@ -505,7 +507,8 @@ def test_van_der_pol_period_converges_at_order_2_ncol(vdp_orbit_mu1, ncol):
         opts = PeriodicOptions(ntst=ntst, ncol=ncol, adapt_every=0,
                                continuation=ContinuationOptions(max_steps=1, tol=1e-12, residual_tol=1e-11))
         guess = orbit_from_samples(t, x, 1.001 * VDP_PERIOD_MU1, 1.0, Mesh.uniform(ntst, ncol))
-        br = periodic_branch(van_der_pol(), guess, 0.5, 1.5, np.ones(2), 1.0, opts, p_direction=1)
+        br = periodic_branch(van_der_pol(), guess, p_range=(0.5, 1.5), options=opts, scale=np.ones(2), p_scale=1.0,
+                             p_direction=1)
         assert br.p[0] == 1.0
         errors.append(abs(br.period[0] - VDP_PERIOD_MU1))
     orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
@@ -542,8 +545,8 @@ def test_constructed_multipliers_by_integration(name, p):
 
 def test_neimark_sacker_point_of_the_constructed_system():
     beta, w2 = 0.5, math.sqrt(2.0)
-    br = periodic_branch(neimark_sacker(beta=beta, w2=w2), unit_cycle_guess(40, 4, 0.2), 0.0, 1.0, np.ones(4), 1.0,
-                         PeriodicOptions(ntst=40, ncol=4), p_direction=1)
+    br = periodic_branch(neimark_sacker(beta=beta, w2=w2), unit_cycle_guess(40, 4, 0.2), p_range=(0.0, 1.0),
+                         options=PeriodicOptions(ntst=40, ncol=4), scale=np.ones(4), p_scale=1.0, p_direction=1)
     assert kinds(br) == ["NS", "EP"]
     ns = br.special_points[0]
     assert abs(ns.p - beta) < 1e-8
@@ -562,8 +565,8 @@ def test_neimark_sacker_point_of_the_constructed_system():
 
 def test_period_doubling_point_of_the_constructed_system():
     beta = 0.5
-    br = periodic_branch(period_doubling(beta=beta), unit_cycle_guess(40, 4, 0.2), 0.0, 1.0, np.ones(4), 1.0,
-                         PeriodicOptions(ntst=40, ncol=4), p_direction=1)
+    br = periodic_branch(period_doubling(beta=beta), unit_cycle_guess(40, 4, 0.2), p_range=(0.0, 1.0),
+                         options=PeriodicOptions(ntst=40, ncol=4), scale=np.ones(4), p_scale=1.0, p_direction=1)
     assert kinds(br) == ["PD", "EP"]
     pd = br.special_points[0]
     assert abs(pd.p - beta) < 1e-8
@@ -620,7 +623,8 @@ def test_no_orbit_near_the_guess_raises_convergence_error():
     # r' = r (mu - r^2) has no cycle at mu = -0.5: a unit circle does not converge
     guess = unit_cycle_guess(10, 2, -0.5)
     with pytest.raises(ConvergenceError, match="no periodic orbit"):
-        periodic_branch(hopf_supercritical(2.0), guess, -1.0, 1.0, np.ones(2), 1.0, PeriodicOptions(ntst=10))
+        periodic_branch(hopf_supercritical(2.0), guess, p_range=(-1.0, 1.0), options=PeriodicOptions(ntst=10),
+                        scale=np.ones(2), p_scale=1.0)
 
 
 # --------------------------------------------------------------------------- options
@@ -654,9 +658,10 @@ def test_closed_loop_of_cycles_is_traversed_once():
 
     system = planar_normal_form(g=lambda p: -3.0 - p * p, dg=lambda p: -2.0 * p, a1=4.0, a2=-1.0, name="isola")
     guess = unit_cycle_guess(40, 2, 0.0, radius=math.sqrt(3.0))
-    br = periodic_branch(system, guess, -5.0, 5.0, np.ones(2), 1.0,
-                         PeriodicOptions(ntst=40, continuation=ContinuationOptions(ds=0.05, ds_max=0.2,
-                                                                                   max_steps=400)))
+    br = periodic_branch(system, guess, p_range=(-5.0, 5.0),
+                         options=PeriodicOptions(ntst=40, continuation=ContinuationOptions(ds=0.05, ds_max=0.2,
+                                                                                   max_steps=400)),
+                         scale=np.ones(2), p_scale=1.0)
     assert br.stop_reason.startswith("closed branch")
     assert br.steps < 200
     folds = sorted(s.p for s in br.special_points if s.kind == "LPC")
@@ -735,7 +740,8 @@ def test_a_seeded_branch_shrinking_to_the_equilibrium_ends_at_the_hopf_point():
     mesh = Mesh.uniform(20, 4)
     theta = 2 * np.pi * mesh.node_times
     guess = OrbitGuess(mesh, 0.5 * np.column_stack([np.cos(theta), np.sin(theta)]), math.pi, 0.25)
-    br = periodic_branch(system, guess, -1.0, 1.0, np.ones(2), 1.0, PeriodicOptions(ntst=20), p_direction=-1)
+    br = periodic_branch(system, guess, p_range=(-1.0, 1.0), options=PeriodicOptions(ntst=20), scale=np.ones(2),
+                         p_scale=1.0, p_direction=-1)
     assert "amplitude returned to zero" in br.stop_reason, br.stop_reason
     assert kinds(br) == ["H"] and 0.0 <= br.p[-1] < 0.01
     assert br.x_max[:, 0].min() > 1e-5 and br.p.min() > 0.0  # stopped just below 1e-3 of the peak, not at 0

@@ -81,10 +81,11 @@ def test_fold_of_cycles_curve_of_the_bautin_normal_form():
     system = bautin()
     options = PeriodicOptions(ntst=20, ncol=4)
     guess, shape = hopf_guess(np.zeros(2), 0.0, 1.0, np.array([1.0, -1j]), Mesh.uniform(20, 4), 0.0)
-    branch = periodic_branch(system.at(1.0), guess, -1.0, 1.0, np.ones(2), 1.0, options, direction=shape)
+    branch = periodic_branch(system.at(1.0), guess, p_range=(-1.0, 1.0), options=options, scale=np.ones(2), p_scale=1.0,
+                             direction=shape)
     lpc = [s for s in branch.special_points if s.kind == "LPC"]
     assert len(lpc) == 1 and abs(lpc[0].p + 0.25) < 1e-8
-    curve = cycle_curve(system, "LPC", lpc[0].solution, 1.0, BOX, np.ones(2), (1.0, 1.0))
+    curve = cycle_curve(system, "LPC", lpc[0].solution, 1.0, box=BOX, scale=np.ones(2), p_scale=(1.0, 1.0))
     b1, b2 = curve.p[:, 0], curve.p[:, 1]
     assert len(b1) > 10
     np.testing.assert_allclose(b1, -b2 ** 2 / 4, atol=1e-8)
@@ -104,7 +105,7 @@ def test_cusp_of_cycles_is_located_on_the_fold_curve():
     system = cusp_of_cycles()
     s0 = 0.3
     curve = cycle_curve(system, "LPC", start(Mesh.uniform(20, 4), math.sqrt(1 + s0), 2, -2 * s0 ** 3), 3 * s0 ** 2,
-                        ((-1.0, 1.0), (-1.0, 1.0)), np.ones(2), (1.0, 1.0))
+                        box=((-1.0, 1.0), (-1.0, 1.0)), scale=np.ones(2), p_scale=(1.0, 1.0))
     s = curve.x_max[:, 0] ** 2 - 1.0
     np.testing.assert_allclose(curve.p[:, 0], -2 * s ** 3, atol=1e-8)
     np.testing.assert_allclose(curve.p[:, 1], 3 * s ** 2, atol=1e-8)
@@ -117,8 +118,8 @@ def test_cusp_of_cycles_is_located_on_the_fold_curve():
 def test_torus_curve_with_its_strong_resonances():
     """p1 = p2^2, kappa = cos(2 pi (0.3 + 0.1 p2)): R4 at p2 = -0.5, R3 at p2 = 1/3."""
     system = torus_two_parameter()
-    curve = cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, ((-1.0, 2.0), (-1.0, 1.0)),
-                        np.ones(4), (1.0, 1.0), kappa=math.cos(0.6 * math.pi))
+    curve = cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, box=((-1.0, 2.0), (-1.0, 1.0)),
+                        scale=np.ones(4), p_scale=(1.0, 1.0), kappa=math.cos(0.6 * math.pi))
     p1, p2 = curve.p[:, 0], curve.p[:, 1]
     np.testing.assert_allclose(p1, p2 ** 2, atol=1e-8)
     np.testing.assert_allclose(curve.kappa, np.cos(2 * np.pi * (0.3 + 0.1 * p2)), atol=1e-8)
@@ -132,8 +133,8 @@ def test_torus_curve_with_its_strong_resonances():
 
 def test_period_doubling_curve():
     system = flip_two_parameter()
-    curve = cycle_curve(system, "PD", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, ((-1.0, 2.0), (-1.0, 1.0)),
-                        np.ones(4), (1.0, 1.0))
+    curve = cycle_curve(system, "PD", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, box=((-1.0, 2.0), (-1.0, 1.0)),
+                        scale=np.ones(4), p_scale=(1.0, 1.0))
     np.testing.assert_allclose(curve.p[:, 0], curve.p[:, 1] ** 2, atol=1e-8)
     critical = np.min(np.abs(curve.multipliers[:, 1:] + 1.0), axis=1)
     np.testing.assert_allclose(critical, 0.0, atol=1e-6)
@@ -143,11 +144,11 @@ def test_period_doubling_curve():
 def test_a_torus_start_needs_kappa_in_range_and_the_box_its_order():
     system = torus_two_parameter()
     with pytest.raises(InvalidInputError, match="kappa"):
-        cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, BOX, np.ones(4), (1.0, 1.0),
-                    kappa=1.5)
+        cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, box=BOX, scale=np.ones(4),
+                    p_scale=(1.0, 1.0), kappa=1.5)
     with pytest.raises(InvalidInputError, match="p2 range"):
-        cycle_curve(system, "PD", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, ((-1, 1), (1, -1)), np.ones(4),
-                    (1.0, 1.0))
+        cycle_curve(system, "PD", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, box=((-1, 1), (1, -1)),
+                    scale=np.ones(4), p_scale=(1.0, 1.0))
 
 
 @pytest.mark.parametrize("ds_max", [0.5, 2.0])
@@ -158,7 +159,8 @@ def test_a_fold_and_two_torus_points_in_one_step_are_all_found(ds_max):
     mesh = Mesh.uniform(20, 4)
     guess = OrbitGuess(mesh, circle(mesh, math.sqrt(0.7), system.n), 2 * np.pi, -0.21)
     options = PeriodicOptions(ntst=20, ncol=4, continuation=ContinuationOptions(ds_max=ds_max))
-    branch = periodic_branch(system, guess, -0.3, -0.2, np.ones(system.n), 1.0, options, p_direction=-1)
+    branch = periodic_branch(system, guess, p_range=(-0.3, -0.2), options=options, scale=np.ones(system.n), p_scale=1.0,
+                             p_direction=-1)
     found = [(s.kind, s.p) for s in branch.special_points if s.kind != "EP"]
     assert [k for k, _ in found] == ["LPC", "NS", "NS"], found
     np.testing.assert_allclose([p for _, p in found], [-0.25, -0.249, -0.248], atol=1e-6)
@@ -167,8 +169,8 @@ def test_a_fold_and_two_torus_points_in_one_step_are_all_found(ds_max):
 
 def swapped(system):
     """The same field with p1 and p2 exchanged."""
-    from shimmy.continuation import TwoParameterVectorField
-    return TwoParameterVectorField(system.n, lambda x, p: system.f(x, p[::-1]), lambda x, p: system.dfdx(x, p[::-1]),
+    from shimmy.continuation import TwoParameterField
+    return TwoParameterField(system.n, lambda x, p: system.f(x, p[::-1]), lambda x, p: system.dfdx(x, p[::-1]),
                                    lambda x, p: system.dfdp(x, p[::-1])[::-1], "swapped " + system.name)
 
 
@@ -176,8 +178,8 @@ def test_turning_points_in_p2_and_crossings_of_marked_loads_are_located():
     """With the torus system's parameters exchanged the curve is p2 = p1^2: a minimum of p2 at
     p1 = 0 and crossings of p2 = 0.25 at p1 = +-0.5."""
     system = swapped(torus_two_parameter())
-    curve = cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.3), 0.09, ((-1.0, 1.0), (-1.0, 2.0)),
-                        np.ones(4), (1.0, 1.0), kappa=math.cos(2 * math.pi * 0.33), p2_marks=(0.25,))
+    curve = cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.3), 0.09, box=((-1.0, 1.0), (-1.0, 2.0)),
+                        scale=np.ones(4), p_scale=(1.0, 1.0), kappa=math.cos(2 * math.pi * 0.33), p2_marks=(0.25,))
     np.testing.assert_allclose(curve.p[:, 1], curve.p[:, 0] ** 2, atol=1e-8)
     turns = kinds(curve, "P2_TURN")
     assert len(turns) == 1 and turns[0].data["turn"] == "min"
@@ -189,7 +191,7 @@ def test_turning_points_in_p2_and_crossings_of_marked_loads_are_located():
 def test_double_hopf_point_of_two_uncoupled_oscillators_is_located_on_the_hopf_curve():
     """x' = (p1 + i) x - |x|^2 x, y' = (p2 + 2i) y - |y|^2 y (complex x, y): the Hopf curve p1 = 0 has
     a double-Hopf point at p2 = 0 with frequencies 1 and 2."""
-    from shimmy.continuation import TwoParameterField, hopf_curve
+    from shimmy.continuation import PointKind, TwoParameterField, hopf_curve
 
     def parts(z):
         return z[0] + 1j * z[1], z[2] + 1j * z[3]
@@ -209,15 +211,15 @@ def test_double_hopf_point_of_two_uncoupled_oscillators_is_located_on_the_hopf_c
         return J
 
     def dfdp(z, p):
-        return np.array([[z[0], 0.0], [z[1], 0.0], [0.0, z[2]], [0.0, z[3]]])
+        return np.array([[z[0], z[1], 0.0, 0.0], [0.0, 0.0, z[2], z[3]]])
 
-    curve = hopf_curve(TwoParameterField(4, f, dfdx, dfdp), np.zeros(4), np.array([0.0, 0.5]), ((-1, 1), (-1, 1)),
-                       np.ones(4), np.ones(2))
+    curve = hopf_curve(TwoParameterField(4, f, dfdx, dfdp), np.zeros(4), np.array([0.0, 0.5]), box=((-1, 1), (-1, 1)),
+                       scale=np.ones(4), p_scale=np.ones(2))
     np.testing.assert_allclose(curve.p[:, 0], 0.0, atol=1e-10)
-    assert len(curve.double_hopf) == 1
-    hh = curve.double_hopf[0]
-    assert abs(hh["p"][1]) < 1e-8 and hh["located"]
-    assert hh["omega"] == pytest.approx(1.0) and hh["omega2"] == pytest.approx(2.0)
+    assert len(curve.points_of(PointKind.DOUBLE_HOPF)) == 1
+    hh = curve.points_of(PointKind.DOUBLE_HOPF)[0]
+    assert abs(hh.p[1]) < 1e-8 and hh.located
+    assert hh.data["omega"] == pytest.approx(1.0) and hh.data["omega2"] == pytest.approx(2.0)
 
 
 def test_fold_curve_started_beside_the_generalised_hopf_point():
@@ -226,10 +228,10 @@ def test_fold_curve_started_beside_the_generalised_hopf_point():
     from shimmy.continuation import start_beside
 
     system = bautin()
-    point, ncol = start_beside(system, "LPC", np.zeros(2), np.array([0.0, 0.05]), (-1.0, 1.0), np.ones(2), 1.0,
-                               PeriodicOptions(ntst=20, ncol=4))
+    point, ncol = start_beside(system, "LPC", np.zeros(2), np.array([0.0, 0.05]), p_range=(-1.0, 1.0),
+                               options=PeriodicOptions(ntst=20, ncol=4), scale=np.ones(2), p_scale=1.0)
     assert point is not None and point.p == pytest.approx(-0.05 ** 2 / 4, abs=1e-9)
-    curve = cycle_curve(system, "LPC", point.solution, 0.05, BOX, np.ones(2), (1.0, 1.0), ncol=ncol)
+    curve = cycle_curve(system, "LPC", point.solution, 0.05, box=BOX, scale=np.ones(2), p_scale=(1.0, 1.0), ncol=ncol)
     np.testing.assert_allclose(curve.p[:, 0], -curve.p[:, 1] ** 2 / 4, atol=1e-8)
     assert curve.p[:, 1].max() == pytest.approx(1.0) and curve.p[:, 1].min() < 1e-3
 
@@ -239,7 +241,7 @@ def coupled_oscillators(w2: float = 2.3):
     y' = (p2 + i w2) y + (|x|^2 - |y|^2) y. A double-Hopf point at (0, 0); the cycle |x|^2 = p1
     (T = 2 pi, y = 0) has the fibre multipliers exp(2 pi (p2 + p1)) exp(+-2 pi i w2): the torus curve
     p2 = -p1, p1 > 0, born at the double-Hopf point, kappa = cos(2 pi w2)."""
-    from shimmy.continuation import TwoParameterVectorField
+    from shimmy.continuation import TwoParameterField
 
     def f(z, p):
         x, y = z[0] + 1j * z[1], z[2] + 1j * z[3]
@@ -265,7 +267,7 @@ def coupled_oscillators(w2: float = 2.3):
         zero = 0.0 * z[0]
         return np.stack([np.stack([z[0], z[1], zero, zero]), np.stack([zero, zero, z[2], z[3]])])
 
-    return TwoParameterVectorField(4, f, dfdx, dfdp, "coupled_oscillators")
+    return TwoParameterField(4, f, dfdx, dfdp, "coupled_oscillators")
 
 
 def test_coupled_oscillators_have_exact_jacobians():
@@ -283,11 +285,11 @@ def test_torus_curve_started_beside_the_double_hopf_point():
     from shimmy.continuation import start_beside
 
     system = coupled_oscillators()
-    point, ncol = start_beside(system, "NS", np.zeros(4), np.array([0.0, -0.02]), (-1.0, 1.0), np.ones(4), 1.0,
-                               PeriodicOptions(ntst=20, ncol=4))
+    point, ncol = start_beside(system, "NS", np.zeros(4), np.array([0.0, -0.02]), p_range=(-1.0, 1.0),
+                               options=PeriodicOptions(ntst=20, ncol=4), scale=np.ones(4), p_scale=1.0)
     assert point is not None and point.p == pytest.approx(0.02, abs=1e-8)
-    curve = cycle_curve(system, "NS", point.solution, -0.02, ((-1.0, 0.5), (-1.0, 1.0)), np.ones(4), (1.0, 1.0),
-                        kappa=math.cos(point.data["torus_angle"]), ncol=ncol)
+    curve = cycle_curve(system, "NS", point.solution, -0.02, box=((-1.0, 0.5), (-1.0, 1.0)), scale=np.ones(4),
+                        p_scale=(1.0, 1.0), kappa=math.cos(point.data["torus_angle"]), ncol=ncol)
     np.testing.assert_allclose(curve.p[:, 1], -curve.p[:, 0], atol=1e-8)
     np.testing.assert_allclose(curve.kappa, math.cos(2 * math.pi * 2.3), atol=1e-8)
     assert curve.p[:, 0].max() == pytest.approx(0.5) and curve.p[:, 0].min() < 1e-3

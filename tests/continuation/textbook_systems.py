@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from shimmy.continuation import TwoParameterVectorField, VectorField
+from shimmy.continuation import TwoParameterField, VectorField
 
 
 def _jacobian(entries, x: np.ndarray) -> np.ndarray:
@@ -330,7 +330,7 @@ ALL_SYSTEMS = {
 # --------------------------------------------------------------------------- two-parameter cycles
 
 
-def radial_two_parameter(G, G_rho, G_p, name: str) -> TwoParameterVectorField:
+def radial_two_parameter(G, G_rho, G_p, name: str) -> TwoParameterField:
     """x' = G x - y, y' = x + G y with G = G(rho, p1, p2), rho = x^2 + y^2.
 
     In polar form r' = r G(r^2, p), theta' = 1: cycles r^2 = rho0 with G(rho0, p) = 0, period
@@ -355,10 +355,10 @@ def radial_two_parameter(G, G_rho, G_p, name: str) -> TwoParameterVectorField:
         g1, g2 = G_p(x ** 2 + y ** 2, p)
         return np.stack([np.stack([g1 * x, g1 * y]), np.stack([g2 * x, g2 * y])])
 
-    return TwoParameterVectorField(2, f, dfdx, dfdp, name)
+    return TwoParameterField(2, f, dfdx, dfdp, name)
 
 
-def bautin() -> TwoParameterVectorField:
+def bautin() -> TwoParameterField:
     """The Bautin normal form G = b1 + b2 rho - rho^2 (l2 = -1).
 
     Hopf points of x = 0 at b1 = 0, a generalised Hopf point at (0, 0); for b2 > 0 the fold of
@@ -370,7 +370,7 @@ def bautin() -> TwoParameterVectorField:
                                 lambda rho, p: (np.ones_like(rho), rho), "bautin")
 
 
-def cusp_of_cycles() -> TwoParameterVectorField:
+def cusp_of_cycles() -> TwoParameterField:
     """G = b1 + b2 (rho - 1) - (rho - 1)^3: the fold curve (b1, b2) = (-2 s^3, 3 s^2) with
     rho0 = 1 + s, a cusp of cycles at (0, 0) on the unit cycle."""
     return radial_two_parameter(lambda rho, p: p[0] + p[1] * (rho - 1.0) - (rho - 1.0) ** 3,
@@ -378,7 +378,7 @@ def cusp_of_cycles() -> TwoParameterVectorField:
                                 lambda rho, p: (np.ones_like(rho), rho - 1.0), "cusp_of_cycles")
 
 
-def torus_two_parameter(w2_0: float = 0.3, w2_slope: float = 0.1) -> TwoParameterVectorField:
+def torus_two_parameter(w2_0: float = 0.3, w2_slope: float = 0.1) -> TwoParameterField:
     """The neimark_sacker system with fibre growth a = p1 - p2^2 and rotation w2 = w2_0 + w2_slope p2.
 
     Unit cycle, T = 2 pi; fibre multipliers exp(a T) exp(+-i w2 T): the torus curve p1 = p2^2 with
@@ -411,10 +411,10 @@ def torus_two_parameter(w2_0: float = 0.3, w2_slope: float = 0.1) -> TwoParamete
         return np.stack([np.stack([zero, zero, u, v]),
                          np.stack([zero, zero, -2 * p[1] * u - w2_slope * v, -2 * p[1] * v + w2_slope * u])])
 
-    return TwoParameterVectorField(4, f, dfdx, dfdp, "torus_two_parameter")
+    return TwoParameterField(4, f, dfdx, dfdp, "torus_two_parameter")
 
 
-def flip_two_parameter(b: float = -1.0) -> TwoParameterVectorField:
+def flip_two_parameter(b: float = -1.0) -> TwoParameterField:
     """The period_doubling system with a = p1 - p2^2: fibre multipliers -exp(a T), -exp(b T),
     T = 2 pi: the period-doubling curve p1 = p2^2."""
     one = period_doubling(beta=0.0, b=b)
@@ -429,7 +429,7 @@ def flip_two_parameter(b: float = -1.0) -> TwoParameterVectorField:
         d = one.dfdp(z, p[0] - p[1] ** 2)
         return np.stack([d, -2.0 * p[1] * d])
 
-    return TwoParameterVectorField(4, f, dfdx, dfdp, "flip_two_parameter")
+    return TwoParameterField(4, f, dfdx, dfdp, "flip_two_parameter")
 
 
 TWO_PARAMETER_SYSTEMS = {

@@ -59,7 +59,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ...version import __version__
-from ...continuation import ContinuationOptions, correct
+from ...continuation import ContinuationOptions, PointKind, correct
 from ...continuation.collocation import Mesh, PeriodicProblem
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import Configuration, affects
@@ -329,7 +329,8 @@ def min_shimmy_sensitivity(model: Model, pairs: dict[str, tuple], fz_box: tuple[
     low = hopf.fz_minimum
     if low is None:
         return None
-    turning = any(abs(e["p"][1] - low["Fz"]) <= 1e-9 * low["Fz"] for c in hopf.curves for e in c.extrema)
+    turning = any(abs(e.p[1] - low["Fz"]) <= 1e-9 * low["Fz"] for c in hopf.curves
+                  for e in c.points_of(PointKind.P2_TURN))
     if turning:
         V, Fz, omega = polish_lowest_point(model, low["V"], low["Fz"])
         source = "lowest point of the Hopf curves"

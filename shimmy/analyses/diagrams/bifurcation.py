@@ -49,8 +49,8 @@ from ...continuation.errors import ConvergenceError as EngineConvergenceError
 from ...continuation.errors import InvalidInputError as EngineInvalidInputError
 from ...continuation.collocation import Mesh, PeriodicProblem
 from ...model.configurations import Configuration
-from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, SpecialPoint, VectorField,
-                           equilibrium_branch, locate, step, tangent, weighted_norm)
+from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, PointKind, Stop, VectorField,
+                             equilibrium_branch, locate, step, tangent, weighted_norm)
 from ...model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.nes import VALID_ANGLE
@@ -132,6 +132,7 @@ class Branch:
     stop_reason: str
     steps: int
     raw: PeriodicBranch | None = None
+    closed: bool = False  # a loop of orbits: its last point joins its first
 
     def to_dict(self) -> dict[str, Any]:
         points = [{"V": float(v), "period": None if math.isnan(T) else float(T), "max_psi": float(a),
@@ -200,10 +201,10 @@ def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | 
 
     report(0.0, "equilibrium branch")
     hopf = hopf_points(config, Fz, params=params, v_range=(v_min, v_max))
-    eq = equilibrium_branch(system, np.zeros(n), v_min, v_min, v_max,
-                            ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000), scale=scale,
+    eq = equilibrium_branch(system, np.zeros(n), v_min, p_range=(v_min, v_max),
+                            options=ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000), scale=scale,
                             p_scale=V_SCALE)
-    engine_h = [s.p for s in eq.special_points if s.kind == "H"]
+    engine_h = [s.p for s in eq.special_points if s.kind == PointKind.HOPF]
     scan_h = [h.V for h in hopf.hopf_points]
     starts = sorted(scan_h)
     for v in scan_h:
@@ -233,14 +234,14 @@ def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | 
         q = vecs[:, i] / vecs[np.argmax(np.abs(vecs[:, i] / scale)), i]
         guess, shape = hopf_guess(np.zeros(n), v_h, ev[i].imag, q, Mesh.uniform(popts.ntst, popts.ncol), 0.0)
         try:
-            raw = periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts, direction=shape,
-                                  limits=limits)
+            raw = periodic_branch(system, guess, p_range=(v_min, v_max), options=popts, scale=scale, p_scale=V_SCALE,
+                                  direction=shape, limits=limits)
         except EngineConvergenceError as exc:  # the engine's, or ours derived from it
             warnings.append(f"no periodic branch from the Hopf point at V = {v_h:.6g} m/s: {exc}")
             continue
         done.append(v_h)
         for s in raw.special_points:
-            if s.kind == "H":  # ended on another Hopf point: the located one it approaches
+            if s.kind == PointKind.HOPF:  # ended on another Hopf point: the located one it approaches
                 near = _hopf_reached(starts, raw)
                 if near is not None:
                     done.append(near)
@@ -332,9 +333,9 @@ def _equilibrium_output(eq: EquilibriumBranch, hopf: HopfResult) -> Branch:
         stable.insert(k, False)
     V_arr = np.array(V)
     zeros = np.zeros_like(V_arr)
-    special = [{"kind": "H", "V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value,
+    special = [{"kind": PointKind.HOPF, "V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value,
                 "lyapunov": h.lyapunov} for h in hopf.hopf_points]
-    special += [{"kind": "BP", "V": v} for v in hopf.branch_points]
+    special += [{"kind": PointKind.BRANCH_POINT, "V": v} for v in hopf.branch_points]
     return Branch("equilibrium", V_arr, np.full_like(V_arr, np.nan), zeros, zeros.copy(), np.array(stable),
                   [None] * V_arr.size, special, "x = 0", eq.stop_reason, eq.steps)
 
@@ -350,7 +351,7 @@ def _periodic_output(raw: PeriodicBranch, params: Parameters, origin: str, hopf_
     special = []
     for s in raw.special_points:
         d = {"kind": s.kind, "V": s.p}
-        if s.kind == "H" and hopf_speeds:
+        if s.kind == PointKind.HOPF and hopf_speeds:
             near = _hopf_reached(hopf_speeds, raw)
             if near is not None:
                 d.update({"V": near, "V_last_point": s.p})
@@ -363,7 +364,7 @@ def _periodic_output(raw: PeriodicBranch, params: Parameters, origin: str, hopf_
             d["torus_angle"] = s.data["torus_angle"]
         special.append(d)
     return Branch("periodic", raw.p, raw.period, psi_amp, l_g * delta_amp, raw.stable, modes, special, origin,
-                  raw.stop_reason, raw.steps, raw)
+                  raw.stop_reason, raw.steps, raw, raw.closed)
 
 
 def _with_hopf_ends(branch: Branch, v_start: float, omega: dict[float, float]) -> Branch:
@@ -374,7 +375,7 @@ def _with_hopf_ends(branch: Branch, v_start: float, omega: dict[float, float]) -
         return V, 2.0 * math.pi / omega[V]
 
     head = [point(v_start)]
-    tail = [point(s["V"]) for s in branch.special_points if s["kind"] == "H" and s["V"] in omega]
+    tail = [point(s["V"]) for s in branch.special_points if s["kind"] == PointKind.HOPF and s["V"] in omega]
     V = np.concatenate([[v for v, _ in head], branch.V, [v for v, _ in tail]])
     T = np.concatenate([[t for _, t in head], branch.period, [t for _, t in tail]])
     zeros_h, zeros_t = np.zeros(len(head)), np.zeros(len(tail))
@@ -382,7 +383,7 @@ def _with_hopf_ends(branch: Branch, v_start: float, omega: dict[float, float]) -
     mode = branch.mode[:1] + branch.mode + branch.mode[-1:][:len(tail)]
     return Branch(branch.kind, V, T, np.concatenate([zeros_h, branch.max_psi, zeros_t]),
                   np.concatenate([zeros_h, branch.max_lateral, zeros_t]), stable, mode, branch.special_points,
-                  branch.origin, branch.stop_reason, branch.steps, branch.raw)
+                  branch.origin, branch.stop_reason, branch.steps, branch.raw, branch.closed)
 
 
 def _on_branch(branches: list[Branch], V: float, period: float, psi_amp: float, lat_amp: float) -> bool:
@@ -462,32 +463,34 @@ def _seeded_branch(config, model, system, Fz, params, v_seed, v_min, v_max, popt
     halves = []
     for direction in (-1, +1):
         try:
-            halves.append(periodic_branch(system, guess, v_min, v_max, scale, V_SCALE, popts,
-                                          p_direction=direction, limits=limits))
+            halves.append(periodic_branch(system, guess, p_range=(v_min, v_max), options=popts, scale=scale,
+                                          p_scale=V_SCALE, p_direction=direction, limits=limits))
         except EngineConvergenceError as exc:  # the engine's, or ours derived from it
             warnings.append(f"{label} at V = {v_seed:.6g} m/s: {exc}")
             return None
-        if halves[0].stop_reason.startswith("closed branch"):  # a loop: one way round covers it
+        if halves[0].closed:  # a loop: one way round covers it
             return _periodic_output(halves[0], params, f"{label} at V = {v_seed:.6g} m/s", [])
     joined = _join(halves[0], halves[1])
     return _periodic_output(joined, params, f"{label} at V = {v_seed:.6g} m/s", [])
 
 
 def _join(down: PeriodicBranch, up: PeriodicBranch) -> PeriodicBranch:
-    """One branch from two halves continued both ways from the same first point."""
+    """One branch from two halves continued both ways from the same first point (open: a loop is kept
+    from its first half alone)."""
     k = down.p.size
 
     def cat(a, b):
         return np.concatenate([a[::-1], b[1:]])
 
-    special = [SpecialPoint(s.kind, s.p, k - 1 - s.index, s.data, s.solution) for s in down.special_points][::-1]
-    special += [SpecialPoint(s.kind, s.p, k - 1 + s.index, s.data, s.solution) for s in up.special_points]
+    special = [replace(s, index=k - 1 - s.index) for s in down.special_points][::-1]
+    special += [replace(s, index=k - 1 + s.index) for s in up.special_points]
     return PeriodicBranch(cat(down.p, up.p), cat(down.period, up.period), cat(down.x_max, up.x_max),
                           cat(down.x_min, up.x_min), cat(down.stable, up.stable),
-                          cat(down.multipliers, up.multipliers), special,
-                          f"decreasing V: {down.stop_reason}; increasing V: {up.stop_reason}",
-                          down.steps + up.steps, up.ntst, up.ncol, down.solutions[::-1] + up.solutions[1:],
-                          max(down.trivial_error, up.trivial_error))
+                          cat(down.multipliers, up.multipliers), up.ntst, up.ncol,
+                          down.solutions[::-1] + up.solutions[1:], max(down.trivial_error, up.trivial_error),
+                          special_points=special, steps=down.steps + up.steps,
+                          stops=[Stop(s.reason, f"{way}: {s.message}")
+                                 for way, half in (("decreasing V", down), ("increasing V", up)) for s in half.stops])
 
 
 def _restore(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray,

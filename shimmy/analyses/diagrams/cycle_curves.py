@@ -30,21 +30,25 @@ from typing import Any, Callable
 import numpy as np
 
 from ...version import __version__
-from ...continuation import (ContinuationOptions, CycleCurve, CycleCurveOptions, SpecialPoint,
-                            TwoParameterVectorField, cycle_curve, start_beside)
+from ...continuation import (CYCLE_BIFURCATIONS, ContinuationOptions, CycleCurve, CycleCurveOptions, PointKind,
+                             SpecialPoint, cycle_curve, start_beside)
 from ...continuation.errors import ContinuationError
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
-from ...model.equations import build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
+from ...model.equations import build_model
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number, check_range
-from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, orbit_limits, bifurcation
-from .hopf_curves import hopf_curves
+from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, orbit_limits
+from .hopf_curves import gear_two_parameter_field, hopf_curves
 from ..core.polylines import near_polyline
 from ..core.executors import describe_work_unit, open_executor, run_dynamic, run_work_unit
 from ..core.stability import hopf_points
 
-KINDS = ("LPC", "NS", "PD")
-KEY_OF_KIND = {"LPC": "fold_curves", "NS": "torus_curves", "PD": "pd_curves"}
+KINDS = CYCLE_BIFURCATIONS
+KEY_OF_KIND = {PointKind.FOLD_OF_CYCLES: "fold_curves", PointKind.TORUS: "torus_curves",
+               PointKind.PERIOD_DOUBLING: "pd_curves"}
+#: Marks on a cycle curve that are not codimension-2 points: its ends, its turns and crossings in Fz
+MARKS = (PointKind.END, PointKind.ZERO_AMPLITUDE, PointKind.P2_TURN, PointKind.P2_MARK)
+ENDS = (PointKind.END, PointKind.ZERO_AMPLITUDE)
 FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 kN
 CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400,
                                                                    max_angle=0.3))
@@ -53,22 +57,9 @@ START_STEPS = 80  # step budget of a start branch
 SCAN_FRACTIONS = (0.3, 0.6, 0.9)  # loads of the one-parameter diagrams, as fractions of the box in Fz
 
 
-def gear_cycle_field(config: Configuration, params: Parameters) -> TwoParameterVectorField:
-    """The gear's vector field in (V, Fz), vectorised over columns, analytic derivatives."""
-    model = build_model(config, params)
-
-    def evaluate(x, p):
-        f, J, dV, dFz = field_and_derivatives(model, x, p[0], p[1])
-        return f, J, np.stack([dV, dFz])
-    return TwoParameterVectorField(model.n_states, lambda x, p: rhs(model, x, p[0], p[1]),
-                                   lambda x, p: jacobian(model, x, p[0], p[1]),
-                                   lambda x, p: np.stack(parameter_jacobian(model, x, p[0], p[1])),
-                                   f"{config.value} in (V, Fz)", evaluate)
-
-
 @dataclass(eq=False)  # compared by identity: list.remove takes the very start
 class Start:
-    kind: str
+    kind: PointKind
     point: SpecialPoint  # located on a branch in V, with its solution
     Fz: float
     ncol: int
@@ -81,7 +72,7 @@ class Start:
 
 @dataclass
 class GearCycleCurve:
-    kind: str
+    kind: PointKind
     curve: CycleCurve
     origin: str
 
@@ -95,8 +86,8 @@ class GearCycleCurve:
 
 def _located_point(s: SpecialPoint, l_g: float) -> dict[str, Any]:
     out: dict[str, Any] = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
-    if "located" in s.data:
-        out["located"] = bool(s.data["located"])
+    if s.located is not None:
+        out["located"] = s.located
     if "x_max" in s.data:
         xmax, xmin = np.array(s.data["x_max"]), np.array(s.data["x_min"])
         out.update({"period": s.data["period"], "max_psi": float(max(abs(xmax[0]), abs(xmin[0]))),
@@ -110,7 +101,7 @@ class CycleCurvesResult:
     params: Parameters
     v_range: tuple[float, float]
     fz_range: tuple[float, float]
-    kinds: tuple[str, ...]
+    kinds: tuple[PointKind, ...]
     curves: list[GearCycleCurve]
     gh_points: list[dict[str, float]]
     double_hopf_points: list[dict[str, float]]
@@ -119,17 +110,17 @@ class CycleCurvesResult:
     starts_tried: int
     warnings: list[str] = field(default_factory=list)
 
-    def of_kind(self, kind: str) -> list[GearCycleCurve]:
+    def of_kind(self, kind: PointKind) -> list[GearCycleCurve]:
         return [c for c in self.curves if c.kind == kind]
 
     def codim2_points(self) -> list[dict[str, Any]]:
         """GH and double-Hopf points of the Hopf curves, and those located on the cycle curves
         (one entry per point: the same point found on two curves is listed once)."""
-        out = [{"kind": "GH", "V": g["V"], "Fz": g["Fz"]} for g in self.gh_points]
-        out += [{"kind": "HH", "V": g["V"], "Fz": g["Fz"]} for g in self.double_hopf_points]
+        out = [{"kind": PointKind.GENERALISED_HOPF, "V": g["V"], "Fz": g["Fz"]} for g in self.gh_points]
+        out += [{"kind": PointKind.DOUBLE_HOPF, "V": g["V"], "Fz": g["Fz"]} for g in self.double_hopf_points]
         for c in self.curves:
             for s in c.curve.special_points:
-                if s.kind in ("EP", "ZA", "P2_TURN", "P2_MARK") or not s.data.get("located", True):
+                if s.kind in MARKS or s.located is False:
                     continue  # ends and load marks are not codimension-2 points; unlocated ones stay in "curves"
                 entry = {"kind": s.kind, "V": s.p, "Fz": s.data["p2"]}
                 # the same point on two curves (LPNS on a fold and a torus curve) agrees to the
@@ -148,7 +139,7 @@ class CycleCurvesResult:
         details = []
         for c in self.curves:
             special = c.curve.special_points
-            turns = [_located_point(s, l_g) | {"turn": s.data["turn"]} for s in special if s.kind == "P2_TURN"]
+            turns = [_located_point(s, l_g) | {"turn": s.data["turn"]} for s in special if s.kind == PointKind.P2_TURN]
             fz = c.curve.p[:, 1]
             lowest = min([{"V": float(c.curve.p[int(np.argmin(fz)), 0]), "Fz": float(fz.min())}]
                          + [t for t in turns if t["turn"] == "min"], key=lambda e: e["Fz"])
@@ -159,11 +150,11 @@ class CycleCurvesResult:
                 "stop_reasons": c.curve.stop_reasons, "steps": c.curve.steps,
                 "fz_min": {"V": lowest["V"], "Fz": lowest["Fz"]}, "fz_max": {"V": highest["V"], "Fz": highest["Fz"]},
                 "turning_points": turns,
-                "crossings": sorted((_located_point(s, l_g) for s in special if s.kind == "P2_MARK"),
+                "crossings": sorted((_located_point(s, l_g) for s in special if s.kind == PointKind.P2_MARK),
                                     key=lambda e: (e["Fz"], e["V"])),
-                "ends": [_located_point(s, l_g) for s in special if s.kind in ("EP", "ZA")],
+                "ends": [_located_point(s, l_g) for s in special if s.kind in ENDS],
                 "codim2_points": [_located_point(s, l_g) for s in special
-                                  if s.kind not in ("EP", "ZA", "P2_TURN", "P2_MARK")],
+                                  if s.kind not in MARKS],
             })
         out.update({"curves": details, "codim2_points": self.codim2_points(), "gh_points": self.gh_points,
                     "double_hopf_points": self.double_hopf_points, "loads": list(self.loads),
@@ -197,7 +188,7 @@ class CurveSearch:
     units finish: a map or a set of curves is the same on any executor.
     :func:`cycle_curves` and the stability maps both drive it."""
 
-    def __init__(self, config: Configuration, params: Parameters, box, kinds: tuple[str, ...],
+    def __init__(self, config: Configuration, params: Parameters, box, kinds: tuple[PointKind, ...],
                  loads: tuple[float, ...]):
         self.config, self.params, self.box, self.kinds, self.loads = config, params, box, kinds, loads
         self.gh: list[dict[str, float]] = []
@@ -216,18 +207,18 @@ class CurveSearch:
 
     def start_units(self, hopf) -> list[BesideUnit]:
         """The branches beside the GH points (fold curves) and double-Hopf points (torus curves)."""
-        self.gh = [{"V": g["p"][0], "Fz": g["p"][1]} for c in hopf.curves for g in c.gh_points]
+        self.gh = [{"V": g.p[0], "Fz": g.p[1]} for c in hopf.curves for g in c.points_of(PointKind.GENERALISED_HOPF)]
         for c in hopf.curves:
-            for g in c.double_hopf:
-                entry = {"V": g["p"][0], "Fz": g["p"][1], "omega": g["omega"], "omega2": g["omega2"]}
+            for g in c.points_of(PointKind.DOUBLE_HOPF):
+                entry = {"V": g.p[0], "Fz": g.p[1], "omega": g.data["omega"], "omega2": g.data["omega2"]}
                 if not any(_close(entry, e, 1e-4) for e in self.hh):
                     self.hh.append(entry)
-        units = [BesideUnit(self.config, self.params, g, "LPC", self.box,
+        units = [BesideUnit(self.config, self.params, g, PointKind.FOLD_OF_CYCLES, self.box,
                             f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
-                 for g in self.gh if "LPC" in self.kinds]
-        units += [BesideUnit(self.config, self.params, g, "NS", self.box,
+                 for g in self.gh if PointKind.FOLD_OF_CYCLES in self.kinds]
+        units += [BesideUnit(self.config, self.params, g, PointKind.TORUS, self.box,
                              f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
-                  for g in self.hh if "NS" in self.kinds]
+                  for g in self.hh if PointKind.TORUS in self.kinds]
         self.hopf_pending = False
         self.beside_order += units
         return units
@@ -384,7 +375,7 @@ def search_done(search: CurveSearch, unit: SearchUnit, result: Any) -> list[Cont
 
 def cycle_curves(config: Configuration | str, *, params: Parameters | None = None,
                  v_range: tuple[float, float] = DIAGRAM_V_RANGE, fz_range: tuple[float, float] = FZ_RANGE,
-                 kinds: tuple[str, ...] = KINDS, loads: tuple[float, ...] = (),
+                 kinds: tuple[PointKind | str, ...] = KINDS, loads: tuple[float, ...] = (),
                  executor: Executor | None = None,
                  progress: Callable[[float, str], None] | None = None) -> CycleCurvesResult:
     """Every fold, torus and period-doubling curve of cycles in the box (m/s, N); ``loads``: the
@@ -405,6 +396,7 @@ def cycle_curves(config: Configuration | str, *, params: Parameters | None = Non
     for k in kinds:
         if k not in KINDS:
             raise InvalidParameterError("kinds", k, ", ".join(KINDS), "is not a kind of cycle curve")
+    kinds = tuple(PointKind(k) for k in kinds)
     if not kinds:
         raise InvalidParameterError("kinds", "", ", ".join(KINDS), "is empty")
     loads = tuple(float(check_number(f"loads[{i}]", f, f_lo, f_hi, "N")) for i, f in enumerate(loads))
@@ -438,14 +430,15 @@ def starts_of_diagram(diagram, Fz: float) -> list[Start]:
 def _continue(config: Configuration, params: Parameters, start: Start, box, loads: tuple[float, ...]
               ) -> tuple[GearCycleCurve | None, str | None]:
     """One curve continued from one start (a unit of :func:`cycle_curves`)."""
-    system = gear_cycle_field(config, params)
-    kappa = math.cos(start.point.data["torus_angle"]) if start.kind == "NS" else None
+    system = gear_two_parameter_field(config, params)
+    kappa = math.cos(start.point.data["torus_angle"]) if start.kind == PointKind.TORUS else None
     if kappa is not None and not -1.0 < kappa < 1.0:
         return None, None
     about = f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin})"
     try:
-        curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box, STATE_SCALE[:system.n],
-                            (V_SCALE, FZ_SCALE), kappa=kappa, options=CURVE_OPTIONS, ncol=start.ncol, p2_marks=loads)
+        curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box=box, options=CURVE_OPTIONS,
+                            scale=STATE_SCALE[:system.n], p_scale=(V_SCALE, FZ_SCALE), kappa=kappa, ncol=start.ncol,
+                            p2_marks=loads)
     except ContinuationError as exc:
         return None, f"{about} not continued: {exc}"
     if len(curve.p) < 2:  # stopped at its start both ways (a start at a strong resonance): no curve to draw
@@ -469,19 +462,20 @@ def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin
     Hopf points just above and below the codimension-2 point's load."""
     out = []
     n = model.n_states
-    system = gear_cycle_field(config, params)
+    system = gear_two_parameter_field(config, params)
     options = BifurcationOptions(max_steps=START_STEPS).periodic()
     for side in (-1.0, 1.0):
         Fz = point["Fz"] * (1.0 + side * BESIDE)
         if not fz_range[0] <= Fz <= fz_range[1]:
             continue
         hopf = hopf_points(config, Fz, params=params, v_range=(v_range[0], v_range[1])).hopf_points
-        near = sorted(hopf, key=lambda h: abs(math.log(h.V / point["V"])))[:2 if kind == "NS" else 1]
+        near = sorted(hopf, key=lambda h: abs(math.log(h.V / point["V"])))[:2 if kind == PointKind.TORUS else 1]
         for h in near:
             if abs(math.log(h.V / point["V"])) > 0.2:
                 continue
-            found, ncol = start_beside(system, kind, np.zeros(n), np.array([h.V, Fz]), v_range, STATE_SCALE[:n],
-                                       V_SCALE, options, limits=orbit_limits(model))
+            found, ncol = start_beside(system, kind, np.zeros(n), np.array([h.V, Fz]), p_range=v_range,
+                                       options=options, scale=STATE_SCALE[:n], p_scale=V_SCALE,
+                                       limits=orbit_limits(model))
             if found is not None:
                 # eager when born at the point (a branch beside it may fold or lose stability
                 # first on another curve, far away: that start waits like a diagram's)

@@ -20,9 +20,8 @@ import numpy as np
 
 from ...version import __version__
 from ...model.configurations import Configuration
-from ...continuation import ContinuationOptions
-from ...model.equations import build_model, jacobian, parameter_jacobian, rhs
-from ...continuation.hopf import HopfCurve, TwoParameterField, hopf_curve
+from ...continuation import ContinuationOptions, HopfCurve, PointKind, TwoParameterField, hopf_curve
+from ...model.equations import build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from ..core.polylines import near_polyline
 from ..core.response import Mode, dominant_mode, torsional_share
@@ -50,9 +49,10 @@ class HopfCurvesResult:
         for c in curves:
             if c.p.size == 0:
                 continue
-            for e in c.extrema + [{"p": c.p[i].tolist(), "omega": float(c.omega[i])} for i in (0, -1)]:
-                if best is None or e["p"][1] < best["Fz"]:
-                    best = {"V": e["p"][0], "Fz": e["p"][1], "frequency_hz": e["omega"] / (2 * math.pi)}
+            ends = [(c.p[i].tolist(), float(c.omega[i])) for i in (0, -1)]
+            for p, omega in [(t.p, t.data["omega"]) for t in c.points_of(PointKind.P2_TURN)] + ends:
+                if best is None or p[1] < best["Fz"]:
+                    best = {"V": p[0], "Fz": p[1], "frequency_hz": omega / (2 * math.pi)}
         return best
 
     @property
@@ -62,8 +62,7 @@ class HopfCurvesResult:
 
     @property
     def gh_points(self) -> list[dict[str, float]]:
-        return [{"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi)}
-                for c in self.curves for g in c.gh_points]
+        return [_gh_point(g) for c in self.curves for g in c.points_of(PointKind.GENERALISED_HOPF)]
 
     def mode_of_curve(self, curve: HopfCurve) -> Mode:
         """"torsional" or "lateral": the larger share of elastic energy in the critical eigenvector
@@ -88,9 +87,8 @@ class HopfCurvesResult:
         cross there); each listed once although it lies on two curves."""
         out: list[dict[str, float]] = []
         for c in self.curves:
-            for g in c.double_hopf:
-                entry = {"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi),
-                         "frequency2_hz": g["omega2"] / (2 * math.pi)}
+            for g in c.points_of(PointKind.DOUBLE_HOPF):
+                entry = _double_hopf_point(g)
                 if not any(abs(e["V"] - entry["V"]) <= 1e-5 * V_SCALE and abs(e["Fz"] - entry["Fz"]) <= 1e-5 * FZ_SCALE
                            for e in out):
                     out.append(entry)
@@ -103,12 +101,10 @@ class HopfCurvesResult:
             curves.append({
                 "points": [{"V": float(p[0]), "Fz": float(p[1]), "frequency_hz": float(w / (2 * math.pi)),
                             "lyapunov": l1} for p, w, l1 in zip(c.p, c.omega, lyap, strict=True)],
-                "gh_points": [{"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi)}
-                              for g in c.gh_points],
-                "fz_extrema": [{"V": e["p"][0], "Fz": e["p"][1]} for e in c.extrema],
-                "double_hopf_points": [{"V": g["p"][0], "Fz": g["p"][1], "frequency_hz": g["omega"] / (2 * math.pi),
-                                        "frequency2_hz": g["omega2"] / (2 * math.pi)} for g in c.double_hopf],
-                "zero_hopf_points": [{"V": g["p"][0], "Fz": g["p"][1]} for g in c.zero_hopf],
+                "gh_points": [_gh_point(g) for g in c.points_of(PointKind.GENERALISED_HOPF)],
+                "fz_extrema": [{"V": e.p[0], "Fz": e.p[1]} for e in c.points_of(PointKind.P2_TURN)],
+                "double_hopf_points": [_double_hopf_point(g) for g in c.points_of(PointKind.DOUBLE_HOPF)],
+                "zero_hopf_points": [{"V": g.p[0], "Fz": g.p[1]} for g in c.points_of(PointKind.ZERO_HOPF)],
                 "closed": c.closed, "stop_reasons": c.stop_reasons, "steps": c.steps})
         return {"config": self.config.value, "params": self.params.to_dict(),
                 "v_range": list(self.v_range), "fz_range": list(self.fz_range), "curves": curves,
@@ -118,15 +114,26 @@ class HopfCurvesResult:
                 "version": __version__}
 
 
+def _gh_point(g) -> dict[str, float]:
+    return {"V": g.p[0], "Fz": g.p[1], "frequency_hz": g.data["omega"] / (2 * math.pi)}
+
+
+def _double_hopf_point(g) -> dict[str, float]:
+    return {"V": g.p[0], "Fz": g.p[1], "frequency_hz": g.data["omega"] / (2 * math.pi),
+            "frequency2_hz": g.data["omega2"] / (2 * math.pi)}
+
+
 def gear_two_parameter_field(config: Configuration, params: Parameters) -> TwoParameterField:
+    """The gear's vector field in (V, Fz), vectorised over columns, analytic derivatives."""
     model = build_model(config, params)
 
-    def dfdp(x, p):
-        dV, dFz = parameter_jacobian(model, x, p[0], p[1])
-        return np.column_stack([dV, dFz])
-
+    def evaluate(x, p):
+        f, J, dV, dFz = field_and_derivatives(model, x, p[0], p[1])
+        return f, J, np.stack([dV, dFz])
     return TwoParameterField(model.n_states, lambda x, p: rhs(model, x, p[0], p[1]),
-                             lambda x, p: jacobian(model, x, p[0], p[1]), dfdp, smooth=config.is_smooth)
+                             lambda x, p: jacobian(model, x, p[0], p[1]),
+                             lambda x, p: np.stack(parameter_jacobian(model, x, p[0], p[1])),
+                             f"{config.value} in (V, Fz)", evaluate, smooth=config.is_smooth)
 
 
 def hopf_curves(config: Configuration | str, *, params: Parameters | None = None,
@@ -154,8 +161,8 @@ def hopf_curves(config: Configuration | str, *, params: Parameters | None = None
             if any(_on_curve(c, h.V, float(Fz)) for c in curves):
                 continue
             try:
-                curve = hopf_curve(system, np.zeros(n), np.array([h.V, float(Fz)]), box, X_SCALE[:n],
-                                   np.array([V_SCALE, FZ_SCALE]), options)
+                curve = hopf_curve(system, np.zeros(n), np.array([h.V, float(Fz)]), box=box, options=options,
+                                   scale=X_SCALE[:n], p_scale=np.array([V_SCALE, FZ_SCALE]))
             except ValueError as exc:
                 warnings.append(f"Hopf point V = {h.V:.6g} m/s, Fz = {Fz:.6g} N not continued: {exc}")
                 continue

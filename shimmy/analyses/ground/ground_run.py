@@ -42,6 +42,7 @@ import numpy as np
 from scipy.ndimage import maximum_filter1d
 
 from ...version import __version__
+from ...continuation import PointKind
 from ...errors import InvalidParameterError
 from ...model import integrator
 from ...model.configurations import ALL_CONFIGURATIONS, Configuration
@@ -323,11 +324,12 @@ def _cycle_curve_polylines(config: Configuration, params: Parameters, v_max: flo
     """(kind, points (k, 2)) of every fold and torus curve in V 1..v_max, the full Fz range (kept per process)."""
     from ..diagrams.cycle_curves import cycle_curves
 
-    result = cycle_curves(config, params=params, v_range=(V_RANGE[0], v_max), fz_range=FZ_RANGE, kinds=("LPC", "NS"))
+    result = cycle_curves(config, params=params, v_range=(V_RANGE[0], v_max), fz_range=FZ_RANGE,
+                          kinds=(PointKind.FOLD_OF_CYCLES, PointKind.TORUS))
     return tuple((c.kind, np.array(c.curve.p, dtype=float)) for c in result.curves if len(c.curve.p) > 1)
 
 
-CURVE_NAMES = {"LPC": "fold", "NS": "torus"}
+CURVE_NAMES = {PointKind.FOLD_OF_CYCLES: "fold", PointKind.TORUS: "torus"}
 
 
 def cycle_curve_crossings(config: Configuration, profile: GroundProfile, *, params: Parameters,

@@ -46,6 +46,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ...version import __version__
+from ...continuation import CYCLE_BIFURCATIONS, PointKind
 from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from ...model.configurations import Configuration
 from ...errors import InvalidParameterError
@@ -108,7 +109,7 @@ def attractors_on(result: BifurcationResult, speeds: np.ndarray) -> list[list[di
         if b.kind != "periodic" or b.V.size < 2:
             continue
         first = np.arange(b.V.size - 1)
-        if b.stop_reason.startswith("closed branch"):  # a loop: its last orbit joins its first
+        if b.closed:  # a loop: its last orbit joins its first
             first = np.append(first, b.V.size - 1)
         second = (first + 1) % b.V.size
         v0s, v1s = b.V[first], b.V[second]
@@ -254,7 +255,7 @@ def _special_points(result: BifurcationResult) -> list[dict[str, Any]]:
         if b.kind != "periodic":
             continue
         for s in b.special_points:
-            if s["kind"] in ("LPC", "NS", "PD", "BPC"):
+            if s["kind"] in (*CYCLE_BIFURCATIONS, PointKind.BRANCH_POINT_OF_CYCLES):
                 k = int(np.argmin(np.abs(b.V - s["V"])))
                 points.append({"kind": s["kind"], "V": float(s["V"]), "mode": b.mode[k]})
     return points
@@ -449,7 +450,8 @@ class _MapBuild:
         self.options = options or BifurcationOptions(mesh_check=False)
         (v_min, v_max), (f_min, f_max) = self.v_range, self.fz_range
         self.loads = np.linspace(f_min, f_max, self.resolution)
-        self.search = CurveSearch(self.config, self.params, ((v_min, v_max), (f_min, f_max)), ("LPC", "NS"),
+        self.search = CurveSearch(self.config, self.params, ((v_min, v_max), (f_min, f_max)),
+                                  (PointKind.FOLD_OF_CYCLES, PointKind.TORUS),
                                   tuple(float(f) for f in self.loads))
         self.rows = np.linspace(f_min, f_max, max(SHADING_ROWS, 4 * self.resolution))
         self.hopf: HopfCurvesResult | None = None
@@ -603,7 +605,7 @@ def _min_shimmy(hopf: HopfCurvesResult, cycles: dict[str, Any], slices: list[Sli
     if low is not None and any(c.p.size for c in hopf.curves):
         candidates.append({"Fz": low["Fz"], "V": low["V"], "source": "Hopf curve"})
     for c in cycles["curves"]:
-        if c["kind"] == "LPC":
+        if c["kind"] == PointKind.FOLD_OF_CYCLES:
             candidates.append({"Fz": c["fz_min"]["Fz"], "V": c["fz_min"]["V"], "source": "fold-of-cycles curve"})
     for s in slices:
         if s.intervals:

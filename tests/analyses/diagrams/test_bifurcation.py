@@ -57,8 +57,8 @@ def test_equilibrium_continuation_finds_every_hopf_point_of_the_scan(config, Fz)
     """At 300 kN two pairs of the original gear cross 0.0075 m/s apart (3.8594 and 3.8669 m/s),
     inside one continuation step: both are located, as at the other loads."""
     model = build_model(config, None)
-    eq = equilibrium_branch(gear_field(model, Fz), np.zeros(model.n_states), 1.0, 1.0, 200.0,
-                            ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000),
+    eq = equilibrium_branch(gear_field(model, Fz), np.zeros(model.n_states), 1.0, p_range=(1.0, 200.0),
+                            options=ContinuationOptions(ds=0.1, ds_max=2.0, max_steps=10_000),
                             scale=STATE_SCALE[:model.n_states], p_scale=V_SCALE)
     engine = [s.p for s in eq.special_points if s.kind == "H"]
     scan = [h.V for h in hopf_points(config, Fz, v_range=(1.0, 200.0)).hopf_points]
