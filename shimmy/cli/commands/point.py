@@ -1,0 +1,97 @@
+"""One operating point: ``params``, ``hopf``, ``eigen``, ``simulate``."""
+
+from __future__ import annotations
+
+import math
+
+from ...model.parameters import PARAMETER_SPECS, V_RANGE
+from ..common import EXIT_FAILED, add_command, add_common, add_config, add_operating_point, emit, limit, limits, params
+
+
+def _cmd_params(args) -> int:
+    rows = [spec.to_dict() for spec in PARAMETER_SPECS.values()]
+    lines = [f"{'name':<11}{'group':<6}{'unit':<11}{'default':>12}{'low':>11}{'high':>11}  description"]
+    for s in PARAMETER_SPECS.values():
+        lines.append(f"{s.name:<11}{s.group:<6}{s.unit:<11}{s.default:>12.6g}{s.low:>11.4g}{s.high:>11.4g}  "
+                     f"{s.description}")
+    emit({"parameters": rows}, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_hopf(args) -> int:
+    from ...analyses.core.stability import hopf_points
+
+    result = hopf_points(args.config, args.Fz, params=params(args), v_range=(args.v_min, args.v_max))
+    payload = result.to_dict()
+    lines = [f"{result.config.value} at Fz = {result.Fz:g} N, V in [{result.v_min:g}, {result.v_max:g}] m/s"]
+    if not result.hopf_points:
+        lines.append("  no Hopf point")
+    for h in result.hopf_points:
+        lines.append(f"  Hopf V = {h.V:.6f} m/s  f = {h.frequency_hz:.4f} Hz  {h.criticality.value}"
+                     f"  ({'loses' if h.destabilising else 'regains'} stability as V increases)")
+    for iv in result.unstable_intervals:
+        lines.append(f"  x = 0 unstable for V in [{iv[0]:.6g}, {iv[1]:.6g}] m/s")
+    emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_eigen(args) -> int:
+    from ...analyses.core.stability import eigenvalues
+    from ...model.parameters import check_operating_point
+
+    V, Fz = check_operating_point(args.V, args.Fz)
+    design = params(args)
+    ev = eigenvalues(args.config, V, Fz, params=design)
+    rows = [{"real": float(e.real), "imag": float(e.imag), "frequency_hz": float(abs(e.imag) / (2 * math.pi)),
+             "damping_ratio": float(-e.real / abs(e)) if abs(e) > 0 else None} for e in ev]
+    payload = {"config": args.config, "V": V, "Fz": Fz, "params": design.to_dict(), "eigenvalues": rows,
+               "stable": bool(ev.real.max() < 0)}
+    lines = [f"{args.config} at V = {V:g} m/s, Fz = {Fz:g} N: x = 0 is "
+             f"{'stable' if payload['stable'] else 'unstable'}",
+             f"  {'real (1/s)':>14}{'imag (rad/s)':>16}{'f (Hz)':>10}{'zeta':>10}"]
+    for r in rows:
+        zeta = "-" if r["damping_ratio"] is None else f"{r['damping_ratio']:.4f}"
+        lines.append(f"  {r['real']:>14.6g}{r['imag']:>16.6g}{r['frequency_hz']:>10.4f}{zeta:>10}")
+    emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_simulate(args) -> int:
+    from ...analyses.core.simulation import simulate
+
+    result = simulate(args.config, args.V, args.Fz, params=params(args),
+                      t_end=limit("simulate", "t_end", args.t_end), exact_nes=args.exact_nes)
+    if args.csv:
+        result.write_csv(args.csv)
+    payload = result.to_dict()
+    amp = result.amplitude
+    freq = "-" if result.frequency_hz != result.frequency_hz else f"{result.frequency_hz:.4f} Hz"
+    text = (f"{result.config.value} at V = {result.V:g} m/s, Fz = {result.Fz:g} N, {result.options.t_end:g} s\n"
+            f"  response        {result.response_type.value}{'' if result.steady else ' (not yet steady)'}\n"
+            f"  max |psi|       {amp['psi']:.6g} rad\n"
+            f"  max |l_g delta| {amp['lateral']:.6g} m\n"
+            f"  frequency       {freq}\n"
+            f"  {result.message}")
+    emit(payload, args.json, text)
+    return 0 if result.success else EXIT_FAILED
+
+
+def add_parsers(commands) -> None:
+    p = add_command(commands, "params", "list every parameter with unit, default, range", _cmd_params)
+    add_common(p, design=False)
+
+    p = add_command(commands, "hopf", "Hopf points of straight rolling in V at one load", _cmd_hopf)
+    add_config(p)
+    p.add_argument("--Fz", required=True, help="vertical load (N)")
+    p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
+    p.add_argument("--v-max", default=V_RANGE[1], help="highest speed (m/s)")
+    add_common(p)
+
+    p = add_command(commands, "eigen", "eigenvalues of straight rolling at one operating point", _cmd_eigen)
+    add_operating_point(p)
+
+    p = add_command(commands, "simulate", "time history at one operating point", _cmd_simulate)
+    add_operating_point(p)
+    p.add_argument("--t-end", default=60.0, help="simulated time (s)" + limits("simulate", "t_end"))
+    p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
+    p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
