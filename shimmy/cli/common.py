@@ -12,7 +12,7 @@ from typing import Any, Callable, Iterator, Sequence
 
 from ..errors import InvalidParameterError
 from ..model.configurations import CONFIGURATION_NAMES
-from ..model.parameters import MATERIALS, Parameters, check_number
+from ..model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, MATERIALS, Parameters, check_number
 from ..service.schemas import SCHEMAS
 
 EXIT_BAD_INPUT = 2
@@ -29,10 +29,30 @@ def limit(analysis: str, name: str, value: Any) -> float | int:
     return int(number) if f.kind == "integer" else number
 
 
-def limits(analysis: str, name: str) -> str:
-    """" (LOW-HIGH UNIT)" of a field, for an option's help."""
-    f = SCHEMAS[analysis].field(name)
-    return f" ({f.low:g} to {f.high:g}{' ' + f.unit if f.unit else ''})"
+def add_field(p: argparse.ArgumentParser, analysis: str, flag: str, help: str, limits: bool = False,
+              **kwargs) -> None:
+    """Option ``flag`` (``--t-end``) with the default, and the choices, the API gives its field (``t_end``) in
+    the request of ``analysis``; ``limits`` adds the field's range to the help, " (LOW to HIGH UNIT)"."""
+    f = SCHEMAS[analysis].field(flag.lstrip("-").replace("-", "_"))
+    default = ",".join(f.default) if isinstance(f.default, list) else f.default
+    if f.kind == "string" and f.choices:
+        kwargs.setdefault("choices", f.choices)
+    if limits:
+        help += f" ({f.low:g} to {f.high:g}{' ' + f.unit if f.unit else ''})"
+    p.add_argument(flag, default=default, help=help, **kwargs)
+
+
+def add_plane(p: argparse.ArgumentParser, analysis: str | None = None, loads: bool = True) -> None:
+    """``--v-min``, ``--v-max`` and, with ``loads``, ``--fz-min``, ``--fz-max``: their defaults those of the
+    API's request of ``analysis``, or without one those of a diagram (``DIAGRAM_V_RANGE``, ``FZ_RANGE``)."""
+    box = {"--v-min": ("lowest speed (m/s)", DIAGRAM_V_RANGE[0]),
+           "--v-max": ("highest speed (m/s)", DIAGRAM_V_RANGE[1]),
+           "--fz-min": ("lowest load (N)", FZ_RANGE[0]), "--fz-max": ("highest load (N)", FZ_RANGE[1])}
+    for flag, (help, default) in list(box.items())[:4 if loads else 2]:
+        if analysis is None:
+            p.add_argument(flag, default=default, help=help)
+        else:
+            add_field(p, analysis, flag, help)
 
 
 def parse_sets(items: Sequence[str] | None) -> dict[str, str]:

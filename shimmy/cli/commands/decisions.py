@@ -6,7 +6,8 @@ import sys
 from urllib.parse import urlencode
 
 from ...model.parameters import FZ_RANGE, PARAMETER_SPECS, check_number
-from ..common import add_command, add_common, add_config, add_progress, emit, float_list, names, params, progress
+from ..common import (add_command, add_common, add_config, add_field, add_plane, add_progress, emit, float_list, names,
+                      params, progress)
 
 
 def _cmd_sensitivity(args) -> int:
@@ -133,7 +134,7 @@ def add_parsers(commands) -> None:
     p = add_command(commands, "sensitivity", "derivatives of the Hopf speeds, the minimum shimmy load and the largest "
                                              "torsional amplitude with respect to every parameter", _cmd_sensitivity)
     add_config(p)
-    p.add_argument("--Fz", default=150e3, help="vertical load (N)")
+    add_field(p, "sensitivity", "--Fz", "vertical load (N)")
     p.add_argument("--params", help="comma-separated parameter names (default: all)")
     p.add_argument("--no-amplitude", action="store_true",
                    help="skip the largest torsional amplitude (which needs one bifurcation diagram)")
@@ -143,21 +144,19 @@ def add_parsers(commands) -> None:
     p = add_command(commands, "optimise", "search device parameters for the best figure of merit under constraints",
                     _cmd_optimise)
     add_config(p)
-    p.add_argument("--objective", default="min_shimmy_Fz", choices=("min_shimmy_Fz", "interval", "max_psi",
-                                                                    "torsion_area"),
-                   help="maximise min_shimmy_Fz; minimise the shimmy interval width or max_psi at --Fz, or the "
-                        "pure-torsion area")
-    p.add_argument("--Fz", default=150e3, help="load (N) of the figures at a load")
+    add_field(p, "optimise", "--objective", "maximise min_shimmy_Fz; minimise the shimmy interval width or max_psi at "
+                                            "--Fz, or the pure-torsion area")
+    add_field(p, "optimise", "--Fz", "load (N) of the figures at a load")
     p.add_argument("--params", help="comma-separated parameters to search in their ranges (default: the "
                                     "configuration's device parameters: r2,e_p,k_s,r3 with the NES, a_p,rho_p with "
                                     "the PD)")
     p.add_argument("--constraint", action="append", metavar="FIGURE[@Fz]<=VALUE",
                    help="constraint on a figure (repeatable), e.g. max_psi<=0.02 or min_shimmy_Fz>=80000")
-    p.add_argument("--method", default="auto", choices=("auto", "gradient", "global"),
-                   help="gradient: Sobol starts then SLSQP with analytic gradients; global: differential evolution")
-    p.add_argument("--starts", default=8, type=int, help="start designs (gradient method)")
-    p.add_argument("--local-runs", default=2, type=int, help="SLSQP runs from the best starts (gradient method)")
-    p.add_argument("--seed", default=0, type=int, help="seed of the start designs")
+    add_field(p, "optimise", "--method",
+              "gradient: Sobol starts then SLSQP with analytic gradients; global: differential evolution")
+    add_field(p, "optimise", "--starts", "start designs (gradient method)", type=int)
+    add_field(p, "optimise", "--local-runs", "SLSQP runs from the best starts (gradient method)", type=int)
+    add_field(p, "optimise", "--seed", "seed of the start designs", type=int)
     add_common(p)
     add_progress(p)
 
@@ -165,12 +164,12 @@ def add_parsers(commands) -> None:
                                             "under parameter tolerances (quasi-Monte Carlo and linear propagation)",
                     _cmd_robustness)
     add_config(p)
-    p.add_argument("--Fz", default=150e3, help="vertical load (N)")
+    add_field(p, "robustness", "--Fz", "vertical load (N)")
     p.add_argument("--tolerance", action="append", metavar="NAME=REL[:normal|uniform]",
                    help="relative tolerance of a parameter (repeatable): standard deviation (normal, the default) "
                         "or half-width (uniform), e.g. k_lam=0.05")
-    p.add_argument("--samples", default=128, type=int, help="quasi-Monte Carlo samples")
-    p.add_argument("--seed", default=0, type=int, help="seed of the scrambled Sobol sequence")
+    add_field(p, "robustness", "--samples", "quasi-Monte Carlo samples", type=int)
+    add_field(p, "robustness", "--seed", "seed of the scrambled Sobol sequence", type=int)
     p.add_argument("--with-samples", action="store_true", help="include every sample's values in the JSON")
     add_common(p)
     add_progress(p)
@@ -180,10 +179,9 @@ def add_parsers(commands) -> None:
     p.add_argument("--values", required=True, help="comma-separated values")
     p.add_argument("--param2", help="second parameter for a two-parameter grid")
     p.add_argument("--values2", help="comma-separated values of the second parameter")
-    p.add_argument("--configs", default="original,nes,pd,nes_pd", help="comma-separated configurations")
-    p.add_argument("--Fz", default=150e3, help="vertical load (N)")
-    p.add_argument("--v-min", default=1.0, help="lowest speed (m/s)")
-    p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
+    add_field(p, "study", "--configs", "comma-separated configurations")
+    add_field(p, "study", "--Fz", "vertical load (N)")
+    add_plane(p, "study", loads=False)
     p.add_argument("--csv", action="store_true", help="write the table as CSV to stdout")
     add_common(p)
     add_progress(p)

@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import math
 
+from ...analyses.diagrams.bifurcation import BifurcationOptions
+from ...analyses.diagrams.cycle_curves import KINDS
 from ...errors import InvalidParameterError
-from ...model.parameters import FZ_RANGE, V_RANGE, check_number
-from ..common import (add_command, add_common, add_config, add_progress, emit, float_list, limit, limits, params,
-                      progress)
+from ...model.parameters import check_number
+from ..common import (add_command, add_common, add_config, add_field, add_plane, add_progress, emit, float_list, limit,
+                      params, progress)
 
 
 def _cmd_bifurcation(args) -> int:
-    from ...analyses.diagrams.bifurcation import BifurcationOptions, bifurcation
+    from ...analyses.diagrams.bifurcation import bifurcation
 
     ntst = limit("bifurcation", "ntst", args.ntst)
     ds_max = check_number("ds_max", args.ds_max, 1e-3, 10.0)
@@ -70,12 +72,12 @@ def _cmd_hopf_curves(args) -> int:
 
 
 def _cmd_curves(args) -> int:
-    from ...analyses.diagrams.cycle_curves import KEY_OF_KIND, KINDS, cycle_curves
+    from ...analyses.diagrams.cycle_curves import KEY_OF_KIND, cycle_curves
 
     kinds = tuple(k.strip().upper() for k in str(args.kinds).split(",") if k.strip())
     for k in kinds:
         if k not in KINDS:
-            raise InvalidParameterError("kinds", args.kinds, "comma-separated kinds among lpc, ns, pd",
+            raise InvalidParameterError("kinds", args.kinds, "comma-separated kinds among " + ", ".join(KINDS).lower(),
                                         f"names an unknown kind ({k.lower()})")
     loads = tuple(float_list("at_fz", args.at_fz)) if args.at_fz else ()
     with progress(args) as bar:
@@ -110,10 +112,9 @@ def add_parsers(commands) -> None:
                     _cmd_bifurcation)
     add_config(p)
     p.add_argument("--Fz", required=True, help="vertical load (N)")
-    p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
-    p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
-    p.add_argument("--ntst", default=40, help="collocation mesh intervals" + limits("bifurcation", "ntst"))
-    p.add_argument("--ds-max", default=0.5, help="largest continuation step (scaled arclength)")
+    add_plane(p, "bifurcation", loads=False)
+    add_field(p, "bifurcation", "--ntst", "collocation mesh intervals", limits=True)
+    p.add_argument("--ds-max", default=BifurcationOptions.ds_max, help="largest continuation step (scaled arclength)")
     p.add_argument("--no-seeds", action="store_true", help="do not look for branches by simulation")
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the branch points to FILE")
@@ -123,20 +124,15 @@ def add_parsers(commands) -> None:
     p = add_command(commands, "hopf-curves", "Hopf curves of straight rolling in (V, Fz) with GH points",
                     _cmd_hopf_curves)
     add_config(p)
-    p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
-    p.add_argument("--v-max", default=V_RANGE[1], help="highest speed (m/s)")
-    p.add_argument("--fz-min", default=FZ_RANGE[0], help="lowest load (N)")
-    p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
+    add_plane(p, "hopf_curves")
     add_common(p)
     add_progress(p)
 
     p = add_command(commands, "curves", "fold, torus and period-doubling curves of cycles in (V, Fz)", _cmd_curves)
     add_config(p)
-    p.add_argument("--kinds", default="lpc,ns,pd", help="comma-separated: lpc, ns, pd")
-    p.add_argument("--v-min", default=1.0, help="lowest speed (m/s)")
-    p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
-    p.add_argument("--fz-min", default=FZ_RANGE[0], help="lowest load (N)")
-    p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
+    kinds = ",".join(KINDS).lower()
+    p.add_argument("--kinds", default=kinds, help="comma-separated: " + kinds.replace(",", ", "))
+    add_plane(p)
     p.add_argument("--at-fz", default="", help="loads (N, comma-separated) where each curve's crossings are located")
     add_common(p)
     add_progress(p)

@@ -8,7 +8,7 @@ import numpy as np
 
 from ...errors import InvalidParameterError
 from ...model.configurations import CONFIGURATION_NAMES
-from ..common import EXIT_FAILED, add_command, add_common, add_config, emit, params, parse_sets
+from ..common import EXIT_FAILED, add_command, add_common, add_config, add_field, emit, params, parse_sets
 
 
 def _read_profile_csv(path: str) -> tuple[list[list[Any]], list[int]]:
@@ -109,9 +109,9 @@ def add_parsers(commands) -> None:
                    help="a preset, or a CSV table of t (s), V (m/s), Fz (N) rows (optional header t,V,Fz)")
     p.add_argument("--profile-set", action="append", metavar="NAME=VALUE",
                    help="adjust a preset's setting (repeatable), e.g. V_rotate=75")
-    p.add_argument("--psi-threshold", default=0.01, help="torsional amplitude counted as shimmy (rad)")
-    p.add_argument("--lateral-threshold", default=0.001, help="lateral amplitude l_g delta counted as shimmy (m)")
-    p.add_argument("--series-dt", default=0.01, help="sampling interval of the series in the JSON and CSV (s)")
+    add_field(p, "ground_run", "--psi-threshold", "torsional amplitude counted as shimmy (rad)")
+    add_field(p, "ground_run", "--lateral-threshold", "lateral amplitude l_g delta counted as shimmy (m)")
+    add_field(p, "ground_run", "--series-dt", "sampling interval of the series in the JSON and CSV (s)")
     p.add_argument("--fold-torus", action="store_true",
                    help="also the crossings of the fold and torus curves of cycles (several seconds per configuration)")
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")

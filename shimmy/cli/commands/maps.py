@@ -3,9 +3,10 @@ merit of configurations)."""
 
 from __future__ import annotations
 
-from ...model.parameters import DEFAULT_MAP_SLICES, FZ_RANGE, check_number
-from ..common import (add_command, add_common, add_config, add_operating_point, add_progress, emit, limit, limits,
-                      params, progress)
+from ...model.configurations import CONFIGURATION_NAMES
+from ...model.parameters import DEFAULT_FZ, DIAGRAM_V_RANGE, FZ_RANGE, check_number
+from ..common import (add_command, add_common, add_config, add_field, add_operating_point, add_plane, add_progress,
+                      emit, limit, params, progress)
 
 
 def _cmd_map(args) -> int:
@@ -94,28 +95,24 @@ def _cmd_metrics(args) -> int:
 def add_parsers(commands) -> None:
     p = add_command(commands, "map", "(V, Fz) stability map: Hopf, fold and torus curves, shimmy types", _cmd_map)
     add_config(p)
-    p.add_argument("--v-min", default=1.0, help="lowest speed (m/s)")
-    p.add_argument("--v-max", default=200.0, help="highest speed (m/s)")
-    p.add_argument("--fz-min", default=FZ_RANGE[0], help="lowest load (N)")
-    p.add_argument("--fz-max", default=FZ_RANGE[1], help="highest load (N)")
-    p.add_argument("--resolution", default=DEFAULT_MAP_SLICES,
-                   help="classified Fz slices, evenly spaced (one more is added through each region between the "
-                        "curves that they miss)" + limits("map", "resolution"))
-    p.add_argument("--n-v", default=100, help="number of speeds per slice on the output grid" + limits("map", "n_v"))
-    p.add_argument("--metrics-Fz", default=150e3, help="load (N) of the speed-interval and amplitude metrics")
+    add_plane(p, "map")
+    add_field(p, "map", "--resolution", "classified Fz slices, evenly spaced (one more is added through each region "
+                                        "between the curves that they miss)", limits=True)
+    add_field(p, "map", "--n-v", "number of speeds per slice on the output grid", limits=True)
+    add_field(p, "map", "--metrics-Fz", "load (N) of the speed-interval and amplitude metrics")
     p.add_argument("--csv", metavar="FILE", help="write the classified grid to FILE")
     add_common(p)
     add_progress(p)
 
     p = add_command(commands, "classify", "shimmy type and stable attractors at one operating point", _cmd_classify)
     add_operating_point(p)
-    p.add_argument("--v-min", default=1.0, help="lowest speed of the diagram the answer is read from (m/s)")
-    p.add_argument("--v-max", default=200.0, help="highest speed of that diagram (m/s)")
+    p.add_argument("--v-min", default=DIAGRAM_V_RANGE[0],
+                   help="lowest speed of the diagram the answer is read from (m/s)")
+    p.add_argument("--v-max", default=DIAGRAM_V_RANGE[1], help="highest speed of that diagram (m/s)")
 
     p = add_command(commands, "metrics", "design figures of merit of configurations against original", _cmd_metrics)
-    p.add_argument("--configs", default="original,nes,pd,nes_pd", help="comma-separated configurations")
-    p.add_argument("--Fz", default=150e3, help="load (N) of the speed-interval and amplitude metrics")
-    p.add_argument("--resolution", default=DEFAULT_MAP_SLICES,
-                   help="classified Fz slices of each map" + limits("map", "resolution"))
+    p.add_argument("--configs", default=",".join(CONFIGURATION_NAMES), help="comma-separated configurations")
+    p.add_argument("--Fz", default=DEFAULT_FZ, help="load (N) of the speed-interval and amplitude metrics")
+    add_field(p, "map", "--resolution", "classified Fz slices of each map", limits=True)
     add_common(p)
     add_progress(p)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..common import add_command, add_common, emit, limit, limits, params
+from ..common import add_command, add_common, add_field, emit, limit, params
 
 
 def _cmd_devices(args) -> int:
@@ -35,7 +35,7 @@ def _cmd_calibrate(args) -> int:
 
 def add_parsers(commands) -> None:
     p = add_command(commands, "devices", "NES torque/stiffness and PD damping curves", _cmd_devices)
-    p.add_argument("--v-max", default=2.0, help="largest PD tangential speed (m/s)" + limits("devices", "v_max"))
+    add_field(p, "devices", "--v-max", "largest PD tangential speed (m/s)", limits=True)
     add_common(p)
 
     p = add_command(commands, "calibrate", "refit the unpublished constants and print residuals", _cmd_calibrate)

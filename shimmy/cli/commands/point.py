@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import math
 
-from ...model.parameters import PARAMETER_SPECS, V_RANGE
-from ..common import EXIT_FAILED, add_command, add_common, add_config, add_operating_point, emit, limit, limits, params
+from ...model.parameters import PARAMETER_SPECS
+from ..common import (EXIT_FAILED, add_command, add_common, add_config, add_field, add_operating_point, add_plane, emit,
+                      limit, params)
 
 
 def _cmd_params(args) -> int:
@@ -83,8 +84,7 @@ def add_parsers(commands) -> None:
     p = add_command(commands, "hopf", "Hopf points of straight rolling in V at one load", _cmd_hopf)
     add_config(p)
     p.add_argument("--Fz", required=True, help="vertical load (N)")
-    p.add_argument("--v-min", default=V_RANGE[0], help="lowest speed (m/s)")
-    p.add_argument("--v-max", default=V_RANGE[1], help="highest speed (m/s)")
+    add_plane(p, "hopf", loads=False)
     add_common(p)
 
     p = add_command(commands, "eigen", "eigenvalues of straight rolling at one operating point", _cmd_eigen)
@@ -92,6 +92,6 @@ def add_parsers(commands) -> None:
 
     p = add_command(commands, "simulate", "time history at one operating point", _cmd_simulate)
     add_operating_point(p)
-    p.add_argument("--t-end", default=60.0, help="simulated time (s)" + limits("simulate", "t_end"))
+    add_field(p, "simulate", "--t-end", "simulated time (s)", limits=True)
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
