@@ -82,22 +82,7 @@ def _cmd_ground_run(args) -> int:
         payload = result.to_dict(stride)
     else:
         payload = comparison.to_dict(stride)
-    lines = [f"{profile.name} profile: {profile.duration:g} s, V {profile.V.min():.4g}..{profile.V.max():.4g} m/s, "
-             f"Fz {profile.Fz.min() / 1e3:.4g}..{profile.Fz.max() / 1e3:.4g} kN; thresholds "
-             f"{options.psi_threshold:g} rad, {1e3 * options.lateral_threshold:g} mm"]
-    for name, r in runs.items():
-        speeds = "-" if r.speed_range is None else f"{r.speed_range[0]:.4g}..{r.speed_range[1]:.4g} m/s"
-        delay = "-" if r.onset_delay_s is None else f"{r.onset_delay_s:.3g} s"
-        lines.append(f"  {name:<8} in shimmy {r.time_in_shimmy_s:7.3f} s (V {speeds}); peak |psi| "
-                     f"{r.peak_psi['value']:.4g} rad at {r.peak_psi['t']:.4g} s ({r.peak_psi['V']:.4g} m/s); "
-                     f"peak |l_g delta| {1e3 * r.peak_lateral['value']:.4g} mm; onset delay {delay}")
-        for c in r.boundary_crossings:
-            lines.append(f"      crosses the {c['curve']} curve at t = {c['t']:.4g} s, V = {c['V']:.5g} m/s, "
-                         f"Fz = {c['Fz'] / 1e3:.5g} kN" + (f" ({c['direction']})" if "direction" in c else ""))
-        if not r.success:
-            lines.append(f"      {r.message}")
-        lines += [f"      warning: {w}" for w in r.warnings]
-    emit(payload, args.json, "\n".join(lines))
+    emit(payload, args.json, comparison.summary_text())
     return 0 if all(r.success for r in runs.values()) else EXIT_FAILED
 
 

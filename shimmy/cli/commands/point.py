@@ -23,16 +23,7 @@ def _cmd_hopf(args) -> int:
     from ...analyses.core.stability import hopf_points
 
     result = hopf_points(args.config, args.Fz, params=params(args), v_range=(args.v_min, args.v_max))
-    payload = result.to_dict()
-    lines = [f"{result.config.value} at Fz = {result.Fz:g} N, V in [{result.v_min:g}, {result.v_max:g}] m/s"]
-    if not result.hopf_points:
-        lines.append("  no Hopf point")
-    for h in result.hopf_points:
-        lines.append(f"  Hopf V = {h.V:.6f} m/s  f = {h.frequency_hz:.4f} Hz  {h.criticality.value}"
-                     f"  ({'loses' if h.destabilising else 'regains'} stability as V increases)")
-    for iv in result.unstable_intervals:
-        lines.append(f"  x = 0 unstable for V in [{iv[0]:.6g}, {iv[1]:.6g}] m/s")
-    emit(payload, args.json, "\n".join(lines))
+    emit(result.to_dict(), args.json, result.summary_text())
     return 0
 
 
@@ -64,16 +55,7 @@ def _cmd_simulate(args) -> int:
                       t_end=limit("simulate", "t_end", args.t_end), exact_nes=args.exact_nes)
     if args.csv:
         result.write_csv(args.csv)
-    payload = result.to_dict()
-    amp = result.amplitude
-    freq = "-" if result.frequency_hz != result.frequency_hz else f"{result.frequency_hz:.4f} Hz"
-    text = (f"{result.config.value} at V = {result.V:g} m/s, Fz = {result.Fz:g} N, {result.options.t_end:g} s\n"
-            f"  response        {result.response_type.value}{'' if result.steady else ' (not yet steady)'}\n"
-            f"  max |psi|       {amp['psi']:.6g} rad\n"
-            f"  max |l_g delta| {amp['lateral']:.6g} m\n"
-            f"  frequency       {freq}\n"
-            f"  {result.message}")
-    emit(payload, args.json, text)
+    emit(result.to_dict(), args.json, result.summary_text())
     return 0 if result.success else EXIT_FAILED
 
 
