@@ -7,7 +7,7 @@ change of shape (a refactoring must leave them identical but for wall-clock time
 
 The command line is run as a process (``python -m shimmy ... --json``); the API's answers come
 from the service's runners with a fresh, empty cache (what ``POST /api/v1/...`` returns as its
-result). Keys that are wall-clock times (``elapsed_s``, ``*_seconds``) are not compared.
+result). Keys that are wall-clock times (``elapsed_s``, ``*_seconds``, ``*_ms``) are not compared.
 """
 
 from __future__ import annotations
@@ -54,7 +54,8 @@ TIMES = ("elapsed_s",)
 
 def strip_times(value):
     if isinstance(value, dict):
-        return {k: strip_times(v) for k, v in value.items() if k not in TIMES and not k.endswith("_seconds")}
+        return {k: strip_times(v) for k, v in value.items()
+                if k not in TIMES and not k.endswith(("_seconds", "_ms"))}
     if isinstance(value, list):
         return [strip_times(v) for v in value]
     return value

@@ -4,7 +4,8 @@ continuation (generic engine) <- model (the gear) <- analyses <- service <- UI (
 ``shimmy.errors`` is the package's exception root, importable from model upwards, and
 ``shimmy.version`` the ground floor every layer may read. Nothing inside the package imports the
 package root (it imports the analyses). The analyses are families, each importing only those below
-it: core <- diagrams <- maps, ground <- decisions.
+it: core <- diagrams <- maps, ground <- decisions. The command line (``cli``) is a front door beside
+the service: it calls the analyses and reads the service's request schemas.
 """
 
 import ast
@@ -16,7 +17,9 @@ import shimmy
 PACKAGE = pathlib.Path(shimmy.__file__).parent
 ROOT = PACKAGE.parent
 LAYERS = ("continuation", "model", "analyses", "service")
-TOP_LEVEL = {"__init__", "__main__", "cli", "errors", "version"}
+TOP_LEVEL = {"__init__", "__main__", "errors", "version"}
+#: Folders at the top that are no layer below the others: the command line.
+FRONT_DOORS = ("cli",)
 UI_LIBRARIES = {"dash", "plotly", "flask", "gunicorn", "diskcache"}
 STDLIB = set(sys.stdlib_module_names)
 
@@ -158,9 +161,24 @@ def test_every_module_sits_in_a_layer():
     top = {p.stem for p in PACKAGE.glob("*.py")}
     assert top == TOP_LEVEL
     folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and p.name != "__pycache__"}
-    assert folders == set(LAYERS)
-    for layer in LAYERS:
+    assert folders == set(LAYERS) | set(FRONT_DOORS)
+    for layer in LAYERS + FRONT_DOORS:
         assert (PACKAGE / layer / "__init__.py").exists(), layer
+
+
+#: What the command line may import from the package: the analyses, the model, the errors (the engine's
+#: too: its InvalidInputError is bad input) and of the service its request schemas and analysis registry.
+CLI_MAY_IMPORT = ("shimmy.cli", "shimmy.analyses", "shimmy.model", "shimmy.errors", "shimmy.continuation.errors",
+                  "shimmy.service.schemas", "shimmy.service.analyses", "shimmy.version")
+
+
+def test_cli_imports_only_the_analyses_the_model_the_errors_and_the_schemas():
+    files = files_of("cli")
+    assert len(files) > 3
+    for path in files:
+        for name in shimmy_imports(path):
+            assert within(name, *CLI_MAY_IMPORT), (path.name, name)
+        assert not {n.split(".")[0] for n in imports(path)} & (UI_LIBRARIES | {"ui", "pages", "app"}), path.name
 
 
 #: What the UI may import from the package: definitions and the service layer, never numerics.

@@ -80,7 +80,7 @@ def test_eigen_json_matches_the_library():
 def test_progress_is_a_bar_on_a_terminal_and_plain_lines_elsewhere():
     import io
 
-    from shimmy.cli import _ProgressBar
+    from shimmy.cli.common import ProgressBar as _ProgressBar
 
     class Terminal(io.StringIO):
         def isatty(self):

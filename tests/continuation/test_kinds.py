@@ -130,6 +130,5 @@ def _ui_offences() -> list[str]:
     return _offences(_python_files("pages", "ui", "app.py"))
 
 
-@pytest.mark.xfail(bool(_ui_offences()), reason="pages/ and ui/ are being converted to PointKind", strict=False)
 def test_the_ui_names_kinds_by_the_enum():
     assert _ui_offences() == []

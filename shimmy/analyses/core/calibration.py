@@ -76,6 +76,10 @@ class CalibrationResult:
                 "amplitude_target": AMPLITUDE_TARGET, "amplitude_computed": self.amplitude_computed,
                 "pd_target_met": self.pd_target_met}
 
+    def summary_text(self) -> str:
+        """The report ``python -m shimmy calibrate`` prints (:func:`format_report`)."""
+        return format_report(self)
+
 
 def _hopf_speeds(config: str, params: Parameters) -> np.ndarray:
     result = hopf_points(config, FZ_REFERENCE, params=params, v_range=(1.0, 200.0))

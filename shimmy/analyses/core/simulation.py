@@ -138,6 +138,17 @@ class SimulationResult:
         data = np.column_stack([self.t, self.states.T, self.lateral])
         np.savetxt(path, data, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
 
+    def summary_text(self) -> str:
+        """The short table ``python -m shimmy simulate`` prints."""
+        amp = self.amplitude
+        freq = "-" if self.frequency_hz != self.frequency_hz else f"{self.frequency_hz:.4f} Hz"
+        return (f"{self.config.value} at V = {self.V:g} m/s, Fz = {self.Fz:g} N, {self.options.t_end:g} s\n"
+                f"  response        {self.response_type.value}{'' if self.steady else ' (not yet steady)'}\n"
+                f"  max |psi|       {amp['psi']:.6g} rad\n"
+                f"  max |l_g delta| {amp['lateral']:.6g} m\n"
+                f"  frequency       {freq}\n"
+                f"  {self.message}")
+
 
 def _json_float(x: float):
     return None if not np.isfinite(x) else float(x)

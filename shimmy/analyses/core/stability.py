@@ -143,6 +143,18 @@ class HopfResult:
                 "success": self.success, "message": self.message, "warnings": list(self.warnings),
                 "n_grid": self.n_grid, "version": __version__}
 
+    def summary_text(self) -> str:
+        """The short table ``python -m shimmy hopf`` prints."""
+        lines = [f"{self.config.value} at Fz = {self.Fz:g} N, V in [{self.v_min:g}, {self.v_max:g}] m/s"]
+        if not self.hopf_points:
+            lines.append("  no Hopf point")
+        for h in self.hopf_points:
+            lines.append(f"  Hopf V = {h.V:.6f} m/s  f = {h.frequency_hz:.4f} Hz  {h.criticality.value}"
+                         f"  ({'loses' if h.destabilising else 'regains'} stability as V increases)")
+        for iv in self.unstable_intervals:
+            lines.append(f"  x = 0 unstable for V in [{iv[0]:.6g}, {iv[1]:.6g}] m/s")
+        return "\n".join(lines)
+
 
 def eigenvalues(config: Configuration | str, V, Fz: float, *, params: Parameters | None = None) -> np.ndarray:
     """Eigenvalues (1/s) of the Jacobian at x = 0; shape (n,) or (len(V), n), sorted by real part."""

@@ -342,6 +342,29 @@ class OptimisationResult:
                 "params": self.params.to_dict(), "elapsed_s": self.elapsed_s, "executor": self.executor,
                 "warnings": self.warnings, "version": __version__}
 
+    def summary_text(self) -> str:
+        """The lines ``python -m shimmy optimise`` prints: the problem, the optimum against the nominal design,
+        the design, the constraints, the figures, the message and the workbench link."""
+        from urllib.parse import urlencode
+
+        f = FIGURES[self.objective]
+        lines = [f"{self.config.value}: {'maximise' if f.sense > 0 else 'minimise'} {f.label}"
+                 + (f" at {self.Fz / 1e3:g} kN" if f.at_load else "") + f" over {', '.join(self.names)} "
+                 f"({self.method}, {self.evaluations} evaluations, {self.elapsed_s:.1f} s)",
+                 f"  optimum {self.objective_value:.6g} {f.unit} (nominal "
+                 + ("not evaluated" if self.nominal_objective is None else f"{self.nominal_objective:.6g} {f.unit}")
+                 + ")",
+                 "  design: " + ", ".join(f"{n} = {v:.6g} {PARAMETER_SPECS[n].unit}".rstrip()
+                                          for n, v in self.design.items())]
+        lines += [f"  constraint {c}" for c in self.constraints]
+        for label, table in self.figures.items():
+            lines.append(f"  {label:<9}" + ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k}: {v}"
+                                                     for k, v in table.items()))
+        lines.append(f"  {self.message}")
+        lines.append("  open in the workbench: /?" + urlencode(self.link_query))
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
 
 def _figure_table(figures: dict, keys) -> dict[str, Any]:
     return {f"{k[0]}" + (f"@{k[1]:g}" if k[1] is not None else ""): figures[k]["value"] for k in keys}

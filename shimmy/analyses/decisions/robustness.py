@@ -195,6 +195,23 @@ class RobustnessResult:
                             "linear": "first-order propagation of the implicit-differentiation sensitivities"},
                 "version": __version__}
 
+    def summary_text(self) -> str:
+        """The table ``python -m shimmy robustness`` prints: the tolerances, each distribution's nominal value,
+        mean, spread and percentiles, sampled and linear, and the probability of shimmy at the operating points."""
+        lines = [f"{self.config.value} at Fz = {self.Fz / 1e3:g} kN, {self.samples} samples (seed {self.seed}): "
+                 + ", ".join(f"{t.name} {100 * t.relative:g} % {t.distribution}" for t in self.tolerances),
+                 f"  {'':<22}{'nominal':>10}{'mean':>10}{'std':>9}{'p05':>10}{'p95':>10}{'linear std':>12}"]
+        rows = [(f"Hopf speed {k + 1} (m/s)", h, 1.0) for k, h in enumerate(self.hopf_points)]
+        if self.min_shimmy:
+            rows.append(("min shimmy Fz (kN)", self.min_shimmy, 1e-3))
+        for label, h, k in rows:
+            lines.append(f"  {label:<22}{h['nominal'] * k:>10.4g}{h['mean'] * k:>10.4g}{h['std'] * k:>9.3g}"
+                         f"{h['p05'] * k:>10.4g}{h['p95'] * k:>10.4g}{h['linear_std'] * k:>12.3g}")
+        lines.append("  P(shimmy) sampled / linear: " + ", ".join(
+            f"{p} {self.p_shimmy[p]:.3f}/{self.p_shimmy_linear[p]:.3f}" for p in self.p_shimmy))
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
 
 def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str] | Mapping[str, float],
                *, samples: int = 128, Fz: float = DEFAULT_FZ, params: Parameters | None = None, seed: int = 0,

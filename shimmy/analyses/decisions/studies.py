@@ -59,6 +59,23 @@ class StudyResult:
                        + [r["config"]] + ["" if r[c] is None else f"{r[c]:.10g}" for c in self.COLUMNS[1:]]
                        + [" ".join(f"{v:.10g}" for v in r["hopf_points"])])
 
+    def summary_text(self) -> str:
+        """The table ``python -m shimmy study`` prints: one row per design and configuration."""
+        lines = [f"study at Fz = {self.Fz:g} N, V {self.v_range[0]:g}..{self.v_range[1]:g} m/s "
+                 f"({self.elapsed_s:.1f} s, {self.executor})",
+                 "".join(f"{p:>12}" for p in self.parameters)
+                 + f"  {'config':<8}{'Hopf start':>11}{'Hopf end':>10}{'max psi':>10}{'at V':>8}"]
+
+        def num(x, fmt):
+            return "-" if x is None else format(x, fmt)
+
+        for r in self.rows:
+            lines.append("".join(f"{r[p]:>12.6g}" for p in self.parameters)
+                         + f"  {r['config']:<8}{num(r['hopf_start'], '11.4f')}{num(r['hopf_end'], '10.4f')}"
+                         f"{num(r['max_psi'], '10.5f')}{num(r['max_psi_V'], '8.2f')}")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
 
 def _check_values(name: str, values: Sequence[float], params: Parameters) -> list[float]:
     if name not in PARAMETER_SPECS:

@@ -182,6 +182,30 @@ class BifurcationResult:
                     w.writerow([i, b.kind, f"{v:.10g}", "" if math.isnan(T) else f"{T:.10g}", f"{a:.10g}",
                                 f"{lat:.10g}", int(bool(s)), m or ""])
 
+    def summary_text(self) -> str:
+        """The short table ``python -m shimmy bifurcation`` prints: the Hopf points, each periodic branch
+        with its special points and end, the largest stable amplitude, the mesh check, the warnings."""
+        lines = [f"{self.config.value} at Fz = {self.Fz:g} N, V in [{self.v_min:g}, {self.v_max:g}] m/s "
+                 f"({self.elapsed_s:.2f} s)"]
+        for h in self.hopf.hopf_points:
+            lines.append(f"  H    V = {h.V:10.5f} m/s  {h.frequency_hz:.4f} Hz  {h.criticality.value}")
+        for i, b in enumerate(self.branches[1:], start=1):
+            stable = int(b.stable.sum())
+            lines.append(f"  branch {i}: {b.kind} from {b.origin}; {b.V.size} points ({stable} stable), "
+                         f"V {b.V.min():.4g}..{b.V.max():.4g} m/s, max |psi| {b.max_psi.max():.5g} rad; "
+                         f"modes {', '.join(sorted({m for m in b.mode if m}))}")
+            for s in b.special_points:
+                if s["kind"] != PointKind.END:
+                    lines.append(f"      {s['kind']:<4} V = {s['V']:.6g} m/s")
+            lines.append(f"      ends: {b.stop_reason}")
+        where = "" if self.max_psi_V is None else f" at V = {self.max_psi_V:.5g} m/s"
+        lines.append(f"  max torsional amplitude of stable cycles: {self.max_psi:.6g} rad{where}")
+        if self.mesh_check:
+            lines.append(f"  mesh check: ntst {self.mesh_check['ntst']} -> {self.mesh_check['ntst_fine']} changes "
+                         f"max |psi| by {self.mesh_check['change']:.2g} rad")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
 
 def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | None = None,
                 v_range: tuple[float, float] = DIAGRAM_V_RANGE, options: BifurcationOptions | None = None,

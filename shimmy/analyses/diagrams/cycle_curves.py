@@ -166,6 +166,31 @@ class CycleCurvesResult:
                               "tolerance (1e-9 in the defining equations)"})
         return out
 
+    def summary_text(self) -> str:
+        """The short table ``python -m shimmy curves`` prints: the curves of each kind, each curve's range of
+        loads, crossings and ends, the codimension-2 points."""
+        data = self.to_dict()
+        lines = [f"{self.config.value}: cycle-bifurcation curves in V {self.v_range[0]:g}..{self.v_range[1]:g} m/s, "
+                 f"Fz {self.fz_range[0]:g}..{self.fz_range[1]:g} N ({self.elapsed_s:.2f} s, "
+                 f"{self.starts_tried} curve starts)"]
+        names = {PointKind.FOLD_OF_CYCLES: "fold", PointKind.TORUS: "torus",
+                 PointKind.PERIOD_DOUBLING: "period-doubling"}
+        for kind in self.kinds:
+            lines.append(f"  {names[kind]} curves: {len(data[KEY_OF_KIND[kind]])}")
+        for i, c in enumerate(data["curves"], start=1):
+            lines.append(f"  {i}. {names[c['kind']]} curve from {c['origin']}: {c['points']} points, Fz "
+                         f"{c['fz_min']['Fz']:.6g} N (V {c['fz_min']['V']:.5g}) .. {c['fz_max']['Fz']:.6g} N "
+                         f"(V {c['fz_max']['V']:.5g})")
+            for x in c["crossings"]:
+                lines.append(f"       at Fz = {x['Fz']:.6g} N: V = {x['V']:.6f} m/s, period {x['period']:.5g} s, "
+                             f"max |psi| {x['max_psi']:.4g} rad")
+            for e in c["stop_reasons"]:
+                lines.append(f"       end: {e}")
+        for p in data["codim2_points"]:
+            lines.append(f"  {p['kind']:<5} V = {p['V']:.6g} m/s, Fz = {p['Fz']:.6g} N")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
 
 def _close(a: dict, b: dict, tol: float) -> bool:
     return abs(a["V"] - b["V"]) <= tol * V_SCALE and abs(a["Fz"] - b["Fz"]) <= tol * FZ_SCALE

@@ -162,6 +162,26 @@ class GroundRunResult:
             out["series_dt"] = series_stride * self.options.dt_out
         return out
 
+    def summary_text(self, header: bool = True) -> str:
+        """The lines ``python -m shimmy ground-run`` prints for this run: time in shimmy, peaks, onset delay,
+        boundary crossings, warnings; with ``header``, the profile and the thresholds first."""
+        p, o = self.profile, self.options
+        lines = [f"{p.name} profile: {p.duration:g} s, V {p.V.min():.4g}..{p.V.max():.4g} m/s, "
+                 f"Fz {p.Fz.min() / 1e3:.4g}..{p.Fz.max() / 1e3:.4g} kN; thresholds "
+                 f"{o.psi_threshold:g} rad, {1e3 * o.lateral_threshold:g} mm"] if header else []
+        speeds = "-" if self.speed_range is None else f"{self.speed_range[0]:.4g}..{self.speed_range[1]:.4g} m/s"
+        delay = "-" if self.onset_delay_s is None else f"{self.onset_delay_s:.3g} s"
+        lines.append(f"  {self.config.value:<8} in shimmy {self.time_in_shimmy_s:7.3f} s (V {speeds}); peak |psi| "
+                     f"{self.peak_psi['value']:.4g} rad at {self.peak_psi['t']:.4g} s ({self.peak_psi['V']:.4g} m/s); "
+                     f"peak |l_g delta| {1e3 * self.peak_lateral['value']:.4g} mm; onset delay {delay}")
+        for c in self.boundary_crossings:
+            lines.append(f"      crosses the {c['curve']} curve at t = {c['t']:.4g} s, V = {c['V']:.5g} m/s, "
+                         f"Fz = {c['Fz'] / 1e3:.5g} kN" + (f" ({c['direction']})" if "direction" in c else ""))
+        if not self.success:
+            lines.append(f"      {self.message}")
+        lines += [f"      warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
 
 def ground_run(config: Configuration | str, profile: Any, *, params: Parameters | None = None, x0=None,
                options: GroundRunOptions | None = None, preset_options: dict[str, Any] | None = None,
@@ -394,6 +414,11 @@ class GroundRunComparison:
         return {"profile": self.profile.to_dict(), "comparison": self.table(), "elapsed_s": self.elapsed_s,
                 "runs": {k: r.to_dict(series_stride, include_series) for k, r in self.runs.items()},
                 "version": __version__}
+
+    def summary_text(self) -> str:
+        """The profile and the thresholds, then each run's lines (:meth:`GroundRunResult.summary_text`)."""
+        runs = list(self.runs.values())
+        return "\n".join([runs[0].summary_text(), *(r.summary_text(header=False) for r in runs[1:])])
 
 
 def _ratio(a: float, b: float) -> float | None:

@@ -142,3 +142,30 @@ def design_report(configs: Sequence[str] = CONFIGURATION_NAMES, *, params: Param
         results[c]["operating_points"] = {name: a["shimmy_type"] for name, a in points[c].items()}
     return {"Fz": Fz, "resolution": resolution, "configs": configs, "metrics": {c: results[c] for c in configs},
             "maps": maps}
+
+
+def design_report_summary(report: dict[str, Any]) -> str:
+    """The tables ``python -m shimmy metrics`` prints for a :func:`design_report`: each configuration's
+    figures of merit with their change against ``original``, then its shimmy type at the operating points."""
+    lines = [f"{'config':<8}{'min shimmy Fz (kN)':>20}{'change':>9}{'lateral min Fz (kN)':>21}{'change':>9}"
+             f"{'torsion area':>14}{'change':>9}{'max psi (rad)':>15}{'change':>9}  shimmy V (m/s) at "
+             f"{report['Fz'] / 1e3:g} kN"]
+    for c, m in report["metrics"].items():
+        d = m["against_original"]
+
+        def rel(key):
+            r = d[key]["relative"]
+            return "" if r is None else f"{100 * r:+.1f}%"
+
+        fz = "-" if m["min_shimmy_Fz"] is None else f"{m['min_shimmy_Fz'] / 1e3:.2f}"
+        lat = "-" if m["lateral_min_Fz"] is None else f"{m['lateral_min_Fz'] / 1e3:.2f}"
+        hull = m["at_Fz"]["shimmy_speed_range"]
+        lines.append(f"{c:<8}{fz:>20}{rel('min_shimmy_Fz'):>9}{lat:>21}{rel('lateral_min_Fz'):>9}"
+                     f"{m['torsion_area']:>14.1f}{rel('torsion_area'):>9}"
+                     f"{m['at_Fz']['max_psi']:>15.5f}{rel('max_psi'):>9}  "
+                     + ("none" if hull is None else f"{hull[0]:.1f}..{hull[1]:.1f}"))
+    names = list(next(iter(report["metrics"].values()))["operating_points"])
+    lines.append(f"\nshimmy type at the operating points{'':<2}" + "".join(f"{n:>10}" for n in names))
+    for c, m in report["metrics"].items():
+        lines.append(f"{c:<37}" + "".join(f"{m['operating_points'][n]:>10}" for n in names))
+    return "\n".join(lines)

@@ -396,6 +396,28 @@ class StabilityMap:
                 for V, t in zip(self.V, row, strict=True):
                     w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
 
+    def summary_text(self, metrics: dict[str, Any] | None = None) -> str:
+        """The short table ``python -m shimmy map`` prints: slices and grid, grid points by type, curves,
+        the minimum shimmy load, with ``metrics`` (:func:`~shimmy.analyses.maps.design_metrics.metrics` of
+        this map) its pure-torsion area, the warnings."""
+        counts = {t: sum(row.count(t) for row in self.shading) for t in SHIMMY_TYPES}
+        lines = [f"{self.config.value}: {len(self.Fz)} classified slices, {len(self.shading_Fz)} x {len(self.V)} "
+                 f"grid, V {self.v_range[0]:g}..{self.v_range[1]:g} m/s, Fz {self.fz_range[0]:g}..{self.fz_range[1]:g} "
+                 f"N ({self.elapsed_s:.1f} s, {self.executor})",
+                 "  grid points by type: " + ", ".join(f"{t} {n}" for t, n in counts.items())
+                 + f"; {len(self.regions)} region polygons",
+                 f"  Hopf curves {len(self.hopf.curves)}, GH points {len(self.hopf.gh_points)}, "
+                 f"fold curves {len(self.fold_curves)}, torus curves {len(self.torus_curves)}"]
+        if self.min_shimmy:
+            lines.append(f"  minimum shimmy load {self.min_shimmy['Fz']:.6g} N at V = {self.min_shimmy['V']:.5g} m/s "
+                         f"({self.min_shimmy['source']})")
+        else:
+            lines.append("  no shimmy anywhere in the map")
+        if metrics is not None:
+            lines.append(f"  pure-torsion area, Fz <= {BAND_FZ_MAX / 1e3:g} kN: {metrics['torsion_area']:.6g} (m/s) kN")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
 
 @dataclass(frozen=True, eq=False)
 class HopfCurvesUnit:
@@ -612,3 +634,16 @@ def _min_shimmy(hopf: HopfCurvesResult, cycles: dict[str, Any], slices: list[Sli
             candidates.append({"Fz": s.Fz, "V": s.intervals[0]["V_start"], "source": "classified slice"})
             break
     return min(candidates, key=lambda c: c["Fz"]) if candidates else None
+
+
+def classification_summary(result: dict[str, Any]) -> str:
+    """The lines ``python -m shimmy classify`` prints for a :func:`classify` answer: the shimmy type, then
+    each stable attractor."""
+    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {result['shimmy_type']}"]
+    for a in result["attractors"]:
+        if a["kind"] == "equilibrium":
+            lines.append("  stable: straight rolling x = 0")
+        else:
+            lines.append(f"  stable: {a['kind']} ({a['mode']}), max |psi| {a['max_psi']:.5g} rad, "
+                         f"max |l_g delta| {a['max_lateral']:.5g} m")
+    return "\n".join(lines)

@@ -1,0 +1,104 @@
+"""``ground-run``: take-off, landing roll or taxi, from a preset or a CSV table of V(t), Fz(t)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ...errors import InvalidParameterError
+from ...model.configurations import CONFIGURATION_NAMES
+from ..common import EXIT_FAILED, add_command, add_common, add_config, add_field, emit, params, parse_sets
+
+
+def _read_profile_csv(path: str) -> tuple[list[list[Any]], list[int]]:
+    """Rows [t, V, Fz] of a CSV file (an optional header naming the columns t, V, Fz in any order;
+    blank lines and lines starting with # skipped) and the file line of each row."""
+    import csv
+
+    with open(path, newline="") as f:
+        lines = [(k, row) for k, row in enumerate(csv.reader(f), start=1)
+                 if row and any(c.strip() for c in row) and not row[0].lstrip().startswith("#")]
+    order = [0, 1, 2]
+    if lines:
+        head = [c.strip() for c in lines[0][1]]
+        try:
+            [float(c) for c in head]
+        except ValueError:
+            if sorted(head) != sorted(["t", "V", "Fz"]):
+                raise InvalidParameterError(f"{path}: header", ",".join(head), "the columns t, V, Fz (s, m/s, N)",
+                                            "does not name the columns") from None
+            order = [head.index(c) for c in ("t", "V", "Fz")]
+            lines = lines[1:]
+
+    def cell(text: str) -> Any:
+        try:
+            return float(text)
+        except ValueError:
+            return text.strip()  # refused by name and row
+
+    rows = [[cell(row[i]) for i in order] if len(row) == 3 else [cell(c) for c in row] for _, row in lines]
+    return rows, [k for k, _ in lines]
+
+
+def _profile(args):
+    from ...analyses.ground.ground_profiles import PRESETS, preset, profile_from_table
+
+    settings = parse_sets(args.profile_set)
+    if args.profile in PRESETS:
+        return preset(args.profile, {k: v for k, v in settings.items()})
+    if settings:
+        raise InvalidParameterError("--profile-set", args.profile_set, f"only with a preset ({', '.join(PRESETS)})",
+                                    "is given with a table")
+    rows, lines = _read_profile_csv(args.profile)
+    try:
+        return profile_from_table(rows)
+    except InvalidParameterError as exc:  # name the file's line as well
+        if exc.field.startswith("profile["):
+            row = int(exc.field[len("profile["):].split("]")[0])
+            raise InvalidParameterError(exc.field, exc.value, exc.allowed,
+                                        message=f"{args.profile}, line {lines[row]}: {exc}") from None
+        raise
+
+
+def _cmd_ground_run(args) -> int:
+    from ...analyses.ground.ground_run import GroundRunOptions, ground_runs
+    from ...model.parameters import check_number
+
+    profile = _profile(args)
+    options = GroundRunOptions(psi_threshold=args.psi_threshold, lateral_threshold=args.lateral_threshold,
+                               exact_nes=args.exact_nes, cycle_curves=args.fold_torus)
+    series_dt = check_number("series_dt", args.series_dt, options.dt_out, 1.0, "s")
+    stride = max(1, int(round(series_dt / options.dt_out)))
+    configs = list(CONFIGURATION_NAMES) if args.config == "all" else [args.config]
+    comparison = ground_runs(profile, params=params(args), configs=configs, options=options)
+    runs = comparison.runs
+    if len(runs) == 1:
+        (result,) = runs.values()
+        if args.csv:
+            names = list(result.series())
+            data = np.column_stack([np.asarray(v) for v in result.series(stride).values()])
+            np.savetxt(args.csv, data, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
+        payload = result.to_dict(stride)
+    else:
+        payload = comparison.to_dict(stride)
+    emit(payload, args.json, comparison.summary_text())
+    return 0 if all(r.success for r in runs.values()) else EXIT_FAILED
+
+
+def add_parsers(commands) -> None:
+    p = add_command(commands, "ground-run", "take-off, landing roll or taxi: V(t), Fz(t) from a profile",
+                    _cmd_ground_run)
+    add_config(p, extra=["all"], help="configuration, or all four compared")
+    p.add_argument("--profile", required=True, metavar="takeoff|landing|taxi|FILE.csv",
+                   help="a preset, or a CSV table of t (s), V (m/s), Fz (N) rows (optional header t,V,Fz)")
+    p.add_argument("--profile-set", action="append", metavar="NAME=VALUE",
+                   help="adjust a preset's setting (repeatable), e.g. V_rotate=75")
+    add_field(p, "ground_run", "--psi-threshold", "torsional amplitude counted as shimmy (rad)")
+    add_field(p, "ground_run", "--lateral-threshold", "lateral amplitude l_g delta counted as shimmy (m)")
+    add_field(p, "ground_run", "--series-dt", "sampling interval of the series in the JSON and CSV (s)")
+    p.add_argument("--fold-torus", action="store_true",
+                   help="also the crossings of the fold and torus curves of cycles (several seconds per configuration)")
+    p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
+    p.add_argument("--csv", metavar="FILE", help="write the series of one configuration to FILE")
+    add_common(p)

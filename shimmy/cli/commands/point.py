@@ -1,0 +1,79 @@
+"""One operating point: ``params``, ``hopf``, ``eigen``, ``simulate``."""
+
+from __future__ import annotations
+
+import math
+
+from ...model.parameters import PARAMETER_SPECS
+from ..common import (EXIT_FAILED, add_command, add_common, add_config, add_field, add_operating_point, add_plane, emit,
+                      limit, params)
+
+
+def _cmd_params(args) -> int:
+    rows = [spec.to_dict() for spec in PARAMETER_SPECS.values()]
+    lines = [f"{'name':<11}{'group':<6}{'unit':<11}{'default':>12}{'low':>11}{'high':>11}  description"]
+    for s in PARAMETER_SPECS.values():
+        lines.append(f"{s.name:<11}{s.group:<6}{s.unit:<11}{s.default:>12.6g}{s.low:>11.4g}{s.high:>11.4g}  "
+                     f"{s.description}")
+    emit({"parameters": rows}, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_hopf(args) -> int:
+    from ...analyses.core.stability import hopf_points
+
+    result = hopf_points(args.config, args.Fz, params=params(args), v_range=(args.v_min, args.v_max))
+    emit(result.to_dict(), args.json, result.summary_text())
+    return 0
+
+
+def _cmd_eigen(args) -> int:
+    from ...analyses.core.stability import eigenvalues
+    from ...model.parameters import check_operating_point
+
+    V, Fz = check_operating_point(args.V, args.Fz)
+    design = params(args)
+    ev = eigenvalues(args.config, V, Fz, params=design)
+    rows = [{"real": float(e.real), "imag": float(e.imag), "frequency_hz": float(abs(e.imag) / (2 * math.pi)),
+             "damping_ratio": float(-e.real / abs(e)) if abs(e) > 0 else None} for e in ev]
+    payload = {"config": args.config, "V": V, "Fz": Fz, "params": design.to_dict(), "eigenvalues": rows,
+               "stable": bool(ev.real.max() < 0)}
+    lines = [f"{args.config} at V = {V:g} m/s, Fz = {Fz:g} N: x = 0 is "
+             f"{'stable' if payload['stable'] else 'unstable'}",
+             f"  {'real (1/s)':>14}{'imag (rad/s)':>16}{'f (Hz)':>10}{'zeta':>10}"]
+    for r in rows:
+        zeta = "-" if r["damping_ratio"] is None else f"{r['damping_ratio']:.4f}"
+        lines.append(f"  {r['real']:>14.6g}{r['imag']:>16.6g}{r['frequency_hz']:>10.4f}{zeta:>10}")
+    emit(payload, args.json, "\n".join(lines))
+    return 0
+
+
+def _cmd_simulate(args) -> int:
+    from ...analyses.core.simulation import simulate
+
+    result = simulate(args.config, args.V, args.Fz, params=params(args),
+                      t_end=limit("simulate", "t_end", args.t_end), exact_nes=args.exact_nes)
+    if args.csv:
+        result.write_csv(args.csv)
+    emit(result.to_dict(), args.json, result.summary_text())
+    return 0 if result.success else EXIT_FAILED
+
+
+def add_parsers(commands) -> None:
+    p = add_command(commands, "params", "list every parameter with unit, default, range", _cmd_params)
+    add_common(p, design=False)
+
+    p = add_command(commands, "hopf", "Hopf points of straight rolling in V at one load", _cmd_hopf)
+    add_config(p)
+    p.add_argument("--Fz", required=True, help="vertical load (N)")
+    add_plane(p, "hopf", loads=False)
+    add_common(p)
+
+    p = add_command(commands, "eigen", "eigenvalues of straight rolling at one operating point", _cmd_eigen)
+    add_operating_point(p)
+
+    p = add_command(commands, "simulate", "time history at one operating point", _cmd_simulate)
+    add_operating_point(p)
+    add_field(p, "simulate", "--t-end", "simulated time (s)", limits=True)
+    p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
+    p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
