@@ -18,8 +18,8 @@ from ..errors import InvalidParameterError
 from . import settings
 from ..analyses.decisions import design_space
 from ..analyses.ground.ground_profiles import MAX_PROFILE_POINTS, PRESETS
-from ..model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, MATERIALS, PARAMETER_SPECS, V_RANGE, Parameters,
-                                check_number, unknown_name_error)
+from ..model.parameters import (DEFAULT_FZ, DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, MATERIALS,
+                                PARAMETER_SPECS, V_RANGE, Parameters, check_number, unknown_name_error)
 
 CONFIGS = tuple(c.value for c in Configuration)
 
@@ -535,7 +535,7 @@ SCHEMAS: dict[str, RequestSchema] = {
         _range("v_max", V_RANGE[1], V_RANGE, "m/s", "highest speed"), PARAMS, MATERIAL)),
     "stability": RequestSchema("stability", "largest eigenvalue real part of x = 0 against V, all configurations", (
         FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),
-        _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
+        _range("v_max", DIAGRAM_V_RANGE[1], V_RANGE, "m/s", "highest speed"),
         Field("n_points", "integer", "speeds on a geometric grid", default=200, low=10, high=2000),
         PARAMS, MATERIAL)),
     "devices": RequestSchema("devices", "NES torque/stiffness and PD damping curves", (
@@ -543,7 +543,7 @@ SCHEMAS: dict[str, RequestSchema] = {
         PARAMS, MATERIAL)),
     "bifurcation": RequestSchema("bifurcation", "bifurcation diagram in V (equilibrium and periodic branches)", (
         _config(), FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),
-        _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
+        _range("v_max", DIAGRAM_V_RANGE[1], V_RANGE, "m/s", "highest speed"),
         Field("ntst", "integer", "collocation mesh intervals", default=40, low=10, high=settings.MAX_NTST),
         Field("seeds", "boolean", "look for branches not born at a Hopf point by simulation", default=True),
         PARAMS, MATERIAL)),
@@ -555,14 +555,14 @@ SCHEMAS: dict[str, RequestSchema] = {
     "map": RequestSchema("map", "(V, Fz) stability map: Hopf, fold and torus curves, shimmy type on a grid, "
                          "design metrics", (
         _config(), _range("v_min", 1.0, V_RANGE, "m/s", "lowest speed"),
-        _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
+        _range("v_max", DIAGRAM_V_RANGE[1], V_RANGE, "m/s", "highest speed"),
         _range("fz_min", FZ_RANGE[0], FZ_RANGE, "N", "lowest load"),
         _range("fz_max", FZ_RANGE[1], FZ_RANGE, "N", "highest load"),
         Field("resolution", "integer", "classified Fz slices (more through regions they miss)",
               default=DEFAULT_MAP_SLICES, low=2, high=settings.MAX_MAP_SLICES),
         Field("n_v", "integer", "speeds per slice on the output grid", default=100, low=10,
               high=settings.MAX_MAP_SPEEDS),
-        Field("metrics_Fz", "number", "load of the speed-interval and amplitude metrics", default=150e3,
+        Field("metrics_Fz", "number", "load of the speed-interval and amplitude metrics", default=DEFAULT_FZ,
               low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
         PARAMS, MATERIAL)),
     "study": RequestSchema("study", "parametric study: Hopf speeds and max torsional amplitude per design and "
@@ -573,9 +573,9 @@ SCHEMAS: dict[str, RequestSchema] = {
         Field("parameter2", "string", "second parameter (two-parameter grid)", choices=tuple(PARAMETER_SPECS)),
         Field("values2", "numbers", "values of the second parameter", high=settings.MAX_STUDY_VALUES),
         Field("configs", "strings", "configurations", default=list(CONFIGS), choices=CONFIGS),
-        Field("Fz", "number", "vertical load", default=150e3, low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
+        Field("Fz", "number", "vertical load", default=DEFAULT_FZ, low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
         _range("v_min", 1.0, V_RANGE, "m/s", "lowest speed"),
-        _range("v_max", 200.0, V_RANGE, "m/s", "highest speed"),
+        _range("v_max", DIAGRAM_V_RANGE[1], V_RANGE, "m/s", "highest speed"),
         PARAMS, MATERIAL)),
     "ground_run": RequestSchema("ground_run", "ground run: take-off, landing roll, taxi or a (t, V, Fz) table; "
                                 "envelopes, time in shimmy, peaks, boundary crossings, onset delay", (
@@ -601,7 +601,8 @@ SCHEMAS: dict[str, RequestSchema] = {
     "sensitivity": RequestSchema("sensitivity", "sensitivities: derivatives of the Hopf speeds and the largest "
                                  "stable torsional amplitude at a load and of the minimum shimmy load, to every "
                                  "parameter (implicit differentiation), as tornado rows", (
-        _config(), Field("Fz", "number", "vertical load", default=150e3, low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
+        _config(), Field("Fz", "number", "vertical load", default=DEFAULT_FZ, low=FZ_RANGE[0], high=FZ_RANGE[1],
+                         unit="N"),
         Field("names", "strings", "parameters to differentiate against (default: all)", choices=tuple(PARAMETER_SPECS)),
         Field("amplitude", "boolean", "also the largest stable torsional amplitude (a bifurcation diagram, ~1 s)",
               default=True),
@@ -614,7 +615,7 @@ SCHEMAS: dict[str, RequestSchema] = {
               default="min_shimmy_Fz", choices=tuple(FIGURE_LIMITS)),
         Field("parameters", "strings", "parameters to search, each within its range (default: those of r2, e_p, "
               "k_s, r3 the configuration has)", choices=tuple(PARAMETER_SPECS)),
-        Field("Fz", "number", "load of the figures taken at a load (interval, max_psi)", default=150e3,
+        Field("Fz", "number", "load of the figures taken at a load (interval, max_psi)", default=DEFAULT_FZ,
               low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
         Field("constraints", "list", "constraints on figures of merit", default=[], low=0, high=MAX_CONSTRAINTS,
               item="constraints: " + CONSTRAINT_TEXT, items=_CONSTRAINT_ITEM),
@@ -639,7 +640,8 @@ SCHEMAS: dict[str, RequestSchema] = {
               item="tolerances: " + TOLERANCE_TEXT, items=_TOLERANCE_ITEM),
         Field("samples", "integer", "samples (a scrambled Sobol sequence)", default=128, low=2,
               high=settings.MAX_ROBUSTNESS_SAMPLES),
-        Field("Fz", "number", "load of the Hopf speeds", default=150e3, low=FZ_RANGE[0], high=FZ_RANGE[1], unit="N"),
+        Field("Fz", "number", "load of the Hopf speeds", default=DEFAULT_FZ, low=FZ_RANGE[0], high=FZ_RANGE[1],
+              unit="N"),
         Field("seed", "integer", "seed of the samples (the same seed gives the same samples)", default=0, low=0,
               high=2 ** 31 - 1),
         PARAMS, MATERIAL)),

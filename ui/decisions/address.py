@@ -12,6 +12,7 @@ from dash import Input, Output
 
 from shimmy.errors import InvalidParameterError
 from shimmy.model.configurations import affects
+from shimmy.model.parameters import DEFAULT_FZ
 from shimmy.service import schemas
 from ui import fields, ids
 from ui.layout import DESIGN
@@ -88,7 +89,7 @@ def _constraint_rows(raw: str | None) -> tuple[list[dict], str | None]:
     rows, bad = [], []
     for k, text in enumerate(t for t in (raw or "").split(",") if t.strip()):
         try:
-            c = schemas.constraint(f"cons[{k}]", text, 150e3)
+            c = schemas.constraint(f"cons[{k}]", text, DEFAULT_FZ)
         except InvalidParameterError as exc:
             bad.append(str(exc))
             continue

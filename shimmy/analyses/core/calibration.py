@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq, least_squares, minimize_scalar
 
-from ...model.parameters import PARAMETER_SPECS, Parameters
+from ...model.parameters import DIAGRAM_V_RANGE, PARAMETER_SPECS, Parameters
 from .simulation import simulate
 from .stability import hopf_points
 
@@ -82,7 +82,7 @@ class CalibrationResult:
 
 
 def _hopf_speeds(config: str, params: Parameters) -> np.ndarray:
-    result = hopf_points(config, FZ_REFERENCE, params=params, v_range=(1.0, 200.0))
+    result = hopf_points(config, FZ_REFERENCE, params=params, v_range=DIAGRAM_V_RANGE)
     speeds = np.array([h.V for h in result.hopf_points])
     if speeds.size != 2:
         return np.array([np.nan, np.nan])

@@ -41,13 +41,13 @@ from ...version import __version__
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import Configuration, affects
 from ...model.equations import build_model
-from ...model.parameters import DEFAULT_FZ, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
+from ...model.parameters import DEFAULT_FZ, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from ..core.executors import open_executor, run_units
 from .design_space import DIFFERENTIABLE, FIGURES, Figure, device_parameters  # noqa: F401 (Figure: re-exported)
 from .sensitivity import (V_BAND, amplitude_sensitivity, coefficient_pairs, hopf_sensitivities,
                           min_shimmy_sensitivity)
 
-FZ_BOX = (1.0e4, 9.0e5)  # N
+FZ_BOX = FZ_RANGE  # N
 
 
 

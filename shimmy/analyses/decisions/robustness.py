@@ -36,14 +36,14 @@ from ...version import __version__
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import OPERATING_POINTS, Configuration, affects
 from ...model.equations import build_model
-from ...model.parameters import DEFAULT_FZ, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
+from ...model.parameters import DEFAULT_FZ, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from .design_space import DISTRIBUTIONS, TOLERANCE_LIMITS
 from ..core.executors import open_executor, run_units
 from .sensitivity import (V_BAND, coefficient_pairs, hopf_sensitivities, jacobian_derivatives, min_shimmy_sensitivity,
                           polish_lowest_point)
 from ..core.stability import Linearisation, hopf_points
 
-FZ_BOX = (1.0e4, 9.0e5)  # N: where the lowest point of the Hopf curves is looked for
+FZ_BOX = FZ_RANGE  # N: where the lowest point of the Hopf curves is looked for
 CHUNK = 16  # samples per executor unit
 
 
@@ -221,7 +221,7 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
-    Fz = check_number("Fz", Fz, 1.0e4, 9.0e5, "N")
+    Fz = check_number("Fz", Fz, *FZ_RANGE, "N")
     samples = int(check_number("samples", samples, 2, 4096, integer=True))
     seed = int(check_number("seed", seed, 0, 2 ** 31 - 1, integer=True))
     if isinstance(tolerances, Mapping):

@@ -64,14 +64,14 @@ from ...continuation.collocation import Mesh, PeriodicProblem
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import Configuration, affects
 from ...model.equations import Model, build_model, jacobian, model_coefficients
-from ...model.parameters import PARAMETER_SPECS, Parameters, check_number, unknown_name_error
+from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from ..diagrams.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, BifurcationOptions, bifurcation, gear_field
 from .design_space import DESIGN_PARAMETERS
 from ..core.stability import Linearisation, hopf_points
 
 #: Relative step of the central differences in the parameters.
 REL_STEP = 1e-5
-V_BAND = (1.0, 200.0)  # m/s: the map's speed range
+V_BAND = DIAGRAM_V_RANGE  # m/s: the map's speed range
 
 NOT_FITTED = "not fitted in this configuration"
 NOT_IN_EQUATIONS = "not in the equations of motion (a geometry record)"
@@ -477,7 +477,7 @@ def sensitivity(config: Configuration | str, Fz: float, *, params: Parameters | 
     torsional amplitude at ``Fz``, with respect to every parameter in ``names`` (default: all)."""
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
-    Fz = check_number("Fz", Fz, 1.0e4, 9.0e5, "N")
+    Fz = check_number("Fz", Fz, *FZ_RANGE, "N")
     names = _check_names(names)
     model = build_model(config, params)
     timings = {}

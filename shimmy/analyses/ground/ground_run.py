@@ -47,7 +47,7 @@ from ...errors import InvalidParameterError
 from ...model import integrator
 from ...model.configurations import ALL_CONFIGURATIONS, Configuration
 from ...model.equations import build_model, jacobian
-from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number
+from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number
 from .ground_profiles import GroundProfile, as_profile
 from ..core.response import dominant_mode, torsional_share
 from ..core.simulation import STATUS_MESSAGES, SimulationOptions, initial_state
@@ -356,7 +356,7 @@ def cycle_curve_crossings(config: Configuration, profile: GroundProfile, *, para
                           t_end: float | None = None) -> list[dict[str, Any]]:
     """Intersections of the trajectory's table segments with the fold and torus curves' polylines."""
     t_end = profile.t[-1] if t_end is None else t_end
-    v_max = float(min(V_RANGE[1], max(200.0, 1.1 * profile.V.max())))
+    v_max = float(min(V_RANGE[1], max(DIAGRAM_V_RANGE[1], 1.1 * profile.V.max())))
     scale = np.array([10.0, 1e5])
     times = np.union1d(profile.t[profile.t < t_end], [t_end])
     path = np.column_stack(profile.at(times)) / scale

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..diagrams.bifurcation import BifurcationOptions
 from ...model.configurations import CONFIGURATION_NAMES, OPERATING_POINTS, Configuration
-from ...model.parameters import DEFAULT_FZ, DEFAULT_MAP_SLICES, Parameters
+from ...model.parameters import DEFAULT_FZ, DEFAULT_MAP_SLICES, FZ_RANGE, Parameters
 from ..core.executors import run_units
 from ..core.response import ShimmyType
 from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, classify, map_slice, stability_maps
@@ -129,7 +129,7 @@ def design_report(configs: Sequence[str] = CONFIGURATION_NAMES, *, params: Param
     report = progress or (lambda fraction, message: None)
     results: dict[str, Any] = {}
     # all maps' units on the executor at once: no worker idles at the end of one map
-    computed = stability_maps(wanted, v_range=BAND_V, fz_range=(1.0e4, 9.0e5), resolution=resolution, params=params,
+    computed = stability_maps(wanted, v_range=BAND_V, fz_range=FZ_RANGE, resolution=resolution, params=params,
                               executor=executor, progress=lambda fraction, message: report(0.97 * fraction, message))
     maps: dict[str, StabilityMap] = dict(zip(wanted, computed, strict=True))
     for c in wanted:

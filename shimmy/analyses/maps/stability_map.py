@@ -54,7 +54,7 @@ from . import map_shading
 from ..diagrams.cycle_curves import CurveSearch, SearchUnit, search_done, starts_of_diagram
 from ..core.executors import name_of, open_executor, run_dynamic
 from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
-from ...model.parameters import (DEFAULT_MAP_SLICES, FZ_RANGE, V_RANGE, Parameters, check_number,
+from ...model.parameters import (DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number,
                                 check_operating_point, check_range)
 from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
 
@@ -64,8 +64,8 @@ COVERAGE_ROUNDS = 2  # rounds of further slices through regions no slice crosses
 #: ... that are at least one grid cell wide and cover this fraction of the map (thinner slivers
 #: between curves that nearly meet are read off the nearest slice at the same speed, and counted)
 COVERAGE_AREA = 2e-4
-DEFAULT_V_RANGE = (1.0, 200.0)
-DEFAULT_FZ_RANGE = (1.0e4, 9.0e5)
+DEFAULT_V_RANGE = DIAGRAM_V_RANGE
+DEFAULT_FZ_RANGE = FZ_RANGE
 #: Simulated V per slice at most where no stable equilibrium or cycle exists; the other grid
 #: points of such a stretch take the answer of the nearest simulated one.
 MAX_SIMULATIONS_PER_SLICE = 12
@@ -74,7 +74,7 @@ FALLBACK_T_END = 60.0  # s
 FINE = 10
 #: Low-load band of the pure-torsion area metric.
 BAND_FZ_MAX = 250.0e3  # N
-BAND_V = (1.0, 200.0)  # m/s
+BAND_V = DIAGRAM_V_RANGE  # m/s
 #: Where x = 0 is stable, a "cycle" smaller than this (rad, m) is x = 0 itself: continuation with the
 #: particle damper can run a branch on through its Hopf point along the trivial orbit (amplitudes
 #: ~1e-100 observed). Where x = 0 is unstable, small cycles are real (with the PD they grow like
