@@ -11,10 +11,20 @@ from .version import __version__
 from .model.configurations import ALL_CONFIGURATIONS, Configuration
 from .errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
 from .model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
-from .analyses.core.simulation import SimulationOptions, SimulationResult, simulate
-from .analyses.core.stability import HopfPoint, HopfResult, eigenvalues, hopf_points
-from .analyses.ground.ground_profiles import GroundProfile, preset, profile_from_table
-from .analyses.ground.ground_run import GroundRunOptions, GroundRunResult, ground_run, ground_runs
+from .continuation.lazy import lazy_exports
+
+#: The analyses' front doors, imported on first use: ``import shimmy`` loads no compiled kernel.
+_EXPORTS = {
+    "SimulationOptions": ".analyses.core.simulation", "SimulationResult": ".analyses.core.simulation",
+    "simulate": ".analyses.core.simulation",
+    "HopfPoint": ".analyses.core.stability", "HopfResult": ".analyses.core.stability",
+    "eigenvalues": ".analyses.core.stability", "hopf_points": ".analyses.core.stability",
+    "GroundProfile": ".analyses.ground.ground_profiles", "preset": ".analyses.ground.ground_profiles",
+    "profile_from_table": ".analyses.ground.ground_profiles",
+    "GroundRunOptions": ".analyses.ground.ground_run", "GroundRunResult": ".analyses.ground.ground_run",
+    "ground_run": ".analyses.ground.ground_run", "ground_runs": ".analyses.ground.ground_run",
+}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 __all__ = [
     "ALL_CONFIGURATIONS", "Configuration", "ConvergenceError", "GeometryError",

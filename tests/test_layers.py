@@ -169,7 +169,7 @@ def test_every_module_sits_in_a_layer():
 #: What the command line may import from the package: the analyses, the model, the errors (the engine's
 #: too: its InvalidInputError is bad input) and of the service its request schemas and analysis registry.
 CLI_MAY_IMPORT = ("shimmy.cli", "shimmy.analyses", "shimmy.model", "shimmy.errors", "shimmy.continuation.errors",
-                  "shimmy.service.schemas", "shimmy.service.analyses", "shimmy.version")
+                  "shimmy.continuation.kinds", "shimmy.service.schemas", "shimmy.service.analyses", "shimmy.version")
 
 
 def test_cli_imports_only_the_analyses_the_model_the_errors_and_the_schemas():

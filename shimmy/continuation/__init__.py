@@ -59,19 +59,27 @@ a start does not converge; both derive from :class:`ContinuationError`. A branch
 why it ended in its ``stops``: a :class:`StopReason` and a message for each direction traced.
 """
 
-from .collocation import Mesh, PeriodicProblem
-from .cycle_curves import CODIM2_KINDS, CycleCurve, CycleCurveOptions, CycleCurveProblem, cycle_curve, start_beside
-from .core import (ContinuationOptions, CurvePoint, CurveProblem, Tracer, correct, locate, point_at, step, tangent,
-                   weighted_norm)
-from .equilibria import EquilibriumBranch, equilibrium_branch
-from .errors import ContinuationError, ConvergenceError, InvalidInputError
-from .fields import TwoParameterField, VectorField
-from .kinds import CYCLE_BIFURCATIONS, PointKind, Stop, StopReason
-from .hopf import HopfCurve, HopfCurveProblem, hopf_curve, hopf_start
-from .lyapunov import first_lyapunov_coefficient, hopf_eigenvectors
-from .periodic_orbits import (OrbitGuess, PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
-                              periodic_branch)
-from .results import ContinuationResult, SpecialPoint
+from .lazy import lazy_exports
+
+#: Where each public name lives: imported on first use (the collocation kernels load numba).
+_EXPORTS = {
+    "Mesh": ".collocation", "PeriodicProblem": ".collocation",
+    "ContinuationOptions": ".core", "CurvePoint": ".core", "CurveProblem": ".core", "Tracer": ".core",
+    "correct": ".core", "locate": ".core", "point_at": ".core", "step": ".core", "tangent": ".core",
+    "weighted_norm": ".core",
+    "CODIM2_KINDS": ".cycle_curves", "CycleCurve": ".cycle_curves", "CycleCurveOptions": ".cycle_curves",
+    "CycleCurveProblem": ".cycle_curves", "cycle_curve": ".cycle_curves", "start_beside": ".cycle_curves",
+    "EquilibriumBranch": ".equilibria", "equilibrium_branch": ".equilibria",
+    "ContinuationError": ".errors", "ConvergenceError": ".errors", "InvalidInputError": ".errors",
+    "TwoParameterField": ".fields", "VectorField": ".fields",
+    "HopfCurve": ".hopf", "HopfCurveProblem": ".hopf", "hopf_curve": ".hopf", "hopf_start": ".hopf",
+    "CYCLE_BIFURCATIONS": ".kinds", "PointKind": ".kinds", "Stop": ".kinds", "StopReason": ".kinds",
+    "first_lyapunov_coefficient": ".lyapunov", "hopf_eigenvectors": ".lyapunov",
+    "OrbitGuess": ".periodic_orbits", "PeriodicBranch": ".periodic_orbits", "PeriodicOptions": ".periodic_orbits",
+    "hopf_guess": ".periodic_orbits", "orbit_from_samples": ".periodic_orbits", "periodic_branch": ".periodic_orbits",
+    "ContinuationResult": ".results", "SpecialPoint": ".results",
+}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 __all__ = [
     "CODIM2_KINDS", "CYCLE_BIFURCATIONS", "ContinuationError", "ContinuationOptions", "ContinuationResult",

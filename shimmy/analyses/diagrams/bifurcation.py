@@ -46,26 +46,25 @@ from scipy.optimize import minimize_scalar
 
 from ...version import __version__
 from ...continuation.errors import ConvergenceError as EngineConvergenceError
-from ...continuation.errors import InvalidInputError as EngineInvalidInputError
 from ...continuation.collocation import Mesh, PeriodicProblem
 from ...model.configurations import Configuration
 from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, PointKind, Stop, VectorField,
                              equilibrium_branch, locate, step, tangent, weighted_norm)
 from ...model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
-from ...errors import ConvergenceError, InvalidParameterError
+from ...errors import ConvergenceError
 from ...model.nes import VALID_ANGLE
-from ...model.parameters import DIAGRAM_V_RANGE, Parameters, check_number
-from ...continuation.periodic_orbits import (PeriodicBranch, PeriodicOptions, hopf_guess, orbit_from_samples,
+from ...model.parameters import DIAGRAM_V_RANGE, Parameters
+from ...continuation.periodic_orbits import (PeriodicBranch, hopf_guess, orbit_from_samples,
                               periodic_branch)
 from ..core.response import mode_of, torsional_share
 from ..core.stability import HopfResult, check_speeds_and_load, hopf_points
+from .options import BifurcationOptions
 
 # Size of a unit step in each unknown (the arclength metric): psi, dpsi, delta, ddelta, lam, psis, dpsis.
 STATE_SCALE = np.array([0.05, 5.0, 0.005, 0.5, 0.01, 0.05, 5.0])
 V_SCALE = 10.0  # m/s
 T_SCALE = 0.01  # s
 MAX_PSI = 1.0  # rad: beyond this a branch is stopped (far outside any physical shimmy)
-PERIOD_MAX = 2.0  # s: a period blow-up (homoclinic approach) stops a branch
 SEED_T_END = 30.0  # s of simulation per seed
 SEED_RETRIES = 2  # further runs of 2 * SEED_T_END from the last state while the motion has not settled
 #: A seed needs the attractor, not the trajectory: its orbit is then converged by collocation (to 1e-9).
@@ -75,35 +74,6 @@ SEED_RTOL = 1e-6
 #: (the torsional isola between two folds above ~720 kN). (state, size): psi in rad, l_g delta in m.
 LARGE_STARTS = (("psi", 0.2), ("lateral", 0.1))
 LARGE_SEED_SPEEDS = (30.0, 80.0)  # m/s
-
-
-@dataclass(frozen=True)
-class BifurcationOptions:
-    ntst: int = 40
-    ncol: int = 4
-    ds: float = 0.05
-    ds_max: float = 0.5
-    max_steps: int = 300
-    seeds: bool = True
-    mesh_check: bool = True
-    exact_nes: bool = False
-    max_angle: float = 0.2  # rad: the tangent turns at most this much per step (curvature control)
-
-    def __post_init__(self):
-        try:  # the engine validates the mesh; the gear's callers see the gear's error class
-            PeriodicOptions(ntst=self.ntst, ncol=self.ncol)
-        except EngineInvalidInputError as exc:
-            raise InvalidParameterError(exc.field, exc.value, exc.allowed, message=str(exc)) from None
-        check_number("ds", self.ds, 1e-6, 1.0)
-        check_number("ds_max", self.ds_max, self.ds, 10.0)
-        check_number("max_steps", self.max_steps, 1, 100_000, integer=True)
-        check_number("max_angle", self.max_angle, 0.01, 3.2, "rad")
-
-    def periodic(self) -> PeriodicOptions:
-        return PeriodicOptions(ntst=self.ntst, ncol=self.ncol, period_max=PERIOD_MAX,
-                               continuation=ContinuationOptions(ds=self.ds, ds_max=self.ds_max,
-                                                                max_steps=int(self.max_steps),
-                                                                max_angle=self.max_angle))
 
 
 def gear_field(model: Model, Fz: float) -> VectorField:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ...analyses.diagrams.bifurcation import BifurcationOptions
-from ...analyses.diagrams.cycle_curves import KINDS
+from ...analyses.diagrams.options import BifurcationOptions
+from ...continuation.kinds import CYCLE_BIFURCATIONS as KINDS
 from ...errors import InvalidParameterError
 from ...model.parameters import check_number
 from ..common import (add_command, add_common, add_config, add_field, add_plane, add_progress, emit, float_list, limit,
