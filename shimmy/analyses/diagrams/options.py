@@ -19,6 +19,10 @@ PERIOD_MAX = 2.0  # s: a period blow-up (homoclinic approach) stops a branch
 
 @dataclass(frozen=True)
 class BifurcationOptions:
+    """A diagram's numerical settings: collocation mesh (``ntst`` intervals of ``ncol`` points), steps,
+    whether to seed branches by simulation, the doubled-mesh check of the largest amplitude, the exact
+    NES torque, and the curvature control of the periodic branches."""
+
     ntst: int = 40
     ncol: int = 4
     ds: float = 0.05
