@@ -7,7 +7,6 @@ numerics directly). :func:`run` validates, consults the shared cache and compute
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -47,10 +46,6 @@ def serves(name: str, *, sync: bool, job: bool) -> Callable[[Runner], Runner]:
 
 def _params(request: dict[str, Any]) -> Parameters:
     return Parameters.from_dict(request["params"])
-
-
-def _finite(x) -> float | None:
-    return float(x) if x is not None and math.isfinite(x) else None
 
 
 @serves("simulate", sync=True, job=True)

@@ -282,7 +282,8 @@ def growth_rates(Fz: float, *, params: Parameters | None = None, v_range: tuple[
     ``v_range`` (m/s), with the Hopf points and unstable intervals, for every configuration:
     ``{"V": [...], "configs": {name: {"max_real" (1/s), "frequency_hz", "hopf_points", "unstable_intervals"}}}``."""
     params = params or Parameters()
-    v_min, v_max = check_pair("v_range", v_range)
+    v_min, v_max, Fz = check_speeds_and_load(v_range, Fz)
+    n_points = int(check_number("n_points", n_points, 10, 2000, integer=True))
     V = np.geomspace(v_min, v_max, n_points)
     out: dict[str, Any] = {"V": V.tolist(), "configs": {}}
     for config in Configuration:
