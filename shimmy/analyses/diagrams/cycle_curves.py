@@ -21,6 +21,7 @@ in Fz and its codimension-2 points, located.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -291,7 +292,7 @@ class CurveSearch:
         self.tried += 1
         if warning:
             self.warnings.append(warning)
-        elif curve is not None and not any(_same_curve(curve, c, self.params.gear.l_g) for c in self.curves):
+        elif curve is not None and not any(same_curve(curve, c, self.params.gear.l_g) for c in self.curves):
             self.curves.append(curve)
 
     def idle(self) -> bool:
@@ -387,6 +388,94 @@ class ContinueUnit:
         search.add_curve(self.start, *result)
 
 
+def reversed_curve(curve: GearCycleCurve) -> GearCycleCurve:
+    """The same curve with its points in the opposite order (its special points' indices with them)."""
+    c = curve.curve
+    last = len(c.p) - 1
+    flipped = CycleCurve(c.kind, c.p[::-1].copy(), c.period[::-1].copy(), c.x_max[::-1].copy(), c.x_min[::-1].copy(),
+                         c.kappa[::-1].copy(), c.multipliers[::-1].copy(), c.solutions[::-1],
+                         special_points=sorted((dataclasses.replace(s, index=last - s.index) for s in c.special_points),
+                                               key=lambda s: s.index),
+                         stops=list(c.stops)[::-1], steps=c.steps, closed=c.closed)
+    return GearCycleCurve(curve.kind, flipped, curve.origin)
+
+
+@dataclass(frozen=True)
+class CurveSeed:
+    """A point of a continued curve with its cycle (collocation mesh and u = (x, T, V)), from which
+    the same curve is continued again at a nearby design (:class:`WarmUnit`): a point where the
+    curve crosses its load most steeply, so that a Newton correction at that load finds it."""
+
+    kind: PointKind
+    origin: str
+    mesh: np.ndarray
+    u: np.ndarray
+    Fz: float
+    ncol: int
+    kappa: float | None
+
+    @classmethod
+    def of(cls, curve: GearCycleCurve, n: int) -> CurveSeed:
+        """The seed of a curve of an ``n``-state model: of its interior points (two steps from either
+        end where it has them) whose cycle is at least a third of the curve's largest (near a GH or
+        double-Hopf point the cycles shrink to x = 0 and a correction there is ill-conditioned), the
+        one whose chord to its neighbours is most nearly along Fz."""
+        c = curve.curve
+        p = c.p / np.array([V_SCALE, FZ_SCALE])
+        count = len(p)
+        amplitude = np.max(0.5 * (c.x_max - c.x_min) / STATE_SCALE[:n], axis=1)
+        inner = list(range(2, count - 2)) or list(range(count))
+        inner = [i for i in inner if amplitude[i] >= amplitude.max() / 3.0] or inner
+
+        def steepness(i: int) -> float:
+            d = p[min(i + 1, count - 1)] - p[max(i - 1, 0)]
+            return abs(d[1]) / max(float(np.hypot(*d)), 1e-300)
+
+        i = max(inner, key=steepness)
+        mesh, u = c.solutions[i]
+        ntst = len(mesh) - 1
+        ncol = int(round(((len(u) - 2) / n - 1) / ntst))
+        kappa = float(c.kappa[i]) if np.isfinite(c.kappa[i]) else None
+        return cls(curve.kind, curve.origin, np.asarray(mesh, float), np.asarray(u, float), float(c.p[i, 1]), ncol,
+                   kappa)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind.value, "origin": self.origin, "mesh": self.mesh.tolist(), "u": self.u.tolist(),
+                "Fz": self.Fz, "ncol": self.ncol, "kappa": self.kappa}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> CurveSeed:
+        return cls(PointKind(data["kind"]), str(data["origin"]), np.asarray(data["mesh"], float),
+                   np.asarray(data["u"], float), float(data["Fz"]), int(data["ncol"]),
+                   None if data["kappa"] is None else float(data["kappa"]))
+
+
+@dataclass(frozen=True, eq=False)
+class WarmUnit:
+    """A curve of a nearby design continued again at this one from its seed: (curve or None,
+    warning or None). The seed is corrected by Newton at its load, then the curve traced both
+    ways exactly as from any start (its points, crossings and codimension-2 points those of the
+    curve at this design, to the location tolerance)."""
+
+    config: Configuration
+    params: Parameters
+    seed: CurveSeed
+    box: tuple[tuple[float, float], tuple[float, float]]
+    loads: tuple[float, ...]
+
+    def run(self) -> tuple[GearCycleCurve | None, str | None]:
+        s = self.seed
+        data = {"x_max": [], "x_min": []}
+        if s.kappa is not None:
+            data["torus_angle"] = math.acos(s.kappa)
+        point = SpecialPoint(s.kind, float(s.u[-1]), 0, data, solution=(s.mesh, s.u))
+        start = Start(s.kind, point, s.Fz, s.ncol, s.origin)
+        return _continue(self.config, self.params, start, self.box, self.loads)
+
+    def describe(self) -> str:
+        return f"{self.seed.kind} curve again from V = {self.seed.u[-1]:.4g} m/s, Fz = {self.seed.Fz / 1e3:.4g} kN"
+
+
 #: A unit of a curve search: run in any process (``executors.run_work_unit``), its result handed
 #: back to the search by its ``hand_in``.
 SearchUnit = BesideUnit | ScanUnit | ContinueUnit
@@ -471,7 +560,7 @@ def _continue(config: Configuration, params: Parameters, start: Start, box, load
     return GearCycleCurve(start.kind, curve, start.origin), None
 
 
-def _same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:
+def same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:
     """Whether a curve continued while another was under way is that curve again (its start, the
     first point of its half traced first, lies on the other)."""
     if new.kind != old.kind:

@@ -33,6 +33,8 @@ Segment = tuple[float, float, str]  # (V_low, V_high, type)
 #: A piece of a slice's interval narrower than this fraction of it is taken as the rounding of
 #: where the slice's located points and the curves' polylines put the same crossing.
 SLIVER = 1e-3
+#: A curve's vertex within this fraction of a load lies on it (the location tolerance of its end points).
+ON_LOAD = 1e-9
 
 
 def crossings(curves: Sequence[Curve], Fz: float) -> list[tuple[float, tuple[str, int]]]:
@@ -41,6 +43,10 @@ def crossings(curves: Sequence[Curve], Fz: float) -> list[tuple[float, tuple[str
     for name, p in curves:
         if len(p) < 2:
             continue
+        # a vertex on the load to rounding (an end located on the box's edge: 899999.9999999998 N or
+        # 900000.0000000008 N) is on it, so that whether a curve crosses an edge row is not rounding's
+        p = p.copy()
+        p[np.abs(p[:, 1] - Fz) <= ON_LOAD * max(abs(Fz), 1.0), 1] = Fz
         a, b = p[:-1], p[1:]
         # half-open segments: a vertex exactly on the load (a curve's start point) counts once
         hit = ((a[:, 1] < Fz) & (Fz <= b[:, 1])) | ((b[:, 1] < Fz) & (Fz <= a[:, 1]))

@@ -38,6 +38,7 @@ another map has units left); each map is the one :func:`stability_map` computes 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -51,7 +52,8 @@ from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurc
 from ...model.configurations import Configuration
 from ...errors import InvalidParameterError
 from . import map_shading
-from ..diagrams.cycle_curves import CurveSearch, SearchUnit, search_done, starts_of_diagram
+from ..diagrams.cycle_curves import (KEY_OF_KIND, CurveSearch, CurveSeed, SearchUnit, search_done,
+                                     starts_of_diagram)
 from ..core.executors import name_of, open_executor, run_dynamic
 from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
 from ...model.parameters import (DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number,
@@ -175,7 +177,7 @@ class SliceResult:
     special_points: list[dict[str, Any]]  # LPC / NS / PD / BPC on periodic branches: kind, V, mode
     intervals: list[dict[str, Any]]  # maximal V intervals of one type other than Stable (fine grid)
     lengths: dict[str, float]  # measure (m/s) of V with each type (fine grid)
-    max_psi: float
+    max_psi: float | None
     max_psi_V: float | None
     simulated: list[float]  # V where the type came from a simulation
     warnings: list[str]
@@ -183,15 +185,18 @@ class SliceResult:
     #: the diagram's located LPC / NS / PD points with their orbits: starts of the map's curves
     #: (not in :meth:`to_dict`)
     starts: list = field(default_factory=list, repr=False)
+    #: carried from the map of a nearby design (:mod:`shimmy.analyses.maps.warm_map`): intervals moved
+    #: with the curves, Hopf points scanned again, no diagram (``max_psi`` None)
+    carried: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         return {"Fz": self.Fz, "hopf_points": self.hopf_points, "special_points": self.special_points,
                 "intervals": self.intervals, "lengths": self.lengths, "max_psi": self.max_psi,
                 "max_psi_V": self.max_psi_V, "simulated_V": self.simulated, "warnings": self.warnings,
-                "elapsed_s": self.elapsed_s}
+                "elapsed_s": self.elapsed_s, **({"carried": True} if self.carried else {})}
 
 
-def _grids(v_min: float, v_max: float, n_v: int) -> tuple[np.ndarray, np.ndarray]:
+def speed_grids(v_min: float, v_max: float, n_v: int) -> tuple[np.ndarray, np.ndarray]:
     fine = np.linspace(v_min, v_max, (n_v - 1) * FINE + 1).round(10)  # no 6.800000000000001 in outputs
     return fine[::FINE].copy(), fine
 
@@ -242,7 +247,7 @@ def _intervals(fine: np.ndarray, types: list[str], critical: list[float] = ()) -
     return out
 
 
-def _lengths(fine: np.ndarray, types: list[str]) -> dict[str, float]:
+def type_lengths(fine: np.ndarray, types: list[str]) -> dict[str, float]:
     """Measure of V with each type: each fine point stands for the cell around it."""
     edges = np.concatenate([[fine[0]], 0.5 * (fine[1:] + fine[:-1]), [fine[-1]]])
     widths = np.diff(edges)
@@ -269,14 +274,14 @@ def map_slice(config: Configuration | str, Fz: float, *, params: Parameters, v_r
     config = Configuration.parse(config)
     options = options or BifurcationOptions(mesh_check=False)
     result = result or bifurcation(config, Fz, v_range=v_range, params=params, options=options)
-    coarse, fine = _grids(*v_range, n_v)
+    coarse, fine = speed_grids(*v_range, n_v)
     types_fine, _, simulated = _slice_types(result, fine, FINE, config, params)
     hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value}
             for h in result.hopf.hopf_points]
     special = _special_points(result)
     critical = [h["V"] for h in hopf] + [p["V"] for p in special]
     return SliceResult(Fz, coarse, types_fine[::FINE], hopf, special, _intervals(fine, types_fine, critical),
-                       _lengths(fine, types_fine), result.max_psi, result.max_psi_V, simulated,
+                       type_lengths(fine, types_fine), result.max_psi, result.max_psi_V, simulated,
                        list(result.warnings), time.perf_counter() - clock, starts_of_diagram(result, Fz))
 
 
@@ -327,6 +332,16 @@ class StabilityMap:
     executor: str
     elapsed_s: float
     warnings: list[str] = field(default_factory=list)
+    #: how it was made: ``resolution`` first slices, ``n_v`` speeds, the slices' diagram options
+    resolution: int = DEFAULT_MAP_SLICES
+    n_v: int = 100
+    options: BifurcationOptions | None = None
+    #: a point with its cycle on each fold and torus curve (:meth:`warm_start`; not in :meth:`to_dict`)
+    seeds: list[CurveSeed] = field(default_factory=list, repr=False)
+    #: the map this one was warmed from (:mod:`shimmy.analyses.maps.warm_map`), else None
+    warmed_from: dict[str, Any] | None = None
+    #: why a map asked to be warmed was computed cold, else None
+    warm_refused: str | None = None
 
     @property
     def min_shimmy_Fz(self) -> float | None:
@@ -381,9 +396,33 @@ class StabilityMap:
                                "same interval on the nearest slices, as fractions of it (mode changes inside it "
                                "interpolated in Fz between the slices below and above)",
                     "regions": "polygons of the shading's row segments between consecutive rows, one per region "
-                               "until it splits or merges; their edges are the curves' crossings of the rows"},
+                               "until it splits or merges; their edges are the curves' crossings of the rows"}
+                | ({} if self.warmed_from is None else {"warmed_from": self.warmed_from})
+                | ({} if self.warm_refused is None else {"warm_refused": self.warm_refused}),
                 "executor": self.executor, "warnings": list(self.warnings), "elapsed_s": self.elapsed_s,
                 "version": __version__}
+
+    def boundaries(self) -> list[tuple[str, np.ndarray]]:
+        """The region boundaries as named polylines in (V, Fz) (:func:`_boundaries`' names)."""
+        out = [(f"hopf{i}", c.p) for i, c in enumerate(self.hopf.curves)]
+        for i, c in enumerate(self.cycles["curves"]):
+            points = self.cycles[KEY_OF_KIND[c["kind"]]][_index_of_kind(self.cycles["curves"], i)]
+            out.append((f"{c['kind']}{i}", np.array([[q["V"], q["Fz"]] for q in points], float).reshape(-1, 2)))
+        return out
+
+    def warm_start(self) -> dict[str, Any]:
+        """What a map of a nearby design is warmed from (:func:`shimmy.analyses.maps.warm_map.warm_map`),
+        JSON-ready: the plane, grid and options, the boundaries, the slices' intervals, the arrangement
+        (curve counts, GH and double-Hopf points, each cycle curve's closure and codimension-2
+        points) and a seed on each fold and torus curve."""
+        options = self.options or BifurcationOptions(mesh_check=False)
+        return {"config": self.config.value, "params": self.params.to_dict(), "v_range": list(self.v_range),
+                "fz_range": list(self.fz_range), "resolution": self.resolution, "n_v": self.n_v,
+                "options": dataclasses.asdict(options), "rows": self.shading_Fz.tolist(),
+                "boundaries": [[name, p.tolist()] for name, p in self.boundaries()],
+                "slices": [s.to_dict() for s in self.slices],
+                "arrangement": arrangement(self.hopf, self.cycles),
+                "seeds": [seed.to_dict() for seed in self.seeds], "version": __version__}
 
     def write_csv(self, path) -> None:
         """The shading (the map's answer on its fine grid): one row per (Fz, V)."""
@@ -543,8 +582,10 @@ class _MapBuild:
         return StabilityMap(self.config, self.params, self.v_range, self.fz_range, V,
                             np.array([s.Fz for s in slices]), [s.types for s in slices], slices, hopf, cycles, rows,
                             map_shading.grid(segments, V), [map_shading.measures(r) for r in segments], fallbacks,
-                            map_shading.polygons(segments, rows), _min_shimmy(hopf, cycles, slices), executor,
-                            self.finished_at + time.perf_counter() - clock, warnings)
+                            map_shading.polygons(segments, rows), lowest_shimmy(hopf, cycles, slices), executor,
+                            self.finished_at + time.perf_counter() - clock, warnings, resolution=self.resolution,
+                            n_v=self.n_v, options=self.options,
+                            seeds=[CurveSeed.of(c, self.config.n_states) for c in self.search.result(0.0).curves])
 
 
 def _tagged_unit(tagged: tuple[int, MapUnit]) -> Any:
@@ -598,7 +639,8 @@ def stability_maps(configs: Sequence[Configuration | str], *, params: Parameters
 def stability_map(config: Configuration | str, *, params: Parameters | None = None,
                   v_range: tuple[float, float] = DEFAULT_V_RANGE, fz_range: tuple[float, float] = DEFAULT_FZ_RANGE,
                   resolution: int = DEFAULT_MAP_SLICES, n_v: int = 100, options: BifurcationOptions | None = None,
-                  executor=None, progress: Callable[[float, str], None] | None = None) -> StabilityMap:
+                  executor=None, progress: Callable[[float, str], None] | None = None,
+                  warm_from: dict[str, Any] | None = None) -> StabilityMap:
     """The (V, Fz) stability map of one configuration: its region boundaries continued as curves,
     the regions' types from ``resolution`` classified Fz slices (and further ones where a region
     lies between them), read off on a fine grid with ``n_v`` speeds.
@@ -607,9 +649,46 @@ def stability_map(config: Configuration | str, *, params: Parameters | None = No
     default: see :mod:`shimmy.analyses.core.executors`), most urgent first: the Hopf curves, then the
     branches beside their GH and double-Hopf points, and the slices' diagrams; each fold or torus
     curve is continued as soon as a start for it is known (a GH or double-Hopf point, or a
-    slice's LPC / NS point), ahead of the remaining slices."""
-    return stability_maps([config], v_range=v_range, fz_range=fz_range, resolution=resolution, params=params, n_v=n_v,
+    slice's LPC / NS point), ahead of the remaining slices.
+
+    ``warm_from``: the :meth:`StabilityMap.warm_start` of a map of the same configuration, plane,
+    grid and options at a nearby design: the map is warmed from it where the arrangement of the
+    curves is unchanged (:func:`shimmy.analyses.maps.warm_map.warm_map`; ``methods`` says
+    ``warmed_from``), else computed cold (``methods`` says ``warm_refused`` and why)."""
+    refused = None
+    if warm_from is not None:
+        from .warm_map import NotWarm, compatible, warm_map
+
+        params = params if params is not None else Parameters()
+        refused = compatible(warm_from, config, v_range=v_range, fz_range=fz_range, resolution=resolution, n_v=n_v,
+                             options=options or BifurcationOptions(mesh_check=False))
+        if refused is None:
+            try:
+                return warm_map(warm_from, params=params, executor=executor, progress=progress)
+            except NotWarm as exc:
+                refused = exc.reason
+        if progress is not None:
+            progress(0.0, f"computing cold: {refused}")
+    smap = stability_maps([config], v_range=v_range, fz_range=fz_range, resolution=resolution, params=params, n_v=n_v,
                           executor=executor, progress=progress, options=options)[0]
+    if refused is not None:
+        smap.warm_refused = refused
+    return smap
+
+
+def _index_of_kind(curves: list[dict[str, Any]], i: int) -> int:
+    """The position of curve ``i`` among the curves of its kind (the order of ``fold_curves`` etc.)."""
+    return sum(1 for c in curves[:i] if c["kind"] == curves[i]["kind"])
+
+
+def arrangement(hopf: HopfCurvesResult, cycles: dict[str, Any]) -> dict[str, Any]:
+    """What must stay the same between two designs for a map to be warmed from the other: the
+    number of Hopf curves with the closure of each, the GH and double-Hopf points, and each fold and
+    torus curve's kind, closure and codimension-2 points (by kind, in order along it)."""
+    return {"hopf_curves": [bool(c.closed) for c in hopf.curves], "gh_points": len(hopf.gh_points),
+            "double_hopf_points": len(hopf.double_hopf_points),
+            "cycle_curves": [{"kind": str(c["kind"]), "closed": bool(c["closed"]),
+                              "codim2": [str(q["kind"]) for q in c["codim2_points"]]} for c in cycles["curves"]]}
 
 
 def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, np.ndarray]]:
@@ -619,7 +698,7 @@ def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, 
     return out
 
 
-def _min_shimmy(hopf: HopfCurvesResult, cycles: dict[str, Any], slices: list[SliceResult]) -> dict[str, Any] | None:
+def lowest_shimmy(hopf: HopfCurvesResult, cycles: dict[str, Any], slices: list[SliceResult]) -> dict[str, Any] | None:
     """Lowest load with any shimmy: the located lowest point of the Hopf and fold curves, or the
     lowest slice with a type other than Stable, whichever is lower."""
     candidates = []

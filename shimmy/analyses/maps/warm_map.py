@@ -1,0 +1,315 @@
+"""A stability map for a design next to one whose map is known, computed from that map.
+
+A map is its region boundaries (the Hopf, fold and torus curves) and its regions' types (read off
+classified slices, :mod:`shimmy.analyses.maps.map_shading`). One slider step changes the design a
+little: the curves move, but where their arrangement stays the same the regions keep their types.
+:func:`warm_map` makes the map of the new design from the old one's :meth:`warm start
+<shimmy.analyses.maps.stability_map.StabilityMap.warm_start>`:
+
+1. **The Hopf curves** are computed afresh (:func:`~shimmy.analyses.diagrams.hopf_curves.hopf_curves`:
+   the same computation as a cold map's, so the same curves, GH and double-Hopf points).
+2. **Every fold and torus curve** is continued again from its seed, a point of the old curve with
+   its cycle, corrected by Newton at the new design on the seed's load and then traced both ways
+   exactly as a cold map traces it (:class:`~shimmy.analyses.diagrams.cycle_curves.WarmUnit`): its
+   points, crossings of the slices' loads, turning points and codimension-2 points are the new
+   design's to the location tolerance. The search for curve starts (branches beside GH and
+   double-Hopf points, the slices' diagrams) is what is saved.
+3. **The arrangement is checked** (:func:`same_arrangement`): the same number of Hopf curves, GH and
+   double-Hopf points, the same fold and torus curves (kind, closure, codimension-2 points in order
+   along each), every slice's Hopf points again as many, and on every shading row and slice load
+   the same sequence of intervals between the curves (which curve, which of its crossings). A
+   curve that appears, vanishes or crosses another changes one of them.
+4. **The slices are carried**: each slice's intervals move with the curves (an end on a curve to
+   that curve's new crossing, an end inside an interval between curves, where a cycle's mode
+   changes, to the same fraction of it), its Hopf points are located again by the eigenvalue scan,
+   its fold and torus points are the new curves' located crossings. Its diagram is not recomputed,
+   so it reports no largest amplitude (``max_psi`` None, ``"carried": true``).
+
+Where the check fails (or a seed does not converge) :func:`warm_map` raises :class:`NotWarm` saying
+why, and :func:`~shimmy.analyses.maps.stability_map.stability_map` with ``warm_from`` computes the map
+cold instead. What the check cannot see: a curve born away from a GH or double-Hopf point between
+the two designs (an isola appearing between two slices) is found only by a cold map, as it is by
+a cold map only where a slice's diagram meets it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from typing import Any, Callable
+
+import numpy as np
+
+from ...continuation import PointKind
+from ...errors import InvalidParameterError
+from ...model.configurations import Configuration
+from ...model.parameters import Parameters, check_range, FZ_RANGE, V_RANGE
+from ..core.executors import describe_work_unit, name_of, open_executor, run_dynamic, run_work_unit
+from ..core.stability import hopf_points
+from ..diagrams.bifurcation import V_SCALE, BifurcationOptions
+from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, GearCycleCurve, WarmUnit, reversed_curve,
+                                     same_curve)
+from ..diagrams.hopf_curves import HopfCurvesResult
+from . import map_shading
+from .stability_map import (FINE, HopfCurvesUnit, SliceResult, StabilityMap, arrangement, lowest_shimmy, speed_grids,
+                            type_lengths)
+
+#: Kinds of a slice's special points that lie on the map's curves (carried to the curves' crossings);
+#: a slice with any other (a period doubling, a branch point of cycles) is not carried.
+ON_CURVES = (PointKind.FOLD_OF_CYCLES, PointKind.TORUS)
+
+
+class NotWarm(Exception):
+    """The map cannot be warmed from the one given; ``reason`` says why (a cold map is needed)."""
+
+    def __init__(self, reason: str):
+        super().__init__(reason)
+        self.reason = reason
+
+
+def design_distance(a: Parameters, b: Parameters) -> float:
+    """The largest relative difference between two designs' parameters (0: the same design)."""
+    da, db = a.to_dict(), b.to_dict()
+    return max((abs(da[k] - db[k]) / max(abs(da[k]), abs(db[k]), 1e-300) for k in da if da[k] != db[k]),
+               default=0.0)
+
+
+def _changed(a: Parameters, b: Parameters) -> dict[str, list[float]]:
+    """{name: [old, new]} of the parameters that differ."""
+    da, db = a.to_dict(), b.to_dict()
+    return {k: [da[k], db[k]] for k in da if da[k] != db[k]}
+
+
+def same_arrangement(old: dict[str, Any], new: dict[str, Any]) -> str | None:
+    """None if two :func:`~shimmy.analyses.maps.stability_map.arrangement` records agree, else what differs."""
+    for key, what in (("hopf_curves", "Hopf curves (count or closure)"), ("gh_points", "GH points"),
+                      ("double_hopf_points", "double-Hopf points")):
+        if old[key] != new[key]:
+            return f"the {what} changed: {old[key]} -> {new[key]}"
+    if len(old["cycle_curves"]) != len(new["cycle_curves"]):
+        return f"{len(old['cycle_curves'])} fold and torus curves became {len(new['cycle_curves'])}"
+    for i, (a, b) in enumerate(zip(old["cycle_curves"], new["cycle_curves"], strict=True)):
+        if a["closed"] and b["closed"]:  # a loop has no first point: its codimension-2 points as a set
+            a, b = dict(a, codim2=sorted(a["codim2"])), dict(b, codim2=sorted(b["codim2"]))
+        if a != b:
+            return f"cycle curve {i + 1} changed: {a} -> {b}"
+    return None
+
+
+def _inside(curves, Fz: float, v_range, tol: float) -> dict:
+    """{(curve, crossing number): V} of the curves' crossings of the load ``Fz``, those within ``tol``
+    (m/s) of the speed range's ends left out (inside or outside by rounding)."""
+    return {label: V for V, label in map_shading.crossings(curves, Fz) if v_range[0] + tol < V < v_range[1] - tol}
+
+
+def arrangement_change(old: dict, new: dict, tol: float) -> str | None:
+    """None if two loads' crossings (:func:`_inside`) are the same curves' in the same order, two of
+    them allowed to swap where they lie within ``tol`` of each other before or after (their order
+    is the polylines' rounding); else what changed."""
+    if set(old) != set(new):
+        gone, born = sorted(set(old) - set(new)), sorted(set(new) - set(old))
+        return f"crossings {_labels(gone)} gone, {_labels(born)} new"
+    for a in old:
+        for b in old:
+            if old[a] < old[b] and new[a] > new[b] and old[b] - old[a] > tol and new[a] - new[b] > tol:
+                return f"{_labels([a])} (V = {old[a]:.4g} m/s) and {_labels([b])} (V = {old[b]:.4g} m/s) swapped"
+    return None
+
+
+def _labels(labels) -> str:
+    return ", ".join(f"{name}#{k}" for name, k in labels) or "none"
+
+
+class _Carrier:
+    """Moves speeds at one load with the curves. A curve's crossing goes to that curve's crossing at
+    the new design; any other speed (an interval's end where a cycle's mode changes, on the slice's
+    fine grid) stays where it was, held inside the same interval between the curves. (Moving it in
+    proportion to its interval moved ends that a cold map leaves where they were: a mode change at
+    a fine-grid midpoint moves only when the design moves it a fine step.)"""
+
+    def __init__(self, old_curves, new_curves, Fz: float, v_range):
+        new = {label: V for V, label in map_shading.crossings(new_curves, Fz)}
+        pairs = sorted([(v_range[0], v_range[0]), (v_range[1], v_range[1])]
+                       + [(V, new[label]) for V, label in map_shading.crossings(old_curves, Fz)
+                          if label in new and v_range[0] < V < v_range[1]])
+        self.old = np.array([p[0] for p in pairs])
+        self.new = np.array([p[1] for p in pairs])
+
+    def __call__(self, V: float) -> float:
+        k = int(np.searchsorted(self.old, V, side="right"))  # self.old[k - 1] <= V < self.old[k]
+        if k == 0 or k == len(self.old):
+            return float(V)
+        if V == self.old[k - 1]:
+            return float(self.new[k - 1])
+        lo, hi = sorted((self.new[k - 1], self.new[k]))
+        return float(min(max(V, lo), hi))
+
+
+def _crossings_of(curves: list[GearCycleCurve], Fz: float) -> dict[str, list[float]]:
+    """The located crossings (P2_MARK points) of the load ``Fz`` on the curves, by kind."""
+    out: dict[str, list[float]] = {}
+    for c in curves:
+        for s in c.curve.points_of(PointKind.P2_MARK):
+            if abs(s.data["p2"] - Fz) <= 1e-9 * max(abs(Fz), 1.0):
+                out.setdefault(str(c.kind), []).append(float(s.p))
+    return out
+
+
+def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameters, v_range, n_v: int,
+                   carry: _Carrier, crossings: dict[str, list[float]]) -> SliceResult:
+    """A slice of the old map at the new design (see the module's step 4)."""
+    clock = time.perf_counter()
+    Fz = float(old["Fz"])
+    scan = hopf_points(config, Fz, params=params, v_range=v_range).hopf_points
+    if len(scan) != len(old["hopf_points"]):
+        raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has {len(scan)} Hopf points, before "
+                      f"{len(old['hopf_points'])}")
+    hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value} for h in scan]
+    special = []
+    for q in old["special_points"]:
+        if q["kind"] not in ON_CURVES:
+            raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a {q['kind']} point, on no curve of the map")
+        V = carry(q["V"])
+        located = crossings.get(str(q["kind"]), [])
+        if located:  # the new curve's located crossing of this load nearest to where it was carried
+            V = min(located, key=lambda x: abs(x - V))
+        special.append({"kind": q["kind"], "V": V, "mode": q["mode"]})
+    # an interval's end at one of the slice's located points goes to that point at the new design
+    exact = list(zip([h["V"] for h in old["hopf_points"]] + [q["V"] for q in old["special_points"]],
+                     [h["V"] for h in hopf] + [q["V"] for q in special], strict=True))
+
+    def moved(V: float) -> float:
+        for was, now in exact:
+            if abs(V - was) <= 1e-9 * max(abs(V), 1.0):
+                return float(now)
+        return carry(V)
+
+    intervals = []
+    for iv in old["intervals"]:
+        a = float(v_range[0]) if iv["V_start"] <= v_range[0] else moved(iv["V_start"])
+        b = float(v_range[1]) if iv["V_end"] >= v_range[1] else moved(iv["V_end"])
+        intervals.append({"type": iv["type"], "V_start": a, "V_end": b})
+    coarse, fine = speed_grids(*v_range, n_v)
+    fine_types = [map_shading.type_at(intervals, float(v)) for v in fine]
+    return SliceResult(Fz, coarse, fine_types[::FINE], hopf, special, intervals, type_lengths(fine, fine_types), None,
+                       None, [carry(v) for v in old["simulated_V"]], list(old["warnings"]),
+                       time.perf_counter() - clock, carried=True)
+
+
+def compatible(start: dict[str, Any], config: Configuration | str, *, v_range, fz_range, resolution: int, n_v: int,
+               options: BifurcationOptions) -> str | None:
+    """None if a map of ``config`` on this plane, grid and options can be warmed from ``start``,
+    else why not."""
+    want = {"config": Configuration.parse(config).value, "v_range": [float(v) for v in v_range],
+            "fz_range": [float(f) for f in fz_range], "resolution": int(resolution), "n_v": int(n_v),
+            "options": dataclasses.asdict(options)}
+    for key, value in want.items():
+        if start.get(key) != value:
+            return f"the nearby map's {key} is {start.get(key)!r}, this map's {value!r}"
+    return None
+
+
+def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
+             progress: Callable[[float, str], None] | None = None) -> StabilityMap:
+    """The map of design ``params`` warmed from ``start`` (:meth:`StabilityMap.warm_start` of a map of
+    the same configuration, plane, grid and options at a nearby design); raises :class:`NotWarm`
+    where the arrangement of the curves changed (see the module)."""
+    clock = time.perf_counter()
+    config = Configuration.parse(start["config"])
+    old_params = Parameters.from_dict(start["params"])
+    v_range = check_range("v", tuple(start["v_range"]), V_RANGE, "m/s")
+    fz_range = check_range("fz", tuple(start["fz_range"]), FZ_RANGE, "N")
+    if not start.get("seeds") and start["arrangement"]["cycle_curves"]:
+        raise InvalidParameterError("warm_from", "a warm start without seeds", "a StabilityMap.warm_start()")
+    if executor is None:
+        with open_executor() as own:
+            smap = warm_map(start, params=params, executor=own, progress=progress)
+        smap.executor = name_of(None)
+        return smap
+    report = progress or (lambda fraction, message: None)
+    n_v, resolution = int(start["n_v"]), int(start["resolution"])
+    options = BifurcationOptions(**start["options"])
+    loads = tuple(float(f) for f in np.linspace(fz_range[0], fz_range[1], resolution))
+    box = (v_range, fz_range)
+    seeds = [CurveSeed.from_dict(s) for s in start["seeds"]]
+    units = [(0, HopfCurvesUnit(config, params, v_range, fz_range))]
+    # every slice's load is marked, so that the slices' fold and torus points are located crossings;
+    # the marks beyond the first slices' loads are dropped from the curves afterwards (as a cold map's)
+    marks = loads + tuple(sorted({float(s["Fz"]) for s in start["slices"]} - set(loads)))
+    units += [(1, WarmUnit(config, params, seed, box, marks)) for seed in seeds]
+    results: dict[int, Any] = {}
+    index = {id(u): k for k, (_, u) in enumerate(units)}
+
+    def done(unit, result):
+        results[index[id(unit)]] = result
+        return []
+
+    report(0.0, "Hopf curves, and each fold and torus curve again from the map of the nearby design")
+    run_dynamic(run_work_unit, units, executor, done, lambda f, m: report(0.8 * f, m), describe_work_unit)
+    hopf: HopfCurvesResult = results[0]
+    curves: list[GearCycleCurve] = []
+    l_g = params.gear.l_g
+    for k, seed in enumerate(seeds, start=1):
+        curve, warning = results[k]
+        if curve is None:
+            raise NotWarm(f"the {seed.kind} curve was not found again at the new design: {warning or 'no curve'}")
+        if any(same_curve(curve, c, l_g) for c in curves):
+            raise NotWarm(f"two {seed.kind} curves of the nearby design are one curve at this design")
+        curves.append(curve)
+    old_boundaries = [(name, np.array(p, float).reshape(-1, 2)) for name, p in start["boundaries"]]
+    old_curves = old_boundaries[len(start["arrangement"]["hopf_curves"]):]
+    scale = np.array([V_SCALE, FZ_SCALE])
+    for k, (curve, (_, before)) in enumerate(zip(curves, old_curves, strict=True)):
+        # the same way round as before (traced from another point, an open curve may come out reversed)
+        if len(before) and np.linalg.norm((curve.curve.p[-1] - before[0]) / scale) \
+                < np.linalg.norm((curve.curve.p[0] - before[0]) / scale):
+            curves[k] = reversed_curve(curve)
+    curves.sort(key=lambda c: KINDS.index(c.kind))  # stable: each kind's in the old order, as a cold map's
+    search = CurveSearch(config, params, box, (PointKind.FOLD_OF_CYCLES, PointKind.TORUS), loads)
+    search.start_units(hopf)  # its GH and double-Hopf points (the units beside them are not run)
+    search.curves, search.tried, search.warnings = curves, len(seeds), []
+    cycles = search.result(0.0).to_dict()
+    why = same_arrangement(start["arrangement"], arrangement(hopf, cycles))
+    if why:
+        raise NotWarm(why)
+    report(0.8, "regions carried along the curves")
+    boundaries = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
+    boundaries += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(curves)]
+    rows = np.array(start["rows"], float)
+    tol = 0.5 * (v_range[1] - v_range[0]) / (n_v - 1)  # half a grid cell
+    for Fz in [float(f) for f in rows] + [float(s["Fz"]) for s in start["slices"]]:
+        change = arrangement_change(_inside(old_boundaries, Fz, v_range, tol), _inside(boundaries, Fz, v_range, tol),
+                                    tol)
+        if change:
+            raise NotWarm(f"the curves' arrangement changed at Fz = {Fz / 1e3:.4g} kN: {change}")
+    slices = [_carried_slice(s, config, params, v_range, n_v,
+                             _Carrier(old_boundaries, boundaries, float(s["Fz"]), v_range),
+                             _crossings_of(curves, float(s["Fz"]))) for s in start["slices"]]
+    for c in curves:
+        c.curve.special_points = [q for q in c.curve.special_points if q.kind != PointKind.P2_MARK
+                                  or not any(abs(q.data["p2"] - f) <= 1e-9 * f for f in marks[len(loads):])]
+    cycles = search.result(0.0).to_dict()
+    warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
+    for s in slices:
+        warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
+    segments, fallbacks = map_shading.row_segments(slices, boundaries, rows, v_range)
+    V = slices[0].V
+    elapsed = time.perf_counter() - clock
+    cycles["elapsed_s"] = elapsed
+    smap = StabilityMap(config, params, v_range, fz_range, V, np.array([s.Fz for s in slices]),
+                        [s.types for s in slices], slices, hopf, cycles, rows, map_shading.grid(segments, V),
+                        [map_shading.measures(r) for r in segments], fallbacks, map_shading.polygons(segments, rows),
+                        lowest_shimmy(hopf, cycles, slices), type(executor).__name__, elapsed, warnings,
+                        resolution=resolution, n_v=n_v, options=options,
+                        seeds=[CurveSeed.of(c, config.n_states) for c in curves],
+                        warmed_from={"params": start["params"], "changed": _changed(old_params, params),
+                                     "method": "Hopf curves computed afresh; each fold and torus curve continued "
+                                               "again from a point of the nearby design's curve (Newton at its "
+                                               "load, then traced both ways); the arrangement of the curves "
+                                               "checked unchanged on every row and slice load; the slices' "
+                                               "intervals carried with the curves (ends on a curve to its new "
+                                               "crossing, mode changes at the same fraction of their interval), "
+                                               "their Hopf points scanned again"})
+    smap.elapsed_s = time.perf_counter() - clock
+    report(1.0, "done")
+    return smap

@@ -1,0 +1,158 @@
+"""Warm maps: the map of a design one slider step away, computed from the cached one, equals the
+cold map of that design.
+
+Independent check: the cold map of the same design (its own curve search from GH and double-Hopf
+points and slice diagrams, its own classified slices). Tolerances (the issue's): located points
+(crossings of the slice loads, turning points in Fz, codimension-2 points, curve ends) and the
+minimum shimmy load within 1e-6 relative; at least 99.5 % of the shading's cells equal, and every
+differing cell beside a change of type in the cold map's row or column (within one cell of a
+region's edge).
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from shimmy.analyses.maps.stability_map import stability_map
+from shimmy.analyses.maps.warm_map import NotWarm, arrangement_change, design_distance, warm_map
+from shimmy.analyses.diagrams.bifurcation import BifurcationOptions
+from shimmy.analyses.diagrams.cycle_curves import CurveSeed
+from shimmy.model.parameters import Parameters
+
+PLANE = dict(v_range=(1.0, 200.0), fz_range=(1.0e4, 9.0e5), resolution=6, n_v=60)
+STEP = {"e_p": 0.0011}  # e_p +10 %: one slider step and more
+REL = 1e-6
+
+
+@pytest.fixture(scope="module")
+def maps():
+    """nes at the nominal design (the cached one), then e_p + 10 %: cold, and warmed from it."""
+    near = stability_map("nes", **PLANE)
+    params = Parameters().with_overrides(STEP)
+    cold = stability_map("nes", params=params, **PLANE)
+    start = json.loads(json.dumps(near.warm_start()))  # as the cache stores it
+    warm = stability_map("nes", params=params, warm_from=start, **PLANE)
+    return near, cold, warm, start
+
+
+#: codimension-2 points on the cycle curves found where a multiplier crosses a value are located to
+#: the multipliers' accuracy (continuation.cycle_curves.codim2.MULTIPLIER_TOL = 1e-5): a cold map
+#: traced from another start finds them as far apart
+CODIM2_REL = 1e-4
+
+
+def _close(a: float, b: float, scale: float, rel: float = REL) -> bool:
+    return abs(a - b) <= rel * max(abs(a), abs(b), scale)
+
+
+def _same_points(cold: list[dict], warm: list[dict], rel: float = REL) -> None:
+    assert len(cold) == len(warm), (cold, warm)
+    for p, q in zip(sorted(cold, key=lambda e: (e["Fz"], e["V"])), sorted(warm, key=lambda e: (e["Fz"], e["V"])),
+                    strict=True):
+        assert p["kind"] == q["kind"] if "kind" in p else True
+        if p.get("located") is False or q.get("located") is False:
+            continue  # the search did not reach its tolerance (the nearest point it got): nothing to compare
+        assert _close(p["V"], q["V"], 1.0, rel) and _close(p["Fz"], q["Fz"], 1e3, rel), (p, q)
+
+
+def test_the_warm_map_says_what_it_was_warmed_from(maps):
+    near, cold, warm, _ = maps
+    methods = warm.to_dict()["methods"]
+    assert methods["warmed_from"]["changed"] == {"e_p": [0.001, 0.0011]}
+    assert methods["warmed_from"]["params"] == near.params.to_dict()
+    assert "warmed_from" not in cold.to_dict()["methods"] and "warm_refused" not in cold.to_dict()["methods"]
+    assert all(s["carried"] and s["max_psi"] is None for s in warm.to_dict()["slices"])
+
+
+def test_warm_curves_are_the_cold_curves(maps):
+    _, cold, warm, _ = maps
+    c, w = cold.to_dict(), warm.to_dict()
+    assert c["gh_points"] == w["gh_points"] and c["double_hopf_points"] == w["double_hopf_points"]
+    assert c["hopf_curves"] == w["hopf_curves"]  # computed afresh, the same computation
+    assert [d["kind"] for d in c["cycle_curves"]] == [d["kind"] for d in w["cycle_curves"]]
+    for dc, dw in zip(c["cycle_curves"], w["cycle_curves"], strict=True):
+        assert dc["closed"] == dw["closed"]
+        for key in ("crossings", "turning_points"):
+            _same_points(dc[key], dw[key])
+        _same_points(dc["codim2_points"], dw["codim2_points"], CODIM2_REL)
+        # an end on the box is located; a zero-amplitude end is where the tracing stopped, beside the
+        # GH or double-Hopf point the curve ends at (which the Hopf curves locate, equal above)
+        _same_points([e for e in dc["ends"] if e["kind"] == "END"], [e for e in dw["ends"] if e["kind"] == "END"])
+        assert [e["kind"] for e in dc["ends"]] == [e["kind"] for e in dw["ends"]]
+    # the map's list (located points only, each once): the same, but for a point one of the two
+    # did not locate on its curve (listed there with "located": false, and not in this list)
+    unlocated = {q["kind"] for d in c["cycle_curves"] + w["cycle_curves"] for q in d["codim2_points"]
+                 if q.get("located") is False}
+
+    def matched(p, among):
+        return any(q["kind"] == p["kind"] and _close(p["V"], q["V"], 1.0, CODIM2_REL)
+                   and _close(p["Fz"], q["Fz"], 1e3, CODIM2_REL) for q in among)
+
+    for a, b in ((c["codim2_points"], w["codim2_points"]), (w["codim2_points"], c["codim2_points"])):
+        assert all(matched(p, b) or p["kind"] in unlocated for p in a), (a, b)
+    assert _close(c["min_shimmy_Fz"], w["min_shimmy_Fz"], 1e3)
+    assert c["min_shimmy"]["source"] == w["min_shimmy"]["source"]
+
+
+def test_warm_slices_are_the_cold_slices_at_their_curves(maps):
+    _, cold, warm, _ = maps
+    assert [s.Fz for s in cold.slices] == [s.Fz for s in warm.slices]
+    for c, w in zip(cold.slices, warm.slices, strict=True):
+        assert [h["V"] for h in c.hopf_points] == [h["V"] for h in w.hopf_points]  # the same scan
+        assert [p["kind"] for p in c.special_points] == [p["kind"] for p in w.special_points]
+        for p, q in zip(c.special_points, w.special_points, strict=True):
+            assert abs(p["V"] - q["V"]) <= 1e-5 * max(p["V"], 1.0), (c.Fz, p, q)  # the curves' located crossings
+        assert [iv["type"] for iv in c.intervals] == [iv["type"] for iv in w.intervals]
+
+
+def test_warm_shading_equals_the_cold_shading(maps):
+    _, cold, warm, _ = maps
+    a, b = np.array(cold.shading), np.array(warm.shading)
+    assert a.shape == b.shape
+    differ = np.argwhere(a != b)
+    assert (a == b).mean() >= 0.995, (a == b).mean()
+    for i, j in differ:  # each beside a change of type in the cold map (an edge of a region)
+        around = {a[i2, j2] for i2 in range(max(i - 1, 0), min(i + 2, a.shape[0]))
+                  for j2 in range(max(j - 1, 0), min(j + 2, a.shape[1]))}
+        assert len(around) > 1, (i, j, a[i, j], b[i, j])
+
+
+def test_a_map_of_other_options_is_computed_cold_and_says_why(maps):
+    _, cold, _, start = maps
+    other = stability_map("nes", params=cold.params, warm_from=start,
+                          options=BifurcationOptions(mesh_check=False, ntst=30), **PLANE)
+    assert other.warmed_from is None
+    assert "options" in other.to_dict()["methods"]["warm_refused"]
+
+
+def test_a_changed_arrangement_is_refused(maps):
+    _, cold, _, start = maps
+    tampered = json.loads(json.dumps(start))
+    tampered["arrangement"]["gh_points"] += 1
+    with pytest.raises(NotWarm, match="GH points"):
+        warm_map(tampered, params=cold.params)
+
+
+def test_seeds_survive_json():
+    near = stability_map("original", v_range=(1.0, 200.0), fz_range=(4.0e5, 9.0e5), resolution=3, n_v=30)
+    assert near.seeds
+    for seed in near.seeds:
+        back = CurveSeed.from_dict(json.loads(json.dumps(seed.to_dict())))
+        assert back.kind == seed.kind and back.Fz == seed.Fz and back.ncol == seed.ncol
+        assert np.array_equal(back.u, seed.u) and np.array_equal(back.mesh, seed.mesh)
+
+
+def test_arrangement_change_allows_swaps_only_within_the_tolerance():
+    before = {("hopf0", 1): 10.0, ("LPC1", 1): 50.0, ("NS2", 1): 50.3}
+    assert arrangement_change(before, {("hopf0", 1): 10.2, ("LPC1", 1): 50.4, ("NS2", 1): 50.1}, 0.5) is None
+    before[("NS2", 1)] = 51.0
+    assert "swapped" in arrangement_change(before, {("hopf0", 1): 10.2, ("LPC1", 1): 52.0, ("NS2", 1): 50.1}, 0.5)
+    assert "gone" in arrangement_change(before, {("hopf0", 1): 10.2, ("LPC1", 1): 50.4}, 0.5)
+
+
+def test_design_distance_is_the_largest_relative_change():
+    p = Parameters()
+    assert design_distance(p, p) == 0.0
+    assert design_distance(p, p.with_overrides({"e_p": 0.0011})) == pytest.approx(0.1 / 1.1)
+
