@@ -7,13 +7,14 @@ from ..common import add_command, add_common, add_field, emit, limit, params
 
 
 def _cmd_devices(args) -> int:
-    from ...analyses.core.device_curves import devices_summary, nes_curve, pd_curves
+    from ...analyses.core.device_curves import nes_curve, pd_curves
+    from ...analyses.core.summaries import devices_summary
 
     design = params(args)
     nes_c = nes_curve(params=design)
     pds = pd_curves(params=design, v_max=limit("devices", "v_max", args.v_max))
     payload = {"params": design.to_dict(), "nes": nes_c.to_dict(), "pd": [c.to_dict() for c in pds]}
-    emit(payload, args.json, devices_summary(nes_c, pds))
+    emit(payload, args.json, devices_summary(payload))
     return 0
 
 
