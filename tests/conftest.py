@@ -94,6 +94,17 @@ def stop_server(server: Server) -> None:
     server.log.close()
 
 
+@pytest.fixture(scope="session", autouse=True)
+def session_cache(tmp_path_factory):
+    """SHIMMY_CACHE_DIR of the session: a fresh result cache for every test, command line and server that does
+    not name its own, so that no test reads a result stored by other code of the same version (the cache
+    keys by version, not by commit) and the user's own cache is left alone."""
+    patch = pytest.MonkeyPatch()
+    patch.setenv("SHIMMY_CACHE_DIR", str(tmp_path_factory.mktemp("session-cache")))
+    yield
+    patch.undo()
+
+
 @pytest.fixture(scope="session")
 def server(tmp_path_factory):
     """gunicorn app:server with 2 workers and a fresh shared cache directory."""

@@ -5,7 +5,8 @@ continuation (generic engine) <- model (the gear) <- analyses <- service <- UI (
 ``shimmy.version`` the ground floor every layer may read. Nothing inside the package imports the
 package root (it imports the analyses). The analyses are families, each importing only those below
 it: core <- diagrams <- maps, ground <- decisions. The command line (``cli``) is a front door beside
-the service: it calls the analyses and reads the service's request schemas.
+the service: it calls the analyses, reads the service's request schemas and answers from (and fills)
+the service's result cache through its analysis registry.
 """
 
 import ast
@@ -167,9 +168,11 @@ def test_every_module_sits_in_a_layer():
 
 
 #: What the command line may import from the package: the analyses, the model, the errors (the engine's
-#: too: its InvalidInputError is bad input) and of the service its request schemas and analysis registry.
+#: too: its InvalidInputError is bad input) and of the service its request schemas, its analysis registry
+#: (whose run_canonical answers from the shared cache) and its settings (where that cache is).
 CLI_MAY_IMPORT = ("shimmy.cli", "shimmy.analyses", "shimmy.model", "shimmy.errors", "shimmy.continuation.errors",
-                  "shimmy.continuation.kinds", "shimmy.service.schemas", "shimmy.service.analyses", "shimmy.version")
+                  "shimmy.continuation.kinds", "shimmy.service.schemas", "shimmy.service.analyses",
+                  "shimmy.service.settings", "shimmy.version")
 
 
 def test_cli_imports_only_the_analyses_the_model_the_errors_and_the_schemas():

@@ -6,18 +6,26 @@ The limits of every option that the API also takes (t_end, resolution, ntst, ...
 API's, read from its request schemas. Long commands report progress on stderr: a bar on a
 terminal, plain lines otherwise (``--progress``).
 
+Commands that the HTTP API also answers read and fill its result cache (``SHIMMY_CACHE_DIR``, the
+store its job workers and the workbench share), by the API's canonical requests: a question
+answered anywhere is answered everywhere. ``--no-cache`` computes without the cache; the JSON's
+``"cache"`` (hit, miss or off) and the text's last line say where an answer came from.
+
 Each command's options sit next to the handler that runs it, in ``shimmy.cli.commands``
-(one module per group of commands); ``shimmy.cli.common`` holds what they share.
+(one module per group of commands); ``shimmy.cli.common`` holds what they share, and
+``shimmy.cli.answers`` what the commands on the cache share.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 from typing import Sequence
 
 from ..continuation.errors import InvalidInputError
 from ..errors import EXPECTED_ERRORS, GeometryError
+from ..service.settings import CacheDirectoryError, cache_dir_setting
 from .commands import decisions, diagrams, ground, maps, model, point
 from .common import EXIT_BAD_INPUT, EXIT_FAILED
 
@@ -28,6 +36,13 @@ Nose-landing-gear shimmy and its suppression by a torsional nonlinear energy sin
 particle damper (PD), in four configurations: original, nes, pd, nes_pd. Every command prints a
 short table, or JSON with --json; bad input exits with status 2 and a message naming the field,
 its value and what is allowed. Units are SI: V in m/s, Fz in N."""
+
+#: What --help says of the cache: which commands use it and where it is.
+CACHE = """The commands the HTTP API also answers ({commands}) share its result cache with the API's job
+workers and the workbench: the directory SHIMMY_CACHE_DIR, by default a per-user folder in the
+temporary directory (now: {where}). A question answered there is answered here at once and the
+other way round; the JSON's "cache" (hit, miss or off) and the text's last line say where the
+answer came from. --no-cache computes without reading or writing the cache."""
 
 EPILOG = """\
 examples:
@@ -49,6 +64,9 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for group in GROUPS:
         group.add_parsers(commands)
+    cached = [name for name, p in commands.choices.items() if any(a.dest == "no_cache" for a in p._actions)]
+    cache = CACHE.format(commands=", ".join(cached), where=cache_dir_setting())
+    parser.description += "\n\n" + textwrap.fill(" ".join(cache.split()), 99)
     return parser
 
 
@@ -62,6 +80,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except EXPECTED_ERRORS as exc:
         print(f"failed: {exc}", file=sys.stderr)
         return EXIT_FAILED
+    except CacheDirectoryError as exc:
+        print(f"error: {exc}; or run with --no-cache", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except BrokenPipeError:  # stdout closed early (| head): not an error of ours
         return 0
     except OSError as exc:

@@ -46,11 +46,17 @@ class CacheDirectoryError(RuntimeError):
     """The cache directory is not private to this user (its values are unpickled)."""
 
 
+def cache_dir_setting() -> pathlib.Path:
+    """Where the cache directory is, without creating or checking it: SHIMMY_CACHE_DIR, or a per-user
+    folder in the temporary directory (``/tmp/shimmy-cache-UID``)."""
+    return pathlib.Path(os.environ.get("SHIMMY_CACHE_DIR")
+                        or os.path.join(tempfile.gettempdir(), f"shimmy-cache-{os.getuid()}"))
+
+
 def cache_dir() -> pathlib.Path:
-    """SHIMMY_CACHE_DIR, or a per-user folder in the temporary directory; created 0700 and
-    refused if another user owns it or anyone else may write to it."""
-    path = os.environ.get("SHIMMY_CACHE_DIR") or os.path.join(tempfile.gettempdir(), f"shimmy-cache-{os.getuid()}")
-    p = pathlib.Path(path)
+    """The cache directory (:func:`cache_dir_setting`); created 0700 and refused if another user owns it
+    or anyone else may write to it."""
+    p = cache_dir_setting()
     p.mkdir(mode=0o700, parents=True, exist_ok=True)
     st = p.stat()
     if st.st_uid != os.getuid():

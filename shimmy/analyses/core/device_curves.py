@@ -83,14 +83,3 @@ def pd_curves(*, params: Parameters | None = None, v_max: float = 2.0, n_points:
                               particle_damper.torsional_damping(rate, pd), particle_damper.torque(rate, pd)))
     return curves
 
-
-def devices_summary(nes_c: NESCurve, pds: list[PDCurve]) -> str:
-    """The lines ``python -m shimmy devices`` prints: the NES's cubic coefficients and the cubic's error,
-    then the PD's torsional damping of each design at six tangential speeds."""
-    lines = [f"NES: k1 = {nes_c.k1:.6g} N m/rad, k3 = {nes_c.k3:.6g} N m/rad^3; cubic vs exact torque: "
-             + ", ".join(f"{100 * e:.2f} % for |a| <= {a} rad" for a, e in nes_c.cubic_error_at.items()),
-             "PD torsional damping c_eq (N m s/rad) at tangential speed v (m/s):",
-             "  " + f"{'v':>8}" + "".join(f"{c.material:>12}" for c in pds)]
-    for i in np.linspace(0, pds[0].speed.size - 1, 6).astype(int):
-        lines.append("  " + f"{pds[0].speed[i]:>8.3g}" + "".join(f"{c.torsional_damping[i]:>12.5g}" for c in pds))
-    return "\n".join(lines)

@@ -20,6 +20,7 @@ from ...model.configurations import STATE_NAMES, Configuration
 from ...model.equations import build_model
 from ...errors import InvalidParameterError
 from ...model.parameters import Parameters, check_number, check_operating_point
+from .summaries import simulation_summary
 from .response import (DECAYED_FRACTION, ResponseType, classify_run, dominant_frequency, peak_amplitude,
                        power_spectra)
 
@@ -139,15 +140,9 @@ class SimulationResult:
         np.savetxt(path, data, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
 
     def summary_text(self) -> str:
-        """The short table ``python -m shimmy simulate`` prints."""
-        amp = self.amplitude
-        freq = "-" if self.frequency_hz != self.frequency_hz else f"{self.frequency_hz:.4f} Hz"
-        return (f"{self.config.value} at V = {self.V:g} m/s, Fz = {self.Fz:g} N, {self.options.t_end:g} s\n"
-                f"  response        {self.response_type.value}{'' if self.steady else ' (not yet steady)'}\n"
-                f"  max |psi|       {amp['psi']:.6g} rad\n"
-                f"  max |l_g delta| {amp['lateral']:.6g} m\n"
-                f"  frequency       {freq}\n"
-                f"  {self.message}")
+        """The short table ``python -m shimmy simulate`` prints
+        (:func:`~shimmy.analyses.core.summaries.simulation_summary`)."""
+        return simulation_summary(self.to_dict())
 
 
 def _json_float(x: float):

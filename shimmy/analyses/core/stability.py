@@ -47,6 +47,7 @@ from ...model.configurations import Configuration
 from ...model.equations import Model, build_model, jacobian
 from ...errors import InvalidParameterError
 from ...model.parameters import V_RANGE, Parameters, check_number, check_operating_point, check_pair
+from .summaries import hopf_summary
 
 
 class Criticality(str, Enum):
@@ -144,16 +145,9 @@ class HopfResult:
                 "n_grid": self.n_grid, "version": __version__}
 
     def summary_text(self) -> str:
-        """The short table ``python -m shimmy hopf`` prints."""
-        lines = [f"{self.config.value} at Fz = {self.Fz:g} N, V in [{self.v_min:g}, {self.v_max:g}] m/s"]
-        if not self.hopf_points:
-            lines.append("  no Hopf point")
-        for h in self.hopf_points:
-            lines.append(f"  Hopf V = {h.V:.6f} m/s  f = {h.frequency_hz:.4f} Hz  {h.criticality.value}"
-                         f"  ({'loses' if h.destabilising else 'regains'} stability as V increases)")
-        for iv in self.unstable_intervals:
-            lines.append(f"  x = 0 unstable for V in [{iv[0]:.6g}, {iv[1]:.6g}] m/s")
-        return "\n".join(lines)
+        """The short table ``python -m shimmy hopf`` prints
+        (:func:`~shimmy.analyses.core.summaries.hopf_summary`)."""
+        return hopf_summary(self.to_dict())
 
 
 def eigenvalues(config: Configuration | str, V, Fz: float, *, params: Parameters | None = None) -> np.ndarray:

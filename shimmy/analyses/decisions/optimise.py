@@ -44,6 +44,7 @@ from ...model.equations import build_model
 from ...model.parameters import DEFAULT_FZ, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from ..core.executors import open_executor, run_units
 from .design_space import DIFFERENTIABLE, FIGURES, Figure, device_parameters  # noqa: F401 (Figure: re-exported)
+from .summaries import constraint_text, optimise_summary
 from .sensitivity import (V_BAND, amplitude_sensitivity, coefficient_pairs, hopf_sensitivities,
                           min_shimmy_sensitivity)
 
@@ -95,8 +96,7 @@ class Constraint:
                 "unit": FIGURES[self.figure].unit}
 
     def __str__(self) -> str:
-        at = f" at {self.Fz / 1e3:g} kN" if self.Fz is not None else ""
-        return f"{self.figure}{at} {self.op} {self.value:g} {FIGURES[self.figure].unit}"
+        return constraint_text(self.to_dict())
 
 
 def _interval_of(result, Fz, params, config, names, gradient, pairs, model):
@@ -343,27 +343,9 @@ class OptimisationResult:
                 "warnings": self.warnings, "version": __version__}
 
     def summary_text(self) -> str:
-        """The lines ``python -m shimmy optimise`` prints: the problem, the optimum against the nominal design,
-        the design, the constraints, the figures, the message and the workbench link."""
-        from urllib.parse import urlencode
-
-        f = FIGURES[self.objective]
-        lines = [f"{self.config.value}: {'maximise' if f.sense > 0 else 'minimise'} {f.label}"
-                 + (f" at {self.Fz / 1e3:g} kN" if f.at_load else "") + f" over {', '.join(self.names)} "
-                 f"({self.method}, {self.evaluations} evaluations, {self.elapsed_s:.1f} s)",
-                 f"  optimum {self.objective_value:.6g} {f.unit} (nominal "
-                 + ("not evaluated" if self.nominal_objective is None else f"{self.nominal_objective:.6g} {f.unit}")
-                 + ")",
-                 "  design: " + ", ".join(f"{n} = {v:.6g} {PARAMETER_SPECS[n].unit}".rstrip()
-                                          for n, v in self.design.items())]
-        lines += [f"  constraint {c}" for c in self.constraints]
-        for label, table in self.figures.items():
-            lines.append(f"  {label:<9}" + ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k}: {v}"
-                                                     for k, v in table.items()))
-        lines.append(f"  {self.message}")
-        lines.append("  open in the workbench: /?" + urlencode(self.link_query))
-        lines += [f"  warning: {w}" for w in self.warnings]
-        return "\n".join(lines)
+        """The lines ``python -m shimmy optimise`` prints
+        (:func:`~shimmy.analyses.decisions.summaries.optimise_summary`)."""
+        return optimise_summary(self.to_dict())
 
 
 def _figure_table(figures: dict, keys) -> dict[str, Any]:

@@ -38,6 +38,7 @@ from ...model.configurations import OPERATING_POINTS, Configuration, affects
 from ...model.equations import build_model
 from ...model.parameters import DEFAULT_FZ, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from .design_space import DISTRIBUTIONS, TOLERANCE_LIMITS
+from .summaries import robustness_summary
 from ..core.executors import open_executor, run_units
 from .sensitivity import (V_BAND, coefficient_pairs, hopf_sensitivities, jacobian_derivatives, min_shimmy_sensitivity,
                           polish_lowest_point)
@@ -196,21 +197,9 @@ class RobustnessResult:
                 "version": __version__}
 
     def summary_text(self) -> str:
-        """The table ``python -m shimmy robustness`` prints: the tolerances, each distribution's nominal value,
-        mean, spread and percentiles, sampled and linear, and the probability of shimmy at the operating points."""
-        lines = [f"{self.config.value} at Fz = {self.Fz / 1e3:g} kN, {self.samples} samples (seed {self.seed}): "
-                 + ", ".join(f"{t.name} {100 * t.relative:g} % {t.distribution}" for t in self.tolerances),
-                 f"  {'':<22}{'nominal':>10}{'mean':>10}{'std':>9}{'p05':>10}{'p95':>10}{'linear std':>12}"]
-        rows = [(f"Hopf speed {k + 1} (m/s)", h, 1.0) for k, h in enumerate(self.hopf_points)]
-        if self.min_shimmy:
-            rows.append(("min shimmy Fz (kN)", self.min_shimmy, 1e-3))
-        for label, h, k in rows:
-            lines.append(f"  {label:<22}{h['nominal'] * k:>10.4g}{h['mean'] * k:>10.4g}{h['std'] * k:>9.3g}"
-                         f"{h['p05'] * k:>10.4g}{h['p95'] * k:>10.4g}{h['linear_std'] * k:>12.3g}")
-        lines.append("  P(shimmy) sampled / linear: " + ", ".join(
-            f"{p} {self.p_shimmy[p]:.3f}/{self.p_shimmy_linear[p]:.3f}" for p in self.p_shimmy))
-        lines += [f"  warning: {w}" for w in self.warnings]
-        return "\n".join(lines)
+        """The table ``python -m shimmy robustness`` prints
+        (:func:`~shimmy.analyses.decisions.summaries.robustness_summary`)."""
+        return robustness_summary(self.to_dict())
 
 
 def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str] | Mapping[str, float],

@@ -67,6 +67,7 @@ from ...model.equations import Model, build_model, jacobian, model_coefficients
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from ..diagrams.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, BifurcationOptions, bifurcation, gear_field
 from .design_space import DESIGN_PARAMETERS
+from .summaries import sensitivity_summary
 from ..core.stability import Linearisation, hopf_points
 
 #: Relative step of the central differences in the parameters.
@@ -249,29 +250,9 @@ class SensitivityResult:
                 "version": __version__}
 
     def summary_text(self, top: int = 8) -> str:
-        """The tables ``python -m shimmy sensitivity`` prints: per quantity its ``top`` largest effects and
-        the device parameters, then the parameters without effect with their reasons."""
-        lines = [f"{self.config.value} at Fz = {self.Fz / 1e3:g} kN: change of each quantity per +1 % of the "
-                 f"parameter (per half of its range in brackets); largest effects first, then the device parameters"]
-        for q in self.to_dict()["quantities"]:
-            lines.append(f"\n{q['label']} = {q['value']:.6g} {q['unit']}")
-            active = [r for r in q["rows"] if r["reason"] is None]
-            shown = active[:top] + [r for r in active[top:] if r["device"]]
-            for r in shown:
-                percent = "(value 0)" if r["per_percent"] is None else f"{r['per_percent']:+.4g}"
-                lines.append(f"  {r['name']:<12}{percent:>12} {q['unit']:<4}"
-                             f"({r['per_half_range']:+.4g} {q['unit']} per half range)")
-            silent = [r["name"] for r in q["rows"] if r["reason"] is not None]
-            if silent:
-                lines.append(f"  no effect: {', '.join(silent)}")
-        if self.max_psi is not None and self.max_psi.get("dA_dp") is None:
-            lines.append(f"\nlargest stable torsional amplitude: {self.max_psi['reason']}")
-        reasons: dict[str, set[str]] = {}
-        for by_name in self.no_effect.values():
-            for name, reason in by_name.items():
-                reasons.setdefault(reason, set()).add(name)
-        lines += [f"  {', '.join(sorted(n))}: {r}" for r, n in reasons.items()]
-        return "\n".join(lines)
+        """The tables ``python -m shimmy sensitivity`` prints: per quantity its ``top`` largest effects
+        (:func:`~shimmy.analyses.decisions.summaries.sensitivity_summary`)."""
+        return sensitivity_summary(self.to_dict(), top)
 
 
 def _check_names(names: Sequence[str] | None) -> list[str]:

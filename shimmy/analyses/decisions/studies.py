@@ -9,7 +9,6 @@ Hopf point, and the largest torsional amplitude of a stable limit cycle with its
 
 from __future__ import annotations
 
-import csv
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
@@ -19,6 +18,7 @@ from ..diagrams.bifurcation import BifurcationOptions, bifurcation
 from ...model.configurations import CONFIGURATION_NAMES, Configuration
 from ...errors import InvalidParameterError
 from ..core.executors import name_of, run_units
+from .summaries import STUDY_COLUMNS, study_summary, write_study_csv
 from ...model.parameters import (DEFAULT_FZ, DIAGRAM_V_RANGE, PARAMETER_SPECS, V_RANGE, Parameters,
                                  check_operating_point, check_range)
 
@@ -39,7 +39,7 @@ class StudyResult:
     elapsed_s: float
     warnings: list[str] = field(default_factory=list)
 
-    COLUMNS = ("config", "hopf_start", "hopf_end", "max_psi", "max_psi_V")
+    COLUMNS = STUDY_COLUMNS
 
     def to_dict(self) -> dict[str, Any]:
         return {"parameters": self.parameters, "values": self.values, "configs": self.configs, "Fz": self.Fz,
@@ -50,31 +50,13 @@ class StudyResult:
                 "version": __version__}
 
     def write_csv(self, stream) -> None:
-        w = csv.writer(stream)
-        units = {"hopf_start": "hopf_start_m_s", "hopf_end": "hopf_end_m_s", "max_psi": "max_psi_rad",
-                 "max_psi_V": "max_psi_V_m_s"}
-        w.writerow(self.parameters + [units.get(c, c) for c in self.COLUMNS] + ["hopf_points_m_s"])
-        for r in self.rows:
-            w.writerow([f"{r[p]:.10g}" for p in self.parameters]
-                       + [r["config"]] + ["" if r[c] is None else f"{r[c]:.10g}" for c in self.COLUMNS[1:]]
-                       + [" ".join(f"{v:.10g}" for v in r["hopf_points"])])
+        """The rows as CSV to ``stream`` (:func:`~shimmy.analyses.decisions.summaries.write_study_csv`)."""
+        write_study_csv(self.to_dict(), stream)
 
     def summary_text(self) -> str:
-        """The table ``python -m shimmy study`` prints: one row per design and configuration."""
-        lines = [f"study at Fz = {self.Fz:g} N, V {self.v_range[0]:g}..{self.v_range[1]:g} m/s "
-                 f"({self.elapsed_s:.1f} s, {self.executor})",
-                 "".join(f"{p:>12}" for p in self.parameters)
-                 + f"  {'config':<8}{'Hopf start':>11}{'Hopf end':>10}{'max psi':>10}{'at V':>8}"]
-
-        def num(x, fmt):
-            return "-" if x is None else format(x, fmt)
-
-        for r in self.rows:
-            lines.append("".join(f"{r[p]:>12.6g}" for p in self.parameters)
-                         + f"  {r['config']:<8}{num(r['hopf_start'], '11.4f')}{num(r['hopf_end'], '10.4f')}"
-                         f"{num(r['max_psi'], '10.5f')}{num(r['max_psi_V'], '8.2f')}")
-        lines += [f"  warning: {w}" for w in self.warnings]
-        return "\n".join(lines)
+        """The table ``python -m shimmy study`` prints: one row per design and configuration
+        (:func:`~shimmy.analyses.decisions.summaries.study_summary`)."""
+        return study_summary(self.to_dict())
 
 
 def _check_values(name: str, values: Sequence[float], params: Parameters) -> list[float]:

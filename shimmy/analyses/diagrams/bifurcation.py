@@ -35,7 +35,6 @@ includes unstable cycles.
 
 from __future__ import annotations
 
-import csv
 import math
 import time
 from dataclasses import dataclass, replace, field
@@ -58,6 +57,7 @@ from ...continuation.periodic_orbits import (PeriodicBranch, hopf_guess, orbit_f
                               periodic_branch)
 from ..core.response import mode_of, torsional_share
 from ..core.stability import HopfResult, check_speeds_and_load, hopf_points
+from .summaries import bifurcation_summary, write_bifurcation_csv
 from .options import BifurcationOptions
 
 # Size of a unit step in each unknown (the arclength metric): psi, dpsi, delta, ddelta, lam, psis, dpsis.
@@ -143,38 +143,13 @@ class BifurcationResult:
                 "warnings": list(self.warnings), "elapsed_s": self.elapsed_s, "version": __version__}
 
     def write_csv(self, path) -> None:
-        with open(path, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["branch", "kind", "V_m_s", "period_s", "max_psi_rad", "max_lateral_m", "stable", "mode"])
-            for i, b in enumerate(self.branches):
-                for v, T, a, lat, s, m in zip(b.V, b.period, b.max_psi, b.max_lateral, b.stable, b.mode,
-                                              strict=True):
-                    w.writerow([i, b.kind, f"{v:.10g}", "" if math.isnan(T) else f"{T:.10g}", f"{a:.10g}",
-                                f"{lat:.10g}", int(bool(s)), m or ""])
+        """Every branch point, one row each (:func:`~shimmy.analyses.diagrams.summaries.write_bifurcation_csv`)."""
+        write_bifurcation_csv(self.to_dict(), path)
 
     def summary_text(self) -> str:
-        """The short table ``python -m shimmy bifurcation`` prints: the Hopf points, each periodic branch
-        with its special points and end, the largest stable amplitude, the mesh check, the warnings."""
-        lines = [f"{self.config.value} at Fz = {self.Fz:g} N, V in [{self.v_min:g}, {self.v_max:g}] m/s "
-                 f"({self.elapsed_s:.2f} s)"]
-        for h in self.hopf.hopf_points:
-            lines.append(f"  H    V = {h.V:10.5f} m/s  {h.frequency_hz:.4f} Hz  {h.criticality.value}")
-        for i, b in enumerate(self.branches[1:], start=1):
-            stable = int(b.stable.sum())
-            lines.append(f"  branch {i}: {b.kind} from {b.origin}; {b.V.size} points ({stable} stable), "
-                         f"V {b.V.min():.4g}..{b.V.max():.4g} m/s, max |psi| {b.max_psi.max():.5g} rad; "
-                         f"modes {', '.join(sorted({m for m in b.mode if m}))}")
-            for s in b.special_points:
-                if s["kind"] != PointKind.END:
-                    lines.append(f"      {s['kind']:<4} V = {s['V']:.6g} m/s")
-            lines.append(f"      ends: {b.stop_reason}")
-        where = "" if self.max_psi_V is None else f" at V = {self.max_psi_V:.5g} m/s"
-        lines.append(f"  max torsional amplitude of stable cycles: {self.max_psi:.6g} rad{where}")
-        if self.mesh_check:
-            lines.append(f"  mesh check: ntst {self.mesh_check['ntst']} -> {self.mesh_check['ntst_fine']} changes "
-                         f"max |psi| by {self.mesh_check['change']:.2g} rad")
-        lines += [f"  warning: {w}" for w in self.warnings]
-        return "\n".join(lines)
+        """The short table ``python -m shimmy bifurcation`` prints
+        (:func:`~shimmy.analyses.diagrams.summaries.bifurcation_summary`)."""
+        return bifurcation_summary(self.to_dict())
 
 
 def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | None = None,

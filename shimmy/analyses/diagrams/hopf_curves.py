@@ -26,6 +26,7 @@ from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, che
 from ..core.polylines import near_polyline
 from ..core.response import Mode, dominant_mode, torsional_share
 from ..core.stability import hopf_points
+from .summaries import hopf_curves_summary
 
 V_SCALE = 10.0  # m/s
 FZ_SCALE = 1.0e4  # N
@@ -114,23 +115,9 @@ class HopfCurvesResult:
                 "version": __version__}
 
     def summary_text(self) -> str:
-        """The short table ``python -m shimmy hopf-curves`` prints: each curve with its GH and double-Hopf
-        points, and the lowest load on a curve."""
-        lines = [f"{self.config.value}: {len(self.curves)} Hopf curve(s) in "
-                 f"V {self.v_range[0]:g}..{self.v_range[1]:g} m/s, "
-                 f"Fz {self.fz_range[0]:g}..{self.fz_range[1]:g} N ({self.elapsed_s:.2f} s)"]
-        for i, c in enumerate(self.curves, start=1):
-            lines.append(f"  curve {i}: {len(c.p)} points, V {c.p[:, 0].min():.4g}..{c.p[:, 0].max():.4g} m/s, "
-                         f"Fz {c.p[:, 1].min():.5g}..{c.p[:, 1].max():.5g} N, {'closed' if c.closed else 'open'}")
-            for g in c.points_of(PointKind.GENERALISED_HOPF):
-                lines.append(f"      GH  V = {g.p[0]:.6g} m/s, Fz = {g.p[1]:.6g} N")
-            for g in c.points_of(PointKind.DOUBLE_HOPF):
-                lines.append(f"      HH  V = {g.p[0]:.6g} m/s, Fz = {g.p[1]:.6g} N "
-                             f"({g.data['omega'] / (2 * math.pi):.4g} and {g.data['omega2'] / (2 * math.pi):.4g} Hz)")
-        if self.fz_minimum:
-            lines.append(f"  lowest load on a Hopf curve: Fz = {self.fz_minimum['Fz']:.6g} N "
-                         f"at V = {self.fz_minimum['V']:.6g} m/s")
-        return "\n".join(lines)
+        """The short table ``python -m shimmy hopf-curves`` prints
+        (:func:`~shimmy.analyses.diagrams.summaries.hopf_curves_summary`)."""
+        return hopf_curves_summary(self.to_dict())
 
 
 def _gh_point(g) -> dict[str, float]:

@@ -49,6 +49,7 @@ from ...model.configurations import ALL_CONFIGURATIONS, Configuration
 from ...model.equations import build_model, jacobian
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number
 from .ground_profiles import GroundProfile, as_profile
+from .summaries import comparison_dict, comparison_summary, comparison_table, ground_run_summary
 from ..core.response import dominant_mode, torsional_share
 from ..core.simulation import STATUS_MESSAGES, SimulationOptions, initial_state
 
@@ -163,24 +164,9 @@ class GroundRunResult:
         return out
 
     def summary_text(self, header: bool = True) -> str:
-        """The lines ``python -m shimmy ground-run`` prints for this run: time in shimmy, peaks, onset delay,
-        boundary crossings, warnings; with ``header``, the profile and the thresholds first."""
-        p, o = self.profile, self.options
-        lines = [f"{p.name} profile: {p.duration:g} s, V {p.V.min():.4g}..{p.V.max():.4g} m/s, "
-                 f"Fz {p.Fz.min() / 1e3:.4g}..{p.Fz.max() / 1e3:.4g} kN; thresholds "
-                 f"{o.psi_threshold:g} rad, {1e3 * o.lateral_threshold:g} mm"] if header else []
-        speeds = "-" if self.speed_range is None else f"{self.speed_range[0]:.4g}..{self.speed_range[1]:.4g} m/s"
-        delay = "-" if self.onset_delay_s is None else f"{self.onset_delay_s:.3g} s"
-        lines.append(f"  {self.config.value:<8} in shimmy {self.time_in_shimmy_s:7.3f} s (V {speeds}); peak |psi| "
-                     f"{self.peak_psi['value']:.4g} rad at {self.peak_psi['t']:.4g} s ({self.peak_psi['V']:.4g} m/s); "
-                     f"peak |l_g delta| {1e3 * self.peak_lateral['value']:.4g} mm; onset delay {delay}")
-        for c in self.boundary_crossings:
-            lines.append(f"      crosses the {c['curve']} curve at t = {c['t']:.4g} s, V = {c['V']:.5g} m/s, "
-                         f"Fz = {c['Fz'] / 1e3:.5g} kN" + (f" ({c['direction']})" if "direction" in c else ""))
-        if not self.success:
-            lines.append(f"      {self.message}")
-        lines += [f"      warning: {w}" for w in self.warnings]
-        return "\n".join(lines)
+        """The lines ``python -m shimmy ground-run`` prints for this run; with ``header``, the profile and the
+        thresholds first (:func:`~shimmy.analyses.ground.summaries.ground_run_summary`)."""
+        return ground_run_summary(self.to_dict(include_series=False), header)
 
 
 def ground_run(config: Configuration | str, profile: Any, *, params: Parameters | None = None, x0=None,
@@ -397,32 +383,18 @@ class GroundRunComparison:
     elapsed_s: float
 
     def table(self) -> list[dict[str, Any]]:
-        base = self.runs.get("original")
-        rows = []
-        for name, r in self.runs.items():
-            row = {"config": name, "time_in_shimmy_s": r.time_in_shimmy_s, "peak_psi": r.peak_psi["value"],
-                   "peak_lateral": r.peak_lateral["value"], "onset_delay_s": r.onset_delay_s,
-                   "speed_range": r.speed_range, "success": r.success}
-            if base is not None:
-                row["time_in_shimmy_change_s"] = r.time_in_shimmy_s - base.time_in_shimmy_s
-                row["peak_psi_ratio"] = _ratio(r.peak_psi["value"], base.peak_psi["value"])
-                row["peak_lateral_ratio"] = _ratio(r.peak_lateral["value"], base.peak_lateral["value"])
-            rows.append(row)
-        return rows
+        """:func:`~shimmy.analyses.ground.summaries.comparison_table` of the runs."""
+        return comparison_table({k: r.summary() for k, r in self.runs.items()})
 
     def to_dict(self, series_stride: int = 10, include_series: bool = True) -> dict[str, Any]:
-        return {"profile": self.profile.to_dict(), "comparison": self.table(), "elapsed_s": self.elapsed_s,
-                "runs": {k: r.to_dict(series_stride, include_series) for k, r in self.runs.items()},
-                "version": __version__}
+        return comparison_dict(self.profile.to_dict(),
+                               {k: r.to_dict(series_stride, include_series) for k, r in self.runs.items()},
+                               self.elapsed_s)
 
     def summary_text(self) -> str:
-        """The profile and the thresholds, then each run's lines (:meth:`GroundRunResult.summary_text`)."""
-        runs = list(self.runs.values())
-        return "\n".join([runs[0].summary_text(), *(r.summary_text(header=False) for r in runs[1:])])
-
-
-def _ratio(a: float, b: float) -> float | None:
-    return float(a / b) if b > 0 and math.isfinite(a) and math.isfinite(b) else None
+        """The profile and the thresholds, then each run's lines
+        (:func:`~shimmy.analyses.ground.summaries.comparison_summary`)."""
+        return comparison_summary(self.to_dict(include_series=False))
 
 
 def ground_runs(profile: Any, *, configs: Sequence[Configuration | str] = ALL_CONFIGURATIONS,

@@ -59,6 +59,7 @@ from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
 from ...model.parameters import (DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number,
                                 check_operating_point, check_range)
 from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
+from .summaries import map_summary, write_map_csv
 
 SHIMMY_TYPES = tuple(ShimmyType)
 SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
@@ -425,37 +426,18 @@ class StabilityMap:
                 "seeds": [seed.to_dict() for seed in self.seeds], "version": __version__}
 
     def write_csv(self, path) -> None:
-        """The shading (the map's answer on its fine grid): one row per (Fz, V)."""
-        import csv
-
-        with open(path, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["Fz_N", "V_m_s", "shimmy_type"])
-            for Fz, row in zip(self.shading_Fz, self.shading, strict=True):
-                for V, t in zip(self.V, row, strict=True):
-                    w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
+        """The shading (the map's answer on its fine grid): one row per (Fz, V)
+        (:func:`~shimmy.analyses.maps.summaries.write_map_csv`)."""
+        write_map_csv(self.to_dict(), path)
 
     def summary_text(self, metrics: dict[str, Any] | None = None) -> str:
-        """The short table ``python -m shimmy map`` prints: slices and grid, grid points by type, curves,
-        the minimum shimmy load, with ``metrics`` (:func:`~shimmy.analyses.maps.design_metrics.metrics` of
-        this map) its pure-torsion area, the warnings."""
-        counts = {t: sum(row.count(t) for row in self.shading) for t in SHIMMY_TYPES}
-        lines = [f"{self.config.value}: {len(self.Fz)} classified slices, {len(self.shading_Fz)} x {len(self.V)} "
-                 f"grid, V {self.v_range[0]:g}..{self.v_range[1]:g} m/s, Fz {self.fz_range[0]:g}..{self.fz_range[1]:g} "
-                 f"N ({self.elapsed_s:.1f} s, {self.executor})",
-                 "  grid points by type: " + ", ".join(f"{t} {n}" for t, n in counts.items())
-                 + f"; {len(self.regions)} region polygons",
-                 f"  Hopf curves {len(self.hopf.curves)}, GH points {len(self.hopf.gh_points)}, "
-                 f"fold curves {len(self.fold_curves)}, torus curves {len(self.torus_curves)}"]
-        if self.min_shimmy:
-            lines.append(f"  minimum shimmy load {self.min_shimmy['Fz']:.6g} N at V = {self.min_shimmy['V']:.5g} m/s "
-                         f"({self.min_shimmy['source']})")
-        else:
-            lines.append("  no shimmy anywhere in the map")
+        """The short table ``python -m shimmy map`` prints, with ``metrics``
+        (:func:`~shimmy.analyses.maps.design_metrics.metrics` of this map) its pure-torsion area
+        (:func:`~shimmy.analyses.maps.summaries.map_summary`)."""
+        result = self.to_dict()
         if metrics is not None:
-            lines.append(f"  pure-torsion area, Fz <= {BAND_FZ_MAX / 1e3:g} kN: {metrics['torsion_area']:.6g} (m/s) kN")
-        lines += [f"  warning: {w}" for w in self.warnings]
-        return "\n".join(lines)
+            result["metrics"] = metrics
+        return map_summary(result)
 
 
 @dataclass(frozen=True, eq=False)

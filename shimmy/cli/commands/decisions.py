@@ -4,64 +4,69 @@ from __future__ import annotations
 
 import sys
 
-from ...model.parameters import FZ_RANGE, check_number
-from ..common import (add_command, add_common, add_config, add_field, add_plane, add_progress, emit, float_list, names,
-                      params, progress)
+from ..answers import add_no_cache, answer, design, emit, note, numbers, request
+from ..common import (add_command, add_common, add_config, add_field, add_plane, add_progress, float_list, names,
+                      progress)
 
 
 def _cmd_sensitivity(args) -> int:
-    from ...analyses.decisions.sensitivity import sensitivity
+    from ...analyses.decisions.summaries import sensitivity_summary
 
-    Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
-    result = sensitivity(args.config, Fz, params=params(args), names=names(args.params),
-                         amplitude=not args.no_amplitude)
-    emit(result.to_dict(), args.json, result.summary_text(top=args.top))
+    derivatives = answer(args, "sensitivity", request("sensitivity", {
+        "config": args.config, **numbers("sensitivity", args, "Fz"), "names": names(args.params),
+        "amplitude": not args.no_amplitude, "params": design(args)}))
+    emit(derivatives.result, [derivatives], args.json, sensitivity_summary(derivatives.result, top=args.top))
     return 0
 
 
 def _cmd_optimise(args) -> int:
-    from ...analyses.decisions.optimise import optimise
+    from ...analyses.decisions.summaries import optimise_summary
 
-    Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
+    canonical = request("optimise", {
+        "config": args.config, "objective": args.objective, "parameters": names(args.params),
+        **numbers("optimise", args, "Fz"), "constraints": args.constraint or [], "method": args.method,
+        "starts": args.starts, "local_runs": args.local_runs, "seed": args.seed, "params": design(args)})
     with progress(args) as bar:
-        result = optimise(args.config, args.objective, parameters=names(args.params), Fz=Fz,
-                          constraints=args.constraint or [], params=params(args), method=args.method,
-                          starts=args.starts, local_runs=args.local_runs, seed=args.seed, progress=bar)
-    emit(result.to_dict(), args.json, result.summary_text())
+        optimum = answer(args, "optimise", canonical, bar)
+    emit(optimum.result, [optimum], args.json, optimise_summary(optimum.result))
     return 0
 
 
 def _cmd_robustness(args) -> int:
-    from ...analyses.decisions.robustness import robustness
+    from ...analyses.decisions.summaries import robustness_summary
 
-    Fz = check_number("Fz", args.Fz, *FZ_RANGE, "N")
+    canonical = request("robustness", {"config": args.config, "tolerances": args.tolerance or [],
+                                       "samples": args.samples, **numbers("robustness", args, "Fz"), "seed": args.seed,
+                                       "params": design(args)})
     with progress(args) as bar:
-        result = robustness(args.config, args.tolerance or [], samples=args.samples, Fz=Fz, params=params(args),
-                            seed=args.seed, progress=bar)
-    payload = result.to_dict()
+        spread = answer(args, "robustness", canonical, bar)
+    payload = spread.result
     if not args.with_samples:
-        for h in payload["hopf_points"] + ([payload["min_shimmy_Fz"]] if payload["min_shimmy_Fz"] else []):
-            h.pop("samples")
-    emit(payload, args.json, result.summary_text())
+        payload = {**payload, "hopf_points": [_without_samples(h) for h in payload["hopf_points"]],
+                   "min_shimmy_Fz": payload["min_shimmy_Fz"] and _without_samples(payload["min_shimmy_Fz"])}
+    emit(payload, [spread], args.json, robustness_summary(payload))
     return 0
 
 
-def _cmd_study(args) -> int:
-    from ...analyses.decisions.studies import study, study_grid
+def _without_samples(distribution: dict) -> dict:
+    return {k: v for k, v in distribution.items() if k != "samples"}
 
-    configs = [c.strip() for c in args.configs.split(",") if c.strip()]
+
+def _cmd_study(args) -> int:
+    from ...analyses.decisions.summaries import study_summary, write_study_csv
+
+    canonical = request("study", {
+        "parameter": args.param, "values": float_list("values", args.values), "parameter2": args.param2,
+        "values2": None if args.values2 is None else float_list("values2", args.values2),
+        "configs": [c.strip() for c in args.configs.split(",") if c.strip()],
+        **numbers("study", args, "Fz", "v_min", "v_max"), "params": design(args)})
     with progress(args) as bar:
-        if args.param2:
-            values = (float_list("values", args.values), float_list("values2", args.values2 or ""))
-            result = study_grid((args.param, args.param2), values, configs=configs, Fz=args.Fz, params=params(args),
-                                v_range=(args.v_min, args.v_max), progress=bar)
-        else:
-            result = study(args.param, float_list("values", args.values), configs=configs, Fz=args.Fz,
-                           params=params(args), v_range=(args.v_min, args.v_max), progress=bar)
+        rows = answer(args, "study", canonical, bar)
     if args.csv:
-        result.write_csv(sys.stdout)
+        write_study_csv(rows.result, sys.stdout)
+        note([rows])
         return 0
-    emit(result.to_dict(), args.json, result.summary_text())
+    emit(rows.result, [rows], args.json, study_summary(rows.result))
     return 0
 
 
@@ -75,6 +80,7 @@ def add_parsers(commands) -> None:
                    help="skip the largest torsional amplitude (which needs one bifurcation diagram)")
     p.add_argument("--top", type=int, default=8, help="rows per quantity in the table")
     add_common(p)
+    add_no_cache(p)
 
     p = add_command(commands, "optimise", "search device parameters for the best figure of merit under constraints",
                     _cmd_optimise)
@@ -94,6 +100,7 @@ def add_parsers(commands) -> None:
     add_field(p, "optimise", "--seed", "seed of the start designs", type=int)
     add_common(p)
     add_progress(p)
+    add_no_cache(p)
 
     p = add_command(commands, "robustness", "Hopf speeds, minimum shimmy load and shimmy at the operating points "
                                             "under parameter tolerances (quasi-Monte Carlo and linear propagation)",
@@ -108,6 +115,7 @@ def add_parsers(commands) -> None:
     p.add_argument("--with-samples", action="store_true", help="include every sample's values in the JSON")
     add_common(p)
     add_progress(p)
+    add_no_cache(p)
 
     p = add_command(commands, "study", "parametric study: Hopf speeds and max amplitude against parameters", _cmd_study)
     p.add_argument("--param", required=True, help="parameter name (see 'params')")
@@ -120,3 +128,4 @@ def add_parsers(commands) -> None:
     p.add_argument("--csv", action="store_true", help="write the table as CSV to stdout")
     add_common(p)
     add_progress(p)
+    add_no_cache(p)

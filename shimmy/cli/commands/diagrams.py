@@ -6,33 +6,47 @@ from ...analyses.diagrams.options import BifurcationOptions
 from ...continuation.kinds import CYCLE_BIFURCATIONS as KINDS
 from ...errors import InvalidParameterError
 from ...model.parameters import check_number
-from ..common import (add_command, add_common, add_config, add_field, add_plane, add_progress, emit, float_list, limit,
+from ..answers import OFF, Answer, add_no_cache, answer, design, numbers, request
+from ..answers import emit as emit_answer
+from ..common import (add_command, add_common, add_config, add_field, add_plane, add_progress, emit, float_list,
                       params, progress)
 
 
 def _cmd_bifurcation(args) -> int:
-    from ...analyses.diagrams.bifurcation import bifurcation
+    from ...analyses.diagrams.summaries import bifurcation_summary, write_bifurcation_csv
 
-    ntst = limit("bifurcation", "ntst", args.ntst)
+    canonical = request("bifurcation", {"config": args.config, **numbers("bifurcation", args, "Fz", "v_min", "v_max",
+                                                                         "ntst"),
+                                        "seeds": not args.no_seeds, "params": design(args)})
     ds_max = check_number("ds_max", args.ds_max, 1e-3, 10.0)
-    options = BifurcationOptions(ntst=ntst, ds=min(BifurcationOptions.ds, ds_max), ds_max=ds_max,
-                                 exact_nes=args.exact_nes, seeds=not args.no_seeds)
+    beyond = [flag for flag, given in (("--ds-max", ds_max != BifurcationOptions.ds_max),
+                                       ("--exact-nes", args.exact_nes)) if given]
     with progress(args) as bar:
-        result = bifurcation(args.config, args.Fz, v_range=(args.v_min, args.v_max), params=params(args),
-                             options=options, progress=bar)
+        if beyond:  # options the API's request does not take: not the question it caches
+            from ...analyses.diagrams.bifurcation import bifurcation
+
+            options = BifurcationOptions(ntst=canonical["ntst"], ds=min(BifurcationOptions.ds, ds_max), ds_max=ds_max,
+                                         exact_nes=args.exact_nes, seeds=canonical["seeds"])
+            result = bifurcation(args.config, canonical["Fz"], v_range=(canonical["v_min"], canonical["v_max"]),
+                                 params=params(args), options=options, progress=bar)
+            diagram = Answer(result.to_dict(), OFF, f"{' and '.join(beyond)}: not in the API's request")
+        else:
+            diagram = answer(args, "bifurcation", canonical, bar)
     if args.csv:
-        result.write_csv(args.csv)
-    emit(result.to_dict(), args.json, result.summary_text())
+        write_bifurcation_csv(diagram.result, args.csv)
+    emit_answer(diagram.result, [diagram], args.json, bifurcation_summary(diagram.result))
     return 0
 
 
 def _cmd_hopf_curves(args) -> int:
-    from ...analyses.diagrams.hopf_curves import hopf_curves
+    from ...analyses.diagrams.summaries import hopf_curves_summary
 
+    canonical = request("hopf_curves", {"config": args.config,
+                                        **numbers("hopf_curves", args, "v_min", "v_max", "fz_min", "fz_max"),
+                                        "params": design(args)})
     with progress(args) as bar:
-        result = hopf_curves(args.config, params=params(args), v_range=(args.v_min, args.v_max),
-                             fz_range=(args.fz_min, args.fz_max), progress=bar)
-    emit(result.to_dict(), args.json, result.summary_text())
+        curves = answer(args, "hopf_curves", canonical, bar)
+    emit_answer(curves.result, [curves], args.json, hopf_curves_summary(curves.result))
     return 0
 
 
@@ -59,12 +73,17 @@ def add_parsers(commands) -> None:
     p.add_argument("--Fz", required=True, help="vertical load (N)")
     add_plane(p, "bifurcation", loads=False)
     add_field(p, "bifurcation", "--ntst", "collocation mesh intervals", limits=True)
-    p.add_argument("--ds-max", default=BifurcationOptions.ds_max, help="largest continuation step (scaled arclength)")
+    p.add_argument("--ds-max", default=BifurcationOptions.ds_max,
+                   help="largest continuation step (scaled arclength); any other than the default is computed "
+                        "without the cache (the API's request has no such field)")
     p.add_argument("--no-seeds", action="store_true", help="do not look for branches by simulation")
-    p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
+    p.add_argument("--exact-nes", action="store_true",
+                   help="use the exact NES torque instead of the cubic (computed without the cache: the API's "
+                        "diagram request has no such field)")
     p.add_argument("--csv", metavar="FILE", help="write the branch points to FILE")
     add_common(p)
     add_progress(p)
+    add_no_cache(p)
 
     p = add_command(commands, "hopf-curves", "Hopf curves of straight rolling in (V, Fz) with GH points",
                     _cmd_hopf_curves)
@@ -72,6 +91,7 @@ def add_parsers(commands) -> None:
     add_plane(p, "hopf_curves")
     add_common(p)
     add_progress(p)
+    add_no_cache(p)
 
     p = add_command(commands, "curves", "fold, torus and period-doubling curves of cycles in (V, Fz)", _cmd_curves)
     add_config(p)

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from ...errors import InvalidParameterError
 from ...model.configurations import CONFIGURATION_NAMES
-from ..common import EXIT_FAILED, add_command, add_common, add_config, add_field, emit, params, parse_sets
+from ..answers import add_no_cache, answer, design, emit, numbers, request
+from ..common import EXIT_FAILED, add_command, add_common, add_config, add_field, parse_sets
 
 
 def _read_profile_csv(path: str) -> tuple[list[list[Any]], list[int]]:
@@ -62,28 +61,29 @@ def _profile(args):
 
 
 def _cmd_ground_run(args) -> int:
-    from ...analyses.ground.ground_run import GroundRunOptions, ground_runs
-    from ...model.parameters import check_number
+    from ...analyses.ground.ground_profiles import PRESETS
+    from ...analyses.ground.summaries import (comparison_dict, comparison_summary, ground_run_summary,
+                                              write_ground_run_csv)
 
     profile = _profile(args)
-    options = GroundRunOptions(psi_threshold=args.psi_threshold, lateral_threshold=args.lateral_threshold,
-                               exact_nes=args.exact_nes, cycle_curves=args.fold_torus)
-    series_dt = check_number("series_dt", args.series_dt, options.dt_out, 1.0, "s")
-    stride = max(1, int(round(series_dt / options.dt_out)))
+    body = {**numbers("ground_run", args, "psi_threshold", "lateral_threshold", "series_dt"),
+            "fold_torus": args.fold_torus, "exact_nes": args.exact_nes, "params": design(args),
+            **({"preset": args.profile, "preset_options": profile.settings} if args.profile in PRESETS
+               else {"profile": profile.rows()})}
     configs = list(CONFIGURATION_NAMES) if args.config == "all" else [args.config]
-    comparison = ground_runs(profile, params=params(args), configs=configs, options=options)
-    runs = comparison.runs
+    requests = [request("ground_run", {**body, "config": config}) for config in configs]  # all checked first
+    runs = [answer(args, "ground_run", canonical) for canonical in requests]
     if len(runs) == 1:
-        (result,) = runs.values()
+        payload = runs[0].result
         if args.csv:
-            names = list(result.series())
-            data = np.column_stack([np.asarray(v) for v in result.series(stride).values()])
-            np.savetxt(args.csv, data, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
-        payload = result.to_dict(stride)
+            write_ground_run_csv(payload, args.csv)
+        text = ground_run_summary(payload)
     else:
-        payload = comparison.to_dict(stride)
-    emit(payload, args.json, comparison.summary_text())
-    return 0 if all(r.success for r in runs.values()) else EXIT_FAILED
+        payload = comparison_dict(runs[0].result["profile"], {c: r.result for c, r in zip(configs, runs, strict=True)},
+                                  sum(r.result["elapsed_s"] for r in runs))
+        text = comparison_summary(payload)
+    emit(payload, runs, args.json, text)
+    return 0 if all(r.result["success"] for r in runs) else EXIT_FAILED
 
 
 def add_parsers(commands) -> None:
@@ -102,3 +102,4 @@ def add_parsers(commands) -> None:
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the series of one configuration to FILE")
     add_common(p)
+    add_no_cache(p)

@@ -5,23 +5,23 @@ from __future__ import annotations
 
 from ...model.configurations import CONFIGURATION_NAMES
 from ...model.parameters import DEFAULT_FZ, DIAGRAM_V_RANGE, FZ_RANGE, check_number
+from ..answers import add_no_cache, answer, design, numbers, request
+from ..answers import emit as emit_answer
 from ..common import (add_command, add_common, add_config, add_field, add_operating_point, add_plane, add_progress,
                       emit, limit, params, progress)
 
 
 def _cmd_map(args) -> int:
-    from ...analyses.maps.design_metrics import metrics
-    from ...analyses.maps.stability_map import stability_map
+    from ...analyses.maps.summaries import map_summary, write_map_csv
 
-    resolution = limit("map", "resolution", args.resolution)
-    n_v = limit("map", "n_v", args.n_v)
+    canonical = request("map", {"config": args.config, "params": design(args),
+                                **numbers("map", args, "v_min", "v_max", "fz_min", "fz_max", "resolution", "n_v",
+                                          "metrics_Fz")})
     with progress(args) as bar:
-        smap = stability_map(args.config, v_range=(args.v_min, args.v_max), fz_range=(args.fz_min, args.fz_max),
-                             resolution=resolution, params=params(args), n_v=n_v, progress=bar)
-        figures = metrics(smap, Fz=limit("map", "metrics_Fz", args.metrics_Fz))
+        smap = answer(args, "map", canonical, bar)
     if args.csv:
-        smap.write_csv(args.csv)
-    emit(smap.to_dict() | {"metrics": figures}, args.json, smap.summary_text(figures))
+        write_map_csv(smap.result, args.csv)
+    emit_answer(smap.result, [smap], args.json, map_summary(smap.result))
     return 0
 
 
@@ -57,6 +57,7 @@ def add_parsers(commands) -> None:
     p.add_argument("--csv", metavar="FILE", help="write the classified grid to FILE")
     add_common(p)
     add_progress(p)
+    add_no_cache(p)
 
     p = add_command(commands, "classify", "shimmy type and stable attractors at one operating point", _cmd_classify)
     add_operating_point(p)

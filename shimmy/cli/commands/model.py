@@ -2,18 +2,17 @@
 
 from __future__ import annotations
 
-
-from ..common import add_command, add_common, add_field, emit, limit, params
+from ..answers import add_no_cache, answer, design, numbers, request
+from ..answers import emit as emit_answer
+from ..common import add_command, add_common, add_field, emit, params
 
 
 def _cmd_devices(args) -> int:
-    from ...analyses.core.device_curves import devices_summary, nes_curve, pd_curves
+    from ...analyses.core.summaries import devices_summary
 
-    design = params(args)
-    nes_c = nes_curve(params=design)
-    pds = pd_curves(params=design, v_max=limit("devices", "v_max", args.v_max))
-    payload = {"params": design.to_dict(), "nes": nes_c.to_dict(), "pd": [c.to_dict() for c in pds]}
-    emit(payload, args.json, devices_summary(nes_c, pds))
+    curves = answer(args, "devices", request("devices", {**numbers("devices", args, "v_max"), "params": design(args)}))
+    payload = {k: curves.result[k] for k in ("params", "nes", "pd")}  # the cubic's error is in nes already
+    emit_answer(payload, [curves], args.json, devices_summary(payload))
     return 0
 
 
@@ -29,6 +28,7 @@ def add_parsers(commands) -> None:
     p = add_command(commands, "devices", "NES torque/stiffness and PD damping curves", _cmd_devices)
     add_field(p, "devices", "--v-max", "largest PD tangential speed (m/s)", limits=True)
     add_common(p)
+    add_no_cache(p)
 
     p = add_command(commands, "calibrate", "refit the unpublished constants and print residuals", _cmd_calibrate)
     add_common(p)

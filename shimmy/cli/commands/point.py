@@ -5,8 +5,10 @@ from __future__ import annotations
 import math
 
 from ...model.parameters import PARAMETER_SPECS
+from ..answers import OFF, Answer, add_no_cache, answer, design, numbers, request
+from ..answers import emit as emit_answer
 from ..common import (EXIT_FAILED, add_command, add_common, add_config, add_field, add_operating_point, add_plane, emit,
-                      limit, params)
+                      params)
 
 
 def _cmd_params(args) -> int:
@@ -20,10 +22,11 @@ def _cmd_params(args) -> int:
 
 
 def _cmd_hopf(args) -> int:
-    from ...analyses.core.stability import hopf_points
+    from ...analyses.core.summaries import hopf_summary
 
-    result = hopf_points(args.config, args.Fz, params=params(args), v_range=(args.v_min, args.v_max))
-    emit(result.to_dict(), args.json, result.summary_text())
+    hopf = answer(args, "hopf", request("hopf", {"config": args.config, **numbers("hopf", args, "Fz", "v_min", "v_max"),
+                                                 "params": design(args)}))
+    emit_answer(hopf.result, [hopf], args.json, hopf_summary(hopf.result))
     return 0
 
 
@@ -49,14 +52,23 @@ def _cmd_eigen(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from ...analyses.core.simulation import simulate
+    from ...analyses.core.summaries import simulation_summary
 
-    result = simulate(args.config, args.V, args.Fz, params=params(args),
-                      t_end=limit("simulate", "t_end", args.t_end), exact_nes=args.exact_nes)
-    if args.csv:
+    canonical = request("simulate", {"config": args.config, **numbers("simulate", args, "V", "Fz", "t_end"),
+                                     "exact_nes": args.exact_nes, "params": design(args)})
+    if args.csv:  # the file needs the time series, which the cache does not hold
+        from ...analyses.core.simulation import simulate
+        from ...model.parameters import Parameters
+
+        result = simulate(args.config, canonical["V"], canonical["Fz"], t_end=canonical["t_end"],
+                          params=Parameters.from_dict(canonical["params"]), exact_nes=canonical["exact_nes"])
         result.write_csv(args.csv)
-    emit(result.to_dict(), args.json, result.summary_text())
-    return 0 if result.success else EXIT_FAILED
+        run = Answer(result.to_dict(), OFF, "--csv needs the time series, which the cache does not hold")
+    else:
+        run = answer(args, "simulate", canonical)
+    payload = {k: v for k, v in run.result.items() if k != "start"}  # the standard start, which the CLI always uses
+    emit_answer(payload, [run], args.json, simulation_summary(payload))
+    return 0 if payload["success"] else EXIT_FAILED
 
 
 def add_parsers(commands) -> None:
@@ -68,6 +80,7 @@ def add_parsers(commands) -> None:
     p.add_argument("--Fz", required=True, help="vertical load (N)")
     add_plane(p, "hopf", loads=False)
     add_common(p)
+    add_no_cache(p)
 
     p = add_command(commands, "eigen", "eigenvalues of straight rolling at one operating point", _cmd_eigen)
     add_operating_point(p)
@@ -76,4 +89,5 @@ def add_parsers(commands) -> None:
     add_operating_point(p)
     add_field(p, "simulate", "--t-end", "simulated time (s)", limits=True)
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
-    p.add_argument("--csv", metavar="FILE", help="write the time series to FILE")
+    p.add_argument("--csv", metavar="FILE", help="write the time series to FILE (computed: the cache holds no series)")
+    add_no_cache(p)
