@@ -15,7 +15,7 @@ import numpy as np
 from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
 from ..model.parameters import Parameters
-from . import cache, schemas
+from . import cache, neighbours, schemas
 from .settings import MAX_SERIES_POINTS
 
 Progress = Callable[[float, str], None]
@@ -122,13 +122,16 @@ def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> di
 
 @serves("map", sync=False, job=True)
 def stability_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    """The map with its design metrics; slices go through the executor of this environment."""
+    """The map with its design metrics; slices go through the executor of this environment. Warmed
+    from the map of the nearest cached design within reach (:mod:`.neighbours`), if there is one;
+    its own warm start is kept for the next."""
     from ..analyses.maps.design_metrics import metrics
     from ..analyses.maps.stability_map import stability_map as run_map
 
     smap = run_map(request["config"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
                    fz_range=(request["fz_min"], request["fz_max"]), resolution=request["resolution"],
-                   n_v=request["n_v"], progress=progress)
+                   n_v=request["n_v"], progress=progress, warm_from=neighbours.nearest("map", request))
+    neighbours.remember("map", request, smap.warm_start())
     out = smap.to_dict()
     out["metrics"] = metrics(smap, Fz=request["metrics_Fz"])
     return out

@@ -14,13 +14,15 @@ the analyses answer uncached and :func:`health` says why (the API's health answe
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import functools
 import logging
 import os
 import pathlib
 import sqlite3
 import time
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import diskcache
 
@@ -77,6 +79,24 @@ def quarantine(path: pathlib.Path, exc: BaseException) -> None:
         path.rename(aside)
     except OSError as exc2:  # another process moved it first; its rebuilt store is used
         log.warning("could not move %s aside: %s", path, exc2)
+
+
+_BYPASSED: contextvars.ContextVar[bool] = contextvars.ContextVar("shimmy_cache_bypassed", default=False)
+
+
+@contextlib.contextmanager
+def bypassed() -> Iterator[None]:
+    """Within it nothing reads or writes the cache beside the analysis itself: the nearest cached
+    design is not looked up (a map is computed cold) and no warm start is kept (``--no-cache``)."""
+    token = _BYPASSED.set(True)
+    try:
+        yield
+    finally:
+        _BYPASSED.reset(token)
+
+
+def is_bypassed() -> bool:
+    return _BYPASSED.get()
 
 
 def results() -> diskcache.Cache:

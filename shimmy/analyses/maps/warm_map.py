@@ -14,22 +14,26 @@ little: the curves move, but where their arrangement stays the same the regions 
    points, crossings of the slices' loads, turning points and codimension-2 points are the new
    design's to the location tolerance. The search for curve starts (branches beside GH and
    double-Hopf points, the slices' diagrams) is what is saved.
-3. **The arrangement is checked** (:func:`same_arrangement`): the same number of Hopf curves, GH and
-   double-Hopf points, the same fold and torus curves (kind, closure, codimension-2 points in order
-   along each), every slice's Hopf points again as many, and on every shading row and slice load
-   the same sequence of intervals between the curves (which curve, which of its crossings). A
-   curve that appears, vanishes or crosses another changes one of them.
-4. **The slices are carried**: each slice's intervals move with the curves (an end on a curve to
-   that curve's new crossing, an end inside an interval between curves, where a cycle's mode
-   changes, to the same fraction of it), its Hopf points are located again by the eigenvalue scan,
-   its fold and torus points are the new curves' located crossings. Its diagram is not recomputed,
-   so it reports no largest amplitude (``max_psi`` None, ``"carried": true``).
+3. **The arrangement is checked** (:func:`same_arrangement`): the same number of Hopf curves (and
+   their closure), GH and double-Hopf points, the same fold and torus curves (kind, closure,
+   codimension-2 points in order along each). Where that fails (a curve appeared, vanished or
+   closed, or a seed did not converge) :func:`warm_map` raises :class:`NotWarm` saying why, and
+   :func:`~shimmy.analyses.maps.stability_map.stability_map` with ``warm_from`` computes the map cold.
+4. **The slices are carried where the curves cross their load in the same order as before**
+   (:func:`arrangement_change`: two crossings may swap only where they lie within half a grid cell,
+   their order being the polylines' rounding): each slice's intervals move with the curves (an end
+   on a curve to that curve's new crossing, an end where a cycle's mode changes stays, held in its
+   interval between the curves), its Hopf points are located again by the eigenvalue scan, its
+   fold and torus points are the new curves' located crossings of its load. Its diagram is not
+   recomputed, so it reports no largest amplitude (``max_psi`` None, ``"carried": true``). A slice
+   whose load the curves now cross otherwise, or with a Hopf point more or less, or with a point
+   on no curve of the map (a period doubling), is computed again; and, as a cold map does, a slice
+   is added through each region between the new curves that no slice crosses.
 
-Where the check fails (or a seed does not converge) :func:`warm_map` raises :class:`NotWarm` saying
-why, and :func:`~shimmy.analyses.maps.stability_map.stability_map` with ``warm_from`` computes the map
-cold instead. What the check cannot see: a curve born away from a GH or double-Hopf point between
-the two designs (an isola appearing between two slices) is found only by a cold map, as it is by
-a cold map only where a slice's diagram meets it.
+The result's ``methods.warmed_from`` names the design warmed from, the parameters changed and the
+slices carried, computed again and added. What the checks cannot see: a curve born away from a GH
+or double-Hopf point between the two designs (an isola appearing) is found only by a cold map, as
+it is by a cold map only where a slice's diagram meets it.
 """
 
 from __future__ import annotations
@@ -51,8 +55,8 @@ from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, Ge
                                      same_curve)
 from ..diagrams.hopf_curves import HopfCurvesResult
 from . import map_shading
-from .stability_map import (FINE, HopfCurvesUnit, SliceResult, StabilityMap, arrangement, lowest_shimmy, speed_grids,
-                            type_lengths)
+from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, FINE, HopfCurvesUnit, SliceResult, SliceUnit, StabilityMap,
+                            arrangement, lowest_shimmy, speed_grids, type_lengths)
 
 #: Kinds of a slice's special points that lie on the map's curves (carried to the curves' crossings);
 #: a slice with any other (a period doubling, a branch point of cycles) is not carried.
@@ -277,14 +281,37 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     boundaries += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(curves)]
     rows = np.array(start["rows"], float)
     tol = 0.5 * (v_range[1] - v_range[0]) / (n_v - 1)  # half a grid cell
-    for Fz in [float(f) for f in rows] + [float(s["Fz"]) for s in start["slices"]]:
+    slices: list[SliceResult] = []
+    again: dict[float, str] = {}  # slices computed again at the new design: load -> why
+    for old in start["slices"]:
+        Fz = float(old["Fz"])
         change = arrangement_change(_inside(old_boundaries, Fz, v_range, tol), _inside(boundaries, Fz, v_range, tol),
                                     tol)
-        if change:
-            raise NotWarm(f"the curves' arrangement changed at Fz = {Fz / 1e3:.4g} kN: {change}")
-    slices = [_carried_slice(s, config, params, v_range, n_v,
-                             _Carrier(old_boundaries, boundaries, float(s["Fz"]), v_range),
-                             _crossings_of(curves, float(s["Fz"]))) for s in start["slices"]]
+        try:
+            if change:
+                raise NotWarm(f"the curves' arrangement changed on it: {change}")
+            slices.append(_carried_slice(old, config, params, v_range, n_v,
+                                         _Carrier(old_boundaries, boundaries, Fz, v_range), _crossings_of(curves, Fz)))
+        except NotWarm as exc:
+            again[Fz] = exc.reason
+    # regions between the new curves that no slice crosses: slices through them, as a cold map adds
+    loads_now = [float(s["Fz"]) for s in start["slices"]]
+    added: list[float] = []
+    for _ in range(COVERAGE_ROUNDS):
+        extra = map_shading.uncovered(loads_now, boundaries, rows, v_range, min_width=2.0 * tol,
+                                      min_area=COVERAGE_AREA * (v_range[1] - v_range[0]) * (fz_range[1] - fz_range[0]))
+        if not extra:
+            break
+        loads_now += extra
+        added += extra
+    fresh = sorted(again) + added
+    if fresh:
+        report(0.8, f"{len(fresh)} slice(s) where the arrangement of the curves changed")
+        units = [(2, SliceUnit(config, Fz, v_range, n_v, params, options)) for Fz in fresh]
+        run_dynamic(run_work_unit, units, executor, lambda unit, result: slices.append(result) or [],
+                    lambda f, m: report(0.8 + 0.15 * f, m), describe_work_unit)
+    slices.sort(key=lambda s: s.Fz)
+    report(0.95, "regions carried along the curves")
     for c in curves:
         c.curve.special_points = [q for q in c.curve.special_points if q.kind != PointKind.P2_MARK
                                   or not any(abs(q.data["p2"] - f) <= 1e-9 * f for f in marks[len(loads):])]
@@ -303,13 +330,19 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
                         resolution=resolution, n_v=n_v, options=options,
                         seeds=[CurveSeed.of(c, config.n_states) for c in curves],
                         warmed_from={"params": start["params"], "changed": _changed(old_params, params),
+                                     "slices": {"carried": len(start["slices"]) - len(again),
+                                                "computed_again": [{"Fz": Fz, "why": why} for Fz, why in
+                                                                   sorted(again.items())],
+                                                "added": added},
                                      "method": "Hopf curves computed afresh; each fold and torus curve continued "
                                                "again from a point of the nearby design's curve (Newton at its "
-                                               "load, then traced both ways); the arrangement of the curves "
-                                               "checked unchanged on every row and slice load; the slices' "
-                                               "intervals carried with the curves (ends on a curve to its new "
-                                               "crossing, mode changes at the same fraction of their interval), "
-                                               "their Hopf points scanned again"})
+                                               "load, then traced both ways), the curves' kinds, closure and "
+                                               "codimension-2 points checked unchanged; a slice whose load the "
+                                               "curves cross in the same order carried with them (an end on a "
+                                               "curve to its new crossing, a mode change kept in its interval), "
+                                               "its Hopf points scanned again; the others computed again, and "
+                                               "slices added through regions between the new curves that none "
+                                               "crosses"})
     smap.elapsed_s = time.perf_counter() - clock
     report(1.0, "done")
     return smap
