@@ -1,0 +1,74 @@
+"""Warm maps against cold maps (the live-maps issue's performance figures).
+
+    python benchmarks/bench_warm_maps.py [--configs nes,nes_pd] [--steps e_p,r2,k_s,a_p] [--repeats 1]
+
+For each configuration: its cold map at the nominal design (the cached one), then for each slider
+step (e_p +10 %, r2 -0.005 m, k_s +10 %, a_p +0.05) the cold map of the stepped design and its map
+warmed from the nominal one, in the same process on the same pool (default executor: one worker
+per core), ``--repeats`` times each, medians. Prints the seconds, the ratio warm / cold, how many
+slices the warm map carried / computed again / added, and the share of equal shading cells
+(warm against cold; the issue's bar: >= 99.5 %). Maps over V 1-200 m/s, Fz 10-900 kN, the
+default resolution and grid.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import time
+
+import numpy as np
+
+from shimmy.analyses.core.executors import describe, open_executor
+from shimmy.analyses.maps.stability_map import stability_map
+from shimmy.model.parameters import Parameters
+
+STEPS = {"e_p": lambda p: {"e_p": round(p.nes.e_p * 1.1, 10)}, "r2": lambda p: {"r2": round(p.nes.r2 - 0.005, 10)},
+         "k_s": lambda p: {"k_s": round(p.nes.k_s * 1.1, 10)}, "a_p": lambda p: {"a_p": round(p.pd.a_p + 0.05, 10)}}
+
+
+def timed(run):
+    clock = time.perf_counter()
+    out = run()
+    return time.perf_counter() - clock, out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--configs", default="original,nes,pd,nes_pd")
+    parser.add_argument("--steps", default=",".join(STEPS))
+    parser.add_argument("--repeats", type=int, default=1)
+    args = parser.parse_args()
+    print(f"machine: {os.cpu_count()} cores; executor: {describe()}")
+    print(f"{'config':8} {'step':5} {'cold s':>8} {'warm s':>8} {'ratio':>6} {'carried/again/added':>20} "
+          f"{'equal cells':>11}")
+    nominal = Parameters()
+    with open_executor() as pool:
+        stability_map("original", fz_range=(1.0e4, 3.0e4), resolution=3, executor=pool)  # workers warm
+        for config in args.configs.split(","):
+            base = stability_map(config, params=nominal, executor=pool)
+            start = json.loads(json.dumps(base.warm_start()))
+            for name in args.steps.split(","):
+                params = nominal.with_overrides(STEPS[name](nominal))
+                colds, warms = [], []
+                for _ in range(args.repeats):
+                    t, cold = timed(lambda: stability_map(config, params=params, executor=pool))
+                    colds.append(t)
+                    t, warm = timed(lambda: stability_map(config, params=params, executor=pool, warm_from=start))
+                    warms.append(t)
+                c, w = statistics.median(colds), statistics.median(warms)
+                info = warm.warmed_from
+                if info is None:
+                    slices = f"cold: {warm.warm_refused[:40]}"
+                else:
+                    s = info["slices"]
+                    slices = f"{s['carried']}/{len(s['computed_again'])}/{len(s['added'])}"
+                equal = float((np.array(cold.shading) == np.array(warm.shading)).mean())
+                print(f"{config:8} {name:5} {c:8.2f} {w:8.2f} {w / c:6.3f} {slices:>20} {100 * equal:10.2f}%",
+                      flush=True)
+
+
+if __name__ == "__main__":
+    main()
