@@ -25,6 +25,9 @@ TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overf
                "style_header": {"backgroundColor": "#eef2f8", "fontWeight": "600"}}
 
 
+#: What the plane shows until the runs are drawn (the page opens on the cached runs, else on this).
+WAITING = "Press Run: the four configurations' runs through this profile are drawn here."
+
 PSI_THR = Quantity("ground_run", "psi_threshold", "the shimmy threshold |psi|", "rad")
 LAT_THR = Quantity("ground_run", "lateral_threshold", "the shimmy threshold |l_g delta|", "mm", 1e-3)
 
@@ -80,7 +83,7 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
         html.Div(address, id=ids.GR_ADDRESS, className="error", role="alert"),  # what of the address is unusable
         html.Div(id=ids.GR_GROUP.error, className="error", role="alert"),
         html.Div(id=ids.GR_SUMMARY),
-        ui.graph(ids.GR_PLANE, figure=style.message_figure("Computing the take-off for the four configurations…")),
+        ui.graph(ids.GR_PLANE, figure=style.message_figure(WAITING)),
         ui.graph(ids.GR_TIME),
         ui.graph(ids.GR_SPEED),
         ui.downloads(ids.GR_GROUP),
@@ -176,11 +179,11 @@ def _notice(results):
 
 
 jobs.register(
-    ids.GR_GROUP, "ground_run", requests=_requests, initial=True, notice=_notice,
+    ids.GR_GROUP, "ground_run", requests=_requests, notice=_notice,
     render=lambda results: (plane(results[0]), envelopes(results, "t"), envelopes(results, "V"), summary(results)),
     outputs=[Output(ids.GR_PLANE, "figure"), Output(ids.GR_TIME, "figure"), Output(ids.GR_SPEED, "figure"),
              Output(ids.GR_SUMMARY, "children")],
-    triggers=[Input(ids.GR_CONFIG, "value")],
+    follow=[Input(ids.GR_CONFIG, "value")],  # which of the four runs' Hopf curves are drawn: starts nothing
     states=[State(ids.GR_PRESET, "value"), State(ids.GR_SETTINGS, "data"), State(ids.GR_TABLE, "data"),
             State(ids.GR_PRESET_ROWS, "data"), State(ids.GR_PSI_THR, "value"), State(ids.GR_LAT_THR, "value"),
             State(ids.design_store(ids.GR), "data")],

@@ -18,21 +18,37 @@ showed its result. At most
 ``MAX_PAGE_REQUESTS`` requests per action. The requests of the last answer are kept in a
 store so that the downloads serialise exactly what is drawn, from the cache (a download never
 computes).
+
+A page computes nothing on opening: it shows the cached answer to its controls, or waits for its
+run button. Its jobs are submitted on behalf of one action of this view of the page (a watcher
+token, :func:`shimmy.service.jobs.release`), and let go as soon as the page waits for them no more:
+when a later action of the page asks something else, when Cancel is pressed, and when the page is
+left (``assets/jobs.js`` posts them to :data:`RELEASE_PATH` on a navigation or as the page goes).
+The service then cancels the jobs nobody else waits for, so that they hold no job slot and nobody's
+next job queues behind them; a job another page or an API client waits for goes on.
 """
 
 from __future__ import annotations
 
+import uuid
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
 import dash
-from dash import Input, Output, State, dcc, html, no_update
+import flask
+from dash import ClientsideFunction, Input, Output, State, dcc, html, no_update
 
 from shimmy.errors import InvalidParameterError
 from shimmy.service import cache, jobs, schemas, settings
+from shimmy.service.api import RequestRefused, parse_json
 
-from . import components
+from . import components, ids as shell_ids
 from .ids import Group
+
+#: Where a page that is left lets its jobs go (under the app's path prefix; assets/jobs.js posts there).
+RELEASE_PATH = "_workbench/release"
+#: (job, watcher) pairs one post may let go (assets/jobs.js keeps as many per page view).
+MAX_RELEASED = 256
 
 
 def controls(group: Group, label: str = "Compute", interval: int = 400) -> list:
@@ -81,19 +97,22 @@ def canonical(analysis: str, wanted: Any) -> list[dict[str, Any]]:
 def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[str, Any]]],
              render: Callable[[list[dict[str, Any]]], tuple], outputs: Sequence[Output], states: Sequence[State],
              download: Download, lock: Sequence[str] = (), error: str | None = None,
-             triggers: Sequence[Input] = (), initial: bool | str = "cached",
+             triggers: Sequence[Input] = (), follow: Sequence[Input] = (),
              notice: Callable[[list[dict[str, Any]]], str] | None = None,
              blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None,
              labels: Callable[..., list[str]] | None = None) -> None:
     """Wire the job of one page.
 
-    ``requests(*trigger values, *state values)`` -> the analysis requests (may raise
+    ``requests(*trigger values, *follow values, *state values)`` -> the analysis requests (may raise
     InvalidParameterError); ``render(results)`` -> one value per entry of ``outputs``;
     ``lock`` are ids of controls disabled while the jobs run; ``error`` the id of the element
     that shows a refusal (the group's error line by default), ``notice(results)`` what it shows with a
-    result; ``triggers`` inputs that start a computation besides the run button. When the page
-    loads, ``initial="cached"`` shows the answer to the page's controls if the cache has it (and
-    computes nothing otherwise), ``True`` computes it, ``False`` does nothing. ``blank()`` -> the
+    result; ``triggers`` inputs that start a computation besides the run button (a user's action
+    on the page's own question: a typed speed, an operating point). ``follow`` are inputs the shown
+    answer follows: the cached answer to the new controls is shown, and the jobs being waited for
+    are asked again for them, but nothing starts from them alone (a choice the page shares with
+    other sections, or of what to draw). When the page loads it shows the answer to its controls if
+    the cache has it and computes nothing otherwise. ``blank()`` -> the
     outputs that replace a shown result when the controls are refused (the old result no longer
     answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay).
     ``labels(*values)`` -> a name for each request (the designs of a comparison): the results are then
@@ -120,30 +139,46 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         kept = wanted if labels is None else {"requests": wanted, "labels": names}
         return (*drawn, notice(results) if notice else "", kept, False, False) + idle + ("100", "")
 
-    @dash.callback(*outputs, *tail, *state, Input(group.run, "n_clicks"), *triggers, *states,
-                   prevent_initial_call=not initial)
+    following = {i.component_id for i in follow}
+    nothing = (no_update,) * (n_out + len(tail) + len(state))
+
+    @dash.callback(*outputs, *tail, *state, Input(group.run, "n_clicks"), *triggers, *follow, *states,
+                   State(group.go, "data"), prevent_initial_call=False)
     def dispatch(_n, *values):
-        """Answer at once when every result is cached; otherwise submit jobs and start reading them."""
-        loading = dash.ctx.triggered_id is None  # the page's first call, not a user's action
+        """Answer at once when every result is cached; otherwise, on the run button or a trigger,
+        submit jobs and start reading them. The jobs the page waited for until now and no longer
+        asks for are let go (after the new ones are submitted: one both ask for is never cancelled)."""
+        *values, previous = values
+        trigger = dash.ctx.triggered_id
+        loading = trigger is None  # the page's first call, not a user's action
+        before, before_watcher = _waiting(previous)[0], _watcher(previous)
+        waited = bool(before) and not previous.get("cancelled")
         try:
             wanted = canonical(analysis, requests(*values))
             names = None if labels is None else _names(labels(*values), wanted)
         except InvalidParameterError as exc:
             if loading:  # the layout already says what of the address could not be used
-                return (no_update,) * (n_out + len(tail) + len(state))
+                return nothing
+            _release(before, before_watcher)
             return refused(str(exc), clear=True)
         results = [cache.get(analysis, r) for r in wanted]
         if all(r is not None for r in results):
+            _release(before, before_watcher)
             return shown(results, wanted, names)
-        if loading and initial == "cached":
-            return (no_update,) * (n_out + len(tail) + len(state))
+        if loading or (trigger in following and not waited):  # nobody asked for a computation
+            return nothing
+        watcher, ids = uuid.uuid4().hex, []
         try:
-            ids = [jobs.submit_canonical(analysis, r)["id"] for r, done in zip(wanted, results, strict=True)
-                   if done is None]
+            for r, done in zip(wanted, results, strict=True):
+                if done is None:
+                    ids.append(jobs.submit_canonical(analysis, r, watcher)["id"])
         except jobs.QueueFull as exc:
+            _release(ids, watcher)
+            _release(before, before_watcher)
             return refused(f"The service is busy: {exc}.")
+        _release(before, before_watcher)
         busy = running() if running is not None else (no_update,) * n_out
-        go = {"jobs": ids, "requests": wanted, **({} if names is None else {"labels": names})}
+        go = {"jobs": ids, "requests": wanted, "watcher": watcher, **({} if names is None else {"labels": names})}
         return (tuple(busy) + (no_update,) * len(tail) + (go, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
@@ -151,15 +186,23 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
                    Input(group.poll, "n_intervals"), State(group.go, "data"), prevent_initial_call=True)
     def poll(_n, go):
         """Progress of the page's jobs; once every result is in the cache, the interval stops and
-        the ready store tells :func:`show` to draw them."""
+        the ready store tells :func:`show` to draw them. A poll that finds its jobs let go by a later
+        action of the page changes nothing: that action wrote the page's state."""
         ids, wanted = _waiting(go)
         if not ids:
             return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update, no_update)
+        watcher = _watcher(go)
+        if go.get("cancelled"):  # the Cancel button let them go; the poll says so (no late progress line after it)
+            return (*refused("", "cancelled"), no_update)
         current = [jobs.get(i) for i in ids]
+        if any(job is not None and _let_go(job, watcher) for job in current):
+            return nothing + (no_update,)
         for job in current:
             if job is None or job["status"] == "cancelled":
+                _release(ids, watcher)
                 return (*refused("", "cancelled"), no_update)
             if job["status"] == "failed":
+                _release(ids, watcher)
                 return (*refused(f"{job['request'].get('config') or analysis}: {job['error']}"), no_update)
         if all(job["status"] == "done" for job in current):  # drawn by show(), not in this tick
             return ((no_update,) * (n_out + len(tail)) + (no_update, True, no_update, True)
@@ -179,7 +222,7 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         """The results of the jobs the poll found done, drawn (once per ready signal)."""
         ids, wanted = _waiting(ready)
         if not ids:
-            return (no_update,) * (n_out + len(tail) + len(state))
+            return nothing
         try:  # the requests came back through the browser's JSON (150000.0 as 150000): canonical again
             wanted = canonical(analysis, wanted)
             names = None if labels is None else _names(ready.get("labels"), wanted)
@@ -192,14 +235,20 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
 
     @dash.callback(Output(group.cancel, "disabled", allow_duplicate=True),
                    Output(group.status, "children", allow_duplicate=True),
+                   Output(group.go, "data", allow_duplicate=True),
                    Input(group.cancel, "n_clicks"), State(group.go, "data"), prevent_initial_call=True)
     def cancel(_n, go):
-        """Cancel the jobs; the poll, the one writer of the page's job state, then says "cancelled" (a
-        poll already on its way cannot overwrite it with a progress line)."""
+        """Let the jobs go (the service cancels those nobody else waits for); the poll, the one writer
+        of the page's job state, then says "cancelled" (a poll already on its way cannot overwrite it
+        with a progress line)."""
         ids, _ = _waiting(go)
-        for job_id in ids:
-            jobs.cancel(job_id, remove=False)
-        return True, "cancelling…" if ids else "cancelled"
+        _release(ids, _watcher(go))
+        if not ids:
+            return True, "cancelled", no_update
+        return True, "cancelling…", {**go, "cancelled": True}
+
+    # The browser remembers the jobs the page waits for, to let them go when the page is left.
+    dash.clientside_callback(ClientsideFunction("jobs", "watch"), Input(group.go, "data"))
 
     @dash.callback(Output(files.download, "data"), Input(files.csv, "n_clicks"), Input(files.json, "n_clicks"),
                    State(store, "data"), prevent_initial_call=True)
@@ -250,6 +299,60 @@ def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
             or len(wanted) > settings.MAX_PAGE_REQUESTS or not all(isinstance(i, str) and len(i) < 64 for i in ids)):
         return [], []
     return ids, wanted
+
+
+def _watcher(go: Any) -> str | None:
+    """The token of the page view's action that submitted the store's jobs (None if there is none)."""
+    watcher = go.get("watcher") if isinstance(go, dict) else None
+    return watcher if isinstance(watcher, str) and 0 < len(watcher) <= 64 else None
+
+
+def _let_go(job: dict[str, Any], watcher: str | None) -> bool:
+    """The page view no longer waits for ``job``: a later action of the page let it go."""
+    return watcher is not None and not job.get("pinned", True) and watcher not in job.get("watchers", [])
+
+
+def _release(ids: Sequence[str], watcher: str | None) -> None:
+    """The page waits for these jobs no more (the service cancels those nobody else waits for)."""
+    if watcher is not None:
+        for job_id in ids:
+            jobs.release(job_id, watcher)
+
+
+def released(body: Any) -> list[tuple[str, str]]:
+    """The (job id, watcher) pairs of a release post (as the browser sent it: checked, never trusted)."""
+    pairs = body.get("jobs") if isinstance(body, dict) else None
+    if not isinstance(pairs, list) or len(pairs) > MAX_RELEASED:
+        raise RequestRefused("jobs must list the jobs to let go", "jobs",
+                             f"a list of at most {MAX_RELEASED} {{id, watcher}} objects")
+    out = []
+    for k, pair in enumerate(pairs):
+        job_id = pair.get("id") if isinstance(pair, dict) else None
+        watcher = _watcher(pair)
+        if not (isinstance(job_id, str) and 0 < len(job_id) <= 64 and watcher is not None):
+            raise RequestRefused(f"jobs[{k}] is not an {{id, watcher}} object of two short strings", f"jobs[{k}]",
+                                 "an object with an id and a watcher of 1 to 64 characters")
+        out.append((job_id, watcher))
+    return out
+
+
+def install(app) -> None:
+    """The route by which a page that is left lets its jobs go (assets/jobs.js posts there), and the
+    leave signal of a navigation inside the app (Dash Pages replaces the page without unloading it)."""
+
+    def release_route():
+        try:
+            pairs = released(parse_json(flask.request))
+        except RequestRefused as exc:
+            return exc.response()
+        for job_id, watcher in pairs:
+            jobs.release(job_id, watcher)
+        return flask.Response(status=204)
+
+    app.server.add_url_rule(app.config.routes_pathname_prefix + RELEASE_PATH, "workbench_release", release_route,
+                            methods=["POST"])
+    app.clientside_callback(ClientsideFunction("jobs", "left"), Input(shell_ids.PAGES_LOCATION, "pathname"),
+                            Input(shell_ids.PAGES_LOCATION, "search"), prevent_initial_call=True)
 
 
 def _duplicate(output: Output) -> Output:

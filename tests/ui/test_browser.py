@@ -16,7 +16,8 @@ from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
-from browser import DOWNLOADS, PAGES, SHOTS, browser_fixture, idle, severe, trace_count, wait_for  # noqa: E402
+from browser import (DOWNLOADS, PAGES, SHOTS, browser_fixture, idle, job_records, on_figure, severe,  # noqa: E402
+                     text_of, trace_count, wait_for)
 
 browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)
 
@@ -41,6 +42,83 @@ def test_every_page_loads_without_console_errors(server, browser, name):
         assert not panel.is_displayed()
     else:
         assert "Design" in panel.text
+
+
+def test_opening_ground_run_and_decisions_starts_no_job_and_run_computes(server, browser):
+    """Pages compute nothing long on opening: the cached answer, else a Run button. Requests no
+    other test asks for (a taxi with its own threshold; NES at 170 kN), so nothing is cached."""
+    before = set(job_records(server))
+    browser.get(server.base + "/ground-run?preset=taxi&psi_thr=0.0123")
+    wait_for(lambda: "taxi preset" in text_of(browser, "gr-source"), what="the taxi preset")
+    browser.get(server.base + "/design?config=nes&Fz=170")
+    wait_for(lambda: "Press Compute" in text_of(browser, "sens-charts"), what="the sensitivities waiting for Compute")
+    idle(browser)
+    time.sleep(2.0)  # a job submitted on opening would be in the store by now
+    assert set(job_records(server)) == before
+    browser.get(server.base + "/ground-run?preset=taxi&psi_thr=0.0123")
+    wait_for(lambda: "Press Run" in text_of(browser, "gr-plane"), what="the ground run waiting for Run")
+    idle(browser)
+    time.sleep(1.0)
+    assert set(job_records(server)) == before
+    assert browser.find_element(By.ID, "gr-run").is_enabled() and text_of(browser, "gr-status") == ""
+    assert severe(browser) == []
+
+    # Compute then computes and draws (the sensitivities: seconds; the ground run's Run: test_browser_ground_run.py).
+    browser.get(server.base + "/design?config=nes&Fz=170")
+    wait_for(lambda: "Press Compute" in text_of(browser, "sens-charts"), what="the sensitivities waiting for Compute")
+    idle(browser)
+    browser.find_element(By.ID, "sens-run").click()
+    bars = wait_for(lambda: on_figure(browser, "sens-hopf_V1", "return g.data[0].y;"), timeout=120,
+                    what="the tornado chart of the first Hopf speed")
+    assert sorted(bars) == ["e_p (m)", "k_s (N/m)", "r2 (m)", "r3 (m)"]  # the NES's parameters
+    new = [j for i, j in job_records(server).items() if i not in before]
+    assert [(j["analysis"], j["request"]["config"], j["request"]["Fz"], j["status"]) for j in new] == [
+        ("sensitivity", "nes", 170000.0, "done")]
+    # Opened again: the cached charts at once, no job.
+    browser.get(server.base + "/design?config=nes&Fz=170")
+    wait_for(lambda: on_figure(browser, "sens-hopf_V1", "return g.data[0].y;"), timeout=20, what="the cached charts")
+    idle(browser)
+    assert len(job_records(server)) == len(before) + 1
+    assert severe(browser) == []
+
+
+def _active(server, ids) -> list[str]:
+    """Those of ``ids`` still queued or running (the read reaps what is gone)."""
+    server.request("GET", "/api/v1/jobs/none")
+    records = job_records(server)
+    return [i for i in ids if records.get(i, {}).get("status") in ("queued", "running")]
+
+
+def test_leaving_a_page_cancels_the_jobs_it_started(server, browser):
+    """Left by loading another page, or by a navigation inside the app (Back after a pushed
+    address: Dash Pages replaces the page without unloading it), the page's jobs nobody else
+    waits for are cancelled and give up their slots."""
+    before = set(job_records(server))
+    browser.get(server.base + "/ground-run?preset=taxi&psi_thr=0.0124")
+    wait_for(lambda: "taxi preset" in text_of(browser, "gr-source"), what="the taxi preset")
+    idle(browser)
+    browser.find_element(By.ID, "gr-run").click()
+    started = wait_for(lambda: len(new := [i for i in job_records(server) if i not in before]) == 4 and new,
+                       timeout=20, what="the four ground runs")
+    assert _active(server, started)
+    browser.get(server.base + "/api")  # another page: this one unloads
+    wait_for(lambda: not _active(server, started), timeout=20, what="the ground runs to be cancelled")
+    assert {job_records(server)[i]["status"] for i in started} <= {"cancelled", "done"}
+    assert "cancelled" in {job_records(server)[i]["status"] for i in started}
+
+    before = set(job_records(server))
+    browser.get(server.base + "/stability-map?shade=nes&fz_min=120&fz_max=480&resolution=8")
+    run = wait_for(lambda: browser.find_elements(By.ID, "map-run"), what="the Compute button")[0]
+    idle(browser)
+    run.click()
+    started = wait_for(lambda: [i for i in job_records(server) if i not in before], timeout=20, what="the map job")
+    assert _active(server, started)
+    browser.execute_script("history.pushState(null, '', '/devices'); dispatchEvent(new PopStateEvent('popstate'));")
+    wait_for(lambda: browser.find_elements(By.ID, "dev-pd"), timeout=20, what="the Devices page")
+    wait_for(lambda: not _active(server, started), timeout=20, what="the map job to be cancelled")
+    assert job_records(server)[started[0]]["status"] == "cancelled"
+    assert job_records(server)[started[0]]["message"] == "cancelled: nobody waits for it any more"
+    assert severe(browser) == []
 
 
 # Null until Plotly has drawn the figure (the table can render first): tests wait on it, never read it raw.
