@@ -100,7 +100,7 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
              triggers: Sequence[Input] = (), follow: Sequence[Input] = (),
              notice: Callable[[list[dict[str, Any]]], str] | None = None,
              blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None,
-             labels: Callable[..., list[str]] | None = None) -> None:
+             waiting: Callable[[], tuple] | None = None, labels: Callable[..., list[str]] | None = None) -> None:
     """Wire the job of one page.
 
     ``requests(*trigger values, *follow values, *state values)`` -> the analysis requests (may raise
@@ -114,7 +114,9 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
     other sections, or of what to draw). When the page loads it shows the answer to its controls if
     the cache has it and computes nothing otherwise. ``blank()`` -> the
     outputs that replace a shown result when the controls are refused (the old result no longer
-    answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay).
+    answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay),
+    and ``waiting()`` those of a page waiting for its button (as its layout has them), shown in their
+    place when the jobs end without a result (cancelled, failed).
     ``labels(*values)`` -> a name for each request (the designs of a comparison): the results are then
     drawn by ``render(results, names)`` and tabulated by ``download.rows(results, names)``, and the
     requests store holds {"requests", "labels"}.
@@ -133,6 +135,12 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         if clear and blank is not None:
             return (*blank(), message, None, True, True) + idle + ("0", status)
         return (no_update,) * n_out + (message, no_update, no_update, no_update) + idle + ("0", status)
+
+    def stopped(message: str, status: str = "") -> tuple:
+        """The jobs ended without a result: what running() put in place of the old outputs goes too."""
+        if running is not None and waiting is not None:
+            return (*waiting(), message, None, True, True) + idle + ("0", status)
+        return refused(message, status)
 
     def shown(results: list[dict[str, Any]], wanted: list[dict[str, Any]], names: list[str] | None) -> tuple:
         drawn = render(results) if labels is None else render(results, names)
@@ -193,17 +201,17 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
             return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update, no_update)
         watcher = _watcher(go)
         if go.get("cancelled"):  # the Cancel button let them go; the poll says so (no late progress line after it)
-            return (*refused("", "cancelled"), no_update)
+            return (*stopped("", "cancelled"), no_update)
         current = [jobs.get(i) for i in ids]
         if any(job is not None and _let_go(job, watcher) for job in current):
             return nothing + (no_update,)
         for job in current:
             if job is None or job["status"] == "cancelled":
                 _release(ids, watcher)
-                return (*refused("", "cancelled"), no_update)
+                return (*stopped("", "cancelled"), no_update)
             if job["status"] == "failed":
                 _release(ids, watcher)
-                return (*refused(f"{job['request'].get('config') or analysis}: {job['error']}"), no_update)
+                return (*stopped(f"{job['request'].get('config') or analysis}: {job['error']}"), no_update)
         if all(job["status"] == "done" for job in current):  # drawn by show(), not in this tick
             return ((no_update,) * (n_out + len(tail)) + (no_update, True, no_update, True)
                     + (no_update,) * len(lock) + ("100", "drawing the results…", {**go, "tick": _n}))

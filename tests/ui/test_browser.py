@@ -94,12 +94,14 @@ def test_leaving_a_page_cancels_the_jobs_it_started(server, browser):
     address: Dash Pages replaces the page without unloading it), the page's jobs nobody else
     waits for are cancelled and give up their slots."""
     before = set(job_records(server))
-    browser.get(server.base + "/ground-run?preset=taxi&psi_thr=0.0124")
-    wait_for(lambda: "taxi preset" in text_of(browser, "gr-source"), what="the taxi preset")
+    browser.get(server.base + "/ground-run?psi_thr=0.0124&r2=0.0813")  # a design of its own: its Hopf curves too
+    wait_for(lambda: "take-off preset" in text_of(browser, "gr-source"), what="the take-off preset")
     idle(browser)
     browser.find_element(By.ID, "gr-run").click()
     started = wait_for(lambda: len(new := [i for i in job_records(server) if i not in before]) == 4 and new,
                        timeout=20, what="the four ground runs")
+    # The page knows its jobs once its Run has been answered (a page left before that cannot name them).
+    wait_for(lambda: "analyses" in text_of(browser, "gr-status"), timeout=20, what="the page reading its jobs")
     assert _active(server, started)
     browser.get(server.base + "/api")  # another page: this one unloads
     wait_for(lambda: not _active(server, started), timeout=20, what="the ground runs to be cancelled")
@@ -112,12 +114,32 @@ def test_leaving_a_page_cancels_the_jobs_it_started(server, browser):
     idle(browser)
     run.click()
     started = wait_for(lambda: [i for i in job_records(server) if i not in before], timeout=20, what="the map job")
+    wait_for(lambda: text_of(browser, "map-status"), timeout=20, what="the page reading its job")
     assert _active(server, started)
     browser.execute_script("history.pushState(null, '', '/devices'); dispatchEvent(new PopStateEvent('popstate'));")
     wait_for(lambda: browser.find_elements(By.ID, "dev-pd"), timeout=20, what="the Devices page")
     wait_for(lambda: not _active(server, started), timeout=20, what="the map job to be cancelled")
     assert job_records(server)[started[0]]["status"] == "cancelled"
     assert job_records(server)[started[0]]["message"] == "cancelled: nobody waits for it any more"
+    assert severe(browser) == []
+
+
+def test_cancel_lets_the_jobs_go_and_the_page_waits_for_run_again(server, browser):
+    before = set(job_records(server))
+    browser.get(server.base + "/ground-run?preset=taxi&psi_thr=0.0125")
+    wait_for(lambda: "taxi preset" in text_of(browser, "gr-source"), what="the taxi preset")
+    idle(browser)
+    browser.find_element(By.ID, "gr-run").click()
+    wait_for(lambda: "Running the four configurations" in text_of(browser, "gr-plane"), timeout=20,
+             what="the plane saying the runs are under way")
+    started = wait_for(lambda: len(new := [i for i in job_records(server) if i not in before]) == 4 and new,
+                       timeout=20, what="the four ground runs")
+    wait_for(lambda: browser.find_element(By.ID, "gr-cancel").is_enabled(), timeout=20, what="Cancel enabled")
+    browser.find_element(By.ID, "gr-cancel").click()
+    wait_for(lambda: text_of(browser, "gr-status") == "cancelled", timeout=20, what='"cancelled"')
+    assert "Press Run" in text_of(browser, "gr-plane")  # not "Running ..." for runs that were cancelled
+    assert browser.find_element(By.ID, "gr-run").is_enabled()
+    wait_for(lambda: not _active(server, started), timeout=20, what="the ground runs to be cancelled")
     assert severe(browser) == []
 
 

@@ -21,6 +21,9 @@ QUANTITIES = {"hopf_V1": ("Hopf speed V1 at {kN} kN", "V1", "m/s", 1.0),
 BARS = {"per_half_range": "per half design range", "per_percent": "per +1 % of the value"}
 SHOWN = {"device": "device parameters", "all": "all parameters"}
 WAITING = "Press Compute: the tornado charts appear here (about 2 s; at once when the cache has them)."
+COMPUTING = "Computing the sensitivities (about 2 s once a job slot is free)…"
+#: What the charts' store holds while the job runs (in place of a result's rows).
+RUNNING = {"computing": True}
 
 
 def section(a) -> list:
@@ -88,7 +91,7 @@ jobs.register(
     states=[State(ids.design_store(ids.DES), "data")],
     download=jobs.Download(ids.SENS, "sensitivities", _csv, single=True,
                            filename=lambda r: f"sensitivities_{r[0]['config']}_{r[0]['Fz'] / 1e3:g}kN"),
-    blank=lambda: (None, ""))
+    blank=lambda: (None, ""), running=lambda: (RUNNING, ""), waiting=lambda: (None, ""))
 
 
 def _no_effect(rows) -> html.Div | None:
@@ -142,6 +145,8 @@ def draw_sensitivities(data, by, shown):
     """One tornado chart per quantity, the parameters without effect under it."""
     if not data:
         return placeholder(WAITING)
+    if data == RUNNING:
+        return placeholder(COMPUTING)
     by = by if by in BARS else "per_half_range"
     charts = []
     for q in data["quantities"]:
