@@ -30,6 +30,8 @@ next job queues behind them; a job another page or an API client waits for goes 
 
 from __future__ import annotations
 
+import math
+import time
 import uuid
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
@@ -100,7 +102,9 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
              triggers: Sequence[Input] = (), follow: Sequence[Input] = (),
              notice: Callable[[list[dict[str, Any]]], str] | None = None,
              blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None,
-             waiting: Callable[[], tuple] | None = None, labels: Callable[..., list[str]] | None = None) -> None:
+             waiting: Callable[[], tuple] | None = None,
+             clock: Callable[[float, str], tuple] | None = None,
+             labels: Callable[..., list[str]] | None = None) -> None:
     """Wire the job of one page.
 
     ``requests(*trigger values, *follow values, *state values)`` -> the analysis requests (may raise
@@ -116,7 +120,10 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
     outputs that replace a shown result when the controls are refused (the old result no longer
     answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay),
     and ``waiting()`` those of a page waiting for its button (as its layout has them), shown in their
-    place when the jobs end without a result (cancelled, failed).
+    place when the jobs end without a result (cancelled, failed). ``clock(seconds, asked)`` -> the
+    outputs shown while the jobs run, redrawn at every read of their progress with the seconds since
+    they were asked for and what was asked, in words (a long run the user watches being made; in
+    place of ``running()``).
     ``labels(*values)`` -> a name for each request (the designs of a comparison): the results are then
     drawn by ``render(results, names)`` and tabulated by ``download.rows(results, names)``, and the
     requests store holds {"requests", "labels"}.
@@ -138,7 +145,7 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
 
     def stopped(message: str, status: str = "") -> tuple:
         """The jobs ended without a result: what running() put in place of the old outputs goes too."""
-        if running is not None and waiting is not None:
+        if (running is not None or clock is not None) and waiting is not None:
             return (*waiting(), message, None, True, True) + idle + ("0", status)
         return refused(message, status)
 
@@ -185,14 +192,17 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
             _release(before, before_watcher)
             return refused(f"The service is busy: {exc}.")
         _release(before, before_watcher)
-        busy = running() if running is not None else (no_update,) * n_out
-        go = {"jobs": ids, "requests": wanted, "watcher": watcher, **({} if names is None else {"labels": names})}
+        busy = (clock(0.0, _asked(wanted)) if clock is not None else running() if running is not None
+                else (no_update,) * n_out)
+        go = {"jobs": ids, "requests": wanted, "watcher": watcher, "asked": time.time(),
+              **({} if names is None else {"labels": names})}
         return (tuple(busy) + (no_update,) * len(tail) + (go, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Output(group.ready, "data"),
-                   Input(group.poll, "n_intervals"), State(group.go, "data"), prevent_initial_call=True)
-    def poll(_n, go):
+                   Input(group.poll, "n_intervals"), State(group.go, "data"), State(group.progress, "value"),
+                   prevent_initial_call=True)
+    def poll(_n, go, shown_progress):
         """Progress of the page's jobs; once every result is in the cache, the interval stops and
         the ready store tells :func:`show` to draw them. A poll that finds its jobs let go by a later
         action of the page changes nothing: that action wrote the page's state."""
@@ -215,14 +225,18 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         if all(job["status"] == "done" for job in current):  # drawn by show(), not in this tick
             return ((no_update,) * (n_out + len(tail)) + (no_update, True, no_update, True)
                     + (no_update,) * len(lock) + ("100", "drawing the results…", {**go, "tick": _n}))
-        fraction = sum(job["progress"] if job["status"] == "running" else 0.0 for job in current) / len(current)
+        # a finished job counts whole, a queued one nothing; the bar never goes back within a run
+        fraction = sum(_fraction(job) for job in current) / len(current)
+        fraction = max(fraction, min(_number(shown_progress) / 100, 1.0))
         first = next(job for job in current if job["status"] != "done")
         label = first["request"].get("config") or analysis
         done = sum(job["status"] == "done" for job in current)
         of = f" [{done} of {len(current)} analyses done]" if len(current) > 1 else ""
         status = (f"{label}: {first['message']}{of}" if first["status"] == "running"
                   else f"{label}: queued ({jobs.counts()['running']} analyses running){of}")
-        return (no_update,) * (n_out + len(tail) + len(state) - 2) + (str(int(100 * fraction)), status, no_update)
+        since = _since(go.get("asked"))
+        drawn = clock(since, _asked(wanted)) if clock is not None and since is not None else (no_update,) * n_out
+        return (*drawn, *(no_update,) * (len(tail) + len(state) - 2), str(int(100 * fraction)), status, no_update)
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(group.ready, "data"),
                    prevent_initial_call=True)
@@ -292,10 +306,12 @@ def _names(names: Any, wanted: list[dict[str, Any]]) -> list[str]:
 
 def _asked(wanted: list[dict[str, Any]]) -> str:
     """What was asked, in the page's words: the configurations (and a map's slices as asked)."""
-    configs = [r.get("config") for r in wanted if r.get("config")]
-    slices = {r.get("resolution") for r in wanted if r.get("resolution") is not None}
+    wanted = [r for r in wanted if isinstance(r, dict)]  # the poll's come back through the browser
+    configs = [str(r["config"])[:40] for r in wanted if r.get("config")]
+    slices = {str(r["resolution"])[:8] for r in wanted if r.get("resolution") is not None}
     what = ", ".join(configs) if configs else f"{len(wanted)} analysis" + ("" if len(wanted) == 1 else "es")
-    return what + (f", {slices.pop()} Fz slices each" if len(slices) == 1 else "")
+    each = " each" if len(wanted) > 1 else ""
+    return what + (f", {slices.pop()} Fz slices{each}" if len(slices) == 1 else "")
 
 
 def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
@@ -307,6 +323,27 @@ def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
             or len(wanted) > settings.MAX_PAGE_REQUESTS or not all(isinstance(i, str) and len(i) < 64 for i in ids)):
         return [], []
     return ids, wanted
+
+
+def _fraction(job: dict[str, Any]) -> float:
+    """How much of ``job`` is done: 1 once done, its reported progress while it runs, 0 queued."""
+    return 1.0 if job["status"] == "done" else job["progress"] if job["status"] == "running" else 0.0
+
+
+def _since(asked: Any) -> float | None:
+    """Seconds since ``asked`` (a time the page's store sent back), or None if it is not one."""
+    if isinstance(asked, bool) or not isinstance(asked, (int, float)) or not 0 < asked <= time.time():
+        return None
+    return time.time() - asked
+
+
+def _number(value: Any) -> float:
+    """A finite number the browser sent back (the progress bar's value, a time), else 0."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        return 0.0
+    return x if math.isfinite(x) else 0.0
 
 
 def _watcher(go: Any) -> str | None:

@@ -206,8 +206,19 @@ def test_map_click_opens_the_time_history_at_that_point(server, browser):
     run.click()
     wait_for(lambda: browser.find_element(By.ID, "map-status").text or None, timeout=30, interval=0.05,
              what="a progress message")
-    rows = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"), timeout=180,
-                    what="the map's summary table")
+    # Watched being made: the figure says what is computed and for how long, the bar never goes back
+    # (two maps: one finishing first counts whole, not as nothing).
+    bars, figures = [], set()
+    while not browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"):
+        assert len(bars) < 900, "the map's summary table after 180 s"
+        bars.append(float(browser.find_element(By.ID, "map-progress").get_attribute("value")))
+        figures.add(text_of(browser, "map-graph"))
+        time.sleep(0.2)
+    assert bars == sorted(bars), bars
+    computing = {t for t in figures if "Computing the map (original, nes, 4 Fz slices each)" in t}
+    assert len(computing) >= 2 and all("so far" in t for t in computing)  # the seconds go on
+    assert not any("Press Compute" in t for t in figures)
+    rows = browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr")
     assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["original", "NES"]
     wait_for(lambda: trace_count(browser, "map-graph") > 8, what="the map's traces")
     idle(browser)
