@@ -32,10 +32,11 @@ server = app.server
 server.config["MAX_CONTENT_LENGTH"] = settings.MAX_BODY_BYTES
 server.register_blueprint(api)
 
-from ui import guard, layout  # noqa: E402  (needs the registered pages)
+from ui import guard, jobs, layout  # noqa: E402  (needs the registered pages)
 
 app.layout = layout.shell()
 guard.install(app)
+jobs.install(app)
 
 # Dash sets itself up on a worker's first request (copying the registered callbacks into its map);
 # two first requests on a threaded worker raced there ("dictionary changed size during iteration",

@@ -25,6 +25,16 @@ TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overf
                "style_header": {"backgroundColor": "#eef2f8", "fontWeight": "600"}}
 
 
+#: What the plane shows until the runs are drawn (the page opens on the cached runs, else on this).
+WAITING = "Press Run: the four configurations' runs through this profile are drawn here."
+RUNNING = "Running the four configurations through the profile (progress above the tables)…"
+
+
+def _placeholders(text: str) -> tuple:
+    """The plane saying ``text`` and the two envelope figures empty (no bare axes), for the four outputs."""
+    empty = style.message_figure("", 40)
+    return style.message_figure(text), empty, empty, ""
+
 PSI_THR = Quantity("ground_run", "psi_threshold", "the shimmy threshold |psi|", "rad")
 LAT_THR = Quantity("ground_run", "lateral_threshold", "the shimmy threshold |l_g delta|", "mm", 1e-3)
 
@@ -36,6 +46,7 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
     psi_value, bad_psi = PSI_THR.from_url("psi_thr", psi_thr, 0.01)
     lat_value, bad_lat = LAT_THR.from_url("lat_thr", lat_thr, 1.0)
     address = " ".join(m for m in (bad_preset, bad_config, bad_psi, bad_lat) if m)
+    plane_figure, by_time, by_speed, _ = _placeholders(WAITING)
     return page(
         query, ids.GR,
         ui.header("Ground run", "The gear through a take-off, a landing roll or a taxi: forward speed and nose-gear "
@@ -80,9 +91,9 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
         html.Div(address, id=ids.GR_ADDRESS, className="error", role="alert"),  # what of the address is unusable
         html.Div(id=ids.GR_GROUP.error, className="error", role="alert"),
         html.Div(id=ids.GR_SUMMARY),
-        ui.graph(ids.GR_PLANE, figure=style.message_figure("Computing the take-off for the four configurations…")),
-        ui.graph(ids.GR_TIME),
-        ui.graph(ids.GR_SPEED),
+        ui.graph(ids.GR_PLANE, figure=plane_figure),
+        ui.graph(ids.GR_TIME, figure=by_time),
+        ui.graph(ids.GR_SPEED, figure=by_speed),
         ui.downloads(ids.GR_GROUP),
         *jobs.stores(ids.GR_GROUP),
         dcc.Store(id=ids.GR_PRESET_ROWS),
@@ -176,11 +187,12 @@ def _notice(results):
 
 
 jobs.register(
-    ids.GR_GROUP, "ground_run", requests=_requests, initial=True, notice=_notice,
+    ids.GR_GROUP, "ground_run", requests=_requests, notice=_notice, running=lambda: _placeholders(RUNNING),
+    waiting=lambda: _placeholders(WAITING),
     render=lambda results: (plane(results[0]), envelopes(results, "t"), envelopes(results, "V"), summary(results)),
     outputs=[Output(ids.GR_PLANE, "figure"), Output(ids.GR_TIME, "figure"), Output(ids.GR_SPEED, "figure"),
              Output(ids.GR_SUMMARY, "children")],
-    triggers=[Input(ids.GR_CONFIG, "value")],
+    follow=[Input(ids.GR_CONFIG, "value")],  # which of the four runs' Hopf curves are drawn: starts nothing
     states=[State(ids.GR_PRESET, "value"), State(ids.GR_SETTINGS, "data"), State(ids.GR_TABLE, "data"),
             State(ids.GR_PRESET_ROWS, "data"), State(ids.GR_PSI_THR, "value"), State(ids.GR_LAT_THR, "value"),
             State(ids.design_store(ids.GR), "data")],

@@ -117,8 +117,16 @@ def _csv_rows(results):
     return ["config", "Fz_N", "V_m_s", "shimmy_type"], rows
 
 
+def _computing(seconds: float, asked: str) -> tuple:
+    """The figure while the map is made: what is computed and for how long so far (the step under
+    way and the progress are in the line above it)."""
+    so_far = f"{seconds:.0f} s" if seconds < 60 else f"{int(seconds) // 60} min {int(seconds) % 60:02d} s"
+    return style.message_figure(f"Computing the map ({asked}): {so_far} so far…", 600), None
+
+
 jobs.register(
     ids.MAP_GROUP, "map", requests=_requests, render=lambda results: (figure(results), summary(results)),
+    clock=_computing, waiting=lambda: (style.message_figure(WAITING, 600), None),
     outputs=[Output(ids.MAP_GRAPH, "figure"), Output(ids.MAP_TABLE, "children")], states=CONTROLS,
     lock=[ids.MAP_SHADE, ids.MAP_RES, ids.MAP_FZMIN, ids.MAP_FZMAX, ids.MAP_VMIN, ids.MAP_VMAX],
     download=jobs.Download(ids.MAP_GROUP, "stability_map", _csv_rows),

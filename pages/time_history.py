@@ -130,7 +130,7 @@ def _file_stem(results):
 
 jobs.register(
     ids.TH_GROUP, "simulate", requests=_requests, blank=lambda: (*_placeholders("Refused: see the message above"), ""),
-    running=lambda: (*_placeholders("Running the time history…"), ""),
+    running=lambda: (*_placeholders("Running the time history…"), ""), waiting=lambda: (*_placeholders(), ""),
     render=lambda results: (*_figures(results[0]), _metrics(results[0]), settled(results[0])),
     notice=lambda results: "" if results[0]["success"] else results[0]["message"],
     outputs=[Output(ids.TH_SERIES, "figure"), Output(ids.TH_SPECTRUM, "figure"), Output(ids.TH_PHASE, "figure"),

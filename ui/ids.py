@@ -85,6 +85,8 @@ class Group:
 
 # -- the shell and the design panel (every page) -----------------------------------------------------------
 
+#: dash.page_container's Location: Dash Pages' router replaces the page when its path or query changes.
+PAGES_LOCATION = "_pages_location"
 URL_UPDATE = "url-update"  # a page's partial updates of the address
 URL_SINK = "url-sink"  # the address as the updater left it
 DESIGN_TOGGLE = "design-toggle"

@@ -18,21 +18,39 @@ showed its result. At most
 ``MAX_PAGE_REQUESTS`` requests per action. The requests of the last answer are kept in a
 store so that the downloads serialise exactly what is drawn, from the cache (a download never
 computes).
+
+A page computes nothing on opening: it shows the cached answer to its controls, or waits for its
+run button. Its jobs are submitted on behalf of one action of this view of the page (a watcher
+token, :func:`shimmy.service.jobs.release`), and let go as soon as the page waits for them no more:
+when a later action of the page asks something else, when Cancel is pressed, and when the page is
+left (``assets/jobs.js`` posts them to :data:`RELEASE_PATH` on a navigation or as the page goes).
+The service then cancels the jobs nobody else waits for, so that they hold no job slot and nobody's
+next job queues behind them; a job another page or an API client waits for goes on.
 """
 
 from __future__ import annotations
 
+import math
+import time
+import uuid
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
 import dash
-from dash import Input, Output, State, dcc, html, no_update
+import flask
+from dash import ClientsideFunction, Input, Output, State, dcc, html, no_update
 
 from shimmy.errors import InvalidParameterError
 from shimmy.service import cache, jobs, schemas, settings
+from shimmy.service.api import RequestRefused, parse_json
 
-from . import components
+from . import components, ids as shell_ids
 from .ids import Group
+
+#: Where a page that is left lets its jobs go (under the app's path prefix; assets/jobs.js posts there).
+RELEASE_PATH = "_workbench/release"
+#: (job, watcher) pairs one post may let go (assets/jobs.js keeps as many per page view).
+MAX_RELEASED = 256
 
 
 def controls(group: Group, label: str = "Compute", interval: int = 400) -> list:
@@ -81,21 +99,31 @@ def canonical(analysis: str, wanted: Any) -> list[dict[str, Any]]:
 def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[str, Any]]],
              render: Callable[[list[dict[str, Any]]], tuple], outputs: Sequence[Output], states: Sequence[State],
              download: Download, lock: Sequence[str] = (), error: str | None = None,
-             triggers: Sequence[Input] = (), initial: bool | str = "cached",
+             triggers: Sequence[Input] = (), follow: Sequence[Input] = (),
              notice: Callable[[list[dict[str, Any]]], str] | None = None,
              blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None,
+             waiting: Callable[[], tuple] | None = None,
+             clock: Callable[[float, str], tuple] | None = None,
              labels: Callable[..., list[str]] | None = None) -> None:
     """Wire the job of one page.
 
-    ``requests(*trigger values, *state values)`` -> the analysis requests (may raise
+    ``requests(*trigger values, *follow values, *state values)`` -> the analysis requests (may raise
     InvalidParameterError); ``render(results)`` -> one value per entry of ``outputs``;
     ``lock`` are ids of controls disabled while the jobs run; ``error`` the id of the element
     that shows a refusal (the group's error line by default), ``notice(results)`` what it shows with a
-    result; ``triggers`` inputs that start a computation besides the run button. When the page
-    loads, ``initial="cached"`` shows the answer to the page's controls if the cache has it (and
-    computes nothing otherwise), ``True`` computes it, ``False`` does nothing. ``blank()`` -> the
+    result; ``triggers`` inputs that start a computation besides the run button (a user's action
+    on the page's own question: a typed speed, an operating point). ``follow`` are inputs the shown
+    answer follows: the cached answer to the new controls is shown, and the jobs being waited for
+    are asked again for them, but nothing starts from them alone (a choice the page shares with
+    other sections, or of what to draw). When the page loads it shows the answer to its controls if
+    the cache has it and computes nothing otherwise. ``blank()`` -> the
     outputs that replace a shown result when the controls are refused (the old result no longer
-    answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay).
+    answers them); ``running()`` -> the outputs shown while the jobs run (default: the old ones stay),
+    and ``waiting()`` those of a page waiting for its button (as its layout has them), shown in their
+    place when the jobs end without a result (cancelled, failed). ``clock(seconds, asked)`` -> the
+    outputs shown while the jobs run, redrawn at every read of their progress with the seconds since
+    they were asked for and what was asked, in words (a long run the user watches being made; in
+    place of ``running()``).
     ``labels(*values)`` -> a name for each request (the designs of a comparison): the results are then
     drawn by ``render(results, names)`` and tabulated by ``download.rows(results, names)``, and the
     requests store holds {"requests", "labels"}.
@@ -115,63 +143,100 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
             return (*blank(), message, None, True, True) + idle + ("0", status)
         return (no_update,) * n_out + (message, no_update, no_update, no_update) + idle + ("0", status)
 
+    def stopped(message: str, status: str = "") -> tuple:
+        """The jobs ended without a result: what running() put in place of the old outputs goes too."""
+        if (running is not None or clock is not None) and waiting is not None:
+            return (*waiting(), message, None, True, True) + idle + ("0", status)
+        return refused(message, status)
+
     def shown(results: list[dict[str, Any]], wanted: list[dict[str, Any]], names: list[str] | None) -> tuple:
         drawn = render(results) if labels is None else render(results, names)
         kept = wanted if labels is None else {"requests": wanted, "labels": names}
         return (*drawn, notice(results) if notice else "", kept, False, False) + idle + ("100", "")
 
-    @dash.callback(*outputs, *tail, *state, Input(group.run, "n_clicks"), *triggers, *states,
-                   prevent_initial_call=not initial)
+    following = {i.component_id for i in follow}
+    nothing = (no_update,) * (n_out + len(tail) + len(state))
+
+    @dash.callback(*outputs, *tail, *state, Input(group.run, "n_clicks"), *triggers, *follow, *states,
+                   State(group.go, "data"), prevent_initial_call=False)
     def dispatch(_n, *values):
-        """Answer at once when every result is cached; otherwise submit jobs and start reading them."""
-        loading = dash.ctx.triggered_id is None  # the page's first call, not a user's action
+        """Answer at once when every result is cached; otherwise, on the run button or a trigger,
+        submit jobs and start reading them. The jobs the page waited for until now and no longer
+        asks for are let go (after the new ones are submitted: one both ask for is never cancelled)."""
+        *values, previous = values
+        trigger = dash.ctx.triggered_id
+        loading = trigger is None  # the page's first call, not a user's action
+        before, before_watcher = _waiting(previous)[0], _watcher(previous)
+        waited = bool(before) and not previous.get("cancelled")
         try:
             wanted = canonical(analysis, requests(*values))
             names = None if labels is None else _names(labels(*values), wanted)
         except InvalidParameterError as exc:
             if loading:  # the layout already says what of the address could not be used
-                return (no_update,) * (n_out + len(tail) + len(state))
+                return nothing
+            _release(before, before_watcher)
             return refused(str(exc), clear=True)
         results = [cache.get(analysis, r) for r in wanted]
         if all(r is not None for r in results):
+            _release(before, before_watcher)
             return shown(results, wanted, names)
-        if loading and initial == "cached":
-            return (no_update,) * (n_out + len(tail) + len(state))
+        if loading or (trigger in following and not waited):  # nobody asked for a computation
+            return nothing
+        watcher, ids = uuid.uuid4().hex, []
         try:
-            ids = [jobs.submit_canonical(analysis, r)["id"] for r, done in zip(wanted, results, strict=True)
-                   if done is None]
+            for r, done in zip(wanted, results, strict=True):
+                if done is None:
+                    ids.append(jobs.submit_canonical(analysis, r, watcher)["id"])
         except jobs.QueueFull as exc:
+            _release(ids, watcher)
+            _release(before, before_watcher)
             return refused(f"The service is busy: {exc}.")
-        busy = running() if running is not None else (no_update,) * n_out
-        go = {"jobs": ids, "requests": wanted, **({} if names is None else {"labels": names})}
+        _release(before, before_watcher)
+        busy = (clock(0.0, _asked(wanted)) if clock is not None else running() if running is not None
+                else (no_update,) * n_out)
+        go = {"jobs": ids, "requests": wanted, "watcher": watcher, "asked": time.time(),
+              **({} if names is None else {"labels": names})}
         return (tuple(busy) + (no_update,) * len(tail) + (go, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Output(group.ready, "data"),
-                   Input(group.poll, "n_intervals"), State(group.go, "data"), prevent_initial_call=True)
-    def poll(_n, go):
+                   Input(group.poll, "n_intervals"), State(group.go, "data"), State(group.progress, "value"),
+                   prevent_initial_call=True)
+    def poll(_n, go, shown_progress):
         """Progress of the page's jobs; once every result is in the cache, the interval stops and
-        the ready store tells :func:`show` to draw them."""
+        the ready store tells :func:`show` to draw them. A poll that finds its jobs let go by a later
+        action of the page changes nothing: that action wrote the page's state."""
         ids, wanted = _waiting(go)
         if not ids:
             return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update, no_update)
+        watcher = _watcher(go)
+        if go.get("cancelled"):  # the Cancel button let them go; the poll says so (no late progress line after it)
+            return (*stopped("", "cancelled"), no_update)
         current = [jobs.get(i) for i in ids]
+        if any(job is not None and _let_go(job, watcher) for job in current):
+            return nothing + (no_update,)
         for job in current:
             if job is None or job["status"] == "cancelled":
-                return (*refused("", "cancelled"), no_update)
+                _release(ids, watcher)
+                return (*stopped("", "cancelled"), no_update)
             if job["status"] == "failed":
-                return (*refused(f"{job['request'].get('config') or analysis}: {job['error']}"), no_update)
+                _release(ids, watcher)
+                return (*stopped(f"{job['request'].get('config') or analysis}: {job['error']}"), no_update)
         if all(job["status"] == "done" for job in current):  # drawn by show(), not in this tick
             return ((no_update,) * (n_out + len(tail)) + (no_update, True, no_update, True)
                     + (no_update,) * len(lock) + ("100", "drawing the results…", {**go, "tick": _n}))
-        fraction = sum(job["progress"] if job["status"] == "running" else 0.0 for job in current) / len(current)
+        # a finished job counts whole, a queued one nothing; the bar never goes back within a run
+        fraction = sum(_fraction(job) for job in current) / len(current)
+        fraction = max(fraction, min(_number(shown_progress) / 100, 1.0))
         first = next(job for job in current if job["status"] != "done")
         label = first["request"].get("config") or analysis
         done = sum(job["status"] == "done" for job in current)
         of = f" [{done} of {len(current)} analyses done]" if len(current) > 1 else ""
         status = (f"{label}: {first['message']}{of}" if first["status"] == "running"
                   else f"{label}: queued ({jobs.counts()['running']} analyses running){of}")
-        return (no_update,) * (n_out + len(tail) + len(state) - 2) + (str(int(100 * fraction)), status, no_update)
+        since = _since(go.get("asked"))
+        drawn = clock(since, _asked(wanted)) if clock is not None and since is not None else (no_update,) * n_out
+        return (*drawn, *(no_update,) * (len(tail) + len(state) - 2), str(int(100 * fraction)), status, no_update)
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(group.ready, "data"),
                    prevent_initial_call=True)
@@ -179,7 +244,7 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         """The results of the jobs the poll found done, drawn (once per ready signal)."""
         ids, wanted = _waiting(ready)
         if not ids:
-            return (no_update,) * (n_out + len(tail) + len(state))
+            return nothing
         try:  # the requests came back through the browser's JSON (150000.0 as 150000): canonical again
             wanted = canonical(analysis, wanted)
             names = None if labels is None else _names(ready.get("labels"), wanted)
@@ -192,14 +257,20 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
 
     @dash.callback(Output(group.cancel, "disabled", allow_duplicate=True),
                    Output(group.status, "children", allow_duplicate=True),
+                   Output(group.go, "data", allow_duplicate=True),
                    Input(group.cancel, "n_clicks"), State(group.go, "data"), prevent_initial_call=True)
     def cancel(_n, go):
-        """Cancel the jobs; the poll, the one writer of the page's job state, then says "cancelled" (a
-        poll already on its way cannot overwrite it with a progress line)."""
+        """Let the jobs go (the service cancels those nobody else waits for); the poll, the one writer
+        of the page's job state, then says "cancelled" (a poll already on its way cannot overwrite it
+        with a progress line)."""
         ids, _ = _waiting(go)
-        for job_id in ids:
-            jobs.cancel(job_id, remove=False)
-        return True, "cancelling…" if ids else "cancelled"
+        _release(ids, _watcher(go))
+        if not ids:
+            return True, "cancelled", no_update
+        return True, "cancelling…", {**go, "cancelled": True}
+
+    # The browser remembers the jobs the page waits for, to let them go when the page is left.
+    dash.clientside_callback(ClientsideFunction("jobs", "watch"), Input(group.go, "data"))
 
     @dash.callback(Output(files.download, "data"), Input(files.csv, "n_clicks"), Input(files.json, "n_clicks"),
                    State(store, "data"), prevent_initial_call=True)
@@ -235,10 +306,12 @@ def _names(names: Any, wanted: list[dict[str, Any]]) -> list[str]:
 
 def _asked(wanted: list[dict[str, Any]]) -> str:
     """What was asked, in the page's words: the configurations (and a map's slices as asked)."""
-    configs = [r.get("config") for r in wanted if r.get("config")]
-    slices = {r.get("resolution") for r in wanted if r.get("resolution") is not None}
+    wanted = [r for r in wanted if isinstance(r, dict)]  # the poll's come back through the browser
+    configs = [str(r["config"])[:40] for r in wanted if r.get("config")]
+    slices = {str(r["resolution"])[:8] for r in wanted if r.get("resolution") is not None}
     what = ", ".join(configs) if configs else f"{len(wanted)} analysis" + ("" if len(wanted) == 1 else "es")
-    return what + (f", {slices.pop()} Fz slices each" if len(slices) == 1 else "")
+    each = " each" if len(wanted) > 1 else ""
+    return what + (f", {slices.pop()} Fz slices{each}" if len(slices) == 1 else "")
 
 
 def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
@@ -250,6 +323,81 @@ def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
             or len(wanted) > settings.MAX_PAGE_REQUESTS or not all(isinstance(i, str) and len(i) < 64 for i in ids)):
         return [], []
     return ids, wanted
+
+
+def _fraction(job: dict[str, Any]) -> float:
+    """How much of ``job`` is done: 1 once done, its reported progress while it runs, 0 queued."""
+    return 1.0 if job["status"] == "done" else job["progress"] if job["status"] == "running" else 0.0
+
+
+def _since(asked: Any) -> float | None:
+    """Seconds since ``asked`` (a time the page's store sent back), or None if it is not one."""
+    if isinstance(asked, bool) or not isinstance(asked, (int, float)) or not 0 < asked <= time.time():
+        return None
+    return time.time() - asked
+
+
+def _number(value: Any) -> float:
+    """A finite number the browser sent back (the progress bar's value, a time), else 0."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        return 0.0
+    return x if math.isfinite(x) else 0.0
+
+
+def _watcher(go: Any) -> str | None:
+    """The token of the page view's action that submitted the store's jobs (None if there is none)."""
+    watcher = go.get("watcher") if isinstance(go, dict) else None
+    return watcher if isinstance(watcher, str) and 0 < len(watcher) <= 64 else None
+
+
+def _let_go(job: dict[str, Any], watcher: str | None) -> bool:
+    """The page view no longer waits for ``job``: a later action of the page let it go."""
+    return watcher is not None and not job.get("pinned", True) and watcher not in job.get("watchers", [])
+
+
+def _release(ids: Sequence[str], watcher: str | None) -> None:
+    """The page waits for these jobs no more (the service cancels those nobody else waits for)."""
+    if watcher is not None:
+        for job_id in ids:
+            jobs.release(job_id, watcher)
+
+
+def released(body: Any) -> list[tuple[str, str]]:
+    """The (job id, watcher) pairs of a release post (as the browser sent it: checked, never trusted)."""
+    pairs = body.get("jobs") if isinstance(body, dict) else None
+    if not isinstance(pairs, list) or len(pairs) > MAX_RELEASED:
+        raise RequestRefused("jobs must list the jobs to let go", "jobs",
+                             f"a list of at most {MAX_RELEASED} {{id, watcher}} objects")
+    out = []
+    for k, pair in enumerate(pairs):
+        job_id = pair.get("id") if isinstance(pair, dict) else None
+        watcher = _watcher(pair)
+        if not (isinstance(job_id, str) and 0 < len(job_id) <= 64 and watcher is not None):
+            raise RequestRefused(f"jobs[{k}] is not an {{id, watcher}} object of two short strings", f"jobs[{k}]",
+                                 "an object with an id and a watcher of 1 to 64 characters")
+        out.append((job_id, watcher))
+    return out
+
+
+def install(app) -> None:
+    """The route by which a page that is left lets its jobs go (assets/jobs.js posts there), and the
+    leave signal of a navigation inside the app (Dash Pages replaces the page without unloading it)."""
+
+    def release_route():
+        try:
+            pairs = released(parse_json(flask.request))
+        except RequestRefused as exc:
+            return exc.response()
+        for job_id, watcher in pairs:
+            jobs.release(job_id, watcher)
+        return flask.Response(status=204)
+
+    app.server.add_url_rule(app.config.routes_pathname_prefix + RELEASE_PATH, "workbench_release", release_route,
+                            methods=["POST"])
+    app.clientside_callback(ClientsideFunction("jobs", "left"), Input(shell_ids.PAGES_LOCATION, "pathname"),
+                            Input(shell_ids.PAGES_LOCATION, "search"), prevent_initial_call=True)
 
 
 def _duplicate(output: Output) -> Output:

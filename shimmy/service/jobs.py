@@ -7,6 +7,13 @@ records the store holds the queue (ids waiting, in order, at most ``MAX_QUEUED_J
 running map (id -> the process that holds one of ``MAX_RUNNING_JOBS`` slots) and an index
 result key -> active job, so that an identical request already queued or running is that job.
 
+Who waits for a job: a workbench page submits on behalf of one view of it (a ``watcher`` token the
+page chose) and :func:`release` says when that view waits no more (the page was left, its question
+changed, its Cancel was pressed); an API client cannot say when it leaves, so its submission pins
+the job. A job nobody waits for any more (no watcher left, not pinned) is cancelled then: it holds
+no slot and nobody's next job queues behind it. Identical requests share one job, so one page
+leaving never cancels what another page or an API client still waits for.
+
 A queued job holds no process. :func:`pump` (called on every submit, read and cancel, and by a
 worker when it finishes) starts a worker for the first queued jobs while slots are free:
 ``python -m shimmy.service.worker ID`` in its own session, so that it outlives the request and
@@ -24,6 +31,7 @@ from __future__ import annotations
 
 import logging
 import os
+import reprlib
 import signal
 import socket
 import subprocess
@@ -36,6 +44,7 @@ from typing import Any
 import diskcache
 import psutil
 
+from ..errors import InvalidParameterError
 from . import analyses, cache, schemas, settings
 
 ACTIVE = ("queued", "running")
@@ -83,8 +92,9 @@ def update(job_id: str, **changes) -> dict[str, Any] | None:
 
 
 def submit(analysis: str, body: dict[str, Any]) -> dict[str, Any]:
-    """The job for ``body``: done at once from the cache, the same job when an identical one is
-    queued or running, else a new queued job (QueueFull when the queue is full)."""
+    """The job for ``body`` (an API client's: it runs to the end unless deleted): done at once from the
+    cache, the same job when an identical one is queued or running, else a new queued job (QueueFull
+    when the queue is full)."""
     if analysis not in analyses.JOB_ANALYSES:
         from ..model.parameters import unknown_name_error
 
@@ -93,11 +103,15 @@ def submit(analysis: str, body: dict[str, Any]) -> dict[str, Any]:
     return submit_canonical(analysis, request)
 
 
-def submit_canonical(analysis: str, request: dict[str, Any]) -> dict[str, Any]:
+def submit_canonical(analysis: str, request: dict[str, Any], watcher: str | None = None) -> dict[str, Any]:
+    """The job for the canonical ``request``, as :func:`submit`; with ``watcher`` (a page view's token)
+    it waits for the job until :func:`release`, else (an API client) the job is pinned."""
+    if watcher is not None:
+        _check_watcher(watcher)
     key = cache.key(analysis, request)
     job = {"id": uuid.uuid4().hex, "analysis": analysis, "request": request, "status": "queued",
            "progress": 0.0, "message": "queued", "error": None, "created": _now(), "heartbeat": _now(),
-           "result_key": key}
+           "result_key": key, "watchers": [] if watcher is None else [watcher], "pinned": watcher is None}
     s = store()
     if cache.get_key(key) is not None:
         job.update(status="done", progress=1.0, message="from the cache")
@@ -107,7 +121,7 @@ def submit_canonical(analysis: str, request: dict[str, Any]) -> dict[str, Any]:
         same = s.get(("active", key))
         existing = s.get(("job", same)) if same else None
         if existing is not None and existing["status"] in ACTIVE:
-            return existing
+            return _put(s, _watched_by(existing, watcher))
         queue = s.get("queue", [])
         if len(queue) >= settings.MAX_QUEUED_JOBS:
             raise QueueFull(len(queue), len(s.get("running", {})))
@@ -124,20 +138,33 @@ def get(job_id: str) -> dict[str, Any] | None:
     return store().get(("job", job_id))
 
 
+def _check_watcher(watcher: Any) -> None:
+    if not isinstance(watcher, str) or not 0 < len(watcher) <= 64:
+        raise InvalidParameterError("watcher", watcher, "a token of 1 to 64 characters",
+                                    message=f"watcher={reprlib.repr(watcher)} is not a token of 1 to 64 characters")
+
+
+def _watched_by(job: dict[str, Any], watcher: str | None) -> dict[str, Any]:
+    """``job`` with ``watcher`` waiting for it too (None: an API client, which pins it). Past
+    MAX_JOB_WATCHERS the job is pinned instead: it then runs to the end, as an API client's does."""
+    if watcher is None or len(job.get("watchers", [])) >= settings.MAX_JOB_WATCHERS:
+        job["pinned"] = True
+    elif watcher not in job.setdefault("watchers", []):
+        job["watchers"].append(watcher)
+    return job
+
+
 def cancel(job_id: str, remove: bool = True) -> dict[str, Any] | None:
-    """Cancel a job (a queued one leaves the queue; a running one's process group is ended) and,
-    with ``remove``, delete its record: (the job as it was cancelled) or None if unknown."""
+    """Cancel a job whoever waits for it (a queued one leaves the queue; a running one's process
+    group is ended) and, with ``remove``, delete its record: (the job as it was cancelled) or None
+    if unknown."""
     s = store()
     with s.transact():
         job = s.get(("job", job_id))
         if job is None:
             return None
         if job["status"] in ACTIVE:
-            job.update(status="cancelled", message="cancelled by request")
-            s.set("queue", [j for j in s.get("queue", []) if j != job_id])
-            if s.get(("active", job["result_key"])) == job_id:
-                s.delete(("active", job["result_key"]))
-            _put(s, job)
+            _end(s, job, "cancelled by request")
         holder = s.get("running", {}).get(job_id)
         if remove:
             s.delete(("job", job_id))
@@ -145,6 +172,38 @@ def cancel(job_id: str, remove: bool = True) -> dict[str, Any] | None:
         _signal_group(holder, signal.SIGTERM)
     pump()
     return job
+
+
+def release(job_id: str, watcher: str) -> dict[str, Any] | None:
+    """``watcher`` waits for the job no more. A queued or running job that nobody else waits for
+    (no other watcher, not pinned by an API client) is cancelled, as by :func:`cancel` but keeping its
+    record; one that others wait for goes on. (The job as it is then) or None if it is unknown."""
+    _check_watcher(watcher)
+    s = store()
+    holder = None
+    with s.transact():
+        job = s.get(("job", job_id))
+        if job is None or watcher not in job.get("watchers", []):
+            return job
+        job["watchers"] = [w for w in job["watchers"] if w != watcher]
+        if job["status"] in ACTIVE and not job["watchers"] and not job.get("pinned", True):
+            _end(s, job, "cancelled: nobody waits for it any more")
+            holder = s.get("running", {}).get(job_id)
+        else:
+            _put(s, job)
+    if holder is not None:
+        _signal_group(holder, signal.SIGTERM)
+        pump()
+    return job
+
+
+def _end(s: diskcache.Cache, job: dict[str, Any], message: str) -> None:
+    """Mark an active job cancelled and take it off the queue and the active index (in a transaction)."""
+    job.update(status="cancelled", message=message)
+    s.set("queue", [j for j in s.get("queue", []) if j != job["id"]])
+    if s.get(("active", job["result_key"])) == job["id"]:
+        s.delete(("active", job["result_key"]))
+    _put(s, job)
 
 
 def result(job: dict[str, Any]) -> dict[str, Any] | None:

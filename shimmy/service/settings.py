@@ -38,6 +38,8 @@ JOB_START_SECONDS = 60.0
 #: Only for a worker on another host sharing the directory: no heartbeat for this long means it is gone
 #: (SHIMMY_JOB_STALE_SECONDS). Workers on this host are judged by their process, never by a late beat.
 JOB_STALE_SECONDS = float(os.environ.get("SHIMMY_JOB_STALE_SECONDS", "30"))
+#: Page views one job records as waiting for it (jobs.release); beyond, the job is pinned (runs to the end).
+MAX_JOB_WATCHERS = 64
 #: Requests one page action may send (configurations x designs); more are refused by name.
 MAX_PAGE_REQUESTS = 8
 

@@ -24,8 +24,8 @@ SHOTS = ROOT / "screenshots"  # screenshots for a person to look at (not committ
 DOWNLOADS = ROOT / ".pytest_cache" / "downloads"
 CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 PAGES = {"overview": "/", "devices": "/devices", "time-history": "/time-history", "bifurcation": "/bifurcation",
-         "stability-map": "/stability-map", "study": "/study", "design": "/design", "validation": "/validation",
-         "api": "/api"}
+         "stability-map": "/stability-map", "ground-run": "/ground-run", "study": "/study", "design": "/design",
+         "validation": "/validation", "api": "/api"}
 
 
 def _ensure_chromium() -> None:
@@ -138,6 +138,16 @@ def trace_count(driver, graph_id: str) -> int:
     """Traces Plotly has drawn in a dcc.Graph (0 until it has drawn: the figure can lag the tables)."""
     return driver.execute_script(f"const g = document.querySelector('#{graph_id} .js-plotly-plot');"
                                  "return g && g.data ? g.data.length : 0;")
+
+
+def job_records(server) -> dict[str, dict]:
+    """Every job the server's job store holds, by id (queued, running and finished ones)."""
+    from shimmy.service import jobs
+
+    with server.cache_env():
+        s = jobs.store()
+        found = (s.get(k) for k in list(s) if isinstance(k, tuple) and len(k) == 2 and k[0] == "job")
+        return {j["id"]: j for j in found if j is not None}
 
 
 def on_figure(driver, graph_id: str, script: str):

@@ -16,7 +16,8 @@ from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
-from browser import DOWNLOADS, PAGES, SHOTS, browser_fixture, idle, severe, trace_count, wait_for  # noqa: E402
+from browser import (DOWNLOADS, PAGES, SHOTS, browser_fixture, idle, job_records, on_figure, severe,  # noqa: E402
+                     text_of, trace_count, wait_for)
 
 browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)
 
@@ -41,6 +42,105 @@ def test_every_page_loads_without_console_errors(server, browser, name):
         assert not panel.is_displayed()
     else:
         assert "Design" in panel.text
+
+
+def test_opening_ground_run_and_decisions_starts_no_job_and_run_computes(server, browser):
+    """Pages compute nothing long on opening: the cached answer, else a Run button. Requests no
+    other test asks for (a taxi with its own threshold; NES at 170 kN), so nothing is cached."""
+    before = set(job_records(server))
+    browser.get(server.base + "/ground-run?preset=taxi&psi_thr=0.0123")
+    wait_for(lambda: "taxi preset" in text_of(browser, "gr-source"), what="the taxi preset")
+    browser.get(server.base + "/design?config=nes&Fz=170")
+    wait_for(lambda: "Press Compute" in text_of(browser, "sens-charts"), what="the sensitivities waiting for Compute")
+    idle(browser)
+    time.sleep(2.0)  # a job submitted on opening would be in the store by now
+    assert set(job_records(server)) == before
+    browser.get(server.base + "/ground-run?preset=taxi&psi_thr=0.0123")
+    wait_for(lambda: "Press Run" in text_of(browser, "gr-plane"), what="the ground run waiting for Run")
+    idle(browser)
+    time.sleep(1.0)
+    assert set(job_records(server)) == before
+    assert browser.find_element(By.ID, "gr-run").is_enabled() and text_of(browser, "gr-status") == ""
+    assert severe(browser) == []
+
+    # Compute then computes and draws (the sensitivities: seconds; the ground run's Run: test_browser_ground_run.py).
+    browser.get(server.base + "/design?config=nes&Fz=170")
+    wait_for(lambda: "Press Compute" in text_of(browser, "sens-charts"), what="the sensitivities waiting for Compute")
+    idle(browser)
+    browser.find_element(By.ID, "sens-run").click()
+    bars = wait_for(lambda: on_figure(browser, "sens-hopf_V1", "return g.data[0].y;"), timeout=120,
+                    what="the tornado chart of the first Hopf speed")
+    assert sorted(bars) == ["e_p (m)", "k_s (N/m)", "r2 (m)", "r3 (m)"]  # the NES's parameters
+    new = [j for i, j in job_records(server).items() if i not in before]
+    assert [(j["analysis"], j["request"]["config"], j["request"]["Fz"], j["status"]) for j in new] == [
+        ("sensitivity", "nes", 170000.0, "done")]
+    # Opened again: the cached charts at once, no job.
+    browser.get(server.base + "/design?config=nes&Fz=170")
+    wait_for(lambda: on_figure(browser, "sens-hopf_V1", "return g.data[0].y;"), timeout=20, what="the cached charts")
+    idle(browser)
+    assert len(job_records(server)) == len(before) + 1
+    assert severe(browser) == []
+
+
+def _active(server, ids) -> list[str]:
+    """Those of ``ids`` still queued or running (the read reaps what is gone)."""
+    server.request("GET", "/api/v1/jobs/none")
+    records = job_records(server)
+    return [i for i in ids if records.get(i, {}).get("status") in ("queued", "running")]
+
+
+def test_leaving_a_page_cancels_the_jobs_it_started(server, browser):
+    """Left by loading another page, or by a navigation inside the app (Back after a pushed
+    address: Dash Pages replaces the page without unloading it), the page's jobs nobody else
+    waits for are cancelled and give up their slots."""
+    before = set(job_records(server))
+    browser.get(server.base + "/ground-run?psi_thr=0.0124&r2=0.0813")  # a design of its own: its Hopf curves too
+    wait_for(lambda: "take-off preset" in text_of(browser, "gr-source"), what="the take-off preset")
+    idle(browser)
+    browser.find_element(By.ID, "gr-run").click()
+    started = wait_for(lambda: len(new := [i for i in job_records(server) if i not in before]) == 4 and new,
+                       timeout=20, what="the four ground runs")
+    # The page knows its jobs once its Run has been answered (a page left before that cannot name them).
+    wait_for(lambda: "analyses" in text_of(browser, "gr-status"), timeout=20, what="the page reading its jobs")
+    assert _active(server, started)
+    browser.get(server.base + "/api")  # another page: this one unloads
+    wait_for(lambda: not _active(server, started), timeout=20, what="the ground runs to be cancelled")
+    assert {job_records(server)[i]["status"] for i in started} <= {"cancelled", "done"}
+    assert "cancelled" in {job_records(server)[i]["status"] for i in started}
+
+    before = set(job_records(server))
+    browser.get(server.base + "/stability-map?shade=nes&fz_min=120&fz_max=480&resolution=8")
+    run = wait_for(lambda: browser.find_elements(By.ID, "map-run"), what="the Compute button")[0]
+    idle(browser)
+    run.click()
+    started = wait_for(lambda: [i for i in job_records(server) if i not in before], timeout=20, what="the map job")
+    wait_for(lambda: text_of(browser, "map-status"), timeout=20, what="the page reading its job")
+    assert _active(server, started)
+    browser.execute_script("history.pushState(null, '', '/devices'); dispatchEvent(new PopStateEvent('popstate'));")
+    wait_for(lambda: browser.find_elements(By.ID, "dev-pd"), timeout=20, what="the Devices page")
+    wait_for(lambda: not _active(server, started), timeout=20, what="the map job to be cancelled")
+    assert job_records(server)[started[0]]["status"] == "cancelled"
+    assert job_records(server)[started[0]]["message"] == "cancelled: nobody waits for it any more"
+    assert severe(browser) == []
+
+
+def test_cancel_lets_the_jobs_go_and_the_page_waits_for_run_again(server, browser):
+    before = set(job_records(server))
+    browser.get(server.base + "/ground-run?preset=taxi&psi_thr=0.0125")
+    wait_for(lambda: "taxi preset" in text_of(browser, "gr-source"), what="the taxi preset")
+    idle(browser)
+    browser.find_element(By.ID, "gr-run").click()
+    wait_for(lambda: "Running the four configurations" in text_of(browser, "gr-plane"), timeout=20,
+             what="the plane saying the runs are under way")
+    started = wait_for(lambda: len(new := [i for i in job_records(server) if i not in before]) == 4 and new,
+                       timeout=20, what="the four ground runs")
+    wait_for(lambda: browser.find_element(By.ID, "gr-cancel").is_enabled(), timeout=20, what="Cancel enabled")
+    browser.find_element(By.ID, "gr-cancel").click()
+    wait_for(lambda: text_of(browser, "gr-status") == "cancelled", timeout=20, what='"cancelled"')
+    assert "Press Run" in text_of(browser, "gr-plane")  # not "Running ..." for runs that were cancelled
+    assert browser.find_element(By.ID, "gr-run").is_enabled()
+    wait_for(lambda: not _active(server, started), timeout=20, what="the ground runs to be cancelled")
+    assert severe(browser) == []
 
 
 # Null until Plotly has drawn the figure (the table can render first): tests wait on it, never read it raw.
@@ -106,8 +206,19 @@ def test_map_click_opens_the_time_history_at_that_point(server, browser):
     run.click()
     wait_for(lambda: browser.find_element(By.ID, "map-status").text or None, timeout=30, interval=0.05,
              what="a progress message")
-    rows = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"), timeout=180,
-                    what="the map's summary table")
+    # Watched being made: the figure says what is computed and for how long, the bar never goes back
+    # (two maps: one finishing first counts whole, not as nothing).
+    bars, figures = [], set()
+    while not browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr"):
+        assert len(bars) < 900, "the map's summary table after 180 s"
+        bars.append(float(browser.find_element(By.ID, "map-progress").get_attribute("value")))
+        figures.add(text_of(browser, "map-graph"))
+        time.sleep(0.2)
+    assert bars == sorted(bars), bars
+    computing = {t for t in figures if "Computing the map (original, nes, 4 Fz slices each)" in t}
+    assert len(computing) >= 2 and all("so far" in t for t in computing)  # the seconds go on
+    assert not any("Press Compute" in t for t in figures)
+    rows = browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr")
     assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["original", "NES"]
     wait_for(lambda: trace_count(browser, "map-graph") > 8, what="the map's traces")
     idle(browser)

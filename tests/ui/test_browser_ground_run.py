@@ -41,8 +41,12 @@ def test_ground_run_page_runs_the_presets_and_a_table(server, browser):
     browser.get_log("browser")
     browser.set_window_size(1440, 900)
     browser.get(server.base + "/ground-run")
-    # Four ground runs as background jobs on the shared server's two job slots: bounded generously
-    # for a loaded machine, not timed.
+    # Nothing runs on opening (tests/ui/test_browser.py checks the job store): Run starts the four
+    # ground runs as background jobs on the shared server's two job slots, bounded generously for a
+    # loaded machine, not timed.
+    wait_for(lambda: "Press Run" in text_of(browser, "gr-plane"), what="the plane waiting for Run")
+    idle(browser)
+    browser.find_element(By.ID, "gr-run").click()
     rows = wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=JOB_WAIT,
                     what="the take-off of the four configurations")
     assert [r[0] for r in rows] == NAMES
@@ -85,6 +89,9 @@ def test_ground_run_page_runs_the_presets_and_a_table(server, browser):
     browser.set_window_size(1024, 768)
     browser.get(server.base + "/ground-run?preset=landing&config=nes")
     wait_for(lambda: "landing roll preset" in text_of(browser, "gr-source"), timeout=30, what="the landing preset")
+    idle(browser)
+    assert not _summary(browser)  # not run on opening
+    browser.find_element(By.ID, "gr-run").click()
     rows = wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=JOB_WAIT, what="the landing roll")
     assert "Hopf curves of NES" in browser.find_element(By.CSS_SELECTOR, "#gr-plane .gtitle").text
     idle(browser)

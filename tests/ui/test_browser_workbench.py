@@ -101,8 +101,9 @@ def test_nothing_falls_back_silently(server, browser):
     assert browser.find_element(By.ID, "th-v").get_attribute("value") == ""  # not a silent 30
     for t_end, why in (("0", "simulated time = 0 s is outside [0.1, 600] s"),
                        ("100000", "simulated time = 100000 s is outside [0.1, 600] s")):
-        type_into(browser.find_element(By.ID, "th-v"), "30")
+        type_into(browser.find_element(By.ID, "th-v"), "30")  # a typed speed runs (Run is off while it does)
         type_into(browser.find_element(By.ID, "th-tend"), t_end)
+        wait_for(lambda: browser.find_element(By.ID, "th-run").is_enabled(), timeout=120, what="the Run button")
         browser.find_element(By.ID, "th-run").click()
         wait_for(lambda w=why: text_of(browser, "th-error") == w, timeout=10, what=f"the t_end refusal {why}")
     open_page(browser, server, "/bifurcation?configs=original")

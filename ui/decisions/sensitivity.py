@@ -20,7 +20,10 @@ QUANTITIES = {"hopf_V1": ("Hopf speed V1 at {kN} kN", "V1", "m/s", 1.0),
               "max_psi": ("Largest stable |psi| at {kN} kN", "max |psi|", "rad", 1.0)}
 BARS = {"per_half_range": "per half design range", "per_percent": "per +1 % of the value"}
 SHOWN = {"device": "device parameters", "all": "all parameters"}
-WAITING = "The tornado charts appear here (about 2 s cold, at once from the cache)."
+WAITING = "Press Compute: the tornado charts appear here (about 2 s; at once when the cache has them)."
+COMPUTING = "Computing the sensitivities (about 2 s once a job slot is free)…"
+#: What the charts' store holds while the job runs (in place of a result's rows).
+RUNNING = {"computing": True}
 
 
 def section(a) -> list:
@@ -80,14 +83,15 @@ def _csv(results):
 
 
 jobs.register(
-    ids.SENS, "sensitivity", requests=_requests, initial=True,
+    ids.SENS, "sensitivity", requests=_requests,
     render=lambda results: (_data(results), _summary(results)),
     outputs=[Output(ids.SENS_DATA, "data"), Output(ids.SENS_SUMMARY, "children")],
-    triggers=[Input(ids.DES_CONFIG, "value"), Input(ids.DES_FZ, "value")], states=[State(ids.design_store(ids.DES),
-                                                                                         "data")],
+    # the page's configuration and load (the optimiser's and robustness's too): shown from the cache, else stale
+    follow=[Input(ids.DES_CONFIG, "value"), Input(ids.DES_FZ, "value")],
+    states=[State(ids.design_store(ids.DES), "data")],
     download=jobs.Download(ids.SENS, "sensitivities", _csv, single=True,
                            filename=lambda r: f"sensitivities_{r[0]['config']}_{r[0]['Fz'] / 1e3:g}kN"),
-    blank=lambda: (None, ""))
+    blank=lambda: (None, ""), running=lambda: (RUNNING, ""), waiting=lambda: (None, ""))
 
 
 def _no_effect(rows) -> html.Div | None:
@@ -141,6 +145,8 @@ def draw_sensitivities(data, by, shown):
     """One tornado chart per quantity, the parameters without effect under it."""
     if not data:
         return placeholder(WAITING)
+    if data == RUNNING:
+        return placeholder(COMPUTING)
     by = by if by in BARS else "per_half_range"
     charts = []
     for q in data["quantities"]:
