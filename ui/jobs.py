@@ -104,6 +104,8 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
              blank: Callable[[], tuple] | None = None, running: Callable[[], tuple] | None = None,
              waiting: Callable[[], tuple] | None = None,
              clock: Callable[[float, str], tuple] | None = None,
+             warm: Callable[[list[dict[str, Any]]], bool] | None = None,
+             fading: Callable[[float, str], tuple] | None = None, stale: str | None = None,
              labels: Callable[..., list[str]] | None = None) -> None:
     """Wire the job of one page.
 
@@ -124,6 +126,11 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
     outputs shown while the jobs run, redrawn at every read of their progress with the seconds since
     they were asked for and what was asked, in words (a long run the user watches being made; in
     place of ``running()``).
+    ``warm(uncached requests)`` -> whether a change of a ``follow`` input computes by itself (a map
+    one slider step from a cached one, warmed from it in a second or two: the page follows the
+    slider); the outputs then are ``fading(seconds, asked)`` while the jobs run (the previous answer
+    kept, faint, for comparison until the new one lands) in place of ``clock``. Where ``warm`` says
+    no, the status line says ``stale`` (the shown answer is of the previous controls), if given.
     ``labels(*values)`` -> a name for each request (the designs of a comparison): the results are then
     drawn by ``render(results, names)`` and tabulated by ``download.rows(results, names)``, and the
     requests store holds {"requests", "labels"}.
@@ -180,8 +187,12 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         if all(r is not None for r in results):
             _release(before, before_watcher)
             return shown(results, wanted, names)
-        if loading or (trigger in following and not waited):  # nobody asked for a computation
+        live = (not loading and trigger in following and warm is not None
+                and warm([r for r, done in zip(wanted, results, strict=True) if done is None]))
+        if loading:
             return nothing
+        if trigger in following and not waited and not live:  # nobody asked for a computation
+            return nothing[:-1] + (stale if stale is not None else no_update,)
         watcher, ids = uuid.uuid4().hex, []
         try:
             for r, done in zip(wanted, results, strict=True):
@@ -192,9 +203,9 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
             _release(before, before_watcher)
             return refused(f"The service is busy: {exc}.")
         _release(before, before_watcher)
-        busy = (clock(0.0, _asked(wanted)) if clock is not None else running() if running is not None
-                else (no_update,) * n_out)
-        go = {"jobs": ids, "requests": wanted, "watcher": watcher, "asked": time.time(),
+        busy = (fading(0.0, _asked(wanted)) if live and fading is not None else clock(0.0, _asked(wanted))
+                if clock is not None else running() if running is not None else (no_update,) * n_out)
+        go = {"jobs": ids, "requests": wanted, "watcher": watcher, "asked": time.time(), "live": bool(live),
               **({} if names is None else {"labels": names})}
         return (tuple(busy) + (no_update,) * len(tail) + (go, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
@@ -235,7 +246,9 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         status = (f"{label}: {first['message']}{of}" if first["status"] == "running"
                   else f"{label}: queued ({jobs.counts()['running']} analyses running){of}")
         since = _since(go.get("asked"))
-        drawn = clock(since, _asked(wanted)) if clock is not None and since is not None else (no_update,) * n_out
+        show_clock = fading if go.get("live") and fading is not None else clock
+        drawn = (show_clock(since, _asked(wanted)) if show_clock is not None and since is not None
+                 else (no_update,) * n_out)
         return (*drawn, *(no_update,) * (len(tail) + len(state) - 2), str(int(100 * fraction)), status, no_update)
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(group.ready, "data"),

@@ -304,6 +304,13 @@ class Parameters:
         return canonical_digest(self.to_dict())
 
 
+def design_distance(a: Parameters, b: Parameters) -> float:
+    """The largest relative difference between two designs' parameters (0: the same design)."""
+    da, db = a.to_dict(), b.to_dict()
+    return max((abs(da[k] - db[k]) / max(abs(da[k]), abs(db[k]), 1e-300) for k in da if da[k] != db[k]),
+               default=0.0)
+
+
 def canonical_json(obj: Any) -> str:
     """JSON with sorted keys and floats written by repr: equal inputs, equal text."""
     return json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=False)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import logging
 from typing import Any
 
-from ..model.parameters import Parameters
+from ..model.parameters import Parameters, design_distance
 from . import cache
 
 log = logging.getLogger(__name__)
@@ -53,26 +53,32 @@ def remember(analysis: str, request: dict[str, Any], start: dict[str, Any]) -> N
         log.error("warm start not kept (%s: %s)", type(exc).__name__, exc)
 
 
-def nearest(analysis: str, request: dict[str, Any]) -> dict[str, Any] | None:
-    """The warm start of the nearest other design of the same question within :data:`MAX_DISTANCE`,
-    or None."""
-    from ..analyses.maps.warm_map import design_distance
-
+def _ranked(analysis: str, request: dict[str, Any]) -> list[dict[str, Any]]:
+    """The listed designs of the same question within reach, nearest first."""
     if cache.is_bypassed():
-        return None
+        return []
     try:
-        store = cache.results()
-        listed = store.get(_question(analysis, request)) or []
+        listed = cache.results().get(_question(analysis, request)) or []
     except cache.DAMAGE as exc:
         log.warning("neighbour index unreadable (%s: %s): computing cold", type(exc).__name__, exc)
-        return None
+        return []
     here = Parameters.from_dict(request["params"])
     ranked = sorted((design_distance(here, Parameters.from_dict(e["params"])), k) for k, e in enumerate(listed)
                     if e["params"] != request["params"])
-    for distance, k in ranked:
-        if distance > MAX_DISTANCE:
-            break
-        start = cache.get_key(listed[k]["key"])
+    return [listed[k] for distance, k in ranked if distance <= MAX_DISTANCE]
+
+
+def within_reach(analysis: str, request: dict[str, Any]) -> bool:
+    """Whether a design near enough to warm from is listed (one small read: for a page deciding to
+    compute by itself)."""
+    return bool(_ranked(analysis, request))
+
+
+def nearest(analysis: str, request: dict[str, Any]) -> dict[str, Any] | None:
+    """The warm start of the nearest other design of the same question within :data:`MAX_DISTANCE`,
+    or None."""
+    for entry in _ranked(analysis, request):
+        start = cache.get_key(entry["key"])
         if start is not None:
             return start
     return None

@@ -47,7 +47,7 @@ import numpy as np
 from ...continuation import PointKind
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
-from ...model.parameters import Parameters, check_range, FZ_RANGE, V_RANGE
+from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_range, design_distance  # noqa: F401 (re-exported)
 from ..core.executors import describe_work_unit, name_of, open_executor, run_dynamic, run_work_unit
 from ..core.stability import hopf_points
 from ..diagrams.bifurcation import V_SCALE, BifurcationOptions
@@ -69,13 +69,6 @@ class NotWarm(Exception):
     def __init__(self, reason: str):
         super().__init__(reason)
         self.reason = reason
-
-
-def design_distance(a: Parameters, b: Parameters) -> float:
-    """The largest relative difference between two designs' parameters (0: the same design)."""
-    da, db = a.to_dict(), b.to_dict()
-    return max((abs(da[k] - db[k]) / max(abs(da[k]), abs(db[k]), 1e-300) for k in da if da[k] != db[k]),
-               default=0.0)
 
 
 def _changed(a: Parameters, b: Parameters) -> dict[str, list[float]]:

@@ -1,0 +1,62 @@
+"""The map follows the design: a design one step from a cached map is computed by itself once the
+design stands still, the previous map faint until the new one lands; a design with no cached
+neighbour waits for Compute and says so. Real Chromium against gunicorn (tests/ui/browser.py)."""
+
+from __future__ import annotations
+
+import pytest
+
+selenium = pytest.importorskip("selenium")
+from selenium.webdriver.common.by import By  # noqa: E402
+
+from browser import (SHOTS, browser_fixture, by_id, idle, job_records, on_figure, pattern, severe,  # noqa: E402
+                     text_of, type_into, wait_for)
+
+browser = browser_fixture("chromium-live-map", "1440,900")
+PAGE = "/stability-map?shade=nes&fz_min=300&fz_max=900&resolution=4"
+
+
+def _title(browser) -> str:
+    return on_figure(browser, "map-graph", "return (g.layout.title && g.layout.title.text) || '';") or ""
+
+
+def _faded(browser) -> bool:
+    return bool(on_figure(browser, "map-graph", "return (g.layout.shapes || []).some(s => s.xref === 'paper' "
+                                                "&& s.fillcolor && s.fillcolor.indexOf('255,255,255') >= 0);"))
+
+
+def test_the_map_follows_a_design_step_by_itself(server, browser):
+    before = set(job_records(server))
+    browser.get(server.base + PAGE + "&e_p=0.0012")
+    run = wait_for(lambda: browser.find_elements(By.ID, "map-run"), what="the Compute button")[0]
+    idle(browser)
+    run.click()
+    wait_for(lambda: "Shimmy type of" in _title(browser), timeout=240, what="the first map")
+    first = [i for i in job_records(server) if i not in before]
+    assert len(first) == 1
+
+    # one step of e_p (+10 %): computed by itself, warmed from the cached map, the old map faint meanwhile
+    box = by_id(browser, pattern("e_p", "param-box"))
+    type_into(box, "0.00132")
+    wait_for(lambda: _faded(browser) or "Computing the map of the new design" in _title(browser), timeout=30,
+             interval=0.05, what="the previous map faint while the next is made")
+    browser.save_screenshot(str(SHOTS / "live-map-fading-1440.png"))
+    wait_for(lambda: "Shimmy type of" in _title(browser) and not _faded(browser), timeout=240,
+             what="the warmed map")
+    second = [j for i, j in job_records(server).items() if i not in before and i not in first]
+    assert len(second) == 1 and second[0]["status"] == "done"
+    assert second[0]["request"]["params"]["e_p"] == 0.00132
+    from shimmy.service import cache
+
+    with server.cache_env():
+        result = cache.get("map", second[0]["request"])
+    assert result["methods"]["warmed_from"]["changed"] == {"e_p": [0.0012, 0.00132]}
+    browser.save_screenshot(str(SHOTS / "live-map-warmed-1440.png"))
+
+    # far away (e_p x 3): nothing starts; the status says the map shown is of the previous design
+    count = len(job_records(server))
+    type_into(box, "0.004")
+    wait_for(lambda: "previous design" in text_of(browser, "map-status"), timeout=30,
+             what="the status naming the previous design")
+    assert len(job_records(server)) == count
+    assert severe(browser) == []
