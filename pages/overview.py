@@ -6,10 +6,10 @@ import dash
 from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.errors import InvalidParameterError
-from shimmy.service import analyses
+from shimmy.service import analyses, neighbours
 from plotly.subplots import make_subplots
 
-from ui import compare, designs, formats, ids, jobs
+from ui import compare, designs, formats, ids, jobs, live
 from ui import components as ui
 from ui.fields import Quantity
 from ui.layout import page
@@ -57,7 +57,7 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
         html.Div(jobs.controls(ids.OV_BOUNDARY, "Compute boundary"), className="controls"),
         html.Div(id=ids.OV_BOUNDARY.error, className="error", role="alert"),
         ui.graph(ids.OV_BOUNDARY_GRAPH, figure=style.message_figure("Press 'Compute boundary' (about 3 s cold, "
-                                                                   "instant when cached)")),
+                                                                   "instant when cached); it then follows the design")),
         ui.downloads(ids.OV_BOUNDARY_FILES, "Download boundary CSV", "Download boundary JSON"),
         *jobs.stores(ids.OV_BOUNDARY),
         html.H2("Regions and curves of cycles in (V, Fz)"),
@@ -70,6 +70,7 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
                                                                   "configuration cold, instant when cached)")),
         ui.downloads(ids.OV_REGIONS_FILES, "Download regions CSV", "Download maps JSON"),
         *jobs.stores(ids.OV_REGIONS),
+        live.settled(ids.OV),
     ])
 
 
@@ -233,8 +234,14 @@ def _boundary_rows(results):
     return ["config", "curve", "V_m_s", "Fz_N", "frequency_hz", "lyapunov"], rows
 
 
+#: the design once it stood still (a slider released): the boundary and the maps follow it
+SETTLED = live.follow_settled(ids.OV)
+
 jobs.register(
-    ids.OV_BOUNDARY, "hopf_curves", requests=_boundary_requests, render=lambda results: (boundary_figure(results),),
+    ids.OV_BOUNDARY, "hopf_curves", requests=lambda _settled, design: _boundary_requests(design),
+    render=lambda results: (boundary_figure(results),),
+    follow=[SETTLED], warm=lambda requests: True,  # a few tenths of a second per configuration: always
+    fading=lambda seconds, asked: (live.fading("Hopf curves of the new design", seconds),),
     outputs=[Output(ids.OV_BOUNDARY_GRAPH, "figure")], states=[State(ids.design_store(ids.OV), "data")],
     download=jobs.Download(ids.OV_BOUNDARY_FILES, "hopf_curves", _boundary_rows))
 
@@ -256,6 +263,11 @@ def _region_rows(results):
 
 
 jobs.register(
-    ids.OV_REGIONS, "map", requests=_regions_requests, render=lambda results: (_regions_figure(results),),
+    ids.OV_REGIONS, "map", requests=lambda _settled, design: _regions_requests(design),
+    render=lambda results: (_regions_figure(results),),
+    follow=[SETTLED], warm=lambda requests: all(neighbours.within_reach("map", r) for r in requests),
+    fading=lambda seconds, asked: (live.fading("Computing the maps of the new design", seconds),),
+    stale="The design changed: the maps shown are of the previous design. Press 'Compute maps' for this one (no "
+          "maps of a nearby design are cached to start from).",
     outputs=[Output(ids.OV_REGIONS_GRAPH, "figure")], states=[State(ids.design_store(ids.OV), "data")],
     download=jobs.Download(ids.OV_REGIONS_FILES, "stability_maps", _region_rows))

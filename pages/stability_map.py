@@ -5,12 +5,12 @@ from __future__ import annotations
 from urllib.parse import urlencode
 
 import dash
-from dash import Input, Output, Patch, State, dcc, html, no_update
+from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
 from shimmy.service import neighbours
-from ui import compare, designs, fields, formats, ids, jobs, merits
+from ui import compare, designs, fields, formats, ids, jobs, live, merits
 from ui import components as ui
 from ui import style
 from ui.fields import Quantity
@@ -71,7 +71,7 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
         html.Div(id=ids.MAP_TABLE, className="table-wrap"),
         ui.downloads(ids.MAP_GROUP),
         *jobs.stores(ids.MAP_GROUP),
-        dcc.Store(id=ids.MAP_DESIGN_SETTLED),
+        live.settled(ids.MAP),
         dcc.Location(id=ids.MAP_NAV, refresh="callback-nav"),
         html.H2("Compare saved designs"),
         html.P("The designs ticked under Compare in the design panel (2 to 4; the current one may be one of them) "
@@ -111,13 +111,6 @@ def _requests(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, design):
 CONTROLS = (State(ids.MAP_SHADE, "value"), State(ids.MAP_OVERLAY, "value"), State(ids.MAP_FZMIN, "value"),
             State(ids.MAP_FZMAX, "value"), State(ids.MAP_VMIN, "value"), State(ids.MAP_VMAX, "value"),
             State(ids.MAP_RES, "value"), State(ids.design_store(ids.MAP), "data"))
-#: the design once it has stood still for SETTLE_MS (a slider released, a value typed): followed,
-#: computed by itself where every map asked for is one step from a cached one (see :func:`_warm`)
-SETTLE_MS = 600
-SETTLED = Input(ids.MAP_DESIGN_SETTLED, "data")
-#: over the previous map while the next is made: its curves and regions stay, faint, for comparison
-FADE = {"type": "rect", "xref": "paper", "yref": "paper", "x0": 0, "x1": 1, "y0": 0, "y1": 1, "layer": "above",
-        "fillcolor": "rgba(255,255,255,0.62)", "line": {"width": 0}}
 STALE = ("The design changed: the map shown is of the previous design. Press Compute for this one (no map of a "
          "nearby design is cached to start from).")
 
@@ -128,24 +121,6 @@ def _csv_rows(results):
     return ["config", "Fz_N", "V_m_s", "shimmy_type"], rows
 
 
-# The design store follows a slider while it is dragged; the map follows the design once it has
-# stood still (in the browser: a timer restarted by every change, no server round trip).
-dash.clientside_callback(
-    """
-    function(design) {
-        const C = window.dash_clientside;
-        window.shimmyMapDesignSeq = (window.shimmyMapDesignSeq || 0) + 1;
-        const seq = window.shimmyMapDesignSeq;
-        return new Promise(resolve => setTimeout(
-            () => resolve(seq === window.shimmyMapDesignSeq ? design : C.no_update), %d));
-    }
-    """ % SETTLE_MS,
-    Output(ids.MAP_DESIGN_SETTLED, "data"),
-    Input(ids.design_store(ids.MAP), "data"),
-    prevent_initial_call=True,
-)
-
-
 def _warm(requests: list[dict]) -> bool:
     """Whether every map asked for can start from the cached map of a nearby design (a quick look
     at the cache's list of designs, nothing computed)."""
@@ -153,13 +128,8 @@ def _warm(requests: list[dict]) -> bool:
 
 
 def _fading(seconds: float, asked: str) -> tuple:
-    """While a map warmed from a nearby design is made: the previous map, faint, under a title that
-    says what is computed and for how long so far (a partial update: nothing of the figure is sent)."""
-    patch = Patch()
-    patch["layout"]["shapes"] = [FADE]
-    patch["layout"]["title"]["text"] = (f"Computing the map of the new design ({asked}): {seconds:.0f} s so far; "
-                                        "the previous design's map, faint")
-    return patch, no_update
+    """While a map warmed from a nearby design is made: the previous map, faint."""
+    return live.fading(f"Computing the map of the new design ({asked})", seconds), no_update
 
 
 def _computing(seconds: float, asked: str) -> tuple:
@@ -173,7 +143,7 @@ jobs.register(
     ids.MAP_GROUP, "map", requests=lambda _settled, *controls: _requests(*controls),
     render=lambda results: (figure(results), summary(results)),
     clock=_computing, waiting=lambda: (style.message_figure(WAITING, 600), None),
-    follow=[SETTLED], warm=_warm, fading=_fading, stale=STALE,
+    follow=[live.follow_settled(ids.MAP)], warm=_warm, fading=_fading, stale=STALE,
     outputs=[Output(ids.MAP_GRAPH, "figure"), Output(ids.MAP_TABLE, "children")], states=CONTROLS,
     lock=[ids.MAP_SHADE, ids.MAP_RES, ids.MAP_FZMIN, ids.MAP_FZMAX, ids.MAP_VMIN, ids.MAP_VMAX],
     download=jobs.Download(ids.MAP_GROUP, "stability_map", _csv_rows),

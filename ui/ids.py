@@ -229,7 +229,6 @@ MAP_VMIN = "map-vmin"
 MAP_VMAX = "map-vmax"
 MAP_RES = "map-res"
 MAP_GRAPH = "map-graph"
-MAP_DESIGN_SETTLED = "map-design-settled"  # the design once it stood still: the map follows it
 MAP_HINT = "map-hint"
 MAP_TABLE = "map-table"
 MAP_SUMMARY = "map-summary"

@@ -60,3 +60,24 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
              what="the status naming the previous design")
     assert len(job_records(server)) == count
     assert severe(browser) == []
+
+
+def test_the_overview_boundary_follows_the_design(server, browser):
+    """The Hopf-curve boundary (a few tenths of a second per configuration) follows every design the
+    panel settles on, with no click."""
+    before = set(job_records(server))
+    browser.get(server.base + "/?e_p=0.0015")
+    wait_for(lambda: browser.find_elements(By.ID, "ov-boundary-graph"), what="the boundary figure")
+    idle(browser)
+    type_into(by_id(browser, pattern("e_p", "param-box")), "0.0016")
+
+    def boundary_jobs():
+        return [j for i, j in job_records(server).items() if i not in before and j["analysis"] == "hopf_curves"]
+
+    wait_for(lambda: len(boundary_jobs()) == 4 and all(j["status"] == "done" for j in boundary_jobs()), timeout=120,
+             what="the four configurations' Hopf curves of the new design")
+    assert {j["request"]["params"]["e_p"] for j in boundary_jobs()} == {0.0016}
+    wait_for(lambda: on_figure(browser, "ov-boundary-graph", "return g.layout.title.text;") ==
+             "Hopf curves of straight rolling", timeout=60, what="the new boundary drawn")
+    assert on_figure(browser, "ov-boundary-graph", "return g.data.length;") >= 4
+    assert severe(browser) == []

@@ -1,0 +1,63 @@
+"""Pages that follow the design: the design once it has stood still, and the previous answer kept
+faint while the next is made.
+
+The design store of a page follows a slider while it is dragged (the linear plots redraw on every
+step); a computation of seconds follows the design only once it stands still: :func:`settled`
+is a store that takes the design :data:`SETTLE_MS` after its last change (a slider released, a
+value typed), by a timer in the browser restarted by every change (no server round trip).
+:func:`fading` is what a page shows while the next answer is made: the previous figure under a
+white veil, its title saying what is computed and for how long (a partial update of the figure:
+nothing of it is sent again).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import dash
+from dash import Input, Output, Patch, dcc
+
+from . import ids, style
+
+SETTLE_MS = 600
+#: over the previous figure while the next is made: its curves and regions stay, faint, for comparison
+VEIL = {"type": "rect", "xref": "paper", "yref": "paper", "x0": 0, "x1": 1, "y0": 0, "y1": 1, "layer": "above",
+        "fillcolor": "rgba(255,255,255,0.62)", "line": {"width": 0}}
+
+
+def settled_id(page: Any) -> str:
+    return f"{page}-design-settled"
+
+
+def settled(page: Any) -> dcc.Store:
+    """The store of ``page``'s design once it stood still, for the page's layout (its callback:
+    :func:`follow_settled`, once at import)."""
+    return dcc.Store(id=settled_id(page))
+
+
+def follow_settled(page: Any) -> Input:
+    """Register the browser's timer that fills :func:`settled` of ``page``; the Input to follow."""
+    dash.clientside_callback(
+        """
+        function(design) {
+            const C = window.dash_clientside, key = "shimmySettle_" + %s;
+            window[key] = (window[key] || 0) + 1;
+            const seq = window[key];
+            return new Promise(resolve => setTimeout(() => resolve(seq === window[key] ? design : C.no_update), %d));
+        }
+        """ % (repr(str(page)), SETTLE_MS),
+        Output(settled_id(page), "data"),
+        Input(ids.design_store(page), "data"),
+        prevent_initial_call=True,
+    )
+    return Input(settled_id(page), "data")
+
+
+def fading(title: str, seconds: float) -> Patch:
+    """The figure while the next answer is made: the shown one under :data:`VEIL`, titled ``title``
+    and the seconds so far."""
+    patch = Patch()
+    patch["layout"]["shapes"] = [VEIL]
+    # the whole title (the house style's), not its text alone: a placeholder figure has none
+    patch["layout"]["title"] = style.title(f"{title}: {seconds:.0f} s so far; the previous design's, faint")
+    return patch
