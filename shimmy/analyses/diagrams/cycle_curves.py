@@ -50,6 +50,9 @@ KEY_OF_KIND = {PointKind.FOLD_OF_CYCLES: "fold_curves", PointKind.TORUS: "torus_
 #: Marks on a cycle curve that are not codimension-2 points: its ends, its turns and crossings in Fz
 MARKS = (PointKind.END, PointKind.ZERO_AMPLITUDE, PointKind.P2_TURN, PointKind.P2_MARK)
 ENDS = (PointKind.END, PointKind.ZERO_AMPLITUDE)
+#: each kind of curve in words (progress and status lines)
+PLAIN = {PointKind.FOLD_OF_CYCLES: "fold-of-cycles", PointKind.TORUS: "torus",
+         PointKind.PERIOD_DOUBLING: "period-doubling"}
 FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 kN
 CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400,
                                                                    max_angle=0.3))
@@ -338,7 +341,9 @@ class BesideUnit:
                               self.origin), []
 
     def describe(self) -> str:
-        return f"branches {self.origin}"
+        where = "GH" if self.kind == PointKind.FOLD_OF_CYCLES else "double-Hopf"
+        return (f"cycles beside the {where} point at V = {self.point['V']:.4g} m/s, "
+                f"Fz = {self.point['Fz'] / 1e3:.4g} kN (where a {PLAIN[self.kind]} curve starts)")
 
     def hand_in(self, search: CurveSearch, result: tuple[list[Start], list[str]]) -> None:
         search.add_beside(self, *result)
@@ -382,7 +387,8 @@ class ContinueUnit:
         return _continue(self.config, self.params, self.start, self.box, self.loads)
 
     def describe(self) -> str:
-        return f"{self.start.kind} curve from V = {self.start.point.p:.4g} m/s, Fz = {self.start.Fz / 1e3:.4g} kN"
+        return (f"{PLAIN[self.start.kind]} curve from V = {self.start.point.p:.4g} m/s, "
+                f"Fz = {self.start.Fz / 1e3:.4g} kN")
 
     def hand_in(self, search: CurveSearch, result: tuple[GearCycleCurve | None, str | None]) -> None:
         search.add_curve(self.start, *result)
@@ -473,7 +479,8 @@ class WarmUnit:
         return _continue(self.config, self.params, start, self.box, self.loads)
 
     def describe(self) -> str:
-        return f"{self.seed.kind} curve again from V = {self.seed.u[-1]:.4g} m/s, Fz = {self.seed.Fz / 1e3:.4g} kN"
+        return (f"{PLAIN[self.seed.kind]} curve of the nearby design again, from V = {self.seed.u[-1]:.4g} m/s, "
+                f"Fz = {self.seed.Fz / 1e3:.4g} kN")
 
 
 #: A unit of a curve search: run in any process (``executors.run_work_unit``), its result handed

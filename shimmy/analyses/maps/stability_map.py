@@ -453,7 +453,7 @@ class HopfCurvesUnit:
         return hopf_curves(self.config, params=self.params, v_range=self.v_range, fz_range=self.fz_range)
 
     def describe(self) -> str:
-        return "Hopf curves"
+        return "Hopf curves of straight rolling"
 
 
 @dataclass(frozen=True, eq=False)
@@ -472,7 +472,7 @@ class SliceUnit:
                          options=self.options)
 
     def describe(self) -> str:
-        return f"slice Fz = {self.Fz / 1e3:.4g} kN"
+        return f"slice at Fz = {self.Fz / 1e3:.4g} kN"
 
 
 #: A unit of a map: its Hopf curves, a slice, or a unit of its curve search.
