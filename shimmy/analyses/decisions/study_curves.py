@@ -43,6 +43,7 @@ from typing import Any, Sequence
 
 import numpy as np
 import scipy.linalg
+from scipy.optimize import brentq
 
 from ...continuation import ContinuationOptions, HopfCurve, PointKind, TwoParameterField, hopf_curve
 from ...errors import ConvergenceError, InvalidParameterError
@@ -57,8 +58,11 @@ from ..core.stability import Linearisation, hopf_points
 CURVE_QUANTITIES = {"hopf_V_start": "m/s", "hopf_V_end": "m/s", "min_shimmy_Fz": "N", "max_psi": "rad"}
 #: Central-difference step of the field's derivative in theta, relative to theta's range.
 THETA_STEP = 1e-6
-#: Start values of theta evenly over its range (plus the base design's value).
-N_STARTS = 5
+#: Start values of theta over its range (plus the base design's value): evenly, and geometrically
+#: too where the range spans more than a decade.
+N_STARTS = 9
+#: Values of theta on which the speed edges are scanned for curves entering through them.
+N_EDGE_SCAN = 200
 V_SCALE = 10.0  # m/s: a unit step of the continuation in V
 X_SCALE = np.array([0.05, 5.0, 0.005, 0.5, 0.01, 0.05, 5.0])
 #: Newton on Re lambda(V) = 0 at fixed theta: converged when a step is below this of V.
@@ -213,7 +217,9 @@ class HopfSpeedCurves:
             for s in c.points_of(PointKind.P2_TURN):
                 if abs(s.p[1] - theta) <= tol:
                     found.append(float(s.p[0]))
-            th = c.p[:, 1]
+            polished: list[tuple[float, float]] = []
+            P, omegas = _polyline(c)
+            th = P[:, 1]
             last = len(th) - 2
             for i in range(len(th) - 1):
                 a, b = th[i], th[i + 1]
@@ -225,23 +231,36 @@ class HopfSpeedCurves:
                 if theta == b and i < last:
                     continue  # counted on the next segment
                 s = (theta - a) / (b - a)
-                V0 = (1 - s) * c.p[i, 0] + s * c.p[i + 1, 0]
-                omega0 = (1 - s) * c.omega[i] + s * c.omega[i + 1]
+                V0 = (1 - s) * P[i, 0] + s * P[i + 1, 0]
+                omega0 = (1 - s) * omegas[i] + s * omegas[i + 1]
                 if self._near_located(c, theta, V0, tol):
                     continue
                 try:
                     V, _ = polish_hopf_speed(lin, V0, omega0)
                 except ConvergenceError:
-                    self.warnings.append(f"Hopf speed near V = {V0:.6g} m/s at {self.param} = {theta:.6g} not "
-                                         "polished: the chord's value is used")
-                    V = V0
-                found.append(V)
+                    V = self._scanned_speed(theta, V0)
+                if any(abs(V - W) <= 1e-9 * max(V, 1.0) and abs(V0 - W0) > 1e-6 * max(V0, 1.0)
+                       for W, W0 in polished):
+                    V = self._scanned_speed(theta, V0)  # two chords converged to one root: near a turn
+                polished.append((V, V0))
+            found.extend(V for V, _ in polished)
         lo, hi = self.v_range
         out: list[float] = []
         for V in sorted(found):
             if lo - 1e-9 * hi <= V <= hi + 1e-9 * hi and not (out and abs(V - out[-1]) <= 1e-9 * max(V, 1.0)):
                 out.append(V)
         return out
+
+    def _scanned_speed(self, theta: float, V0: float) -> float:
+        """The Hopf speed nearest V0 from the eigenvalue scan near it (where Newton's method does not
+        converge: near a turn in theta, or where another eigenvalue comes close to the critical one)."""
+        design = self.params.with_sampled({self.param: theta})
+        lo, hi = self.v_range
+        window = (max(lo, 0.8 * V0), min(hi, 1.25 * V0))
+        found = hopf_points(self.config, self.Fz, params=design, v_range=window).hopf_points
+        if not found:
+            raise ConvergenceError(f"no Hopf speed near V = {V0:.6g} m/s at {self.param} = {theta:.6g}")
+        return min((h.V for h in found), key=lambda V: abs(V - V0))
 
     @staticmethod
     def _near_located(c: HopfCurve, theta: float, V: float, tol: float) -> bool:
@@ -303,6 +322,43 @@ class HopfSpeedCurves:
         return out
 
 
+def _grid(lo: float, hi: float, n: int) -> np.ndarray:
+    """n values evenly over [lo, hi], and n geometrically spaced too if lo > 0 and hi > 10 lo."""
+    even = np.linspace(lo, hi, n)
+    if lo > 0 and hi > 10 * lo:
+        return np.unique(np.concatenate([even, np.geomspace(lo, hi, n)]))
+    return even
+
+
+def _polyline(c: HopfCurve) -> tuple[np.ndarray, np.ndarray]:
+    """The curve's points in (V, theta) and omega, with its located turning points in theta inserted
+    (so that the chords reach the tip of each turn)."""
+    P, omega = list(c.p), list(c.omega)
+    for s in sorted(c.points_of(PointKind.P2_TURN), key=lambda s: -s.index):
+        if s.located and 0 < s.index < len(c.p):
+            P.insert(s.index, np.array(s.p))
+            omega.insert(s.index, s.data["omega"])
+    return np.array(P), np.array(omega)
+
+
+def _edge_starts(config: Configuration, params: Parameters, name: str, Fz: float, V: float,
+                 thetas: np.ndarray) -> list[float]:
+    """Values of theta where a Hopf curve crosses the speed edge V: sign changes of the ordered real
+    parts of J(V; theta) on ``thetas``, refined by Brent's method (curves entering through a speed edge
+    between the starts are continued from there)."""
+    def ordered(theta: float) -> np.ndarray:
+        model = Model(config, params, model_coefficients(config, _design(params, name, theta)))
+        return np.sort(np.linalg.eigvals(Linearisation(model, Fz).at(V)).real)[::-1]
+
+    re = np.array([ordered(t) for t in thetas])
+    count = (re > 0).sum(axis=1)
+    out = []
+    for i in np.nonzero(count[:-1] != count[1:])[0]:
+        k = int(min(count[i], count[i + 1]))
+        out.append(float(brentq(lambda t: ordered(t)[k], thetas[i], thetas[i + 1], xtol=1e-12 * abs(thetas[-1]))))
+    return out
+
+
 def hopf_speed_curves(config: Configuration | str, parameter: str, *, Fz: float = DEFAULT_FZ,
                       params: Parameters | None = None, v_range: tuple[float, float] = DIAGRAM_V_RANGE,
                       p_range: tuple[float, float] | None = None) -> HopfSpeedCurves:
@@ -321,23 +377,30 @@ def hopf_speed_curves(config: Configuration | str, parameter: str, *, Fz: float 
     options = ContinuationOptions(ds=0.05, ds_max=0.5, max_steps=2000, max_correction=1.0)
     box = ((v_lo, v_hi), (p_lo, p_hi))
     p_scale = np.array([V_SCALE, span / 10.0])
-    starts = list(np.linspace(p_lo, p_hi, N_STARTS))
+    thetas = _grid(p_lo, p_hi, N_STARTS)
+    starts = [(None, float(t)) for t in thetas]
     nominal = float(getattr(params, parameter))
     if p_lo < nominal < p_hi:
-        starts.append(nominal)
+        starts.append((None, nominal))
+    fine = _grid(p_lo, p_hi, N_EDGE_SCAN)
+    starts += [(V, t) for V in (v_lo, v_hi) for t in _edge_starts(config, params, parameter, Fz, V, fine)]
     curves: list[HopfCurve] = []
     warnings: list[str] = []
-    for theta in starts:
-        design = params.with_sampled({parameter: float(theta)})
-        for h in hopf_points(config, Fz, params=design, v_range=(v_lo, v_hi)).hopf_points:
-            q = np.array([h.V, theta]) / p_scale
+    for V_edge, theta in starts:
+        design = params.with_sampled({parameter: theta})
+        if V_edge is None:
+            points = [h.V for h in hopf_points(config, Fz, params=design, v_range=(v_lo, v_hi)).hopf_points]
+        else:
+            points = [V_edge]
+        for V in points:
+            q = np.array([V, theta]) / p_scale
             if any(near_polyline(c.p / p_scale, q) is not None for c in curves):
                 continue
             try:
-                curve = hopf_curve(system, np.zeros(n), np.array([h.V, float(theta)]), box=box, options=options,
+                curve = hopf_curve(system, np.zeros(n), np.array([V, theta]), box=box, options=options,
                                    scale=X_SCALE[:n], p_scale=p_scale)
             except ValueError as exc:
-                warnings.append(f"Hopf point V = {h.V:.6g} m/s at {parameter} = {theta:.6g} not continued: {exc}")
+                warnings.append(f"Hopf point V = {V:.6g} m/s at {parameter} = {theta:.6g} not continued: {exc}")
                 continue
             curves.append(curve)
     return HopfSpeedCurves(config, parameter, Fz, params, (v_lo, v_hi), (p_lo, p_hi), curves,
