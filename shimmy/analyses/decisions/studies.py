@@ -18,6 +18,7 @@ from ..diagrams.bifurcation import BifurcationOptions, bifurcation
 from ...model.configurations import CONFIGURATION_NAMES, Configuration
 from ...errors import InvalidParameterError
 from ..core.executors import name_of, run_units
+from .study_curves import hopf_speed_curves
 from .summaries import STUDY_COLUMNS, study_summary, write_study_csv
 from ...model.parameters import (DEFAULT_FZ, DIAGRAM_V_RANGE, PARAMETER_SPECS, V_RANGE, Parameters,
                                  check_operating_point, check_range)
@@ -38,6 +39,8 @@ class StudyResult:
     executor: str
     elapsed_s: float
     warnings: list[str] = field(default_factory=list)
+    #: Exact curves of the Hopf speeds against the parameter (:mod:`.study_curves`); a one-parameter study's.
+    curves: list[dict[str, Any]] = field(default_factory=list)
 
     COLUMNS = STUDY_COLUMNS
 
@@ -47,7 +50,7 @@ class StudyResult:
                 "units": {"hopf_start": "m/s", "hopf_end": "m/s", "max_psi": "rad", "max_psi_V": "m/s",
                           "Fz": "N"},
                 "executor": self.executor, "warnings": self.warnings, "elapsed_s": self.elapsed_s,
-                "version": __version__}
+                "curves": self.curves, "version": __version__}
 
     def write_csv(self, stream) -> None:
         """The rows as CSV to ``stream`` (:func:`~shimmy.analyses.decisions.summaries.write_study_csv`)."""
@@ -114,11 +117,20 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
           Fz: float = DEFAULT_FZ, params: Parameters | None = None, v_range: tuple[float, float] = DIAGRAM_V_RANGE,
           options: BifurcationOptions | None = None, executor=None,
           progress: Callable[[float, str], None] | None = None) -> StudyResult:
-    """One-parameter study: a row per (value, configuration)."""
+    """One-parameter study: a row per (value, configuration), and per configuration the exact curves
+    hopf_V_start and hopf_V_end (m/s) over the parameter's whole range
+    (:func:`~shimmy.analyses.decisions.study_curves.hopf_speed_curves`), through the sampled values."""
     base = params if params is not None else Parameters()
     checked = _check_values(parameter, values, base)
-    return _run([parameter], [{parameter: v} for v in checked], configs, Fz, v_range, base, executor, progress,
-                options)
+    result = _run([parameter], [{parameter: v} for v in checked], configs, Fz, v_range, base, executor, progress,
+                  options)
+    clock = time.perf_counter()
+    for config in result.configs:
+        speeds = hopf_speed_curves(config, parameter, Fz=result.Fz, params=base, v_range=result.v_range)
+        result.curves += [c.to_dict() for c in speeds.study_curves(values=checked)]
+        result.warnings += [f"{config}, curves in {parameter}: {w}" for w in speeds.warnings]
+    result.elapsed_s += time.perf_counter() - clock
+    return result
 
 
 def study_grid(parameters: tuple[str, str], values: tuple[Sequence[float], Sequence[float]],

@@ -109,8 +109,36 @@ def study_summary(result: dict[str, Any]) -> str:
         lines.append("".join(f"{r[p]:>12.6g}" for p in parameters)
                      + f"  {r['config']:<8}{num(r['hopf_start'], '11.4f')}{num(r['hopf_end'], '10.4f')}"
                      f"{num(r['max_psi'], '10.5f')}{num(r['max_psi_V'], '8.2f')}")
+    lines += study_curves_lines(result.get("curves", []))
     lines += [f"  warning: {w}" for w in result["warnings"]]
     return "\n".join(lines)
+
+
+def study_curves_lines(curves: list[dict[str, Any]], rows: int = 11) -> list[str]:
+    """The study curves as text: per configuration, p against each quantity on ``rows`` grid values
+    (evenly picked, the ends included) and the special points."""
+    lines: list[str] = []
+    by_config: dict[str, list[dict[str, Any]]] = {}
+    for c in curves:
+        by_config.setdefault(c["config"], []).append(c)
+
+    def num(x):
+        return f"{'-':>14}" if x is None else f"{x:14.6g}"
+
+    for config, group in by_config.items():
+        p = group[0]["p"]
+        lines.append(f"curves of {config} against {group[0]['param']} ({len(p)} exact points each, "
+                     f"{p[0]:g}..{p[-1]:g}):")
+        lines.append(f"{group[0]['param']:>14}" + "".join(f"{c['quantity'] + ' (' + c['unit'] + ')':>24}"
+                                                           for c in group))
+        picks = sorted({round(k * (len(p) - 1) / (rows - 1)) for k in range(rows)}) if len(p) > 1 else [0]
+        for i in picks:
+            lines.append(f"{p[i]:14.6g}" + "".join(f"{num(c['values'][i]):>24}" for c in group))
+        for c in group:
+            for s in c["special_points"]:
+                lines.append(f"  {c['quantity']}: {s['kind']} at {c['param']} = {s['p']:.8g}, "
+                             f"value {s['value']:.8g} {c['unit']}")
+    return lines
 
 
 def write_study_csv(result: dict[str, Any], stream) -> None:
