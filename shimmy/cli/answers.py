@@ -65,9 +65,9 @@ def answer(args, analysis: str, canonical: dict[str, Any],
     from ..service.analyses import RUNNERS, run_canonical
 
     if args.no_cache:
-        from ..service import cache
+        from ..service.cache import bypassed
 
-        with cache.bypassed():  # nor a cached neighbour: a map is computed cold
+        with bypassed():  # nor a cached neighbour: a map is computed cold
             return Answer(RUNNERS[analysis](canonical, progress), OFF, "--no-cache")
     result, hit = run_canonical(analysis, canonical, progress)
     return Answer(result, HIT if hit else MISS)
