@@ -16,8 +16,9 @@ from typing import Any, Callable, Sequence
 from ...version import __version__
 from ..diagrams.bifurcation import BifurcationOptions, bifurcation
 from ...model.configurations import CONFIGURATION_NAMES, Configuration
-from ...errors import InvalidParameterError
+from ...errors import ConvergenceError, InvalidParameterError
 from ..core.executors import name_of, run_units
+from .min_shimmy_curve import min_shimmy_curve
 from .study_curves import hopf_speed_curves
 from .summaries import STUDY_COLUMNS, study_summary, write_study_csv
 from ...model.parameters import (DEFAULT_FZ, DIAGRAM_V_RANGE, PARAMETER_SPECS, V_RANGE, Parameters,
@@ -119,7 +120,9 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
           progress: Callable[[float, str], None] | None = None) -> StudyResult:
     """One-parameter study: a row per (value, configuration), and per configuration the exact curves
     hopf_V_start and hopf_V_end (m/s) over the parameter's whole range
-    (:func:`~shimmy.analyses.decisions.study_curves.hopf_speed_curves`), through the sampled values."""
+    (:func:`~shimmy.analyses.decisions.study_curves.hopf_speed_curves`), through the sampled values,
+    and min_shimmy_Fz (N), the lowest point of the Hopf curves in (V, Fz) over the plane V in the
+    study's range, Fz 10-900 kN (:func:`~shimmy.analyses.decisions.min_shimmy_curve.min_shimmy_curve`)."""
     base = params if params is not None else Parameters()
     checked = _check_values(parameter, values, base)
     result = _run([parameter], [{parameter: v} for v in checked], configs, Fz, v_range, base, executor, progress,
@@ -129,6 +132,13 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
         speeds = hopf_speed_curves(config, parameter, Fz=result.Fz, params=base, v_range=result.v_range)
         result.curves += [c.to_dict() for c in speeds.study_curves(values=checked)]
         result.warnings += [f"{config}, curves in {parameter}: {w}" for w in speeds.warnings]
+        try:
+            lowest, notes = min_shimmy_curve(config, parameter, params=base, v_range=result.v_range, values=checked)
+        except ConvergenceError as exc:
+            result.warnings.append(f"{config}, min_shimmy_Fz in {parameter}: not followed: {exc}")
+        else:
+            result.curves.append(lowest.to_dict())
+            result.warnings += [f"{config}, min_shimmy_Fz in {parameter}: {w}" for w in notes]
     result.elapsed_s += time.perf_counter() - clock
     return result
 

@@ -74,7 +74,7 @@ TRACK_MARGIN = 1e-3
 SNAP = 1e-8
 
 
-def _design(params: Parameters, name: str, value: float) -> SimpleNamespace:
+def design_with(params: Parameters, name: str, value: float) -> SimpleNamespace:
     """params' groups with one value changed, without range checks (the continuation locates the box's
     ends by stepping just past them; the model is smooth there)."""
     spec = PARAMETER_SPECS[name]
@@ -119,7 +119,7 @@ def design_two_parameter_field(config: Configuration, params: Parameters, name: 
         if m is None:
             if len(cache) > 64:
                 cache.clear()
-            m = cache[theta] = Model(config, params, model_coefficients(config, _design(params, name, theta)))
+            m = cache[theta] = Model(config, params, model_coefficients(config, design_with(params, name, theta)))
         return m
 
     h = THETA_STEP * span
@@ -202,7 +202,7 @@ class HopfSpeedCurves:
     warnings: list[str] = field(default_factory=list)
 
     def linearisation(self, theta: float) -> Linearisation:
-        model = Model(self.config, self.params, model_coefficients(self.config, _design(self.params, self.param,
+        model = Model(self.config, self.params, model_coefficients(self.config, design_with(self.params, self.param,
                                                                                          theta)))
         return Linearisation(model, self.Fz)
 
@@ -347,7 +347,7 @@ def _edge_starts(config: Configuration, params: Parameters, name: str, Fz: float
     parts of J(V; theta) on ``thetas``, refined by Brent's method (curves entering through a speed edge
     between the starts are continued from there)."""
     def ordered(theta: float) -> np.ndarray:
-        model = Model(config, params, model_coefficients(config, _design(params, name, theta)))
+        model = Model(config, params, model_coefficients(config, design_with(params, name, theta)))
         return np.sort(np.linalg.eigvals(Linearisation(model, Fz).at(V)).real)[::-1]
 
     re = np.array([ordered(t) for t in thetas])
