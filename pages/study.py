@@ -143,24 +143,55 @@ jobs.register(
     blank=lambda: (style.message_figure("Refused: see the message above", 560), None))
 
 
+#: the panels: (key of a sampled row, quantity of an exact curve, axis title, scale of the values)
+PANELS = (("hopf_start", "hopf_V_start", "first Hopf V (m/s)", 1.0),
+          ("hopf_end", "hopf_V_end", "last Hopf V (m/s)", 1.0),
+          (None, "min_shimmy_Fz", "min shimmy Fz (kN)", 1e-3),
+          ("max_psi", None, "max stable |psi| (rad)", 1.0))
+
+
 def figure(result):
+    """Per configuration: the exact curves over the parameter's whole range (lines; the points where
+    the picture changes as crosses) with the sampled diagrams' values as markers on them; the largest
+    amplitude from the samples alone (lines between them)."""
     name = result["parameters"][0]
-    fig = make_subplots(rows=3, cols=1, shared_xaxes=True, vertical_spacing=0.06)
+    fig = make_subplots(rows=len(PANELS), cols=1, shared_xaxes=True, vertical_spacing=0.05)
+    curves = {(c["config"], c["quantity"]): c for c in result.get("curves") or []}
     for config in result["configs"]:
         rows = sorted((r for r in result["rows"] if r["config"] == config), key=lambda r: r[name])
         x = [r[name] for r in rows]
         colour, label = style.CONFIG_COLOURS[config], style.CONFIG_LABELS[config]
-        for row, key in ((1, "hopf_start"), (2, "hopf_end"), (3, "max_psi")):
-            fig.add_scatter(x=x, y=[r[key] for r in rows], mode="lines+markers", name=label, legendgroup=config,
-                            showlegend=row == 1, line={"color": colour, "width": 2}, marker={"size": 7},
-                            hovertemplate=f"{label}<br>{name} %{{x:.4g}}<br>%{{y:.5g}}<extra></extra>", row=row, col=1)
-    fig.update_layout(title=style.title(f"Study in {name} at Fz = {result['Fz'] / 1e3:g} kN"), height=660,
+        shown = False
+        for row, (key, quantity, _, scale) in enumerate(PANELS, start=1):
+            curve = curves.get((config, quantity))
+            hover = f"{label}<br>{name} %{{x:.4g}}<br>%{{y:.6g}}<extra>WHAT</extra>"
+            if curve is not None:
+                fig.add_scatter(x=curve["p"], y=[None if v is None else v * scale for v in curve["values"]],
+                                mode="lines", name=label, legendgroup=config, showlegend=not shown,
+                                line={"color": colour, "width": 2}, hovertemplate=hover.replace("WHAT", "exact curve"), row=row, col=1)
+                shown = True
+                marks = [q for q in curve["special_points"] if isinstance(q.get("value"), (int, float))]
+                if marks:
+                    fig.add_scatter(x=[q["p"] for q in marks], y=[q["value"] * scale for q in marks], mode="markers",
+                                    name=f"{label}: where the picture changes", legendgroup=config, showlegend=False,
+                                    marker={"symbol": "x", "size": 10, "color": colour},
+                                    text=[q["kind"] for q in marks], row=row, col=1,
+                                    hovertemplate=f"{label}: %{{text}}<br>{name} %{{x:.6g}}<br>%{{y:.6g}}"
+                                                  "<extra></extra>")
+            if key is not None:
+                fig.add_scatter(x=x, y=[r[key] for r in rows], name=label, legendgroup=config, showlegend=not shown,
+                                mode="markers" if curve is not None else "lines+markers",
+                                line={"color": colour, "width": 2},
+                                marker={"size": 8, "color": colour, "line": {"width": 1.5, "color": "#fff"}},
+                                hovertemplate=hover.replace("WHAT", "sampled diagram"), row=row, col=1)
+                shown = True
+    fig.update_layout(title=style.title(f"Study in {name} at Fz = {result['Fz'] / 1e3:g} kN: exact curves (lines), "
+                                        "sampled diagrams (markers)"), height=820,
                       template="plotly_white", margin={**style.MARGIN, "l": 70},
-                      legend={"orientation": "h", "y": -0.1})
-    fig.update_xaxes(title_text=f"{name}{_unit(name)}", row=3, col=1)
-    fig.update_yaxes(title_text="first Hopf V (m/s)", row=1, col=1)
-    fig.update_yaxes(title_text="last Hopf V (m/s)", row=2, col=1)
-    fig.update_yaxes(title_text="max stable |psi| (rad)", row=3, col=1)
+                      legend={"orientation": "h", "y": -0.08})
+    fig.update_xaxes(title_text=f"{name}{_unit(name)}", row=len(PANELS), col=1)
+    for row, (_, _, title, _) in enumerate(PANELS, start=1):
+        fig.update_yaxes(title_text=title, row=row, col=1)
     return fig
 
 
@@ -200,10 +231,10 @@ dash.clientside_callback(
     """
     function(log, fig) {
         const C = window.dash_clientside;
-        if (!fig || !fig.layout || !fig.layout.yaxis3) { return C.no_update; }
+        if (!fig || !fig.layout || !fig.layout.yaxis4) { return C.no_update; }
         const type = (log || []).includes("log") ? "log" : "linear";
-        if ((fig.layout.yaxis3.type || "linear") === type) { return C.no_update; }
-        const layout = Object.assign({}, fig.layout, {yaxis3: Object.assign({}, fig.layout.yaxis3, {type: type,
+        if ((fig.layout.yaxis4.type || "linear") === type) { return C.no_update; }
+        const layout = Object.assign({}, fig.layout, {yaxis4: Object.assign({}, fig.layout.yaxis4, {type: type,
                                      autorange: true})});
         return Object.assign({}, fig, {layout: layout});
     }

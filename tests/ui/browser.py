@@ -79,13 +79,15 @@ def severe(driver) -> list[str]:
 
 
 def wait_for(predicate, timeout=60.0, interval=0.1, what="condition"):
+    """``predicate()`` once it is true; ``what`` (text, or a function giving it when the wait fails:
+    the page's state then) names what was waited for."""
     deadline = time.time() + timeout
     while time.time() < deadline:
         value = predicate()
         if value:
             return value
         time.sleep(interval)
-    raise AssertionError(f"timed out waiting for {what}")
+    raise AssertionError(f"timed out waiting for {what() if callable(what) else what}")
 
 
 def idle(driver, timeout=60.0):

@@ -227,7 +227,9 @@ def test_study_skips_what_a_parameter_cannot_affect_and_refuses_empty_values(ser
     assert browser.execute_script("return arguments[0].scrollWidth <= arguments[0].clientWidth", values)
     browser.find_element(By.ID, "study-run").click()
     configs = ("return [...document.querySelectorAll('#study-summary tbody tr')].map(r => r.cells[1].innerText);")
-    wait_for(lambda: browser.execute_script(configs), timeout=120, what="the study table")
+    wait_for(lambda: browser.execute_script(configs), timeout=120,
+             what=lambda: f"the study table (status: {text_of(browser, 'study-status')!r}, error: "
+                          f"{text_of(browser, 'study-error')!r})")
     idle(browser)
     assert browser.execute_script(configs) == ["NES", "NES"]  # original skipped
     browser.find_elements(By.CSS_SELECTOR, "#study-view input")[1].click()
@@ -236,7 +238,11 @@ def test_study_skips_what_a_parameter_cannot_affect_and_refuses_empty_values(ser
     assert len(browser.find_elements(By.CSS_SELECTOR, "#study-pivot tbody tr")) == 2
     browser.find_element(By.CSS_SELECTOR, "#study-log input").click()
     wait_for(lambda: browser.execute_script("return document.querySelector('#study-graph .js-plotly-plot')"
-                                            ".layout.yaxis3.type") == "log", timeout=10, what="the log axis")
+                                            ".layout.yaxis4.type") == "log", timeout=10, what="the log axis")
+    # the exact curves over the whole range (lines) beside the sampled values (markers)
+    modes = browser.execute_script("return document.querySelector('#study-graph .js-plotly-plot').data"
+                                   ".map(t => [t.mode, t.x.length]);")
+    assert [m for m in modes if m[0] == "lines" and m[1] > 10] and [m for m in modes if m[0] == "markers"]
     type_into(browser.find_element(By.ID, "study-values"), "")
     browser.find_element(By.ID, "study-run").click()
     wait_for(lambda: text_of(browser, "study-error").startswith("Values is empty"), timeout=10, what="the refusal")
