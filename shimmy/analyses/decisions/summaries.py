@@ -118,14 +118,14 @@ def study_curves_lines(curves: list[dict[str, Any]], rows: int = 11) -> list[str
     """The study curves as text: per configuration, p against each quantity on ``rows`` grid values
     (evenly picked, the ends included) and the special points."""
     lines: list[str] = []
-    by_config: dict[str, list[dict[str, Any]]] = {}
-    for c in curves:
-        by_config.setdefault(c["config"], []).append(c)
+    by_config: dict[tuple, list[dict[str, Any]]] = {}
+    for c in curves:  # a table per configuration and grid (the curves on the same values of p side by side)
+        by_config.setdefault((c["config"], tuple(c["p"])), []).append(c)
 
     def num(x):
         return f"{'-':>14}" if x is None else f"{x:14.6g}"
 
-    for config, group in by_config.items():
+    for (config, _), group in by_config.items():
         p = group[0]["p"]
         lines.append(f"curves of {config} against {group[0]['param']} ({len(p)} exact points each, "
                      f"{p[0]:g}..{p[-1]:g}):")
@@ -136,8 +136,9 @@ def study_curves_lines(curves: list[dict[str, Any]], rows: int = 11) -> list[str
             lines.append(f"{p[i]:14.6g}" + "".join(f"{num(c['values'][i]):>24}" for c in group))
         for c in group:
             for s in c["special_points"]:
-                lines.append(f"  {c['quantity']}: {s['kind']} at {c['param']} = {s['p']:.8g}, "
-                             f"value {s['value']:.8g} {c['unit']}")
+                value = s.get("value")
+                lines.append(f"  {c['quantity']}: {s['kind']} at {c['param']} = {s['p']:.8g}"
+                             + ("" if value is None else f", value {value:.8g} {c['unit']}"))
     return lines
 
 
