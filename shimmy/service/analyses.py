@@ -123,7 +123,7 @@ def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> di
 @serves("map", sync=False, job=True)
 def stability_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """The map with its design metrics; slices go through the executor of this environment. Warmed
-    from the map of the nearest cached design within reach (:mod:`.neighbours`), if there is one;
+    from the map of the nearest cached design within reach (:mod:`shimmy.service.neighbours`), if there is one;
     its own warm start is kept for the next."""
     from ..analyses.maps.design_metrics import metrics
     from ..analyses.maps.stability_map import stability_map as run_map

@@ -1,13 +1,14 @@
 """The nearest cached design: where a map one slider step away is warmed from.
 
-Every map the service computes leaves its warm start (:meth:`StabilityMap.warm_start`: its curves'
-seeds, slices and arrangement, about 100-150 kB) in the shared result cache, and its design in an
+Every map the service computes leaves its warm start
+(:meth:`~shimmy.analyses.maps.stability_map.StabilityMap.warm_start`: its curves' seeds, slices and
+arrangement, about 100-150 kB) in the shared result cache, and its design in an
 index of the maps of the same question but the design (configuration, plane, grid, options: the
 request without ``params``). :func:`nearest` reads that index (one small entry, however many
 designs it lists) and returns the warm start of the nearest design within :data:`MAX_DISTANCE`, so
 finding a neighbour costs one cache read and a few dozen comparisons.
 
-The index keeps the :data:`KEEP` most recent designs of each question; a warm start whose entry
+The index keeps the ``KEEP`` most recent designs of each question; a warm start whose entry
 the cache has evicted is skipped. Updates are transactions of the store (diskcache ``transact``),
 so the gunicorn workers, job workers and the command line can all add to one index.
 """

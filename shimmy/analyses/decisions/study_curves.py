@@ -74,7 +74,7 @@ TRACK_MARGIN = 1e-3
 SNAP = 1e-8
 
 
-def design_with(params: Parameters, name: str, value: float) -> SimpleNamespace:
+def design_with(params: Parameters, name: str, value: float) -> Any:
     """params' groups with one value changed, without range checks (the continuation locates the box's
     ends by stepping just past them; the model is smooth there)."""
     spec = PARAMETER_SPECS[name]

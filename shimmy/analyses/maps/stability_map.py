@@ -404,7 +404,8 @@ class StabilityMap:
                 "version": __version__}
 
     def boundaries(self) -> list[tuple[str, np.ndarray]]:
-        """The region boundaries as named polylines in (V, Fz) (:func:`_boundaries`' names)."""
+        """The region boundaries as named polylines in (V, Fz): ``hopf<i>`` for the Hopf curves, then
+        the kind and index of each fold and torus curve (``LPC2``), as the shading names them."""
         out = [(f"hopf{i}", c.p) for i, c in enumerate(self.hopf.curves)]
         for i, c in enumerate(self.cycles["curves"]):
             points = self.cycles[KEY_OF_KIND[c["kind"]]][_index_of_kind(self.cycles["curves"], i)]

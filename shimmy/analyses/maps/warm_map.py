@@ -100,9 +100,9 @@ def _inside(curves, Fz: float, v_range, tol: float) -> dict:
 
 
 def arrangement_change(old: dict, new: dict, tol: float) -> str | None:
-    """None if two loads' crossings (:func:`_inside`) are the same curves' in the same order, two of
-    them allowed to swap where they lie within ``tol`` of each other before or after (their order
-    is the polylines' rounding); else what changed."""
+    """None if two loads' crossings ({(curve, crossing number): V} inside the speed range) are the
+    same curves' in the same order, two of them allowed to swap where they lie within ``tol`` of
+    each other before or after (their order is the polylines' rounding); else what changed."""
     if set(old) != set(new):
         gone, born = sorted(set(old) - set(new)), sorted(set(new) - set(old))
         return f"crossings {_labels(gone)} gone, {_labels(born)} new"
