@@ -168,7 +168,8 @@ def figure(result):
             if curve is not None:
                 fig.add_scatter(x=curve["p"], y=[None if v is None else v * scale for v in curve["values"]],
                                 mode="lines", name=label, legendgroup=config, showlegend=not shown,
-                                line={"color": colour, "width": 2}, hovertemplate=hover.replace("WHAT", "exact curve"), row=row, col=1)
+                                line={"color": colour, "width": 2}, hovertemplate=hover.replace("WHAT", "exact curve"),
+                                row=row, col=1)
                 shown = True
                 marks = [q for q in curve["special_points"] if isinstance(q.get("value"), (int, float))]
                 if marks:
