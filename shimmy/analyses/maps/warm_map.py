@@ -88,6 +88,8 @@ def same_arrangement(old: dict[str, Any], new: dict[str, Any]) -> str | None:
     for i, (a, b) in enumerate(zip(old["cycle_curves"], new["cycle_curves"], strict=True)):
         if a["closed"] and b["closed"]:  # a loop has no first point: its codimension-2 points as a set
             a, b = dict(a, codim2=sorted(a["codim2"])), dict(b, codim2=sorted(b["codim2"]))
+        elif a["codim2"] == b["codim2"][::-1]:  # traced from another point: the same points the other way
+            b = dict(b, codim2=a["codim2"])
         if a != b:
             return f"cycle curve {i + 1} changed: {a} -> {b}"
     return None

@@ -156,3 +156,15 @@ def test_design_distance_is_the_largest_relative_change():
     assert design_distance(p, p) == 0.0
     assert design_distance(p, p.with_overrides({"e_p": 0.0011})) == pytest.approx(0.1 / 1.1)
 
+
+
+def test_an_open_curve_traced_the_other_way_round_is_the_same_curve():
+    from shimmy.analyses.maps.warm_map import same_arrangement
+
+    old = {"hopf_curves": [True], "gh_points": 1, "double_hopf_points": 0,
+           "cycle_curves": [{"kind": "NS", "closed": False, "codim2": ["LPNS", "R4"]}]}
+    new = json.loads(json.dumps(old))
+    new["cycle_curves"][0]["codim2"] = ["R4", "LPNS"]
+    assert same_arrangement(old, new) is None
+    new["cycle_curves"][0]["codim2"] = ["R4", "R3"]
+    assert "cycle curve 1 changed" in same_arrangement(old, new)
