@@ -94,7 +94,7 @@ class PeriodicBranch(ContinuationResult):
             raise InvalidInputError("rates", None, "a branch with its rates and lengths")
         sigma = np.asarray(sigma, float)[:, None]
         h = float(self.lengths[i + 1])
-        values = [np.column_stack([self.p, self.period, self.x_max, self.x_min])[k] for k in (i, i + 1)]
+        values = [np.concatenate([[self.p[k], self.period[k]], self.x_max[k], self.x_min[k]]) for k in (i, i + 1)]
         slopes = [h * self.rates[k] for k in (i, i + 1)]
         s2, s3 = sigma * sigma, sigma ** 3
         q = ((2 * s3 - 3 * s2 + 1) * values[0] + (s3 - 2 * s2 + sigma) * slopes[0]
@@ -143,10 +143,10 @@ def _orbit_measures(problem: PeriodicProblem, u: np.ndarray):
     return x.max(axis=0), x.min(axis=0)
 
 
-def _orbit_rates(problem: PeriodicProblem, point: CurvePoint) -> np.ndarray:
-    """d/ds of (p, T, x_max, x_min) at a point from its unit tangent: a state's extreme over the
-    orbit moves like the tangent's state part at the (sampled) instant of that extreme."""
-    _, x = problem.sample(point.u)
+def _orbit_rates(problem: PeriodicProblem, point: CurvePoint, x: np.ndarray) -> np.ndarray:
+    """d/ds of (p, T, x_max, x_min) at a point from its unit tangent (``x``: the orbit sampled by
+    ``problem.sample``): a state's extreme over the orbit moves like the tangent's state part at
+    the (sampled) instant of that extreme."""
     _, dx = problem.sample(point.tangent)
     columns = np.arange(x.shape[1])
     t = point.tangent
@@ -260,9 +260,10 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, *, p_range: tuple[fl
     tracer = Tracer(problem, first, copts)
 
     mu0 = problem.multipliers(first.u)
-    xmax0, xmin0 = _orbit_measures(problem, first.u)
+    _, x0 = problem.sample(first.u)
+    xmax0, xmin0 = x0.max(axis=0), x0.min(axis=0)
     rows: dict[str, list] = {"p": [first.u[-1]], "T": [first.u[-2]], "xmax": [xmax0], "xmin": [xmin0],
-                             "mu": [mu0], "rate": [_orbit_rates(problem, first)], "length": [0.0]}
+                             "mu": [mu0], "rate": [_orbit_rates(problem, first, x0)], "length": [0.0]}
     solutions = [(mesh.points.copy(), first.u.copy())]
     special: list[SpecialPoint] = []
     amp_first = _amplitude(problem, xmax0, xmin0)
@@ -395,8 +396,9 @@ def _p_direction(problem: PeriodicProblem, u: np.ndarray) -> np.ndarray:
 
 def _record(problem: PeriodicProblem, rows, solutions, point: CurvePoint, prev: CurvePoint) -> None:
     """Append a point; ``prev`` is the point its step started from (on the same mesh)."""
-    xmax, xmin = _orbit_measures(problem, point.u)
-    rows["rate"].append(_orbit_rates(problem, point))
+    _, x = problem.sample(point.u)
+    xmax, xmin = x.max(axis=0), x.min(axis=0)
+    rows["rate"].append(_orbit_rates(problem, point, x))
     rows["length"].append(weighted_norm(point.u - prev.u, problem.weights))
     rows["p"].append(point.u[-1])
     rows["T"].append(point.u[-2])
