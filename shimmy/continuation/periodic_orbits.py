@@ -84,21 +84,22 @@ class PeriodicBranch(ContinuationResult):
                 "multipliers_abs": np.abs(self.multipliers).tolist(), "ntst": self.ntst, "ncol": self.ncol,
                 "trivial_error": self.trivial_error, **super().to_dict()}
 
-    def between(self, i: int, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def between(self, i, sigma) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """p, T, x_max and x_min (rows: one per sigma) between point i (sigma = 0) and i + 1
         (sigma = 1) on the cubic Hermite polynomial, in arclength, through both points' values and
-        rates. In arclength the branch is smooth where it is steep in p (at a Hopf point the
-        amplitude grows linearly in s, p like s^2), so points taken from it are where a straight
-        segment in p is not (p^(1/2) there)."""
+        rates (``i`` an index, or one per sigma). In arclength the branch is smooth where it is
+        steep in p (at a Hopf point the amplitude grows linearly in s, p like s^2), so points taken
+        from it are where a straight segment in p is not (p^(1/2) there)."""
         if self.rates is None or self.lengths is None:
             raise InvalidInputError("rates", None, "a branch with its rates and lengths")
-        sigma = np.asarray(sigma, float)[:, None]
-        h = float(self.lengths[i + 1])
-        values = [np.concatenate([[self.p[k], self.period[k]], self.x_max[k], self.x_min[k]]) for k in (i, i + 1)]
-        slopes = [h * self.rates[k] for k in (i, i + 1)]
+        sigma = np.asarray(sigma, float).ravel()
+        i = np.broadcast_to(np.asarray(i, int), sigma.shape)
+        table = np.column_stack([self.p, self.period, self.x_max, self.x_min])
+        h = self.lengths[i + 1][:, None]
+        sigma = sigma[:, None]
         s2, s3 = sigma * sigma, sigma ** 3
-        q = ((2 * s3 - 3 * s2 + 1) * values[0] + (s3 - 2 * s2 + sigma) * slopes[0]
-             + (3 * s2 - 2 * s3) * values[1] + (s3 - s2) * slopes[1])
+        q = ((2 * s3 - 3 * s2 + 1) * table[i] + (s3 - 2 * s2 + sigma) * h * self.rates[i]
+             + (3 * s2 - 2 * s3) * table[i + 1] + (s3 - s2) * h * self.rates[i + 1])
         n = self.x_max.shape[1]
         return q[:, 0], q[:, 1], q[:, 2:2 + n], q[:, 2 + n:]
 

@@ -321,19 +321,20 @@ def _amplitudes(x_max: np.ndarray, x_min: np.ndarray) -> np.ndarray:
     return np.column_stack([np.maximum(np.abs(x_max[:, k]), np.abs(x_min[:, k])) for k in (0, 2)])
 
 
-def _added(raw: PeriodicBranch, i: int) -> np.ndarray:
-    """Where (sigma in (0, 1), in arclength) to add drawn points between points i and i + 1: the step
-    is halved, and its halves again (at most ``DRAW_SPLITS`` times), while a straight segment in V
-    strays from the branch's cubic in arclength by more than ``DRAW_TOL`` of the torsional or lateral
-    amplitude there, checked at the segment's quarter points and middle (where V turns inside a
-    segment, a fold, the segment is linear in arclength instead)."""
+def _added(raw: PeriodicBranch) -> tuple[np.ndarray, np.ndarray]:
+    """Where to add drawn points between the computed orbits: (step index i, sigma in (0, 1), in
+    arclength from point i to i + 1), sorted. Each step is halved, and its halves again (at most
+    ``DRAW_SPLITS`` times), while a straight segment in V strays from the branch's cubic in
+    arclength by more than ``DRAW_TOL`` of the torsional or lateral amplitude there, checked at the
+    segment's quarter points and middle (where V turns inside a segment, a fold, the segment is
+    linear in arclength instead)."""
     quarters = np.array([0.25, 0.5, 0.75])
-    done: list[float] = []
-    pieces = np.array([[0.0, 1.0]])
+    steps, lo, hi = np.arange(raw.p.size - 1), np.zeros(raw.p.size - 1), np.ones(raw.p.size - 1)
+    added_steps, added_sigma = [], []
     for _ in range(DRAW_SPLITS):
-        checks = pieces[:, :1] + quarters[None, :] * (pieces[:, 1:] - pieces[:, :1])
-        p_n, _, xa_n, xi_n = raw.between(i, pieces.ravel())
-        p_c, _, xa_c, xi_c = raw.between(i, checks.ravel())
+        checks = lo[:, None] + quarters[None, :] * (hi - lo)[:, None]
+        p_n, _, xa_n, xi_n = raw.between(np.repeat(steps, 2), np.column_stack([lo, hi]).ravel())
+        p_c, _, xa_c, xi_c = raw.between(np.repeat(steps, 3), checks.ravel())
         a_n = _amplitudes(xa_n, xi_n).reshape(-1, 2, 2)
         a_c = _amplitudes(xa_c, xi_c).reshape(-1, 3, 2)
         v_n, v_c = p_n.reshape(-1, 2), p_c.reshape(-1, 3)
@@ -342,13 +343,19 @@ def _added(raw: PeriodicBranch, i: int) -> np.ndarray:
         f = np.where((f >= 0.0) & (f <= 1.0), f, quarters[None, :])
         line = a_n[:, :1, :] + f[:, :, None] * (a_n[:, 1:, :] - a_n[:, :1, :])
         error = np.max(np.abs(line - a_c) / np.maximum(np.abs(a_c), 1e-12), axis=(1, 2))
-        split = pieces[error > DRAW_TOL]
-        if split.size == 0:
+        split = error > DRAW_TOL
+        if not split.any():
             break
-        middle = split.mean(axis=1)
-        done.extend(middle)
-        pieces = np.concatenate([np.column_stack([split[:, 0], middle]), np.column_stack([middle, split[:, 1]])])
-    return np.sort(np.array(done))
+        steps, lo, hi = steps[split], lo[split], hi[split]
+        middle = 0.5 * (lo + hi)
+        added_steps.append(steps)
+        added_sigma.append(middle)
+        steps, lo, hi = np.tile(steps, 2), np.concatenate([lo, middle]), np.concatenate([middle, hi])
+    if not added_steps:
+        return np.zeros(0, int), np.zeros(0)
+    steps, sigma = np.concatenate(added_steps), np.concatenate(added_sigma)
+    order = np.lexsort((sigma, steps))
+    return steps[order], sigma[order]
 
 
 def _drawn(raw: PeriodicBranch) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -358,21 +365,21 @@ def _drawn(raw: PeriodicBranch) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.
     point located in that step (else as the nearer one)."""
     if raw.rates is None or raw.p.size < 2:
         return raw.p, raw.period, raw.x_max, raw.x_min, raw.stable
-    parts = [(raw.p[:1], raw.period[:1], raw.x_max[:1], raw.x_min[:1], raw.stable[:1])]
-    for i in range(raw.p.size - 1):
-        sigma = _added(raw, i)
-        if sigma.size:
-            p, T, x_max, x_min = raw.between(i, sigma)
-            stable = np.where(sigma <= 0.5, raw.stable[i], raw.stable[i + 1])
-            if raw.stable[i] != raw.stable[i + 1]:
-                lo, hi = sorted((raw.p[i], raw.p[i + 1]))
-                at = [s.p for s in raw.special_points if s.index in (i, i + 1) and lo <= s.p <= hi]
-                if at:
-                    stable = np.where((p - at[0]) * (raw.p[i] - at[0]) >= 0, raw.stable[i], raw.stable[i + 1])
-            parts.append((p, T, x_max, x_min, stable))
-        parts.append((raw.p[i + 1:i + 2], raw.period[i + 1:i + 2], raw.x_max[i + 1:i + 2], raw.x_min[i + 1:i + 2],
-                      raw.stable[i + 1:i + 2]))
-    return tuple(np.concatenate(column) for column in zip(*parts, strict=True))
+    steps, sigma = _added(raw)
+    if steps.size == 0:
+        return raw.p, raw.period, raw.x_max, raw.x_min, raw.stable
+    p, T, x_max, x_min = raw.between(steps, sigma)
+    stable = np.where(sigma <= 0.5, raw.stable[steps], raw.stable[steps + 1])
+    for i in np.unique(steps[raw.stable[steps] != raw.stable[steps + 1]]):
+        lo, hi = sorted((raw.p[i], raw.p[i + 1]))
+        at = [s.p for s in raw.special_points if s.index in (i, i + 1) and lo <= s.p <= hi]
+        if at:
+            here = steps == i
+            stable[here] = np.where((p[here] - at[0]) * (raw.p[i] - at[0]) >= 0, raw.stable[i], raw.stable[i + 1])
+    # computed orbit i sorts before the points added in step i (position i + sigma, sigma in (0, 1))
+    order = np.argsort(np.concatenate([np.arange(raw.p.size, dtype=float), steps + sigma]), kind="stable")
+    return tuple(np.concatenate([a, b])[order] for a, b in ((raw.p, p), (raw.period, T), (raw.x_max, x_max),
+                                                            (raw.x_min, x_min), (raw.stable, stable)))
 
 
 def _periodic_output(raw: PeriodicBranch, params: Parameters, origin: str, hopf_speeds: list[float]) -> Branch:
