@@ -71,12 +71,37 @@ class PeriodicBranch(ContinuationResult):
     ncol: int
     solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, u) per point
     trivial_error: float  # max |mu_trivial - 1| over the branch: accuracy check
+    #: (points, 2 + 2n): derivatives along the branch, per unit arclength (the weighted norm), of
+    #: p, T, x_max and x_min at each point, from its tangent (a state's max over the orbit moves
+    #: like the tangent at the instant of that max); None where they are not known
+    rates: np.ndarray | None = None
+    #: (points,): arclength (weighted chord) from the previous point to each point, 0 at the first
+    lengths: np.ndarray | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {"p": self.p.tolist(), "period": self.period.tolist(), "x_max": self.x_max.tolist(),
                 "x_min": self.x_min.tolist(), "stable": self.stable.tolist(),
                 "multipliers_abs": np.abs(self.multipliers).tolist(), "ntst": self.ntst, "ncol": self.ncol,
                 "trivial_error": self.trivial_error, **super().to_dict()}
+
+    def between(self, i, sigma) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """p, T, x_max and x_min (rows: one per sigma) between point i (sigma = 0) and i + 1
+        (sigma = 1) on the cubic Hermite polynomial, in arclength, through both points' values and
+        rates (``i`` an index, or one per sigma). In arclength the branch is smooth where it is
+        steep in p (at a Hopf point the amplitude grows linearly in s, p like s^2), so points taken
+        from it are where a straight segment in p is not (p^(1/2) there)."""
+        if self.rates is None or self.lengths is None:
+            raise InvalidInputError("rates", None, "a branch with its rates and lengths")
+        sigma = np.asarray(sigma, float).ravel()
+        i = np.broadcast_to(np.asarray(i, int), sigma.shape)
+        table = np.column_stack([self.p, self.period, self.x_max, self.x_min])
+        h = self.lengths[i + 1][:, None]
+        sigma = sigma[:, None]
+        s2, s3 = sigma * sigma, sigma ** 3
+        q = ((2 * s3 - 3 * s2 + 1) * table[i] + (s3 - 2 * s2 + sigma) * h * self.rates[i]
+             + (3 * s2 - 2 * s3) * table[i + 1] + (s3 - s2) * h * self.rates[i + 1])
+        n = self.x_max.shape[1]
+        return q[:, 0], q[:, 1], q[:, 2:2 + n], q[:, 2 + n:]
 
     def orbit(self, i: int, system: VectorField, per_interval: int = 12) -> tuple[np.ndarray, np.ndarray]:
         """t (s) and x (k, n) of point i over one period."""
@@ -117,6 +142,16 @@ def orbit_from_samples(t: np.ndarray, x: np.ndarray, period: float, p: float, me
 def _orbit_measures(problem: PeriodicProblem, u: np.ndarray):
     _, x = problem.sample(u)
     return x.max(axis=0), x.min(axis=0)
+
+
+def _orbit_rates(problem: PeriodicProblem, point: CurvePoint, x: np.ndarray) -> np.ndarray:
+    """d/ds of (p, T, x_max, x_min) at a point from its unit tangent (``x``: the orbit sampled by
+    ``problem.sample``): a state's extreme over the orbit moves like the tangent's state part at
+    the (sampled) instant of that extreme."""
+    _, dx = problem.sample(point.tangent)
+    columns = np.arange(x.shape[1])
+    t = point.tangent
+    return np.concatenate([[t[-1], t[-2]], dx[x.argmax(axis=0), columns], dx[x.argmin(axis=0), columns]])
 
 
 def _amplitude(problem: PeriodicProblem, x_max, x_min) -> float:
@@ -226,9 +261,10 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, *, p_range: tuple[fl
     tracer = Tracer(problem, first, copts)
 
     mu0 = problem.multipliers(first.u)
-    xmax0, xmin0 = _orbit_measures(problem, first.u)
+    _, x0 = problem.sample(first.u)
+    xmax0, xmin0 = x0.max(axis=0), x0.min(axis=0)
     rows: dict[str, list] = {"p": [first.u[-1]], "T": [first.u[-2]], "xmax": [xmax0], "xmin": [xmin0],
-                             "mu": [mu0]}
+                             "mu": [mu0], "rate": [_orbit_rates(problem, first, x0)], "length": [0.0]}
     solutions = [(mesh.points.copy(), first.u.copy())]
     special: list[SpecialPoint] = []
     amp_first = _amplitude(problem, xmax0, xmin0)
@@ -244,7 +280,7 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, *, p_range: tuple[fl
         prev, new, h, bound = out
         if bound is not None:
             if new is not None:
-                _record(problem, rows, solutions, new)
+                _record(problem, rows, solutions, new, prev)
                 special.extend(_detect(problem, rows, prev, new, copts))
                 special.append(_special(problem, PointKind.END, new, rows))
             stop = Stop(StopReason.BOUND, f"reached the parameter bound p = {bound:g}")
@@ -259,7 +295,7 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, *, p_range: tuple[fl
         if T_new <= 0:
             stop = Stop(StopReason.NONPOSITIVE_PERIOD, "period became non-positive: the continuation left the branch")
             break
-        _record(problem, rows, solutions, new)
+        _record(problem, rows, solutions, new, prev)
         found = _detect(problem, rows, prev, new, copts)
         zero = amp_first if hopf_start else 1e-3 * amp_peak  # below this a cycle's amplitude counts as zero
         ends = [s for s in found if s.kind == PointKind.FOLD_OF_CYCLES
@@ -319,8 +355,9 @@ def periodic_branch(system: VectorField, guess: OrbitGuess, *, p_range: tuple[fl
     trivial = float(np.max(np.abs(mu[:, 0] - 1.0)))
     return PeriodicBranch(np.array(rows["p"]), np.array(rows["T"]), np.array(rows["xmax"]),
                           np.array(rows["xmin"]), np.abs(mu[:, 1:]).max(axis=1, initial=0.0) < 1.0, mu,
-                          problem.mesh.ntst, problem.mesh.ncol, solutions, trivial, special_points=special,
-                          stops=[stop], steps=steps, closed=stop.reason is StopReason.CLOSED)
+                          problem.mesh.ntst, problem.mesh.ncol, solutions, trivial, np.array(rows["rate"]),
+                          np.array(rows["length"]), special_points=special, stops=[stop], steps=steps,
+                          closed=stop.reason is StopReason.CLOSED)
 
 
 def _measures(problem: PeriodicProblem, rows) -> np.ndarray:
@@ -358,8 +395,12 @@ def _p_direction(problem: PeriodicProblem, u: np.ndarray) -> np.ndarray:
     return t / weighted_norm(t, problem.weights)
 
 
-def _record(problem: PeriodicProblem, rows, solutions, point: CurvePoint) -> None:
-    xmax, xmin = _orbit_measures(problem, point.u)
+def _record(problem: PeriodicProblem, rows, solutions, point: CurvePoint, prev: CurvePoint) -> None:
+    """Append a point; ``prev`` is the point its step started from (on the same mesh)."""
+    _, x = problem.sample(point.u)
+    xmax, xmin = x.max(axis=0), x.min(axis=0)
+    rows["rate"].append(_orbit_rates(problem, point, x))
+    rows["length"].append(weighted_norm(point.u - prev.u, problem.weights))
     rows["p"].append(point.u[-1])
     rows["T"].append(point.u[-2])
     rows["xmax"].append(xmax)

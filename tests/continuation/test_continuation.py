@@ -405,6 +405,49 @@ def test_supercritical_hopf_branch_amplitude_period_and_multipliers():
     assert kinds(br) == ["EP"] and abs(br.p[-1] - 1.0) <= 1e-9 and "bound p = 1" in br.stop_reason
 
 
+def test_points_between_steps_lie_on_the_branch_where_the_chord_in_p_does_not():
+    """PeriodicBranch.between: the cubic in arclength through two points and their rates. On the
+    normal form r = mu^(1/2) (steep at the Hopf point) its midpoints are within 2e-4 of the exact
+    amplitude (x_max is sampled, 12 per interval: 1e-4 of itself), where the straight segment in
+    p misses by up to ~3 % next to the Hopf point; rates against finite differences of x_max."""
+    br = hopf_branch(hopf_supercritical(2.0), 2.0, 0.0, -1.0, 1.0)
+    assert br.rates.shape == (br.p.size, 2 + 2 * 2) and br.lengths[0] == 0.0 and np.all(br.lengths[1:] > 0)
+    cubic, chord = [], []
+    for i in range(br.p.size - 1):
+        p, T, x_max, x_min = br.between(i, np.array([0.0, 0.5, 1.0]))
+        np.testing.assert_allclose(p[[0, 2]], br.p[i:i + 2], rtol=0, atol=1e-15)  # through both points
+        np.testing.assert_allclose(T, math.pi, atol=1e-9)
+        exact = math.sqrt(p[1])
+        cubic.append(abs(x_max[1, 0] - exact) / exact)
+        cubic.append(abs(-x_min[1, 1] - exact) / exact)
+        chord.append(abs(np.interp(p[1], br.p[i:i + 2], br.x_max[i:i + 2, 0]) - exact) / exact)
+    assert max(cubic) < 2e-4, max(cubic)
+    assert max(chord) > 1e-2, max(chord)  # the step control alone leaves the chord this far off
+    # rates: d p / ds and d x_max / ds against centred differences over the neighbours (their error,
+    # second order in the long steps of this branch, is up to 1 % of the largest rate)
+    s = np.cumsum(br.lengths)
+    middle = slice(1, br.p.size - 1)
+    for column, values in ((0, br.p), (2, br.x_max[:, 0])):
+        a, b, c = values[:-2], values[1:-1], values[2:]
+        ha, hb = s[1:-1] - s[:-2], s[2:] - s[1:-1]
+        centred = (hb / ha * (b - a) + ha / hb * (c - b)) / (ha + hb)
+        np.testing.assert_allclose(br.rates[middle, column], centred, atol=2e-2 * np.abs(br.rates[:, column]).max())
+
+
+def test_points_between_steps_through_a_fold_of_cycles():
+    """Across the fold of the quintic normal form (p turns inside a step of arclength 0.16) the
+    cubic in arclength stays near the branch: p + r^2 - r^4 = 0 at every step's midpoint to 3e-3 of
+    r^2 (the error of the cubic, fourth order in the step, is largest at the fold), against
+    1.5e-2 for the midpoint of the straight segment there."""
+    br = hopf_branch(hopf_subcritical_quintic(1.0), 1.0, 0.0, -1.0, 1.0, PeriodicOptions(ntst=40, ncol=4))
+    cubic, chord = [], []
+    for i in range(br.p.size - 1):
+        p, _, x_max, _ = br.between(i, np.array([0.5]))
+        for where, q, r in ((cubic, p[0], x_max[0, 0]), (chord, br.p[i:i + 2].mean(), br.x_max[i:i + 2, 0].mean())):
+            where.append(abs(q + r ** 2 - r ** 4) / r ** 2)
+    assert max(cubic) < 3e-3 and max(chord) > 5 * max(cubic), (max(cubic), max(chord))
+
+
 @pytest.mark.parametrize("mu", [0.1, 0.5, 2.0])
 def test_multipliers_of_the_exact_circle(mu):
     """PeriodicProblem.multipliers on the exact orbit (no continuation): [1, exp(-2 mu T)]."""
