@@ -241,7 +241,7 @@ jobs.register(
     ids.OV_BOUNDARY, "hopf_curves", requests=lambda _settled, design: _boundary_requests(design),
     render=lambda results: (boundary_figure(results),),
     follow=[SETTLED], warm=lambda requests: True,  # a few tenths of a second per configuration: always
-    fading=lambda seconds, asked: (live.fading("Hopf curves of the new design", seconds),),
+    fading=lambda seconds, asked: (live.fading("New design's Hopf curves", seconds),),
     outputs=[Output(ids.OV_BOUNDARY_GRAPH, "figure")], states=[State(ids.design_store(ids.OV), "data")],
     download=jobs.Download(ids.OV_BOUNDARY_FILES, "hopf_curves", _boundary_rows))
 
@@ -266,7 +266,7 @@ jobs.register(
     ids.OV_REGIONS, "map", requests=lambda _settled, design: _regions_requests(design),
     render=lambda results: (_regions_figure(results),),
     follow=[SETTLED], warm=lambda requests: all(neighbours.within_reach("map", r) for r in requests),
-    fading=lambda seconds, asked: (live.fading("Computing the maps of the new design", seconds),),
+    fading=lambda seconds, asked: (live.fading("New design's maps", seconds),),
     stale="The design changed: the maps shown are of the previous design. Press 'Compute maps' for this one (no "
           "maps of a nearby design are cached to start from).",
     outputs=[Output(ids.OV_REGIONS_GRAPH, "figure")], states=[State(ids.design_store(ids.OV), "data")],

@@ -129,7 +129,7 @@ def _warm(requests: list[dict]) -> bool:
 
 def _fading(seconds: float, asked: str) -> tuple:
     """While a map warmed from a nearby design is made: the previous map, faint."""
-    return live.fading(f"Computing the map of the new design ({asked})", seconds), no_update
+    return live.fading("New design's map", seconds), no_update
 
 
 def _computing(seconds: float, asked: str) -> tuple:

@@ -59,5 +59,5 @@ def fading(title: str, seconds: float) -> Patch:
     patch = Patch()
     patch["layout"]["shapes"] = [VEIL]
     # the whole title (the house style's), not its text alone: a placeholder figure has none
-    patch["layout"]["title"] = style.title(f"{title}: {seconds:.0f} s so far; the previous design's, faint")
+    patch["layout"]["title"] = style.title(f"{title}: {seconds:.0f} s so far (faint: the previous one)")
     return patch

@@ -38,7 +38,7 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
     # one step of e_p (+10 %): computed by itself, warmed from the cached map, the old map faint meanwhile
     box = by_id(browser, pattern("e_p", "param-box"))
     type_into(box, "0.00132")
-    wait_for(lambda: _faded(browser) or "Computing the map of the new design" in _title(browser), timeout=30,
+    wait_for(lambda: _faded(browser) or "New design's map" in _title(browser), timeout=30,
              interval=0.05, what="the previous map faint while the next is made")
     browser.save_screenshot(str(SHOTS / "live-map-fading-1440.png"))
     wait_for(lambda: "Shimmy type of" in _title(browser) and not _faded(browser), timeout=240,
