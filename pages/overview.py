@@ -66,8 +66,7 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
                "(the same maps as on the Stability map page, shared through the cache).", className="hint"),
         html.Div(jobs.controls(ids.OV_REGIONS, "Compute maps"), className="controls"),
         html.Div(id=ids.OV_REGIONS.error, className="error", role="alert"),
-        ui.graph(ids.OV_REGIONS_GRAPH, figure=style.message_figure("Press 'Compute maps' (about 15-25 s per "
-                                                                  "configuration cold, instant when cached)")),
+        ui.graph(ids.OV_REGIONS_GRAPH, figure=style.message_figure(REGIONS_WAITING)),
         ui.downloads(ids.OV_REGIONS_FILES, "Download regions CSV", "Download maps JSON"),
         *jobs.stores(ids.OV_REGIONS),
         live.settled(ids.OV),
@@ -246,6 +245,10 @@ jobs.register(
     download=jobs.Download(ids.OV_BOUNDARY_FILES, "hopf_curves", _boundary_rows))
 
 
+REGIONS_WAITING = ("Press 'Compute maps' (about 15-25 s per configuration cold, instant when cached; then they "
+                   "follow the design where a nearby design's maps are cached)")
+
+
 def _regions_requests(design):
     return [{"config": config, **design} for config in CONFIGS]
 
@@ -269,5 +272,6 @@ jobs.register(
     fading=lambda seconds, asked: (live.fading("New design's maps", seconds),),
     stale="The design changed: the maps shown are of the previous design. Press 'Compute maps' for this one (no "
           "maps of a nearby design are cached to start from).",
+    waiting=lambda: (style.message_figure(REGIONS_WAITING),),
     outputs=[Output(ids.OV_REGIONS_GRAPH, "figure")], states=[State(ids.design_store(ids.OV), "data")],
     download=jobs.Download(ids.OV_REGIONS_FILES, "stability_maps", _region_rows))

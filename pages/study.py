@@ -146,7 +146,7 @@ jobs.register(
 #: the panels: (key of a sampled row, quantity of an exact curve, axis title, scale of the values)
 PANELS = (("hopf_start", "hopf_V_start", "first Hopf V (m/s)", 1.0),
           ("hopf_end", "hopf_V_end", "last Hopf V (m/s)", 1.0),
-          (None, "min_shimmy_Fz", "min shimmy Fz (kN)", 1e-3),
+          (None, "min_shimmy_Fz", "lowest Hopf Fz (kN)", 1e-3),
           ("max_psi", None, "max stable |psi| (rad)", 1.0))
 
 

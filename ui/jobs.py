@@ -152,7 +152,7 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
 
     def stopped(message: str, status: str = "") -> tuple:
         """The jobs ended without a result: what running() put in place of the old outputs goes too."""
-        if (running is not None or clock is not None) and waiting is not None:
+        if (running is not None or clock is not None or fading is not None) and waiting is not None:
             return (*waiting(), message, None, True, True) + idle + ("0", status)
         return refused(message, status)
 
@@ -191,7 +191,11 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
                 and warm([r for r, done in zip(wanted, results, strict=True) if done is None]))
         if loading:
             return nothing
-        if trigger in following and not waited and not live:  # nobody asked for a computation
+        if trigger in following and not live and not (waited and not previous.get("live")):
+            # nobody asked for a computation: a change followed by itself computes only where warm says
+            if waited:  # a run the page started by itself for an earlier design: let it go
+                _release(before, before_watcher)
+                return stopped("", stale or "")
             return nothing[:-1] + (stale if stale is not None else no_update,)
         watcher, ids = uuid.uuid4().hex, []
         try:

@@ -42,7 +42,7 @@ def remember(analysis: str, request: dict[str, Any], start: dict[str, Any]) -> N
     """Keep ``start`` (a warm start of the result of ``request``) and list its design."""
     if cache.is_bypassed():
         return
-    try:
+    try:  # never fails the computed map it is called for: a locked store (diskcache.Timeout) included
         store = cache.results()
         store.set(_start_key(analysis, request), start)
         question = _question(analysis, request)
@@ -50,7 +50,7 @@ def remember(analysis: str, request: dict[str, Any], start: dict[str, Any]) -> N
             listed = [e for e in (store.get(question) or []) if e["params"] != request["params"]]
             store.set(question, ([{"params": request["params"], "key": _start_key(analysis, request)}]
                                  + listed)[:KEEP])
-    except cache.DAMAGE as exc:
+    except Exception as exc:  # noqa: BLE001 - see above
         log.error("warm start not kept (%s: %s)", type(exc).__name__, exc)
 
 
@@ -59,14 +59,16 @@ def _ranked(analysis: str, request: dict[str, Any]) -> list[dict[str, Any]]:
     if cache.is_bypassed():
         return []
     try:
-        listed = cache.results().get(_question(analysis, request)) or []
-    except cache.DAMAGE as exc:
+        store = cache.results()
+        listed = store.get(_question(analysis, request)) or []
+        here = Parameters.from_dict(request["params"])
+        ranked = sorted((design_distance(here, Parameters.from_dict(e["params"])), k) for k, e in enumerate(listed)
+                        if e["params"] != request["params"])
+        # a warm start the cache has evicted (large entries go first) is no neighbour
+        return [listed[k] for distance, k in ranked if distance <= MAX_DISTANCE and listed[k]["key"] in store]
+    except Exception as exc:  # noqa: BLE001 - an unreadable index or store: no neighbour, the map is cold
         log.warning("neighbour index unreadable (%s: %s): computing cold", type(exc).__name__, exc)
         return []
-    here = Parameters.from_dict(request["params"])
-    ranked = sorted((design_distance(here, Parameters.from_dict(e["params"])), k) for k, e in enumerate(listed)
-                    if e["params"] != request["params"])
-    return [listed[k] for distance, k in ranked if distance <= MAX_DISTANCE]
 
 
 def within_reach(analysis: str, request: dict[str, Any]) -> bool:

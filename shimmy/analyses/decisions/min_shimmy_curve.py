@@ -98,11 +98,23 @@ def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Par
     for k in range(len(grid)):
         live = [(solutions[j][k][1], j) for j in range(len(starts)) if solutions[j][k] is not None]
         lowest.append(min(live)[1] if live else None)
+    switches = []
     for k in range(len(grid) - 1):
         a, b = lowest[k], lowest[k + 1]
         if a is not None and b is not None and a != b and solutions[a][k + 1] and solutions[b][k]:
-            special.append(_switch(config, params, parameter, grid, k, solutions[a], solutions[b]))
+            switches.append(_switch(config, params, parameter, grid, k, solutions[a], solutions[b]))
+    special += switches
     curve_values = [None if j is None else solutions[j][k][1] for k, j in enumerate(lowest)]
+    if None in curve_values:
+        gone = [grid[k] for k, v in enumerate(curve_values) if v is None]
+        warnings.append(f"no followed lowest point of the Hopf curves at {parameter} = {gone[0]:g}..{gone[-1]:g} "
+                        "(every one ended there); the value there is left out, not zero")
+    # the located switches are points of the curve too (its corners)
+    for q in switches:
+        if q.get("located", True):
+            at = int(np.searchsorted(grid, q["p"]))
+            grid.insert(at, q["p"])
+            curve_values.insert(at, q["value"])
     for k in (0, len(grid) - 1):  # the range's ends against the Hopf curves computed there
         there = hopf_curves(config, params=params.with_overrides({parameter: grid[k]}), v_range=v_range,
                             fz_range=fz_range).fz_minimum
@@ -140,8 +152,12 @@ def _switch(config, params, parameter, grid, k, a_sol, b_sol) -> dict:
         t = 0.5 * (t0 + t1)
         w = (t - grid[k]) / (grid[k + 1] - grid[k])
         model = _model(config, params, parameter, t)
-        fa = polish_lowest_point(model, za0[0] + w * (za1[0] - za0[0]), za0[1] + w * (za1[1] - za0[1]))
-        fb = polish_lowest_point(model, zb0[0] + w * (zb1[0] - zb0[0]), zb0[1] + w * (zb1[1] - zb0[1]))
+        try:
+            fa = polish_lowest_point(model, za0[0] + w * (za1[0] - za0[0]), za0[1] + w * (za1[1] - za0[1]))
+            fb = polish_lowest_point(model, zb0[0] + w * (zb1[0] - zb0[0]), zb0[1] + w * (zb1[1] - zb0[1]))
+        except ConvergenceError:  # the bracket is all that is known
+            return {"kind": "switch", "p": 0.5 * (t0 + t1), "value": None, "located": False,
+                    "bracket": [t0, t1]}
         if fa[1] < fb[1]:
             t0 = t
         else:

@@ -39,6 +39,7 @@ another map has units left); each map is the one :func:`stability_map` computes 
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 import time
 from dataclasses import dataclass, field
@@ -61,6 +62,7 @@ from ...model.parameters import (DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, 
 from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
 from .summaries import map_summary, write_map_csv
 
+log = logging.getLogger(__name__)
 SHIMMY_TYPES = tuple(ShimmyType)
 SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
 COVERAGE_ROUNDS = 2  # rounds of further slices through regions no slice crosses
@@ -189,6 +191,9 @@ class SliceResult:
     #: carried from the map of a nearby design (:mod:`shimmy.analyses.maps.warm_map`): intervals moved
     #: with the curves, Hopf points scanned again, no diagram (``max_psi`` None)
     carried: bool = False
+    #: the design (parameters) its diagram was computed at (a warm start's record: a carried slice
+    #: keeps its own; not in :meth:`to_dict`)
+    computed_at: dict[str, float] | None = field(default=None, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         return {"Fz": self.Fz, "hopf_points": self.hopf_points, "special_points": self.special_points,
@@ -422,7 +427,7 @@ class StabilityMap:
                 "fz_range": list(self.fz_range), "resolution": self.resolution, "n_v": self.n_v,
                 "options": dataclasses.asdict(options), "rows": self.shading_Fz.tolist(),
                 "boundaries": [[name, p.tolist()] for name, p in self.boundaries()],
-                "slices": [s.to_dict() for s in self.slices],
+                "slices": [s.to_dict() | {"computed_at": s.computed_at or self.params.to_dict()} for s in self.slices],
                 "arrangement": arrangement(self.hopf, self.cycles),
                 "seeds": [seed.to_dict() for seed in self.seeds], "version": __version__}
 
@@ -650,6 +655,9 @@ def stability_map(config: Configuration | str, *, params: Parameters | None = No
                 return warm_map(warm_from, params=params, executor=executor, progress=progress)
             except NotWarm as exc:
                 refused = exc.reason
+            except Exception as exc:  # noqa: BLE001 - a warm start that fails in any way: the cold map answers
+                log.warning("warming the %s map failed (%s: %s): computing it cold", config, type(exc).__name__, exc)
+                refused = f"warming failed ({type(exc).__name__}: {exc})"
         if progress is not None:
             progress(0.0, f"computing cold: {refused}")
     smap = stability_maps([config], v_range=v_range, fz_range=fz_range, resolution=resolution, params=params, n_v=n_v,

@@ -61,6 +61,11 @@ from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, FINE, HopfCurvesUnit
 #: Kinds of a slice's special points that lie on the map's curves (carried to the curves' crossings);
 #: a slice with any other (a period doubling, a branch point of cycles) is not carried.
 ON_CURVES = (PointKind.FOLD_OF_CYCLES, PointKind.TORUS)
+#: A slice is carried only within this largest relative parameter change from the design its
+#: diagram was computed at (a mode change inside an interval stays where that diagram put it: the
+#: farther the design, the farther it may be off); farther, it is computed again. One slider step of
+#: 10 % is carried once; a walk of several steps recomputes its slices every 10 %.
+CARRY_DISTANCE = 0.1
 
 
 class NotWarm(Exception):
@@ -135,6 +140,9 @@ class _Carrier:
         self.new = np.array([p[1] for p in pairs])
 
     def __call__(self, V: float) -> float:
+        return float(min(max(self._moved(V), self.old[0]), self.old[-1]))  # inside the speed range
+
+    def _moved(self, V: float) -> float:
         k = int(np.searchsorted(self.old, V, side="right"))  # self.old[k - 1] <= V < self.old[k]
         if k == 0 or k == len(self.old):
             return float(V)
@@ -155,23 +163,33 @@ def _crossings_of(curves: list[GearCycleCurve], Fz: float) -> dict[str, list[flo
 
 
 def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameters, v_range, n_v: int,
-                   carry: _Carrier, crossings: dict[str, list[float]]) -> SliceResult:
-    """A slice of the old map at the new design (see the module's step 4)."""
+                   carry: _Carrier, crossings: dict[str, list[float]], tol: float) -> SliceResult:
+    """A slice of the old map at the new design (see the module's step 4); NotWarm where it cannot be
+    carried (it is then computed again)."""
     clock = time.perf_counter()
     Fz = float(old["Fz"])
+    computed_at = old.get("computed_at")
+    if computed_at is None or design_distance(params, Parameters.from_dict(computed_at)) > CARRY_DISTANCE:
+        raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN was computed at a design more than "
+                      f"{CARRY_DISTANCE:g} (relative) from this one")
     scan = hopf_points(config, Fz, params=params, v_range=v_range).hopf_points
     if len(scan) != len(old["hopf_points"]):
         raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has {len(scan)} Hopf points, before "
                       f"{len(old['hopf_points'])}")
     hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value} for h in scan]
-    special = []
+    special: list[dict[str, Any]] = []
+    taken: set[float] = set()
     for q in old["special_points"]:
         if q["kind"] not in ON_CURVES:
             raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a {q['kind']} point, on no curve of the map")
         V = carry(q["V"])
-        located = crossings.get(str(q["kind"]), [])
-        if located:  # the new curve's located crossing of this load nearest to where it was carried
-            V = min(located, key=lambda x: abs(x - V))
+        # the new curve's located crossing of this load where the point was carried, each used once
+        located = [x for x in crossings.get(str(q["kind"]), []) if abs(x - V) <= tol and x not in taken]
+        if not located:
+            raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a {q['kind']} point at V = {q['V']:.5g} m/s that "
+                          "no curve of the map crosses there now")
+        V = min(located, key=lambda x: abs(x - V))
+        taken.add(V)
         special.append({"kind": q["kind"], "V": V, "mode": q["mode"]})
     # an interval's end at one of the slice's located points goes to that point at the new design
     exact = list(zip([h["V"] for h in old["hopf_points"]] + [q["V"] for q in old["special_points"]],
@@ -191,8 +209,9 @@ def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameter
     coarse, fine = speed_grids(*v_range, n_v)
     fine_types = [map_shading.type_at(intervals, float(v)) for v in fine]
     return SliceResult(Fz, coarse, fine_types[::FINE], hopf, special, intervals, type_lengths(fine, fine_types), None,
-                       None, [carry(v) for v in old["simulated_V"]], list(old["warnings"]),
-                       time.perf_counter() - clock, carried=True)
+                       None, [carry(v) for v in old["simulated_V"]],
+                       [f"{w} (at the design the slice was computed at)" for w in old["warnings"]],
+                       time.perf_counter() - clock, carried=True, computed_at=computed_at)
 
 
 def compatible(start: dict[str, Any], config: Configuration | str, *, v_range, fz_range, resolution: int, n_v: int,
@@ -286,7 +305,8 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
             if change:
                 raise NotWarm(f"the curves' arrangement changed on it: {change}")
             slices.append(_carried_slice(old, config, params, v_range, n_v,
-                                         _Carrier(old_boundaries, boundaries, Fz, v_range), _crossings_of(curves, Fz)))
+                                         _Carrier(old_boundaries, boundaries, Fz, v_range), _crossings_of(curves, Fz),
+                                         tol))
         except NotWarm as exc:
             again[Fz] = exc.reason
     # regions between the new curves that no slice crosses: slices through them, as a cold map adds
@@ -301,12 +321,24 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         added += extra
     fresh = sorted(again) + added
     if fresh:
-        report(0.8, f"{len(fresh)} slice(s) where the arrangement of the curves changed")
+        report(0.8, f"{len(again)} slice(s) computed again, {len(added)} added through regions no slice crosses")
         units = [(2, SliceUnit(config, Fz, v_range, n_v, params, options)) for Fz in fresh]
-        run_dynamic(run_work_unit, units, executor, lambda unit, result: slices.append(result) or [],
+        computed: list[SliceResult] = []
+        run_dynamic(run_work_unit, units, executor, lambda unit, result: computed.append(result) or [],
                     lambda f, m: report(0.8 + 0.15 * f, m), describe_work_unit)
+        for s in computed:  # a fold or torus point on no curve of the map: a curve the warm map lacks
+            # just above and below the load too: a curve ending on a box edge at this load crosses it there
+            near = [x for f in (s.Fz, s.Fz * (1 + 1e-7), s.Fz * (1 - 1e-7))
+                    for x in map_shading.crossings(boundaries, f)]
+            on_curves = {str(k): [V for V, (name, _) in near if name.startswith(k)] for k in ON_CURVES}
+            for q in s.special_points:
+                if q["kind"] in ON_CURVES and not any(abs(V - q["V"]) <= 2 * tol for V in on_curves[str(q["kind"])]):
+                    raise NotWarm(f"the slice computed at Fz = {s.Fz / 1e3:.4g} kN has a {q['kind']} point at "
+                                  f"V = {q['V']:.5g} m/s on no curve of the map: a curve a cold map would continue")
+            s.computed_at = params.to_dict()
+        slices += computed
     slices.sort(key=lambda s: s.Fz)
-    report(0.95, "regions carried along the curves")
+    report(0.95, "the shading read off the slices along the curves")
     for c in curves:
         c.curve.special_points = [q for q in c.curve.special_points if q.kind != PointKind.P2_MARK
                                   or not any(abs(q.data["p2"] - f) <= 1e-9 * f for f in marks[len(loads):])]

@@ -62,7 +62,13 @@ def test_the_warm_map_says_what_it_was_warmed_from(maps):
     assert methods["warmed_from"]["changed"] == {"e_p": [0.001, 0.0011]}
     assert methods["warmed_from"]["params"] == near.params.to_dict()
     assert "warmed_from" not in cold.to_dict()["methods"] and "warm_refused" not in cold.to_dict()["methods"]
-    assert all(s["carried"] and s["max_psi"] is None for s in warm.to_dict()["slices"])
+    info = methods["warmed_from"]["slices"]
+    slices = warm.to_dict()["slices"]
+    assert info["carried"] >= len(slices) - 2 and info["added"] == []
+    assert sum(bool(s.get("carried")) for s in slices) == info["carried"]
+    assert all(s["max_psi"] is None for s in slices if s.get("carried"))
+    assert all(s["max_psi"] is not None for s in slices if not s.get("carried"))
+    assert all(a["why"] for a in info["computed_again"])
 
 
 def test_warm_curves_are_the_cold_curves(maps):
@@ -168,3 +174,19 @@ def test_an_open_curve_traced_the_other_way_round_is_the_same_curve():
     assert same_arrangement(old, new) is None
     new["cycle_curves"][0]["codim2"] = ["R4", "R3"]
     assert "cycle curve 1 changed" in same_arrangement(old, new)
+
+
+def test_slices_computed_far_from_this_design_are_computed_again(maps):
+    """A slice is carried only within CARRY_DISTANCE of the design its diagram was computed at (a
+    walk of slider steps would otherwise keep mode changes where the first cold map put them)."""
+    _, cold, _, start = maps
+    far = json.loads(json.dumps(start))
+    for s in far["slices"]:
+        s["computed_at"] = dict(s["computed_at"], e_p=0.003)
+    warm = warm_map(far, params=cold.params)
+    again = warm.warmed_from["slices"]["computed_again"]
+    assert warm.warmed_from["slices"]["carried"] == 0 and len(again) == len(start["slices"])
+    assert all("computed at a design" in a["why"] for a in again)
+    assert not any(s.carried for s in warm.slices)
+    a, b = np.array(cold.shading), np.array(warm.shading)
+    assert (a == b).mean() >= 0.995
