@@ -35,7 +35,8 @@ def main() -> None:
           executor=InlineExecutor())  # its sampled rows, and its curves as above
     sampled_s = time.perf_counter() - clock
     print(f"study curve {args.config} in {args.param} ({len(curves[0].p)} exact points): {curve_s:.3f} s "
-          f"(target <= 2 s); sampled study of 9 values (with its curves): {sampled_s:.2f} s; ratio {sampled_s / curve_s:.0f}x")
+          f"(target <= 2 s); sampled study of 9 values (with its curves): {sampled_s:.2f} s; "
+          f"ratio {sampled_s / curve_s:.0f}x")
 
 
 if __name__ == "__main__":
