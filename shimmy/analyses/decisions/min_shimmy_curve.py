@@ -30,20 +30,15 @@ import numpy as np
 from ...continuation import PointKind
 from ...errors import ConvergenceError
 from ...model.configurations import Configuration
-from ...model.equations import Model, model_coefficients
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, Parameters
 from ..diagrams.hopf_curves import hopf_curves
-from .sensitivity import polish_lowest_point
-from .study_curves import StudyCurve, design_with, parameter_range
+from .sensitivity import model_with, polish_lowest_point
+from .study_curves import StudyCurve, parameter_range
 
 #: Grid values of theta over its range (plus the base value and any asked for).
 N_GRID = 41
 #: A switch between two minima is located to this fraction of theta's range.
 SWITCH_TOL = 1e-10
-
-
-def _model(config: Configuration, params: Parameters, name: str, theta: float) -> Model:
-    return Model(config, params, model_coefficients(config, design_with(params, name, theta)))
 
 
 def _minima(hopf) -> list[tuple[float, float]]:
@@ -65,7 +60,7 @@ def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Par
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
     lo, hi = parameter_range(parameter, params)
-    base = float(getattr(getattr(params, _group(parameter)), parameter))
+    base = float(getattr(params, parameter))
     warnings: list[str] = []
     starts = _minima(hopf_curves(config, params=params, v_range=v_range, fz_range=fz_range))
     if not starts:
@@ -77,13 +72,13 @@ def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Par
     solutions: list[list[tuple[float, float] | None]] = [[None] * len(grid) for _ in starts]
     special: list[dict] = []
     for j, start in enumerate(starts):
-        solutions[j][k0] = polish_lowest_point(_model(config, params, parameter, base), *start)[:2]
+        solutions[j][k0] = polish_lowest_point(model_with(config, params, parameter, base), *start)[:2]
         for order in (range(k0 + 1, len(grid)), range(k0 - 1, -1, -1)):
             path = [k0]
             for k in order:
                 guess = _predict(grid, solutions[j], path, k)
                 try:
-                    V, Fz, _ = polish_lowest_point(_model(config, params, parameter, grid[k]), *guess)
+                    V, Fz, _ = polish_lowest_point(model_with(config, params, parameter, grid[k]), *guess)
                 except ConvergenceError:
                     special.append({"kind": "end", "p": grid[path[-1]], "value": solutions[j][path[-1]][1],
                                     "V": solutions[j][path[-1]][0]})
@@ -127,12 +122,6 @@ def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Par
     return curve, warnings
 
 
-def _group(name: str) -> str:
-    from ...model.parameters import PARAMETER_SPECS
-
-    return PARAMETER_SPECS[name].group
-
-
 def _predict(grid, solutions, path, k) -> tuple[float, float]:
     """The secant through the last two solutions on the path, at grid[k] (the last one alone at first)."""
     last = solutions[path[-1]]
@@ -151,7 +140,7 @@ def _switch(config, params, parameter, grid, k, a_sol, b_sol) -> dict:
     for _ in range(200):
         t = 0.5 * (t0 + t1)
         w = (t - grid[k]) / (grid[k + 1] - grid[k])
-        model = _model(config, params, parameter, t)
+        model = model_with(config, params, parameter, t)
         try:
             fa = polish_lowest_point(model, za0[0] + w * (za1[0] - za0[0]), za0[1] + w * (za1[1] - za0[1]))
             fb = polish_lowest_point(model, zb0[0] + w * (zb1[0] - zb0[0]), zb0[1] + w * (zb1[1] - zb0[1]))

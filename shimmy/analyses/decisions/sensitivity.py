@@ -81,15 +81,21 @@ ZERO_SLOPE = ("enters only the particle damper's torque n r^2 c*(r |dpsi|) dpsi,
 NO_LINEAR_EFFECT = "does not enter the linearisation of straight rolling"
 
 
-def _with_value(params: Parameters, name: str, value: float):
+def design_with(params: Parameters, name: str, value: float) -> Any:
     """An object with params' groups and one value changed, without range checks (a central
-    difference at a range end steps 1e-5 outside it; the model is smooth there)."""
+    difference at a range end steps 1e-5 outside it, a continuation in the parameter locates the
+    range's ends by stepping just past them; the model is smooth there)."""
     spec = PARAMETER_SPECS[name]
     group = copy.copy(getattr(params, spec.group))
     object.__setattr__(group, name, float(value))
     groups = {g: getattr(params, g) for g in ("gear", "nes", "pd")}
     groups[spec.group] = group
     return SimpleNamespace(**groups)
+
+
+def model_with(config: Configuration, params: Parameters, name: str, value: float) -> Model:
+    """The model of ``config`` at ``params`` with one parameter's value changed (:func:`design_with`)."""
+    return Model(config, params, model_coefficients(config, design_with(params, name, value)))
 
 
 def parameter_step(params: Parameters, name: str) -> float:
@@ -105,8 +111,8 @@ def coefficient_pairs(config: Configuration, params: Parameters, names: Sequence
     for name in names:
         h = parameter_step(params, name)
         value = float(getattr(params, name))
-        out[name] = (model_coefficients(config, _with_value(params, name, value + h)),
-                     model_coefficients(config, _with_value(params, name, value - h)), h)
+        out[name] = (model_coefficients(config, design_with(params, name, value + h)),
+                     model_coefficients(config, design_with(params, name, value - h)), h)
     return out
 
 

@@ -34,11 +34,9 @@ speed.
 
 from __future__ import annotations
 
-import copy
 import math
 import time
 from dataclasses import dataclass, field
-from types import SimpleNamespace
 from typing import Any, Sequence
 
 import numpy as np
@@ -48,11 +46,12 @@ from scipy.optimize import brentq
 from ...continuation import ContinuationOptions, HopfCurve, PointKind, TwoParameterField, hopf_curve
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import Configuration
-from ...model.equations import Model, field_and_derivatives, jacobian, model_coefficients, rhs
+from ...model.equations import Model, field_and_derivatives, jacobian, rhs
 from ...model.parameters import (DEFAULT_FZ, DIAGRAM_V_RANGE, FZ_RANGE, PARAMETER_SPECS, V_RANGE, Parameters,
                                  check_number, check_range, unknown_name_error)
 from ..core.polylines import near_polyline
 from ..core.stability import Linearisation, hopf_points
+from .sensitivity import model_with
 
 #: The quantities a study curve can follow, with their units.
 CURVE_QUANTITIES = {"hopf_V_start": "m/s", "hopf_V_end": "m/s", "min_shimmy_Fz": "N", "max_psi": "rad"}
@@ -72,17 +71,6 @@ TRACK_MARGIN = 1e-3
 #: Values of theta closer than this (relative to its range) are one grid value (a curve's end located
 #: on a range end lies within the location tolerance of it).
 SNAP = 1e-8
-
-
-def design_with(params: Parameters, name: str, value: float) -> Any:
-    """params' groups with one value changed, without range checks (the continuation locates the box's
-    ends by stepping just past them; the model is smooth there)."""
-    spec = PARAMETER_SPECS[name]
-    group = copy.copy(getattr(params, spec.group))
-    object.__setattr__(group, name, float(value))
-    groups = {g: getattr(params, g) for g in ("gear", "nes", "pd")}
-    groups[spec.group] = group
-    return SimpleNamespace(**groups)
 
 
 def parameter_range(name: str, params: Parameters) -> tuple[float, float]:
@@ -119,7 +107,7 @@ def design_two_parameter_field(config: Configuration, params: Parameters, name: 
         if m is None:
             if len(cache) > 64:
                 cache.clear()
-            m = cache[theta] = Model(config, params, model_coefficients(config, design_with(params, name, theta)))
+            m = cache[theta] = model_with(config, params, name, theta)
         return m
 
     h = THETA_STEP * span
@@ -202,8 +190,7 @@ class HopfSpeedCurves:
     warnings: list[str] = field(default_factory=list)
 
     def linearisation(self, theta: float) -> Linearisation:
-        model = Model(self.config, self.params, model_coefficients(self.config, design_with(self.params, self.param,
-                                                                                         theta)))
+        model = model_with(self.config, self.params, self.param, theta)
         return Linearisation(model, self.Fz)
 
     def speeds_at(self, theta: float) -> list[float]:
@@ -347,7 +334,7 @@ def _edge_starts(config: Configuration, params: Parameters, name: str, Fz: float
     parts of J(V; theta) on ``thetas``, refined by Brent's method (curves entering through a speed edge
     between the starts are continued from there)."""
     def ordered(theta: float) -> np.ndarray:
-        model = Model(config, params, model_coefficients(config, design_with(params, name, theta)))
+        model = model_with(config, params, name, theta)
         return np.sort(np.linalg.eigvals(Linearisation(model, Fz).at(V)).real)[::-1]
 
     re = np.array([ordered(t) for t in thetas])

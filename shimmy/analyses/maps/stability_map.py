@@ -53,7 +53,7 @@ from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurc
 from ...model.configurations import Configuration
 from ...errors import InvalidParameterError
 from . import map_shading
-from ..diagrams.cycle_curves import (KEY_OF_KIND, CurveSearch, CurveSeed, SearchUnit, search_done,
+from ..diagrams.cycle_curves import (KEY_OF_KIND, CurveSearch, CurveSeed, GearCycleCurve, SearchUnit, search_done,
                                      starts_of_diagram)
 from ..core.executors import name_of, open_executor, run_dynamic
 from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
@@ -683,9 +683,15 @@ def arrangement(hopf: HopfCurvesResult, cycles: dict[str, Any]) -> dict[str, Any
 
 
 def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, np.ndarray]]:
-    """The region boundaries: every Hopf, fold and torus curve as a polyline in (V, Fz)."""
+    """The region boundaries of a map being built (:func:`curve_boundaries` of its curves so far)."""
+    return curve_boundaries(hopf, search.result(0.0).curves)
+
+
+def curve_boundaries(hopf: HopfCurvesResult, curves: Sequence[GearCycleCurve]) -> list[tuple[str, np.ndarray]]:
+    """The region boundaries: every Hopf, fold and torus curve as a polyline in (V, Fz), named
+    ``hopf<i>``, then the kind and index of each cycle curve (``LPC2``), as the shading names them."""
     out = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
-    out += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(search.result(0.0).curves)]
+    out += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(curves)]
     return out
 
 

@@ -47,7 +47,7 @@ import numpy as np
 from ...continuation import PointKind
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
-from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_range, design_distance  # noqa: F401 (re-exported)
+from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_range, design_distance
 from ..core.executors import describe_work_unit, name_of, open_executor, run_dynamic, run_work_unit
 from ..core.stability import hopf_points
 from ..diagrams.bifurcation import V_SCALE, BifurcationOptions
@@ -56,7 +56,7 @@ from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, Ge
 from ..diagrams.hopf_curves import HopfCurvesResult
 from . import map_shading
 from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, FINE, HopfCurvesUnit, SliceResult, SliceUnit, StabilityMap,
-                            arrangement, lowest_shimmy, speed_grids, type_lengths)
+                            arrangement, curve_boundaries, lowest_shimmy, speed_grids, type_lengths)
 
 #: Kinds of a slice's special points that lie on the map's curves (carried to the curves' crossings);
 #: a slice with any other (a period doubling, a branch point of cycles) is not carried.
@@ -291,8 +291,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     if why:
         raise NotWarm(why)
     report(0.8, "regions carried along the curves")
-    boundaries = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
-    boundaries += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(curves)]
+    boundaries = curve_boundaries(hopf, curves)
     rows = np.array(start["rows"], float)
     tol = 0.5 * (v_range[1] - v_range[0]) / (n_v - 1)  # half a grid cell
     slices: list[SliceResult] = []

@@ -173,15 +173,15 @@ def test_amplitude_derivative_equals_differences_of_re_solved_orbits(config):
     u = raw.solutions[i][1].copy()
     u[-1] = amp["V"]
     from shimmy.model.equations import model_coefficients
-    from shimmy.analyses.decisions.sensitivity import _with_value
+    from shimmy.analyses.decisions.sensitivity import design_with
 
     for name in names:
         v = float(getattr(PARAMS, name))
         h = 1e-4 * v
         up = _amplitude_at_fixed_speed(model, Fz, problem, u,
-                                       model_coefficients(model.config, _with_value(PARAMS, name, v + h)))
+                                       model_coefficients(model.config, design_with(PARAMS, name, v + h)))
         down = _amplitude_at_fixed_speed(model, Fz, problem, u,
-                                         model_coefficients(model.config, _with_value(PARAMS, name, v - h)))
+                                         model_coefficients(model.config, design_with(PARAMS, name, v - h)))
         assert amp["dA_dp"][name] == pytest.approx((up - down) / (2 * h), rel=2e-4, abs=1e-9 / v), name
     # The envelope in V: the derivative at fixed speed is that of the diagram's maximum (whole
     # diagrams re-computed, 1 % steps: their own mesh and refinement noise limits the comparison).

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 from shimmy.analyses.maps.stability_map import stability_map
-from shimmy.analyses.maps.warm_map import NotWarm, arrangement_change, design_distance, warm_map
+from shimmy.analyses.maps.warm_map import NotWarm, arrangement_change, warm_map
 from shimmy.analyses.diagrams.bifurcation import BifurcationOptions
 from shimmy.analyses.diagrams.cycle_curves import CurveSeed
-from shimmy.model.parameters import Parameters
+from shimmy.model.parameters import Parameters, design_distance
 
 PLANE = dict(v_range=(1.0, 200.0), fz_range=(1.0e4, 9.0e5), resolution=6, n_v=60)
 STEP = {"e_p": 0.0011}  # e_p +10 %: one slider step and more
