@@ -100,7 +100,7 @@ class Constraint:
 
 
 def _interval_of(result, Fz, params, config, names, gradient, pairs, model):
-    from ..maps.stability_map import map_slice
+    from ..maps.map_slices import map_slice
 
     s = map_slice(config, Fz, v_range=(V_BAND[0], V_BAND[1]), n_v=200, params=params, result=result)
     if not s.intervals:
@@ -152,7 +152,8 @@ def figures_of(config: Configuration | str, params: Parameters, wanted: Sequence
                 out[key] = {"value": value, "gradient": grad, "V": diagrams[Fz].max_psi_V}
         elif figure == "torsion_area":
             from ..maps.design_metrics import torsion_area
-            from ..maps.stability_map import BAND_FZ_MAX, stability_map
+            from ..maps.map_slices import BAND_FZ_MAX
+            from ..maps.stability_map import stability_map
 
             with open_executor(max_workers=1) as inline:
                 smap = stability_map(config, v_range=V_BAND, fz_range=(FZ_BOX[0], BAND_FZ_MAX), resolution=6,

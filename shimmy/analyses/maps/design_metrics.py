@@ -27,7 +27,8 @@ from ...model.configurations import CONFIGURATION_NAMES, OPERATING_POINTS, Confi
 from ...model.parameters import DEFAULT_FZ, DEFAULT_MAP_SLICES, FZ_RANGE, Parameters
 from ..core.executors import run_units
 from ..core.response import ShimmyType
-from .stability_map import BAND_FZ_MAX, BAND_V, StabilityMap, classify, map_slice, stability_maps
+from .map_slices import BAND_FZ_MAX, BAND_V, classify, map_slice
+from .stability_map import StabilityMap, stability_maps
 
 BASELINE = "original"
 _trapezoid = getattr(np, "trapezoid", None) or np.trapz  # numpy 2 renamed it

@@ -9,25 +9,27 @@ How a map is built (what :func:`stability_map` returns says the same in ``method
   the GH and double-Hopf points and from the LPC / NS points of the slices' diagrams, whose seeds
   include large-amplitude starts). Each curve's crossings of the first slices' loads are
   located, so those slices' LPC and NS points lie on the drawn curves.
-* **The regions' types** come from classified slices: the stable attractors at each V read off
-  a slice's bifurcation diagram (:func:`attractors_at`): x = 0 where its eigenvalues say so, and
-  every periodic branch point with all nontrivial Floquet multipliers inside the unit circle,
-  with its mode (torsional / lateral / both, :func:`shimmy.analyses.core.response.mode_of`). The type
-  (:func:`shimmy_type`) is Bistable if a torsional and a lateral cycle are both stable, else
-  Both if a stable cycle has both motions large, else Torsion or Lateral after the stable
-  cycle, else Stable. Where neither x = 0 nor any cycle is stable (past a torus point the
-  attractor is quasi-periodic), the type comes from a time simulation from the standard
-  start (psi = 0.001 rad) at that V; the attractor is then reported with
-  ``"kind": "simulation"``. ``resolution`` slices evenly spaced in Fz, and one more through
-  each region between the curves that none of them crosses (:func:`map_shading.uncovered`).
+* **The regions' types** come from classified slices: the stable attractors at each V read off a
+  slice's bifurcation diagram (:func:`~shimmy.analyses.maps.map_slices.attractors_at`): x = 0
+  where its eigenvalues say so, and every periodic branch point with all nontrivial Floquet
+  multipliers inside the unit circle, with its mode (torsional / lateral / both,
+  :func:`shimmy.analyses.core.response.mode_of`). The type
+  (:func:`~shimmy.analyses.core.response.shimmy_type`) is Bistable if a torsional and a lateral
+  cycle are both stable, else Both if a stable cycle has both motions large, else Torsion or
+  Lateral after the stable cycle, else Stable. Where neither x = 0 nor any cycle is stable (past a
+  torus point the attractor is quasi-periodic), the type comes from a time simulation from the
+  standard start (psi = 0.001 rad) at that V; the attractor is then reported with ``"kind":
+  "simulation"``. ``resolution`` slices evenly spaced in Fz, and one more through each region
+  between the curves that none of them crosses (:func:`map_shading.uncovered`).
 * **Shading and region polygons** are read off the slices along the curves
   (:mod:`shimmy.analyses.maps.map_shading`): each row interval between two boundary crossings takes
   the types of the same interval on the nearest slices (mode changes inside it interpolated
   in Fz), on 180 rows (at least four per slice); the polygons chain the rows' segments.
 
-:func:`classify` runs exactly the slice computation at one Fz and reads the answer at V: at a
-slice load it gives the map's answer; between slices it agrees with the shading wherever the
-type is set by the curves (a mode change inside a region is interpolated by the shading).
+:func:`~shimmy.analyses.maps.map_slices.classify` (in :mod:`.map_slices`, with the slices) runs
+exactly the slice computation at one Fz and reads the answer at V: at a slice load it gives the
+map's answer; between slices it agrees with the shading wherever the type is set by the curves (a
+mode change inside a region is interpolated by the shading).
 
 All units of a map (the Hopf curves, branches beside codimension-2 points, curve continuations,
 slices) go through :mod:`shimmy.analyses.core.executors` (a local process pool, or a Dask cluster),
@@ -40,7 +42,6 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import math
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
@@ -48,275 +49,25 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ...version import __version__
-from ...continuation import CYCLE_BIFURCATIONS, PointKind
-from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurcation
+from ...continuation import PointKind
+from ..diagrams.bifurcation import BifurcationOptions
 from ...model.configurations import Configuration
 from ...errors import InvalidParameterError
 from . import map_shading
-from ..diagrams.cycle_curves import (KEY_OF_KIND, CurveSearch, CurveSeed, GearCycleCurve, SearchUnit, search_done,
-                                     starts_of_diagram)
+from ..diagrams.cycle_curves import (KEY_OF_KIND, CurveSearch, CurveSeed, GearCycleCurve, SearchUnit, search_done)
 from ..core.executors import name_of, open_executor, run_dynamic
 from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
-from ...model.parameters import (DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number,
-                                check_operating_point, check_range)
-from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
+from ...model.parameters import DEFAULT_MAP_SLICES, FZ_RANGE, V_RANGE, Parameters, check_number, check_range
+from .map_slices import DEFAULT_V_RANGE, SliceResult, map_slice
 from .summaries import map_summary, write_map_csv
 
 log = logging.getLogger(__name__)
-SHIMMY_TYPES = tuple(ShimmyType)
 SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
 COVERAGE_ROUNDS = 2  # rounds of further slices through regions no slice crosses
 #: ... that are at least one grid cell wide and cover this fraction of the map (thinner slivers
 #: between curves that nearly meet are read off the nearest slice at the same speed, and counted)
 COVERAGE_AREA = 2e-4
-DEFAULT_V_RANGE = DIAGRAM_V_RANGE
 DEFAULT_FZ_RANGE = FZ_RANGE
-#: Simulated V per slice at most where no stable equilibrium or cycle exists; the other grid
-#: points of such a stretch take the answer of the nearest simulated one.
-MAX_SIMULATIONS_PER_SLICE = 12
-FALLBACK_T_END = 60.0  # s
-#: Fine grid (per output grid step) on which speed intervals and region lengths are measured.
-FINE = 10
-#: Low-load band of the pure-torsion area metric.
-BAND_FZ_MAX = 250.0e3  # N
-BAND_V = DIAGRAM_V_RANGE  # m/s
-#: Where x = 0 is stable, a "cycle" smaller than this (rad, m) is x = 0 itself: continuation with the
-#: particle damper can run a branch on through its Hopf point along the trivial orbit (amplitudes
-#: ~1e-100 observed). Where x = 0 is unstable, small cycles are real (with the PD they grow like
-#: (V - V_H)^2 from the Hopf point) and count.
-TRIVIAL_PSI = 1e-6
-TRIVIAL_LATERAL = 1e-7
-
-
-# --------------------------------------------------------------------------- attractors
-
-
-def attractors_at(result: BifurcationResult, V: float) -> list[dict[str, Any]]:
-    """The stable equilibria and limit cycles of a bifurcation diagram at speed V."""
-    return attractors_on(result, np.array([float(V)]))[0]
-
-
-def attractors_on(result: BifurcationResult, speeds: np.ndarray) -> list[list[dict[str, Any]]]:
-    """:func:`attractors_at` at each of ``speeds`` (one pass over each branch for all of them): x = 0
-    where no unstable interval holds V, then, branch by branch, every branch segment whose speeds
-    bracket V, interpolated linearly, if stable (the nearer end's flag where the ends differ) with
-    a mode."""
-    speeds = np.asarray(speeds, float)
-    found: list[list[dict[str, Any]]] = [[] for _ in speeds]
-    equilibrium_stable = np.ones(speeds.size, bool)
-    for a, b in result.hopf.unstable_intervals:
-        equilibrium_stable &= ~((a <= speeds) & (speeds <= b))
-    for g in np.nonzero(equilibrium_stable)[0]:
-        found[g].append({"kind": "equilibrium", "mode": None, "max_psi": 0.0, "max_lateral": 0.0,
-                         "period": None, "branch": 0})
-    tol = 1e-7 * np.maximum(1.0, np.abs(speeds))  # end points located on a range bound to rounding
-    for k, b in enumerate(result.branches):
-        if b.kind != "periodic" or b.V.size < 2:
-            continue
-        first = np.arange(b.V.size - 1)
-        if b.closed:  # a loop: its last orbit joins its first
-            first = np.append(first, b.V.size - 1)
-        second = (first + 1) % b.V.size
-        v0s, v1s = b.V[first], b.V[second]
-        lo, hi = np.minimum(v0s, v1s), np.maximum(v0s, v1s)
-        inside = (lo[None, :] - tol[:, None] <= speeds[:, None]) & (speeds[:, None] <= hi[None, :] + tol[:, None]) \
-            & (v0s != v1s)[None, :]
-        gs, segs = np.nonzero(inside)  # by speed, then along the branch
-        if gs.size == 0:
-            continue
-        i, j = first[segs], second[segs]
-        v0, v1 = b.V[i], b.V[j]
-        f = np.minimum(np.maximum((speeds[gs] - v0) / (v1 - v0), 0.0), 1.0)
-        near = np.where(f <= 0.5, i, j)
-        flags = np.asarray(b.stable, bool)
-        stable = np.where(flags[i] == flags[j], flags[i], flags[near])
-        amp = b.max_psi[i] + f * (b.max_psi[j] - b.max_psi[i])
-        lateral = b.max_lateral[i] + f * (b.max_lateral[j] - b.max_lateral[i])
-        period = b.period[i] + f * (b.period[j] - b.period[i])
-        for h in np.nonzero(stable)[0]:
-            mode = b.mode[near[h]] or b.mode[i[h]] or b.mode[j[h]]
-            if mode is None:
-                continue
-            g = gs[h]
-            if equilibrium_stable[g] and amp[h] <= TRIVIAL_PSI and lateral[h] <= TRIVIAL_LATERAL:
-                continue  # a zero-amplitude end point, or a branch run on along a stable x = 0
-            if amp[h] <= 0.0 and lateral[h] <= 0.0:
-                continue  # the zero-amplitude end point at a Hopf point
-            found[g].append({"kind": "limit cycle", "mode": mode, "max_psi": float(amp[h]),
-                             "max_lateral": float(lateral[h]), "period": float(period[h]), "branch": k})
-    return found
-
-
-_RESPONSE_MODE = {ResponseType.TORSION: Mode.TORSIONAL, ResponseType.LATERAL: Mode.LATERAL,
-                  ResponseType.BOTH: Mode.BOTH}
-
-
-def simulated_attractor(config: Configuration, V: float, Fz: float, params: Parameters) -> dict[str, Any]:
-    """The attractor reached from the standard start, for speeds with no stable equilibrium or cycle."""
-    from ..core.simulation import simulate
-
-    run = simulate(config, V, Fz, params=params, t_end=FALLBACK_T_END)
-    mode = _RESPONSE_MODE.get(run.response_type)
-    note = "" if run.success else f"simulation stopped: {run.message}"
-    if run.response_type is ResponseType.STABLE:
-        note = note or "the simulation decays (slowly) although x = 0 is unstable"
-    return {"kind": "simulation", "mode": mode, "max_psi": float(run.amplitude["psi"]),
-            "max_lateral": float(run.amplitude["lateral"]), "period": None,
-            "frequency_hz": None if not math.isfinite(run.frequency_hz) else float(run.frequency_hz),
-            "steady": bool(run.steady), "note": note}
-
-
-# --------------------------------------------------------------------------- one slice
-
-
-@dataclass
-class SliceResult:
-    """One Fz slice of a map: types on the V grid, special points, speed measures."""
-
-    Fz: float
-    V: np.ndarray  # output grid (m/s)
-    types: list[str]
-    hopf_points: list[dict[str, Any]]
-    special_points: list[dict[str, Any]]  # LPC / NS / PD / BPC on periodic branches: kind, V, mode
-    intervals: list[dict[str, Any]]  # maximal V intervals of one type other than Stable (fine grid)
-    lengths: dict[str, float]  # measure (m/s) of V with each type (fine grid)
-    max_psi: float | None
-    max_psi_V: float | None
-    simulated: list[float]  # V where the type came from a simulation
-    warnings: list[str]
-    elapsed_s: float
-    #: the diagram's located LPC / NS / PD points with their orbits: starts of the map's curves
-    #: (not in :meth:`to_dict`)
-    starts: list = field(default_factory=list, repr=False)
-    #: carried from the map of a nearby design (:mod:`shimmy.analyses.maps.warm_map`): intervals moved
-    #: with the curves, Hopf points scanned again, no diagram (``max_psi`` None)
-    carried: bool = False
-    #: the design (parameters) its diagram was computed at (a warm start's record: a carried slice
-    #: keeps its own; not in :meth:`to_dict`)
-    computed_at: dict[str, float] | None = field(default=None, repr=False)
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"Fz": self.Fz, "hopf_points": self.hopf_points, "special_points": self.special_points,
-                "intervals": self.intervals, "lengths": self.lengths, "max_psi": self.max_psi,
-                "max_psi_V": self.max_psi_V, "simulated_V": self.simulated, "warnings": self.warnings,
-                "elapsed_s": self.elapsed_s, **({"carried": True} if self.carried else {})}
-
-
-def speed_grids(v_min: float, v_max: float, n_v: int) -> tuple[np.ndarray, np.ndarray]:
-    fine = np.linspace(v_min, v_max, (n_v - 1) * FINE + 1).round(10)  # no 6.800000000000001 in outputs
-    return fine[::FINE].copy(), fine
-
-
-def _slice_types(result: BifurcationResult, fine: np.ndarray, coarse_step: int, config: Configuration,
-                 params: Parameters) -> tuple[list[str], list[list[dict]], list[float]]:
-    """Types on the fine grid; stretches with no stable equilibrium or cycle are simulated at
-    their output-grid points (at most MAX_SIMULATIONS_PER_SLICE, spread evenly)."""
-    attractors = attractors_on(result, fine)
-    empty = [i for i, a in enumerate(attractors) if not a]
-    simulated: list[float] = []
-    if empty:
-        on_grid = [i for i in empty if i % coarse_step == 0] or [empty[len(empty) // 2]]
-        if len(on_grid) > MAX_SIMULATIONS_PER_SLICE:
-            pick = np.linspace(0, len(on_grid) - 1, MAX_SIMULATIONS_PER_SLICE).round().astype(int)
-            on_grid = [on_grid[k] for k in sorted(set(pick.tolist()))]
-        runs = {i: simulated_attractor(config, float(fine[i]), result.Fz, params) for i in on_grid}
-        simulated = [float(fine[i]) for i in on_grid]
-        keys = np.array(on_grid)
-        for i in empty:
-            j = int(keys[np.argmin(np.abs(keys - i))])
-            attractors[i] = [dict(runs[j], simulated_at=float(fine[j]))] if j != i else [runs[j]]
-    return [shimmy_type(a) for a in attractors], attractors, simulated
-
-
-def _intervals(fine: np.ndarray, types: list[str], critical: list[float] = ()) -> list[dict[str, Any]]:
-    """Maximal V intervals of one type other than Stable. An end between two grid points moves to
-    the located Hopf / fold / torus point between them, if there is one (exact), else to the
-    middle between them (within half a fine step: a cycle's mode changing), so that two
-    intervals that meet share their end."""
-    crit = np.sort(np.asarray(list(critical), float))
-
-    def snap(inside: int, outside: int) -> float:
-        lo, hi = sorted((fine[inside], fine[outside]))
-        hits = crit[(crit >= lo) & (crit <= hi)]
-        return float(hits[0]) if hits.size else float(0.5 * (lo + hi))
-
-    out = []
-    start = 0
-    n = len(types)
-    for i in range(1, n + 1):
-        if i == n or types[i] != types[start]:
-            if types[start] != "Stable":
-                out.append({"type": types[start],
-                            "V_start": snap(start, start - 1) if start > 0 else float(fine[0]),
-                            "V_end": snap(i - 1, i) if i < n else float(fine[-1])})
-            start = i
-    return out
-
-
-def type_lengths(fine: np.ndarray, types: list[str]) -> dict[str, float]:
-    """Measure of V with each type: each fine point stands for the cell around it."""
-    edges = np.concatenate([[fine[0]], 0.5 * (fine[1:] + fine[:-1]), [fine[-1]]])
-    widths = np.diff(edges)
-    return {t: float(sum(w for w, ty in zip(widths, types, strict=True) if ty == t)) for t in SHIMMY_TYPES}
-
-
-def _special_points(result: BifurcationResult) -> list[dict[str, Any]]:
-    points = []
-    for b in result.branches:
-        if b.kind != "periodic":
-            continue
-        for s in b.special_points:
-            if s["kind"] in (*CYCLE_BIFURCATIONS, PointKind.BRANCH_POINT_OF_CYCLES):
-                k = int(np.argmin(np.abs(b.V - s["V"])))
-                points.append({"kind": s["kind"], "V": float(s["V"]), "mode": b.mode[k]})
-    return points
-
-
-def map_slice(config: Configuration | str, Fz: float, *, params: Parameters, v_range: tuple[float, float], n_v: int,
-              options: BifurcationOptions | None = None, result=None) -> SliceResult:
-    """The map's computation on one load: diagram in V (``result`` if already computed, with the same
-    load, range and parameters), types on the grid, special points."""
-    clock = time.perf_counter()
-    config = Configuration.parse(config)
-    options = options or BifurcationOptions(mesh_check=False)
-    result = result or bifurcation(config, Fz, v_range=v_range, params=params, options=options)
-    coarse, fine = speed_grids(*v_range, n_v)
-    types_fine, _, simulated = _slice_types(result, fine, FINE, config, params)
-    hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value}
-            for h in result.hopf.hopf_points]
-    special = _special_points(result)
-    critical = [h["V"] for h in hopf] + [p["V"] for p in special]
-    return SliceResult(Fz, coarse, types_fine[::FINE], hopf, special, _intervals(fine, types_fine, critical),
-                       type_lengths(fine, types_fine), result.max_psi, result.max_psi_V, simulated,
-                       list(result.warnings), time.perf_counter() - clock, starts_of_diagram(result, Fz))
-
-
-# --------------------------------------------------------------------------- classify
-
-
-def classify(config: Configuration | str, V: float, Fz: float, *, params: Parameters | None = None,
-             v_range: tuple[float, float] = DEFAULT_V_RANGE, options: BifurcationOptions | None = None,
-             result: BifurcationResult | None = None) -> dict[str, Any]:
-    """Shimmy type and stable attractors at (V, Fz): the map's computation on the slice at Fz.
-
-    ``result`` may pass an already computed diagram at this Fz over ``v_range``."""
-    config = Configuration.parse(config)
-    params = params if params is not None else Parameters()
-    V, Fz = check_operating_point(V, Fz)
-    v_min, v_max = check_range("v", v_range, V_RANGE, "m/s")
-    if not v_min <= V <= v_max:
-        raise InvalidParameterError("V", V, f"a number in [{v_min:g}, {v_max:g}] m/s (the diagram's range)")
-    if result is None:
-        result = bifurcation(config, Fz, v_range=(v_min, v_max), params=params,
-                             options=options or BifurcationOptions(mesh_check=False))
-    found = attractors_at(result, V)
-    if not found:
-        found = [simulated_attractor(config, V, Fz, params)]
-    return {"config": config.value, "V": V, "Fz": Fz, "shimmy_type": shimmy_type(found), "attractors": found,
-            "hopf_points": [h.V for h in result.hopf.hopf_points], "warnings": list(result.warnings),
-            "version": __version__}
-
-
 @dataclass
 class StabilityMap:
     config: Configuration
@@ -711,15 +462,3 @@ def lowest_shimmy(hopf: HopfCurvesResult, cycles: dict[str, Any], slices: list[S
             break
     return min(candidates, key=lambda c: c["Fz"]) if candidates else None
 
-
-def classification_summary(result: dict[str, Any]) -> str:
-    """The lines ``python -m shimmy classify`` prints for a :func:`classify` answer: the shimmy type, then
-    each stable attractor."""
-    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {result['shimmy_type']}"]
-    for a in result["attractors"]:
-        if a["kind"] == "equilibrium":
-            lines.append("  stable: straight rolling x = 0")
-        else:
-            lines.append(f"  stable: {a['kind']} ({a['mode']}), max |psi| {a['max_psi']:.5g} rad, "
-                         f"max |l_g delta| {a['max_lateral']:.5g} m")
-    return "\n".join(lines)

@@ -55,8 +55,9 @@ from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, Ge
                                      same_curve)
 from ..diagrams.hopf_curves import HopfCurvesResult
 from . import map_shading
-from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, FINE, HopfCurvesUnit, SliceResult, SliceUnit, StabilityMap,
-                            arrangement, curve_boundaries, lowest_shimmy, speed_grids, type_lengths)
+from .map_slices import FINE, SliceResult, speed_grids, type_lengths
+from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, HopfCurvesUnit, SliceUnit, StabilityMap, arrangement,
+                            curve_boundaries, lowest_shimmy)
 
 #: Kinds of a slice's special points that lie on the map's curves (carried to the curves' crossings);
 #: a slice with any other (a period doubling, a branch point of cycles) is not carried.

@@ -26,7 +26,7 @@ def _cmd_map(args) -> int:
 
 
 def _cmd_classify(args) -> int:
-    from ...analyses.maps.stability_map import classification_summary, classify
+    from ...analyses.maps.map_slices import classification_summary, classify
 
     result = classify(args.config, args.V, args.Fz, params=params(args), v_range=(args.v_min, args.v_max))
     emit(result, args.json, classification_summary(result))

@@ -18,9 +18,10 @@ from shimmy.analyses.core.executors import InlineExecutor
 from shimmy.analyses.core.simulation import simulate
 from shimmy.analyses.core.stability import hopf_points
 from shimmy.analyses.maps import map_shading
-from shimmy.analyses.maps.stability_map import (SHIMMY_TYPES, TRIVIAL_LATERAL, TRIVIAL_PSI, attractors_at,
-                                                attractors_on,
-                                          classify, shimmy_type, stability_map, stability_maps)
+from shimmy.analyses.core.response import shimmy_type
+from shimmy.analyses.maps.map_slices import (SHIMMY_TYPES, TRIVIAL_LATERAL, TRIVIAL_PSI, attractors_at, attractors_on,
+                                             classify)
+from shimmy.analyses.maps.stability_map import stability_map, stability_maps
 
 RESPONSE_OF_MODE = {"torsional": "Torsion", "lateral": "Lateral", "both": "Both"}
 
