@@ -32,6 +32,7 @@ SLICES = Quantity("map", "resolution", "Fz slices", "")
 METRICS_FZ = Quantity("map", "metrics_Fz", "figures at Fz", "kN", 1e3)
 WAITING = "Press Compute: tens of seconds per configuration cold on 2 cores, instant from the cache"
 HEIGHT, BOTTOM = 740, 176
+FAINT, FAINT_REGIONS = 0.35, 0.16  # a previous design's curves and regions under the map being made
 
 
 def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | None = None,
@@ -132,6 +133,11 @@ def _fading(seconds: float, asked: str) -> tuple:
     return live.fading("New design's map", seconds), no_update
 
 
+def _sketch(sketches, previous, live) -> tuple:
+    """While maps are made: their curves so far (:func:`sketch_figure`)."""
+    return sketch_figure(sketches, previous, live), no_update
+
+
 def _computing(seconds: float, asked: str) -> tuple:
     """The figure while the map is made: what is computed and for how long so far (the step under
     way and the progress are in the line above it)."""
@@ -143,7 +149,7 @@ jobs.register(
     ids.MAP_GROUP, "map", requests=lambda _settled, *controls: _requests(*controls),
     render=lambda results: (figure(results), summary(results)),
     clock=_computing, waiting=lambda: (style.message_figure(WAITING, 600), None),
-    follow=[live.follow_settled(ids.MAP)], warm=_warm, fading=_fading, stale=STALE,
+    follow=[live.follow_settled(ids.MAP)], warm=_warm, fading=_fading, stale=STALE, sketch=_sketch,
     outputs=[Output(ids.MAP_GRAPH, "figure"), Output(ids.MAP_TABLE, "children")], states=CONTROLS,
     lock=[ids.MAP_SHADE, ids.MAP_RES, ids.MAP_FZMIN, ids.MAP_FZMAX, ids.MAP_VMIN, ids.MAP_VMAX],
     download=jobs.Download(ids.MAP_GROUP, "stability_map", _csv_rows),
@@ -215,10 +221,17 @@ def figure(results, series=None, what="configuration"):
     fig.add_heatmap(x=V, y=Fz, z=codes, zmin=0, zmax=n, colorscale=scale, showscale=False,
                     opacity=0.0 if regions else 0.6, customdata=grid["types"], name="shimmy type", showlegend=False,
                     hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history</extra>")
-    for region in regions:
-        fig.add_scatter(x=region["V"], y=[f / 1e3 for f in region["Fz"]], mode="lines", fill="toself",
-                        fillcolor=style.SHIMMY_TYPE_COLOURS[region["type"]], opacity=0.6, line={"width": 0},
-                        hoverinfo="skip", showlegend=False, name=region["type"])
+    _regions(fig, shaded, 0.6)
+    _curves(fig, results, series, what, halo)
+    inside = [(name, v, f) for name, (v, f) in ui.OPERATING_POINTS.items()
+              if min(V) <= v <= max(V) and min(Fz) <= f <= max(Fz)]
+    _finish(fig, series, what, inside, (min(V), max(V)), (min(Fz), max(Fz)))
+    return fig
+
+
+def _curves(fig, results, series, what, halo, faint=False):
+    """Each result's Hopf, fold and torus curves and GH / double-Hopf points in its series' colour
+    (``faint``: thin and pale, a previous design's under the one being made)."""
     for k, (result, (label, colour)) in enumerate(zip(results, series, strict=True)):
         group = f"{what}-{k}"
         for key, (kind, dash_style, width) in CURVE_STYLES.items():
@@ -229,18 +242,21 @@ def figure(results, series=None, what="configuration"):
                                     line={"color": "rgba(255,255,255,0.85)", "width": width + 3})
                 fig.add_scatter(x=x, y=y, mode="lines",
                                 name=f"{label}: {kind}", legendgroup=group, showlegend=False,
-                                line={"color": colour, "dash": dash_style, "width": width},
+                                line={"color": colour, "dash": dash_style, "width": 1.2 if faint else width},
+                                opacity=FAINT if faint else 1.0,
                                 hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
         for key, (kind, symbol, size) in MARKERS.items():
             points = result.get(key) or []
-            if points:
+            if points and not faint:
                 fig.add_scatter(x=[g["V"] for g in points], y=[g["Fz"] / 1e3 for g in points], mode="markers",
                                 name=f"{label}: {kind}", legendgroup=group, showlegend=False,
                                 marker={"symbol": symbol, "size": size, "color": colour,
                                         "line": {"width": 1.5, "color": "#fff"}},
                                 hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
-    inside = [(name, v, f) for name, (v, f) in ui.OPERATING_POINTS.items()
-              if min(V) <= v <= max(V) and min(Fz) <= f <= max(Fz)]
+
+
+def _finish(fig, series, what, inside, v_range, fz_range):
+    """The operating points ``inside`` the plane, the three legends, the axes' ranges."""
     if inside:
         fig.add_scatter(x=[v for _, v, _ in inside], y=[f for _, _, f in inside], mode="markers+text",
                         text=[name for name, _, _ in inside], textposition="top right",
@@ -259,10 +275,44 @@ def figure(results, series=None, what="configuration"):
         style.legend_key(fig, t, "legend3", mode="markers",
                          marker={"symbol": "square", "size": 13, "color": style.SHIMMY_TYPE_COLOURS[t],
                                  "opacity": 0.75, "line": {"width": 1, "color": "#888"}})
-    fig.update_xaxes(range=[min(V), max(V)])
-    fig.update_yaxes(range=[min(Fz), max(Fz)])
+    fig.update_xaxes(range=list(v_range))
+    fig.update_yaxes(range=list(fz_range))
     fig.update_layout(margin={**style.MARGIN, "b": BOTTOM})
     style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM)
+
+
+def _regions(fig, result, opacity):
+    for region in result.get("regions") or []:
+        fig.add_scatter(x=region["V"], y=[f / 1e3 for f in region["Fz"]], mode="lines", fill="toself",
+                        fillcolor=style.SHIMMY_TYPE_COLOURS[region["type"]], opacity=opacity, line={"width": 0},
+                        hoverinfo="skip", showlegend=False, name=region["type"])
+
+
+def sketch_figure(sketches, previous=None, live=False):
+    """The maps being made as far as they are known: their Hopf curves, then each fold and torus
+    curve as it is continued, before the slices and the shading are done; over the previous
+    design's map, faint (its regions pale, its curves thin), when the map follows the design."""
+    known = [s for s in sketches if s]
+    series = [(style.CONFIG_LABELS[s["config"]], style.CONFIG_COLOURS[s["config"]]) for s in known]
+    curves = sum(len(s["fold_curves"]) + len(s["torus_curves"]) for s in known)
+    what = "the new design's map" if live else "the map"
+    head = (f"Making {what}: Hopf curves so far; the fold and torus curves, then the shading, follow" if not curves
+            else f"Making {what}: Hopf curves and {curves} fold / torus curve{'s' if curves != 1 else ''} so far; "
+                 "the shading follows")
+    fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    v_range = known[0]["v_range"]
+    fz_range = [f / 1e3 for f in known[0]["fz_range"]]
+    before = [r for r in previous or [] if r.get("config") == known[0]["config"]  # the same map, earlier
+              and r.get("v_range") == known[0]["v_range"] and r.get("fz_range") == known[0]["fz_range"]][:1]
+    if before:
+        _regions(fig, before[0], FAINT_REGIONS)
+        _curves(fig, before, [(f"{label} (previous)", colour) for label, colour in
+                              ((style.CONFIG_LABELS[r["config"]], style.CONFIG_COLOURS[r["config"]]) for r in before)],
+                "previous", False, faint=True)
+    _curves(fig, known, series, "configuration", False)
+    inside = [(name, v, f) for name, (v, f) in ui.OPERATING_POINTS.items()
+              if v_range[0] <= v <= v_range[1] and fz_range[0] <= f <= fz_range[1]]
+    _finish(fig, series, "configuration", inside, v_range, fz_range)
     return fig
 
 

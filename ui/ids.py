@@ -59,6 +59,10 @@ class Group:
         return self._id("ready")
 
     @property
+    def sketched(self) -> str:
+        return self._id("sketched")
+
+    @property
     def error(self) -> str:
         return self._id("error")
 

@@ -62,9 +62,10 @@ def controls(group: Group, label: str = "Compute", interval: int = 400) -> list:
 
 
 def stores(group: Group) -> list:
-    """The store of the shown results' requests, the ids of the jobs being waited for and the
-    jobs whose results are ready to be drawn."""
-    return [dcc.Store(id=group.requests), dcc.Store(id=group.go), dcc.Store(id=group.ready)]
+    """The store of the shown results' requests, the ids of the jobs being waited for, the jobs
+    whose results are ready to be drawn, and what of the jobs' sketches is drawn."""
+    return [dcc.Store(id=group.requests), dcc.Store(id=group.go), dcc.Store(id=group.ready),
+            dcc.Store(id=group.sketched)]
 
 
 @dataclass(frozen=True)
@@ -106,7 +107,9 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
              clock: Callable[[float, str], tuple] | None = None,
              warm: Callable[[list[dict[str, Any]]], bool] | None = None,
              fading: Callable[[float, str], tuple] | None = None, stale: str | None = None,
-             labels: Callable[..., list[str]] | None = None) -> None:
+             labels: Callable[..., list[str]] | None = None,
+             sketch: Callable[[list[dict[str, Any] | None], list[dict[str, Any]] | None, bool], tuple] | None = None
+             ) -> None:
     """Wire the job of one page.
 
     ``requests(*trigger values, *follow values, *state values)`` -> the analysis requests (may raise
@@ -134,6 +137,10 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
     ``labels(*values)`` -> a name for each request (the designs of a comparison): the results are then
     drawn by ``render(results, names)`` and tabulated by ``download.rows(results, names)``, and the
     requests store holds {"requests", "labels"}.
+    ``sketch(sketches, previous, live)`` -> the outputs drawn from what the running jobs know so far
+    (``job["sketch"]`` of each, None where a job has none; a map's curves before its shading), over
+    ``previous``, the results shown until now (None if none), ``live`` where the run follows the design
+    by itself; redrawn each time a sketch grows, and in place of the clock and the fading once drawn.
     """
     store, files = group.requests, download.files
     error = error or group.error
@@ -215,31 +222,34 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Output(group.ready, "data"),
-                   Input(group.poll, "n_intervals"), State(group.go, "data"), State(group.progress, "value"),
+                   Output(group.sketched, "data"), Input(group.poll, "n_intervals"), State(group.go, "data"),
+                   State(group.progress, "value"), State(group.sketched, "data"), State(store, "data"),
                    prevent_initial_call=True)
-    def poll(_n, go, shown_progress):
+    def poll(_n, go, shown_progress, sketched, kept):
         """Progress of the page's jobs; once every result is in the cache, the interval stops and
         the ready store tells :func:`show` to draw them. A poll that finds its jobs let go by a later
-        action of the page changes nothing: that action wrote the page's state."""
+        action of the page changes nothing: that action wrote the page's state. While they run, what
+        they know so far is drawn by ``sketch`` each time it grows."""
         ids, wanted = _waiting(go)
         if not ids:
-            return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update, no_update)
+            return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update, no_update, no_update)
         watcher = _watcher(go)
         if go.get("cancelled"):  # the Cancel button let them go; the poll says so (no late progress line after it)
-            return (*stopped("", "cancelled"), no_update)
+            return (*stopped("", "cancelled"), no_update, no_update)
         current = [jobs.get(i) for i in ids]
         if any(job is not None and _let_go(job, watcher) for job in current):
-            return nothing + (no_update,)
+            return nothing + (no_update, no_update)
         for job in current:
             if job is None or job["status"] == "cancelled":
                 _release(ids, watcher)
-                return (*stopped("", "cancelled"), no_update)
+                return (*stopped("", "cancelled"), no_update, no_update)
             if job["status"] == "failed":
                 _release(ids, watcher)
-                return (*stopped(f"{job['request'].get('config') or analysis}: {job['error']}"), no_update)
+                return (*stopped(f"{job['request'].get('config') or analysis}: {job['error']}"), no_update,
+                        no_update)
         if all(job["status"] == "done" for job in current):  # drawn by show(), not in this tick
             return ((no_update,) * (n_out + len(tail)) + (no_update, True, no_update, True)
-                    + (no_update,) * len(lock) + ("100", "drawing the results…", {**go, "tick": _n}))
+                    + (no_update,) * len(lock) + ("100", "drawing the results…", {**go, "tick": _n}, no_update))
         # a finished job counts whole, a queued one nothing; the bar never goes back within a run
         fraction = sum(_fraction(job) for job in current) / len(current)
         fraction = max(fraction, min(_number(shown_progress) / 100, 1.0))
@@ -253,7 +263,17 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         show_clock = fading if go.get("live") and fading is not None else clock
         drawn = (show_clock(since, _asked(wanted)) if show_clock is not None and since is not None
                  else (no_update,) * n_out)
-        return (*drawn, *(no_update,) * (len(tail) + len(state) - 2), str(int(100 * fraction)), status, no_update)
+        mark = no_update
+        if sketch is not None:
+            sketches = [job.get("sketch") if job["status"] == "running" else None for job in current]
+            stamp = {"jobs": ids, "sizes": [_size(s) for s in sketches]}
+            drawn_before = isinstance(sketched, dict) and sketched.get("jobs") == ids
+            if any(sketches) and stamp != sketched:
+                drawn, mark = sketch(sketches, _shown(analysis, kept), bool(go.get("live"))), stamp
+            elif drawn_before:  # the sketch stays until the answer (no clock or veil over it)
+                drawn = (no_update,) * n_out
+        return (*drawn, *(no_update,) * (len(tail) + len(state) - 2), str(int(100 * fraction)), status, no_update,
+                mark)
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(group.ready, "data"),
                    prevent_initial_call=True)
@@ -340,6 +360,25 @@ def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
             or len(wanted) > settings.MAX_PAGE_REQUESTS or not all(isinstance(i, str) and len(i) < 64 for i in ids)):
         return [], []
     return ids, wanted
+
+
+def _size(sketch: Any) -> int:
+    """How much a job's sketch holds (it only grows while the job runs): its lists' lengths."""
+    if not isinstance(sketch, dict):
+        return 0
+    return sum(len(v) for v in sketch.values() if isinstance(v, list))
+
+
+def _shown(analysis: str, kept: Any) -> list[dict[str, Any]] | None:
+    """The results shown until now (the requests store's), from the cache; None if any is gone."""
+    wanted = kept.get("requests") if isinstance(kept, dict) else kept
+    if not wanted:
+        return None
+    try:
+        results = [cache.get(analysis, r) for r in canonical(analysis, wanted)]
+    except InvalidParameterError:
+        return None
+    return None if any(r is None for r in results) else results
 
 
 def _fraction(job: dict[str, Any]) -> float:

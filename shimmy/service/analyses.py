@@ -124,13 +124,15 @@ def hopf_curves(request: dict[str, Any], progress: Progress | None = None) -> di
 def stability_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """The map with its design metrics; slices go through the executor of this environment. Warmed
     from the map of the nearest cached design within reach (:mod:`shimmy.service.neighbours`), if there is one;
-    its own warm start is kept for the next."""
+    its own warm start is kept for the next. A job's progress with a ``sketch`` (a job worker's) is told
+    the curves as they are known, for the map page to draw them before the shading."""
     from ..analyses.maps.design_metrics import metrics
     from ..analyses.maps.stability_map import stability_map as run_map
 
     smap = run_map(request["config"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
                    fz_range=(request["fz_min"], request["fz_max"]), resolution=request["resolution"],
-                   n_v=request["n_v"], progress=progress, warm_from=neighbours.nearest("map", request))
+                   n_v=request["n_v"], progress=progress, warm_from=neighbours.nearest("map", request),
+                   sketch=getattr(progress, "sketch", None))
     neighbours.remember("map", request, smap.warm_start())
     out = smap.to_dict()
     out["metrics"] = metrics(smap, Fz=request["metrics_Fz"])

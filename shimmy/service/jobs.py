@@ -369,20 +369,36 @@ def _run_one(job_id: str) -> bool:
     if job is None or job["status"] != "running":
         return job is not None and job["status"] != "cancelled"
 
-    def progress(fraction: float, message: str) -> None:
-        now = update(job_id, progress=float(min(max(fraction, 0.0), 1.0)), message=message)
-        if now is None or now["status"] == "cancelled":
-            raise Cancelled()
-
     try:
-        analyses.run_canonical(job["analysis"], job["request"], progress)
+        analyses.run_canonical(job["analysis"], job["request"], _Progress(job_id))
     except Cancelled:
         return False
     except Exception as exc:  # noqa: BLE001 - every failure is reported on the job
-        update(job_id, status="failed", error=f"{type(exc).__name__}: {exc}")
+        update(job_id, status="failed", error=f"{type(exc).__name__}: {exc}", sketch=None)
         return True
-    update(job_id, status="done", progress=1.0, message="done")
+    update(job_id, status="done", progress=1.0, message="done", sketch=None)
     return True
+
+
+class _Progress:
+    """A running job's progress (``progress(fraction, message)``) and :meth:`sketch`: what of its
+    answer is known so far, kept on the job's record (``job["sketch"]``, not in the API's view) for
+    the pages to draw before the answer is done, dropped when it ends. Either raises
+    :class:`Cancelled` once the job is cancelled."""
+
+    def __init__(self, job_id: str):
+        self.job_id = job_id
+
+    def __call__(self, fraction: float, message: str) -> None:
+        self._check(update(self.job_id, progress=float(min(max(fraction, 0.0), 1.0)), message=message))
+
+    def sketch(self, partial: dict[str, Any]) -> None:
+        self._check(update(self.job_id, sketch=partial))
+
+    @staticmethod
+    def _check(now: dict[str, Any] | None) -> None:
+        if now is None or now["status"] == "cancelled":
+            raise Cancelled()
 
 
 def _next(finished: str, me: dict[str, Any]) -> str | None:

@@ -31,6 +31,11 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
     run = wait_for(lambda: browser.find_elements(By.ID, "map-run"), what="the Compute button")[0]
     idle(browser)
     run.click()
+    # the curves are drawn as they are known, before the slices and the shading
+    wait_for(lambda: "Making the map: Hopf curves" in _title(browser), timeout=240, interval=0.1,
+             what="the first map's curves before its shading")
+    assert on_figure(browser, "map-graph", "return g.data.filter(t => t.fill === 'toself').length;") == 0
+    browser.save_screenshot(str(SHOTS / "live-map-sketch-1440.png"))
     wait_for(lambda: "Shimmy type of" in _title(browser), timeout=240, what="the first map")
     first = [i for i in job_records(server) if i not in before]
     assert len(first) == 1
@@ -38,9 +43,16 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
     # one step of e_p (+10 %): computed by itself, warmed from the cached map, the old map faint meanwhile
     box = by_id(browser, pattern("e_p", "param-box"))
     type_into(box, "0.00132")
-    wait_for(lambda: _faded(browser) or "New design's map" in _title(browser), timeout=30,
+    wait_for(lambda: _faded(browser) or "New design's map" in _title(browser)
+             or "Making the new design's map" in _title(browser), timeout=30,
              interval=0.05, what="the previous map faint while the next is made")
     browser.save_screenshot(str(SHOTS / "live-map-fading-1440.png"))
+    # the new design's curves as they come, over the previous map (its regions and curves faint)
+    wait_for(lambda: "Making the new design's map" in _title(browser), timeout=120, interval=0.1,
+             what="the new design's curves over the previous map")
+    assert on_figure(browser, "map-graph", "return g.data.filter(t => (t.name || '').indexOf('(previous)') >= 0)"
+                                           ".length;") > 0
+    browser.save_screenshot(str(SHOTS / "live-map-sketch-warm-1440.png"))
     wait_for(lambda: "Shimmy type of" in _title(browser) and not _faded(browser), timeout=240,
              what="the warmed map")
     second = [j for i, j in job_records(server).items() if i not in before and i not in first]

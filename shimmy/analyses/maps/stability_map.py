@@ -68,6 +68,27 @@ COVERAGE_ROUNDS = 2  # rounds of further slices through regions no slice crosses
 #: between curves that nearly meet are read off the nearest slice at the same speed, and counted)
 COVERAGE_AREA = 2e-4
 DEFAULT_FZ_RANGE = FZ_RANGE
+#: ``sketch(curves so far)``: called while a map is made, each time a curve is known (the Hopf curves,
+#: then each fold and torus curve), with :func:`sketch_of` (to draw the boundaries before the shading)
+Sketch = Callable[[dict[str, Any]], None]
+
+
+def sketch_of(config: Configuration, v_range: tuple[float, float], fz_range: tuple[float, float],
+              hopf: HopfCurvesResult, curves: Sequence[GearCycleCurve]) -> dict[str, Any]:
+    """The curves of a map known so far, JSON-ready under the keys of :meth:`StabilityMap.to_dict`
+    (curve points with V and Fz only): the Hopf curves with their GH and double-Hopf points, and
+    the fold and torus curves continued so far."""
+    def line(p: np.ndarray) -> list[dict[str, float]]:
+        return [{"V": float(v), "Fz": float(f)} for v, f in p]
+
+    out: dict[str, Any] = {"config": config.value, "v_range": list(v_range), "fz_range": list(fz_range),
+                           "hopf_curves": [line(c.p) for c in hopf.curves], "gh_points": hopf.gh_points,
+                           "double_hopf_points": hopf.double_hopf_points}
+    for kind, key in KEY_OF_KIND.items():
+        out[key] = [line(c.curve.p) for c in curves if c.kind == kind]
+    return out
+
+
 @dataclass
 class StabilityMap:
     config: Configuration
@@ -261,6 +282,8 @@ class _MapBuild:
         self.search.expect_sources(len(self.loads))
         self.pending = 0  # units submitted or queued and not finished
         self.finished_at = 0.0  # s after the start when its last unit finished
+        self.sketch: Sketch | None = None
+        self._sketched = -1  # curves known at the last sketch
 
     def _slice_unit(self, Fz: float) -> SliceUnit:
         return SliceUnit(self.config, float(Fz), self.v_range, self.n_v, self.params, self.options)
@@ -304,6 +327,9 @@ class _MapBuild:
             more += self._coverage()
         if not more and self.pending == 0:
             self.finished_at = elapsed
+        if self.sketch is not None and self.hopf is not None and len(self.search.curves) != self._sketched:
+            self._sketched = len(self.search.curves)
+            self.sketch(sketch_of(self.config, self.v_range, self.fz_range, self.hopf, self.search.curves))
         return self._counted(more)
 
     def result(self, executor: str) -> StabilityMap:
@@ -335,14 +361,15 @@ def _tagged_unit(tagged: tuple[int, MapUnit]) -> Any:
 def stability_maps(configs: Sequence[Configuration | str], *, params: Parameters | None = None,
                    v_range: tuple[float, float] = DEFAULT_V_RANGE, fz_range: tuple[float, float] = DEFAULT_FZ_RANGE,
                    resolution: int = DEFAULT_MAP_SLICES, n_v: int = 100, options: BifurcationOptions | None = None,
-                   executor=None, progress: Callable[[float, str], None] | None = None) -> list[StabilityMap]:
+                   executor=None, progress: Callable[[float, str], None] | None = None,
+                   sketches: Sequence[Sketch | None] = ()) -> list[StabilityMap]:
     """The maps of several configurations (same plane, resolution and parameters), in the order
     given: :func:`stability_map` of each, their units all through one ``executor`` at once.
 
     The maps' units share the workers, most urgent first (every map's curve units ahead of any
     slice), so that no worker idles while another map's units wait: one map's last curve or slice
     no longer holds the workers back. Each map's ``elapsed_s`` is the time until its own last unit
-    finished."""
+    finished. ``sketches``: a :data:`Sketch` per map (or None), told each curve of it as it is known."""
     clock = time.perf_counter()
     configs = list(configs)
     builds = [_MapBuild(c, v_range, fz_range, resolution, params, n_v, options) for c in configs]
@@ -351,12 +378,14 @@ def stability_maps(configs: Sequence[Configuration | str], *, params: Parameters
     if executor is None:
         with open_executor() as own:
             maps = stability_maps(configs, v_range=v_range, fz_range=fz_range, resolution=resolution, params=params,
-                                  n_v=n_v, executor=own, progress=progress, options=options)
+                                  n_v=n_v, executor=own, progress=progress, options=options, sketches=sketches)
         for smap in maps:
             smap.executor = name_of(None)
         return maps
     report = progress or (lambda fraction, message: None)
     several = len(builds) > 1
+    for build, sketch in zip(builds, sketches, strict=False):  # maps beyond the sketches given: none
+        build.sketch = sketch
 
     def done(tagged: tuple[int, MapUnit], result: Any) -> list[tuple[int, tuple[int, MapUnit]]]:
         k, unit = tagged
@@ -379,7 +408,7 @@ def stability_map(config: Configuration | str, *, params: Parameters | None = No
                   v_range: tuple[float, float] = DEFAULT_V_RANGE, fz_range: tuple[float, float] = DEFAULT_FZ_RANGE,
                   resolution: int = DEFAULT_MAP_SLICES, n_v: int = 100, options: BifurcationOptions | None = None,
                   executor=None, progress: Callable[[float, str], None] | None = None,
-                  warm_from: dict[str, Any] | None = None) -> StabilityMap:
+                  warm_from: dict[str, Any] | None = None, sketch: Sketch | None = None) -> StabilityMap:
     """The (V, Fz) stability map of one configuration: its region boundaries continued as curves,
     the regions' types from ``resolution`` classified Fz slices (and further ones where a region
     lies between them), read off on a fine grid with ``n_v`` speeds.
@@ -393,7 +422,10 @@ def stability_map(config: Configuration | str, *, params: Parameters | None = No
     ``warm_from``: the :meth:`StabilityMap.warm_start` of a map of the same configuration, plane,
     grid and options at a nearby design: the map is warmed from it where the arrangement of the
     curves is unchanged (:func:`shimmy.analyses.maps.warm_map.warm_map`; ``methods`` says
-    ``warmed_from``), else computed cold (``methods`` says ``warm_refused`` and why)."""
+    ``warmed_from``), else computed cold (``methods`` says ``warm_refused`` and why).
+
+    ``sketch`` (a :data:`Sketch`) is told the curves known so far each time one more is: the Hopf
+    curves first, then each fold and torus curve, before the slices and the shading are done."""
     refused = None
     if warm_from is not None:
         from .warm_map import NotWarm, compatible, warm_map
@@ -403,7 +435,7 @@ def stability_map(config: Configuration | str, *, params: Parameters | None = No
                              options=options or BifurcationOptions(mesh_check=False))
         if refused is None:
             try:
-                return warm_map(warm_from, params=params, executor=executor, progress=progress)
+                return warm_map(warm_from, params=params, executor=executor, progress=progress, sketch=sketch)
             except NotWarm as exc:
                 refused = exc.reason
             except Exception as exc:  # noqa: BLE001 - a warm start that fails in any way: the cold map answers
@@ -412,7 +444,7 @@ def stability_map(config: Configuration | str, *, params: Parameters | None = No
         if progress is not None:
             progress(0.0, f"computing cold: {refused}")
     smap = stability_maps([config], v_range=v_range, fz_range=fz_range, resolution=resolution, params=params, n_v=n_v,
-                          executor=executor, progress=progress, options=options)[0]
+                          executor=executor, progress=progress, options=options, sketches=[sketch])[0]
     if refused is not None:
         smap.warm_refused = refused
     return smap

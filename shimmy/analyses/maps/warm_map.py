@@ -56,8 +56,8 @@ from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, Ge
 from ..diagrams.hopf_curves import HopfCurvesResult
 from . import map_shading
 from .map_slices import FINE, SliceResult, speed_grids, type_lengths
-from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, HopfCurvesUnit, SliceUnit, StabilityMap, arrangement,
-                            curve_boundaries, lowest_shimmy)
+from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, HopfCurvesUnit, SliceUnit, Sketch, StabilityMap,
+                            arrangement, curve_boundaries, lowest_shimmy, sketch_of)
 
 #: Kinds of a slice's special points that lie on the map's curves (carried to the curves' crossings);
 #: a slice with any other (a period doubling, a branch point of cycles) is not carried.
@@ -229,10 +229,11 @@ def compatible(start: dict[str, Any], config: Configuration | str, *, v_range, f
 
 
 def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
-             progress: Callable[[float, str], None] | None = None) -> StabilityMap:
+             progress: Callable[[float, str], None] | None = None, sketch: Sketch | None = None) -> StabilityMap:
     """The map of design ``params`` warmed from ``start`` (:meth:`StabilityMap.warm_start` of a map of
     the same configuration, plane, grid and options at a nearby design); raises :class:`NotWarm`
-    where the arrangement of the curves changed (see the module)."""
+    where the arrangement of the curves changed (see the module). ``sketch`` is told the curves
+    known so far as each is (the Hopf curves, then each fold and torus curve found again)."""
     clock = time.perf_counter()
     config = Configuration.parse(start["config"])
     old_params = Parameters.from_dict(start["params"])
@@ -242,7 +243,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         raise InvalidParameterError("warm_from", "a warm start without seeds", "a StabilityMap.warm_start()")
     if executor is None:
         with open_executor() as own:
-            smap = warm_map(start, params=params, executor=own, progress=progress)
+            smap = warm_map(start, params=params, executor=own, progress=progress, sketch=sketch)
         smap.executor = name_of(None)
         return smap
     report = progress or (lambda fraction, message: None)
@@ -261,6 +262,9 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
 
     def done(unit, result):
         results[index[id(unit)]] = result
+        if sketch is not None and 0 in results:
+            found = [results[k][0] for k in sorted(results) if k > 0 and results[k][0] is not None]
+            sketch(sketch_of(config, v_range, fz_range, results[0], found))
         return []
 
     report(0.0, "Hopf curves, and each fold and torus curve again from the map of the nearby design")

@@ -25,14 +25,18 @@ STEP = {"e_p": 0.0011}  # e_p +10 %: one slider step and more
 REL = 1e-6
 
 
+#: what the cold and the warm map of the stepped design sketched while they were made
+SKETCHES: dict[str, list[dict]] = {"cold": [], "warm": []}
+
+
 @pytest.fixture(scope="module")
 def maps():
     """nes at the nominal design (the cached one), then e_p + 10 %: cold, and warmed from it."""
     near = stability_map("nes", **PLANE)
     params = Parameters().with_overrides(STEP)
-    cold = stability_map("nes", params=params, **PLANE)
+    cold = stability_map("nes", params=params, sketch=SKETCHES["cold"].append, **PLANE)
     start = json.loads(json.dumps(near.warm_start()))  # as the cache stores it
-    warm = stability_map("nes", params=params, warm_from=start, **PLANE)
+    warm = stability_map("nes", params=params, warm_from=start, sketch=SKETCHES["warm"].append, **PLANE)
     return near, cold, warm, start
 
 
@@ -190,3 +194,35 @@ def test_slices_computed_far_from_this_design_are_computed_again(maps):
     assert not any(s.carried for s in warm.slices)
     a, b = np.array(cold.shading), np.array(warm.shading)
     assert (a == b).mean() >= 0.995
+
+
+def _lines(curves: list[list[dict]]) -> list[list[tuple[float, float]]]:
+    """Polylines as (V, Fz) tuples, each from its lower end, in one order (a curve found again may
+    come out traced the other way, and the map orders its curves after the sketches)."""
+    out = []
+    for c in curves:
+        line = [(p["V"], p["Fz"]) for p in c]
+        out.append(min(line, line[::-1]))
+    return sorted(out)
+
+
+@pytest.mark.parametrize("which", ["cold", "warm"])
+def test_a_map_sketches_its_curves_as_it_makes_them(maps, which):
+    """The Hopf curves first, then one more fold or torus curve at a time; the last sketch has the
+    map's curves, point for point, before its slices and shading are done."""
+    _, cold, warm, _ = maps
+    result = (cold if which == "cold" else warm).to_dict()
+    sketches = SKETCHES[which]
+    assert sketches, "no sketch while the map was made"
+    json.dumps(sketches)  # JSON-ready, as the job record stores them
+    counts = [len(s["fold_curves"]) + len(s["torus_curves"]) for s in sketches]
+    assert counts == sorted(set(counts)), counts  # each sketch knows more curves than the one before
+    for s in sketches:
+        assert s["config"] == "nes" and s["hopf_curves"] == [[{"V": p["V"], "Fz": p["Fz"]} for p in c]
+                                                            for c in result["hopf_curves"]]
+        assert s["gh_points"] == result["gh_points"] and s["double_hopf_points"] == result["double_hopf_points"]
+        assert s["v_range"] == result["v_range"] and s["fz_range"] == result["fz_range"]
+    last = sketches[-1]
+    for key in ("fold_curves", "torus_curves"):
+        assert _lines(last[key]) == _lines(result[key]), key
+    assert counts[-1] == len(result["cycle_curves"]) >= 2
