@@ -363,10 +363,12 @@ def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
 
 
 def _size(sketch: Any) -> int:
-    """How much a job's sketch holds (it only grows while the job runs): its lists' lengths."""
+    """How much a job's sketch holds (it only grows while the job runs): its lists' items, those of
+    lists of lists (a map's curves: their points) counted one by one."""
     if not isinstance(sketch, dict):
         return 0
-    return sum(len(v) for v in sketch.values() if isinstance(v, list))
+    return sum(len(item) if isinstance(item, list) else 1 for v in sketch.values() if isinstance(v, list)
+               for item in v)
 
 
 def _shown(analysis: str, kept: Any) -> list[dict[str, Any]] | None:

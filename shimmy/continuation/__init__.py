@@ -69,6 +69,7 @@ _EXPORTS = {
     "weighted_norm": ".core",
     "CODIM2_KINDS": ".cycle_curves", "CycleCurve": ".cycle_curves", "CycleCurveOptions": ".cycle_curves",
     "CycleCurveProblem": ".cycle_curves", "cycle_curve": ".cycle_curves", "start_beside": ".cycle_curves",
+    "join_halves": ".cycle_curves",
     "EquilibriumBranch": ".equilibria", "equilibrium_branch": ".equilibria",
     "ContinuationError": ".errors", "ConvergenceError": ".errors", "InvalidInputError": ".errors",
     "TwoParameterField": ".fields", "VectorField": ".fields",
@@ -86,7 +87,7 @@ __all__ = [
     "ConvergenceError", "CurvePoint", "CurveProblem", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem",
     "EquilibriumBranch", "HopfCurve", "HopfCurveProblem", "InvalidInputError", "Mesh", "OrbitGuess",
     "PeriodicBranch", "PeriodicOptions", "PeriodicProblem", "PointKind", "SpecialPoint", "Stop", "StopReason",
-    "Tracer", "TwoParameterField", "VectorField", "correct", "cycle_curve", "equilibrium_branch",
+    "Tracer", "TwoParameterField", "VectorField", "correct", "cycle_curve", "equilibrium_branch", "join_halves",
     "first_lyapunov_coefficient", "hopf_curve", "hopf_eigenvectors", "hopf_guess", "hopf_start", "locate",
     "orbit_from_samples", "periodic_branch", "point_at", "start_beside", "step", "tangent", "weighted_norm",
 ]

@@ -322,3 +322,46 @@ def test_remembered_collocation_blocks_follow_the_second_parameter():
     after = problem.cycle_jacobian(moved).toarray()
     np.testing.assert_array_equal(after, fresh.cycle_jacobian(moved).toarray())
     assert np.abs(after - before).max() > 1e-3
+
+
+@pytest.mark.parametrize("case", ["torus, both ends on the box", "fold, ending at GH"])
+def test_two_halves_traced_apart_join_into_the_curve_traced_both_ways(case):
+    """join_halves: the halves traced from one start in separate calls (as two processes do) give
+    the curve cycle_curve traces both ways: the same points to the Newton tolerance, in the same
+    order, the same special points at the same indices, both stops."""
+    from shimmy.continuation.cycle_curves.tracing import join_halves
+
+    if case.startswith("torus"):
+        system = torus_two_parameter()
+        args = (system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0)
+        kw = dict(box=((-1.0, 2.0), (-1.0, 1.0)), scale=np.ones(4), p_scale=(1.0, 1.0), kappa=math.cos(0.6 * math.pi),
+                  p2_marks=(0.25, -0.75))
+    else:
+        system = bautin()
+        options = PeriodicOptions(ntst=20, ncol=4)
+        guess, shape = hopf_guess(np.zeros(2), 0.0, 1.0, np.array([1.0, -1j]), Mesh.uniform(20, 4), 0.0)
+        branch = periodic_branch(system.at(0.5), guess, p_range=(-1.0, 1.0), options=options, scale=np.ones(2),
+                                 p_scale=1.0, direction=shape)
+        lpc = [s for s in branch.special_points if s.kind == "LPC"]
+        args = (system, "LPC", lpc[0].solution, 0.5)
+        kw = dict(box=BOX, scale=np.ones(2), p_scale=(1.0, 1.0), p2_marks=(0.25,))
+    whole = cycle_curve(*args, **kw)
+    joined = join_halves(cycle_curve(*args, directions=(1,), **kw), cycle_curve(*args, directions=(-1,), **kw))
+    assert len(joined.p) == len(whole.p) and joined.closed == whole.closed
+    np.testing.assert_allclose(joined.p, whole.p, atol=1e-7)
+    np.testing.assert_allclose(joined.x_max, whole.x_max, atol=1e-6)
+    assert [(s.kind, s.index) for s in joined.special_points] == [(s.kind, s.index) for s in whole.special_points]
+    for a, b in zip(joined.special_points, whole.special_points, strict=True):
+        assert a.p == pytest.approx(b.p, abs=1e-7) and a.data["p2"] == pytest.approx(b.data["p2"], abs=1e-7)
+    assert joined.stop_reasons == whole.stop_reasons and joined.steps == whole.steps
+    assert len(joined.solutions) == len(joined.p)
+    with pytest.raises(InvalidInputError, match="minus"):
+        join_halves(cycle_curve(*args, directions=(1,), **kw), torus_or_flip(case))
+
+
+def torus_or_flip(case):
+    """A half of a curve of another kind (a period-doubling curve, or a torus curve)."""
+    kind, system, kappa = (("PD", flip_two_parameter(), None) if case.startswith("torus")
+                           else ("NS", torus_two_parameter(), math.cos(0.6 * math.pi)))
+    return cycle_curve(system, kind, start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, box=((-1.0, 2.0), (-1.0, 1.0)),
+                       scale=np.ones(4), p_scale=(1.0, 1.0), kappa=kappa, directions=(1,))

@@ -32,7 +32,7 @@ import numpy as np
 
 from ...version import __version__
 from ...continuation import (CYCLE_BIFURCATIONS, ContinuationOptions, CycleCurve, CycleCurveOptions, PointKind,
-                             SpecialPoint, cycle_curve, start_beside)
+                             SpecialPoint, cycle_curve, join_halves, start_beside)
 from ...continuation.errors import ContinuationError
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
@@ -461,13 +461,16 @@ class WarmUnit:
     """A curve of a nearby design continued again at this one from its seed: (curve or None,
     warning or None). The seed is corrected by Newton at its load, then the curve traced both
     ways exactly as from any start (its points, crossings and codimension-2 points those of the
-    curve at this design, to the location tolerance)."""
+    curve at this design, to the location tolerance). With ``direction`` +1 or -1 only that half
+    is traced (a :class:`~shimmy.continuation.cycle_curves.CycleCurve` half, or None and a
+    warning): the two halves run as two units and :func:`joined_halves` makes the curve."""
 
     config: Configuration
     params: Parameters
     seed: CurveSeed
     box: tuple[tuple[float, float], tuple[float, float]]
     loads: tuple[float, ...]
+    direction: int = 0  # 0: both ways
 
     def run(self) -> tuple[GearCycleCurve | None, str | None]:
         s = self.seed
@@ -476,11 +479,26 @@ class WarmUnit:
             data["torus_angle"] = math.acos(s.kappa)
         point = SpecialPoint(s.kind, float(s.u[-1]), 0, data, solution=(s.mesh, s.u))
         start = Start(s.kind, point, s.Fz, s.ncol, s.origin)
-        return _continue(self.config, self.params, start, self.box, self.loads)
+        return _continue(self.config, self.params, start, self.box, self.loads,
+                         (self.direction,) if self.direction else (1, -1))
 
     def describe(self) -> str:
+        half = {1: ", towards higher Fz", -1: ", towards lower Fz"}.get(self.direction, "")
         return (f"{PLAIN[self.seed.kind]} curve of the nearby design again, from V = {self.seed.u[-1]:.4g} m/s, "
-                f"Fz = {self.seed.Fz / 1e3:.4g} kN")
+                f"Fz = {self.seed.Fz / 1e3:.4g} kN{half}")
+
+
+def joined_halves(plus: tuple[GearCycleCurve | None, str | None], minus: tuple[GearCycleCurve | None, str | None]
+                  ) -> tuple[GearCycleCurve | None, str | None]:
+    """The curve from the results of the two half units of one seed (:class:`WarmUnit` with
+    ``direction`` +1 and -1), as the unit tracing both ways gives it."""
+    for half, warning in (plus, minus):
+        if half is None:
+            return None, warning
+    curve = join_halves(plus[0].curve, minus[0].curve)
+    if len(curve.p) < 2:
+        return None, f"{plus[0].origin}: gives no curve: {'; '.join(curve.stop_reasons)}"
+    return GearCycleCurve(plus[0].kind, curve, plus[0].origin), None
 
 
 #: A unit of a curve search: run in any process (``executors.run_work_unit``), its result handed
@@ -548,9 +566,10 @@ def starts_of_diagram(diagram, Fz: float) -> list[Start]:
             for s in b.raw.special_points if s.kind in KINDS]
 
 
-def _continue(config: Configuration, params: Parameters, start: Start, box, loads: tuple[float, ...]
-              ) -> tuple[GearCycleCurve | None, str | None]:
-    """One curve continued from one start (a unit of :func:`cycle_curves`)."""
+def _continue(config: Configuration, params: Parameters, start: Start, box, loads: tuple[float, ...],
+              directions: tuple[int, ...] = (1, -1)) -> tuple[GearCycleCurve | None, str | None]:
+    """One curve continued from one start (a unit of :func:`cycle_curves`); with one of
+    ``directions``, the half traced that way (whatever its length: the other half may hold the rest)."""
     system = gear_two_parameter_field(config, params)
     kappa = math.cos(start.point.data["torus_angle"]) if start.kind == PointKind.TORUS else None
     if kappa is not None and not -1.0 < kappa < 1.0:
@@ -559,10 +578,10 @@ def _continue(config: Configuration, params: Parameters, start: Start, box, load
     try:
         curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box=box, options=CURVE_OPTIONS,
                             scale=STATE_SCALE[:system.n], p_scale=(V_SCALE, FZ_SCALE), kappa=kappa, ncol=start.ncol,
-                            p2_marks=loads)
+                            p2_marks=loads, directions=directions)
     except ContinuationError as exc:
         return None, f"{about} not continued: {exc}"
-    if len(curve.p) < 2:  # stopped at its start both ways (a start at a strong resonance): no curve to draw
+    if len(curve.p) < 2 and len(directions) == 2:  # stopped at its start both ways (at a strong resonance)
         return None, f"{about} gives no curve: {'; '.join(curve.stop_reasons)}"
     return GearCycleCurve(start.kind, curve, start.origin), None
 

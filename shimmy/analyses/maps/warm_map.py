@@ -51,7 +51,8 @@ from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_range, desi
 from ..core.executors import describe_work_unit, name_of, open_executor, run_dynamic, run_work_unit
 from ..core.stability import hopf_points
 from ..diagrams.bifurcation import V_SCALE, BifurcationOptions
-from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, GearCycleCurve, WarmUnit, reversed_curve,
+from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, GearCycleCurve, WarmUnit, joined_halves,
+                                     reversed_curve,
                                      same_curve)
 from ..diagrams.hopf_curves import HopfCurvesResult
 from . import map_shading
@@ -256,15 +257,26 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     # every slice's load is marked, so that the slices' fold and torus points are located crossings;
     # the marks beyond the first slices' loads are dropped from the curves afterwards (as a cold map's)
     marks = loads + tuple(sorted({float(s["Fz"]) for s in start["slices"]} - set(loads)))
-    units += [(1, WarmUnit(config, params, seed, box, marks)) for seed in seeds]
+    # each curve's two halves from its seed as two units (unit 2j + 1 towards higher Fz, 2j + 2 lower),
+    # so that the longest curve's halves run side by side
+    units += [(1, WarmUnit(config, params, seed, box, marks, direction)) for seed in seeds for direction in (1, -1)]
     results: dict[int, Any] = {}
     index = {id(u): k for k, (_, u) in enumerate(units)}
+
+    def curve_of(j: int) -> tuple[GearCycleCurve | None, str | None]:
+        return joined_halves(results[2 * j + 1], results[2 * j + 2])
 
     def done(unit, result):
         results[index[id(unit)]] = result
         if sketch is not None and 0 in results:
-            found = [results[k][0] for k in sorted(results) if k > 0 and results[k][0] is not None]
-            sketch(sketch_of(config, v_range, fz_range, results[0], found))
+            found = []
+            for j in range(len(seeds)):
+                halves = [results.get(2 * j + 1), results.get(2 * j + 2)]
+                if all(h is not None for h in halves):
+                    found.append(curve_of(j)[0])
+                else:  # one half known: drawn as it is
+                    found += [h[0] for h in halves if h is not None]
+            sketch(sketch_of(config, v_range, fz_range, results[0], [c for c in found if c is not None]))
         return []
 
     report(0.0, "Hopf curves, and each fold and torus curve again from the map of the nearby design")
@@ -272,8 +284,8 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     hopf: HopfCurvesResult = results[0]
     curves: list[GearCycleCurve] = []
     l_g = params.gear.l_g
-    for k, seed in enumerate(seeds, start=1):
-        curve, warning = results[k]
+    for j, seed in enumerate(seeds):
+        curve, warning = curve_of(j)
         if curve is None:
             raise NotWarm(f"the {seed.kind} curve was not found again at the new design: {warning or 'no curve'}")
         if any(same_curve(curve, c, l_g) for c in curves):

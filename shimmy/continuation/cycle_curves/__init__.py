@@ -21,14 +21,15 @@ Laid out as MATCONT (one curve type per defining system) and BifurcationKit.jl (
   of the cycle equations in (x, T)), :mod:`.period_doubling` (PD: the linearised collocation with
   v(0) + v(1) = 0), :mod:`.torus` (NS: two periods with v(0) - 2 kappa v(1) + v(2) = 0);
 * :mod:`.tracing`: :func:`cycle_curve` and :func:`start_beside`, the curve traced both ways with
-  its ends, turns and marks in p2;
+  its ends, turns and marks in p2 (or one way: :func:`join_halves` joins two halves traced apart);
 * :mod:`.codim2`: detection and location of the codimension-2 points along a curve.
 """
 
 from .bordered import DEFINING_SYSTEMS, CycleCurveProblem
-from .tracing import CycleCurve, CycleCurveOptions, cycle_curve, start_beside
+from .tracing import CycleCurve, CycleCurveOptions, cycle_curve, join_halves, start_beside
 
 #: Codimension-2 points reported on each curve type.
 CODIM2_KINDS = {kind: system.codim2 for kind, system in DEFINING_SYSTEMS.items()}
 
-__all__ = ["CODIM2_KINDS", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem", "cycle_curve", "start_beside"]
+__all__ = ["CODIM2_KINDS", "CycleCurve", "CycleCurveOptions", "CycleCurveProblem", "cycle_curve", "join_halves",
+           "start_beside"]

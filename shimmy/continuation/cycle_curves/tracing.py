@@ -348,6 +348,32 @@ def _closed(rows: dict) -> bool:
     return float(np.linalg.norm(prev + s * seg - first)) < length / 3.0
 
 
+def join_halves(plus: CycleCurve, minus: CycleCurve) -> CycleCurve:
+    """The curve :func:`cycle_curve` traces both ways, from its two halves traced apart from the same
+    start (``directions=(1,)`` and ``(-1,)``, for example in two processes): the second half
+    reversed, then the first, as one curve; the first alone if it closed (the second then retraces
+    it). The halves' shared start point is kept once."""
+    if plus.kind != minus.kind:
+        raise InvalidInputError("minus", minus.kind.value, f"a half of the same {plus.kind} curve")
+    if plus.closed:
+        return plus
+    count = len(minus.p)
+    order = np.arange(count - 1, 0, -1, dtype=int)  # reversed, without the shared start point
+    special = [replace(s, index=count - 1 - s.index) for s in minus.special_points]  # its start: the shared point
+    special += [replace(s, index=count - 1 + s.index) for s in plus.special_points]
+    special.sort(key=lambda s: s.index)
+
+    def joined(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.concatenate([a[order], b]) if count > 1 else b.copy()
+
+    return CycleCurve(plus.kind, joined(minus.p, plus.p), joined(minus.period, plus.period),
+                      joined(minus.x_max, plus.x_max), joined(minus.x_min, plus.x_min),
+                      joined(minus.kappa, plus.kappa), joined(minus.multipliers, plus.multipliers),
+                      [minus.solutions[i] for i in order] + list(plus.solutions), special_points=special,
+                      stops=list(plus.stops) + list(minus.stops), steps=plus.steps + minus.steps,
+                      closed=minus.closed)
+
+
 def _join(kind: PointKind, halves, stops, steps) -> CycleCurve:
     """One curve: the second half reversed, then the first (they share the start point)."""
     parts = []
@@ -359,8 +385,8 @@ def _join(kind: PointKind, halves, stops, steps) -> CycleCurve:
         if len(halves) == 2 and h_index == 0:
             order = list(range(count - 1, 0, -1))  # reversed, without the shared start point
             position = {i: k for k, i in enumerate(order)}
-            for s in pts:
-                special.append(replace(s, index=position.get(s.index, 0)))
+            for s in pts:  # one at the start is at the shared point, where the other half begins
+                special.append(replace(s, index=position.get(s.index, len(order))))
         else:
             order = list(range(count))
             for s in pts:

@@ -208,15 +208,16 @@ def _lines(curves: list[list[dict]]) -> list[list[tuple[float, float]]]:
 
 @pytest.mark.parametrize("which", ["cold", "warm"])
 def test_a_map_sketches_its_curves_as_it_makes_them(maps, which):
-    """The Hopf curves first, then one more fold or torus curve at a time; the last sketch has the
-    map's curves, point for point, before its slices and shading are done."""
+    """The Hopf curves first, then one more fold or torus curve (or half of one) at a time; the last
+    sketch has the map's curves, point for point, before its slices and shading are done."""
     _, cold, warm, _ = maps
     result = (cold if which == "cold" else warm).to_dict()
     sketches = SKETCHES[which]
     assert sketches, "no sketch while the map was made"
     json.dumps(sketches)  # JSON-ready, as the job record stores them
     counts = [len(s["fold_curves"]) + len(s["torus_curves"]) for s in sketches]
-    assert counts == sorted(set(counts)), counts  # each sketch knows more curves than the one before
+    points = [sum(len(c) for c in s["fold_curves"] + s["torus_curves"]) for s in sketches]
+    assert counts == sorted(counts) and points == sorted(set(points)), (counts, points)  # each knows more
     for s in sketches:
         assert s["config"] == "nes" and s["hopf_curves"] == [[{"V": p["V"], "Fz": p["Fz"]} for p in c]
                                                             for c in result["hopf_curves"]]
