@@ -26,8 +26,10 @@ class Workbench(Dash):
         return config
 
 
+# compress: responses (the 6.3 MB of component bundles, figures' JSON) sent zstd, brotli or gzip to a
+# browser that accepts it (flask-compress, through Dash's own option)
 app = Workbench(__name__, use_pages=True, title="shimmy workbench", suppress_callback_exceptions=True,
-                update_title=None)
+                update_title=None, compress=True)
 server = app.server
 server.config["MAX_CONTENT_LENGTH"] = settings.MAX_BODY_BYTES
 server.register_blueprint(api)
