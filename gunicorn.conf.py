@@ -22,3 +22,11 @@ def on_starting(server):
         libc = ctypes.CDLL(None, use_errno=True)
         if libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) != 0:
             server.log.warning("could not become the child subreaper (errno %d)", ctypes.get_errno())
+
+
+def post_worker_init(worker):
+    """Load the numba kernels before the worker takes requests (shimmy.service.warmup), so that no
+    user's first answer waits for them."""
+    from shimmy.service.warmup import warm_kernels
+
+    worker.log.info("kernels loaded in %.1f s", warm_kernels())
