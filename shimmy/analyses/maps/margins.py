@@ -46,6 +46,10 @@ from .summaries import basins_summary, margins_summary
 
 ENERGY_COMPONENTS = tuple(COMPONENTS)
 MIN_ANGLE_DEG = 1.0
+#: Sizes probed per round of the bisection (:func:`~shimmy.analyses.core.basins.refine`'s ``width``): two
+#: interior sizes of a bracket while it is the only one open (trisection: two runs side by side), one per bracket
+#: when several are. Fixed, not the executor's worker count, so that a margin is the same on every executor.
+ROUND_WIDTH = 2
 
 
 def _header(config: Configuration, V: float, Fz: float, params: Parameters, found: PointAttractors,
@@ -283,14 +287,14 @@ def margins(config: Configuration | str, V: float, Fz: float, *, params: Paramet
     sizes = geometric_sizes(options.min_size, options.max_size, options.scan_points)
     report(0.1, "bracketing scan")
     if energy:
-        rays, best = smallest_over_directions(probe, len(names), sizes, options.rtol, width=runs.width,
+        rays, best = smallest_over_directions(probe, len(names), sizes, options.rtol, width=ROUND_WIDTH,
                                               min_angle=math.radians(MIN_ANGLE_DEG))
         found_at = {label: (s.threshold, s.direction) for label, s in best.items()}
         swept = len(rays)
     else:
         ray = Ray(np.array([1.0]))
         scan([ray], sizes, probe)
-        refine([ray], probe, options.rtol, runs.width)
+        refine([ray], probe, options.rtol, ROUND_WIDTH)
         found_at = {label: (ray.threshold(label), ray.direction) for label in ray.reached()}
         swept = 1
     report(0.95, "checking every threshold by two runs")

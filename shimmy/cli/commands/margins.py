@@ -48,7 +48,7 @@ def add_parsers(commands) -> None:
     add_no_cache(p)
 
     p = add_command(commands, "basins", "basin fractions at one operating point: the share of kicks up to a size "
-                    "that ends on each attractor, with 95 % intervals", _cmd_basins)
+                    "that ends on each attractor, with 95-percent intervals", _cmd_basins)
     add_operating_point(p)
     add_field(p, "basins", "--radius", "kicks uniform in the energy ball of this yaw angle", limits=True)
     add_field(p, "basins", "--samples", "kicks sampled", limits=True)
