@@ -3,7 +3,7 @@
 * **Attractors** (:func:`point_attractors`): the stable equilibrium and stable limit cycles of the
   one-parameter bifurcation diagram in V at the load, at the point's speed (the map's reading,
   :func:`~shimmy.analyses.maps.stability_map.attractors_at`), and the diagram's unstable cycles at
-  that speed (the saddle cycles between the basins). Then full runs from the standard start
+  that speed (the saddle cycles between the basins). Then runs from the standard start
   (psi = 0.001 rad), a large yaw angle (0.2 rad) and a large lateral deflection (l_g delta = 0.1 m),
   the diagram's own large starts: each run's end is matched to the attractors; a settled end that
   matches none (a motion the diagram has not got, such as a quasi-periodic one past a torus point)
@@ -17,10 +17,10 @@
 * **Runs** (:class:`RunUnit`, through the executor): the compiled integrator (as
   :func:`~shimmy.analyses.core.simulation.simulate`, same tolerances), in windows of ``WINDOW``
   (1 s, more than six periods of the slowest shimmy mode); a run stops early when two windows in a
-  row are matched to the same attractor. A run matched to none by ``t_max`` is ``UNSETTLED``; a
-  failed integration ``FAILED``. A *full* run (the checks of a threshold, the discovery runs) goes
-  on to ``t_max`` and is judged on its last ``FULL_WINDOW`` (20 s) against the 20 s before, as a
-  time history's steady state is.
+  row are matched to the same attractor. A run that gets to ``t_max`` is judged on its last
+  ``FULL_WINDOW`` (20 s; amplitudes the largest over it, falling or settled against the 20 s
+  before, as a time history's steady state is): matched, or ``UNSETTLED``; a failed integration is
+  ``FAILED``. A *full* run (the checks of a threshold) never stops early.
 * **The disturbance's size** (:class:`EnergyNorm`): the energy of the linearised gear at straight
   rolling, E = (1/2)(I_psi dpsi^2 + k_psi' psi^2 + I_x ddelta^2 + k_delta delta^2), with I_psi =
   I_z (+ I_pd with the particle damper) and k_psi' = k_psi (+ k_1 with the NES, whose absorber is at
@@ -181,14 +181,11 @@ def run_to_attractor(model, x0: np.ndarray, V: float, Fz: float, attractors: Att
         previous = here
         if streak >= 2:
             return here, float(psi[w]), float(delta[w]), (w + 1) * WINDOW, True
-    if not full:
-        return UNSETTLED, float(psi[-1]), float(delta[-1]), windows * WINDOW, False
     span = max(1, min(int(round(FULL_WINDOW / WINDOW)), windows // 2))
     last = (psi[-span:].max(), delta[-span:].max())
     before = (psi[-2 * span:-span].max(), delta[-2 * span:-span].max()) if windows >= 2 * span else last
-    e_last = attractors.vector(*last)
-    e_before = attractors.vector(*before)
-    size, size_before = float(np.linalg.norm(e_last)), float(np.linalg.norm(e_before))
+    size = float(np.linalg.norm(attractors.vector(*last)))
+    size_before = float(np.linalg.norm(attractors.vector(*before)))
     settled = size_before > 0 and abs(size / size_before - 1.0) < STEADY_CHANGE
     label = attractors.label(last[0], last[1], size < size_before)
     return label, float(last[0]), float(last[1]), windows * WINDOW, bool(settled or label >= 0)
@@ -278,7 +275,7 @@ def point_attractors(config: Configuration, V: float, Fz: float, *, params: Para
         x0 = np.zeros(n)
         x0[0 if what == "psi" else 2] = size if what == "psi" else size / l_g
         starts.append(tuple(x0))
-    units = [RunUnit(config, V, Fz, params, (x0,), classifier(), t_max, full=True) for x0 in starts]
+    units = [RunUnit(config, V, Fz, params, (x0,), classifier(), t_max) for x0 in starts]
     ends = [r[0] for r in run_units(units)]
     for (name, _, _), (label, psi, delta, _, settled) in zip(DISCOVERY_STARTS, ends, strict=True):
         if label == FAILED:
