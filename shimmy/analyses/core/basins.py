@@ -37,8 +37,9 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-#: Labels of runs that ended on no attractor.
+#: The label of a run that settled on no attractor in the time allowed.
 UNSETTLED = -1
+#: The label of a run whose integration failed.
 FAILED = -2
 
 #: Interior sizes per bracket and round at most (three divide a bracket by four).
