@@ -19,8 +19,10 @@
   (1 s, more than six periods of the slowest shimmy mode); a run stops early when two windows in a
   row are matched to the same attractor. A run that gets to ``t_max`` is judged on its last
   ``FULL_WINDOW`` (20 s; amplitudes the largest over it, falling or settled against the 20 s
-  before, as a time history's steady state is): matched, or ``UNSETTLED``; a failed integration is
-  ``FAILED``. A *full* run (the checks of a threshold) never stops early.
+  before, as a time history's steady state is): matched, or ``UNSETTLED``; where straight rolling
+  is the only attractor and there is no saddle cycle, a run still falling by more than 1 % against
+  the 20 s before ends on it (a slow decay, as a time history's response type ``Stable``); a failed
+  integration is ``FAILED``. A *full* run (the checks of a threshold) never stops early.
 * **The disturbance's size** (:class:`EnergyNorm`): the energy of the linearised gear at straight
   rolling, E = (1/2)(I_psi dpsi^2 + k_psi' psi^2 + I_x ddelta^2 + k_delta delta^2), with I_psi =
   I_z (+ I_pd with the particle damper) and k_psi' = k_psi (+ k_1 with the NES, whose absorber is at
@@ -50,6 +52,7 @@ EQUILIBRIUM_FRACTION = 0.05
 EQUILIBRIUM_REFERENCE_PSI = 0.01  # rad: the scale of "small" where there is no cycle
 WINDOW = 1.0  # s
 FULL_WINDOW = 20.0  # s
+DECAY_RATIO = 0.99  # a run falling by more than 1 % per window decays (as a time history's response type)
 STEADY_CHANGE = 0.01  # a full run is settled when its amplitude changed by less than this between windows
 DT_OUT = 0.001  # s
 #: Discovery starts: (what, size): psi in rad, the lateral deflection l_g delta in m.
@@ -112,6 +115,13 @@ class AttractorSet:
         sizes += [float(np.linalg.norm(self.vector(*s))) for s in self.saddles]
         base = min(sizes) if sizes else math.sqrt(self.k_psi) * EQUILIBRIUM_REFERENCE_PSI
         return EQUILIBRIUM_FRACTION * base
+
+    def decaying(self) -> int:
+        """The equilibrium's index where it is the only attractor and there is no saddle cycle (a run still
+        falling at the end goes there), else UNSETTLED."""
+        if self.saddles or len(self.attractors) != 1 or not self.equilibrium[0]:
+            return UNSETTLED
+        return 0
 
     def label(self, psi_amp: float, delta_amp: float, falling: bool) -> int:
         """The attractor the amplitudes match, or UNSETTLED."""
@@ -188,6 +198,8 @@ def run_to_attractor(model, x0: np.ndarray, V: float, Fz: float, attractors: Att
     size_before = float(np.linalg.norm(attractors.vector(*before)))
     settled = size_before > 0 and abs(size / size_before - 1.0) < STEADY_CHANGE
     label = attractors.label(last[0], last[1], size < size_before)
+    if label < 0 and size < DECAY_RATIO * size_before:
+        label = attractors.decaying()  # still falling, with nothing else to go to: the time history's Stable
     return label, float(last[0]), float(last[1]), windows * WINDOW, bool(settled or label >= 0)
 
 

@@ -148,3 +148,19 @@ def test_a_diagram_of_another_load_is_refused():
     with pytest.raises(InvalidParameterError) as info:
         margins("original", 50.0, 850e3, diagram=other, executor=InlineExecutor())
     assert info.value.field == "diagram"
+
+
+def test_a_run_is_on_an_attractor_only_within_ten_percent_and_nearer_to_it_than_to_every_saddle():
+    """The classifier on its own: energy-weighted amplitudes (k_psi = 4, k_delta = 1: e = (2 psi, delta))."""
+    from shimmy.analyses.core.basins import UNSETTLED
+    from shimmy.analyses.maps.point_attractors import AttractorSet
+
+    cycles = AttractorSet(((0.0, 0.0), (0.5, 0.0), (0.0, 2.0)), (True, False, False), ((0.3, 0.0),), 4.0, 1.0)
+    assert cycles.label(0.52, 0.0, False) == 1 and cycles.label(0.0, 1.85, False) == 2
+    assert cycles.label(0.56, 0.0, False) == UNSETTLED  # 12 % off
+    assert cycles.label(0.3, 0.0, True) == UNSETTLED  # on the saddle
+    assert cycles.label(0.005, 0.0, True) == 0 and cycles.label(0.005, 0.0, False) == UNSETTLED  # x = 0 if falling
+    assert cycles.label(0.02, 0.0, True) == UNSETTLED  # 0.04 > 5 % of the smallest cycle's 0.6
+    assert cycles.decaying() == UNSETTLED
+    alone = AttractorSet(((0.0, 0.0),), (True,), (), 4.0, 1.0)
+    assert alone.decaying() == 0 and alone.label(0.0004, 0.0, True) == 0 and alone.label(0.0006, 0.0, True) == UNSETTLED
