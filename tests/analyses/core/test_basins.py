@@ -95,7 +95,7 @@ def test_the_smallest_threshold_over_all_directions_is_the_nearest_point_of_the_
     M = anisotropic_map()
     _, s, vt = np.linalg.svd(M)
     exact = R_UNSTABLE / s[0]
-    probe = radial_probe(subcritical, [0.0, R_STABLE], M)
+    probe = radial_probe(subcritical, [0.0, R_STABLE], M, dt=0.1)
     sweep = sweep_directions(4)
     assert np.max(np.abs(sweep @ vt[0])) < math.cos(math.radians(15))  # no swept direction is near the answer
     rays, best = smallest_over_directions(probe, 4, geometric_sizes(0.02, 0.8, 10), rtol=2e-3, width=2)
