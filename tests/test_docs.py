@@ -47,7 +47,7 @@ def test_docs_build_in_strict_mode_with_every_page(site):
     for page in ("index", "model", "numerics", "validation", "http-api", "openapi", "cli", "python-api",
                  "continuation", "tutorials/index", "tutorials/reproduce-study", "tutorials/new-nes-design",
                  "tutorials/dask-map", "tutorials/ground-runs", "tutorials/design-sessions",
-                 "tutorials/design-decisions"):
+                 "tutorials/design-decisions", "tutorials/disturbance-margins"):
         assert (site / f"{page}.html").is_file(), page
 
 
@@ -125,7 +125,7 @@ def _documented_commands() -> list[tuple[str, str]]:
 def test_the_docs_show_commands():
     pages = {page for page, _ in _documented_commands()}
     assert {"tutorials/reproduce-study.md", "tutorials/new-nes-design.md", "tutorials/dask-map.md",
-            "tutorials/ground-runs.md", "tutorials/design-decisions.md"} <= pages
+            "tutorials/ground-runs.md", "tutorials/design-decisions.md", "tutorials/disturbance-margins.md"} <= pages
 
 
 @pytest.mark.parametrize("page,command", _documented_commands(),
@@ -142,7 +142,8 @@ def _examples_with_output() -> list[tuple[str, str, str]]:
     """(page, code, printed output) of every ```python block followed directly by a ```text block
     on the tutorial pages whose output does not depend on timing (the Dask page's does)."""
     found = []
-    for name in ("tutorials/reproduce-study.md", "tutorials/new-nes-design.md", "tutorials/ground-runs.md"):
+    for name in ("tutorials/reproduce-study.md", "tutorials/new-nes-design.md", "tutorials/ground-runs.md",
+                 "tutorials/disturbance-margins.md"):
         text = (DOCS / name).read_text()
         for code, output in re.findall(r"```python\n(.*?)```\n\n```text\n(.*?)```", text, flags=re.S):
             found.append((name, code, output))
@@ -152,7 +153,8 @@ def _examples_with_output() -> list[tuple[str, str, str]]:
 def test_the_tutorials_show_python_examples():
     assert {page for page, _, _ in _examples_with_output()} == {"tutorials/reproduce-study.md",
                                                                 "tutorials/new-nes-design.md",
-                                                                "tutorials/ground-runs.md"}
+                                                                "tutorials/ground-runs.md",
+                                                                "tutorials/disturbance-margins.md"}
 
 
 @pytest.mark.slow

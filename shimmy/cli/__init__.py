@@ -26,7 +26,7 @@ from typing import Sequence
 from ..continuation.errors import InvalidInputError
 from ..errors import EXPECTED_ERRORS, GeometryError
 from ..service.settings import CacheDirectoryError, cache_dir_setting
-from .commands import decisions, diagrams, ground, maps, model, point
+from .commands import decisions, diagrams, ground, maps, margins, model, point
 from .common import EXIT_BAD_INPUT, EXIT_FAILED
 
 __all__ = ["build_parser", "main"]
@@ -49,13 +49,14 @@ examples:
   python -m shimmy params
   python -m shimmy hopf --config nes --Fz 150000
   python -m shimmy simulate --config original --V 50 --Fz 850000 --t-end 60
+  python -m shimmy margins --config original --V 50 --Fz 550000 --direction psi
   python -m shimmy map --config nes_pd --resolution 10 --json > map.json
   python -m shimmy study --param e_p --values 0.0005,0.001,0.005 --configs nes,nes_pd
 
 'python -m shimmy COMMAND --help' describes a command and its options."""
 
 #: The groups of commands, in the order ``--help`` lists their commands.
-GROUPS = (point, ground, diagrams, maps, decisions, model)
+GROUPS = (point, margins, ground, diagrams, maps, decisions, model)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -211,6 +211,25 @@ def robustness(request: dict[str, Any], progress: Progress | None = None) -> dic
                           params=_params(request), seed=request["seed"], progress=progress).to_dict()
 
 
+@serves("margins", sync=False, job=True)
+def margins(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """The attractors at a point and the smallest disturbance to each; runs through the executor of this environment."""
+    from ..analyses.maps.margins import margins as run_margins
+
+    settings = ("direction", "max_size", "min_size", "scan_points", "rtol", "t_max")
+    return run_margins(request["config"], request["V"], request["Fz"], params=_params(request), progress=progress,
+                       **{name: request[name] for name in settings}).to_dict()
+
+
+@serves("basins", sync=False, job=True)
+def basins(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """Basin fractions at a point: sampled disturbances through the executor of this environment."""
+    from ..analyses.maps.margins import basins as run_basins
+
+    return run_basins(request["config"], request["V"], request["Fz"], params=_params(request), progress=progress,
+                      **{name: request[name] for name in ("radius", "samples", "seed", "t_max")}).to_dict()
+
+
 def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
     """A ground-run preset's table rows [t, V, Fz], its complete settings, each setting's range and
     its assumptions, for a profile editor (a table of a few hundred points: nothing to cache)."""

@@ -18,6 +18,7 @@ from ..errors import InvalidParameterError
 from . import settings
 from ..analyses.decisions import design_space
 from ..analyses.ground.ground_profiles import MAX_PROFILE_POINTS, PRESETS
+from ..analyses.maps import margin_options
 from ..model.parameters import (DEFAULT_FZ, DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, MATERIALS,
                                 PARAMETER_SPECS, V_RANGE, Parameters, check_number, unknown_name_error)
 
@@ -449,8 +450,15 @@ def _check_robustness(out: dict[str, Any]) -> None:
     out["tolerances"] = tols
 
 
-_CHECKS = {"sensitivity": _check_sensitivity, "optimise": _check_optimise, "robustness": _check_robustness}
+def _check_margins(out: dict[str, Any]) -> None:
+    """The settings together, as the analysis checks them (min_size below max_size)."""
+    margin_options.MarginOptions(**{name: out[name] for name in margin_options.MarginOptions.__dataclass_fields__})
+
+
+_CHECKS = {"sensitivity": _check_sensitivity, "optimise": _check_optimise, "robustness": _check_robustness,
+           "margins": _check_margins}
 _RULES = {
+    "margins": "Margins: min_size below max_size.",
     "optimise": "Optimise: the search parameters are parameters of the configuration (default: those of r2, e_p, "
                 "k_s, r3 it has); local_runs at most starts; method gradient only for figures with derivatives ("
                 + ", ".join(DIFFERENTIABLE) + "); constraints as 'FIGURE<=VALUE', 'FIGURE@Fz>=VALUE' or "
@@ -515,6 +523,17 @@ FZ = Field("Fz", "number", "vertical load", required=True, low=FZ_RANGE[0], high
 
 def _range(name: str, default: float, bounds: tuple[float, float], unit: str, what: str) -> Field:
     return Field(name, "number", what, default=default, low=bounds[0], high=bounds[1], unit=unit)
+
+
+def _setting(name: str, what: str, options: Any) -> Field:
+    """A setting of a margin or of basin fractions: its default and limits those of the analysis's options."""
+    low, high, unit, integer = margin_options.LIMITS[name]
+    return Field(name, "integer" if integer else "number", what, default=getattr(options, name), low=low, high=high,
+                 unit=unit)
+
+
+_MARGIN, _BASIN = margin_options.MarginOptions(), margin_options.BasinOptions()
+_T_MAX = "longest run; a run that settles on no attractor by then counts as unsettled"
 
 
 SCHEMAS: dict[str, RequestSchema] = {
@@ -645,6 +664,23 @@ SCHEMAS: dict[str, RequestSchema] = {
         Field("seed", "integer", "seed of the samples (the same seed gives the same samples)", default=0, low=0,
               high=2 ** 31 - 1),
         PARAMS, MATERIAL)),
+    "margins": RequestSchema("margins", "disturbance margins at one operating point: its attractors and the smallest "
+                             "disturbance from straight rolling that ends on each, each checked by two runs", (
+        _config(), V, FZ,
+        Field("direction", "string", "the disturbed component (psi, dpsi, delta, ddelta; the rest at rest), or all "
+              "four in the energy norm (energy)", default=_MARGIN.direction, choices=margin_options.DIRECTIONS),
+        _setting("max_size", "largest disturbance scanned, as the yaw angle of the same energy", _MARGIN),
+        _setting("min_size", "smallest disturbance scanned, as the yaw angle of the same energy", _MARGIN),
+        _setting("scan_points", "sizes of the bracketing scan (geometric steps)", _MARGIN),
+        _setting("rtol", "relative tolerance of the bisection", _MARGIN), _setting("t_max", _T_MAX, _MARGIN),
+        PARAMS, MATERIAL)),
+    "basins": RequestSchema("basins", "basin fractions at one operating point: the share of disturbances up to a "
+                            "size ending on each attractor, with 95 % intervals", (
+        _config(), V, FZ,
+        _setting("radius", "disturbances uniform in the energy ball of this yaw angle", _BASIN),
+        _setting("samples", "disturbances sampled", _BASIN),
+        _setting("seed", "seed of the samples (the same seed gives the same samples)", _BASIN),
+        _setting("t_max", _T_MAX, _BASIN), PARAMS, MATERIAL)),
 }
 
 def validate(analysis: str, body: Any, extra: tuple[str, ...] = ()) -> dict[str, Any]:

@@ -217,6 +217,11 @@ def run_dynamic(fn: Callable[[Any], Any], units: Sequence[tuple[float, Any]], ex
     return finished
 
 
+def executor_width(executor: Executor) -> int:
+    """Units in flight at once on ``executor``: its workers (threads of a Dask cluster; one inline)."""
+    return _width(executor)
+
+
 def _width(executor: Executor) -> int:
     """Units in flight at once on ``executor``: its workers (threads of a Dask cluster)."""
     if isinstance(executor, InlineExecutor):

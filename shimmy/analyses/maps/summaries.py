@@ -51,3 +51,68 @@ def write_map_csv(result: dict[str, Any], path) -> None:
         for Fz, row in zip(shading["Fz"], shading["types"], strict=True):
             for V, t in zip(shading["V"], row, strict=True):
                 w.writerow([f"{Fz:.10g}", f"{V:.10g}", t])
+
+
+def _attractor_line(a: dict[str, Any]) -> str:
+    amp = a["amplitude"]
+    motion = "motion (simulated)" if a["kind"] == "simulation" else "cycle"
+    what = "straight rolling" if a["mode"] == "equilibrium" else f"{a['mode']} {motion}"
+    size = "" if a["mode"] == "equilibrium" else f"  psi {amp['psi']:.4g} rad, l_g delta {amp['lateral']:.4g} m"
+    return f"  {what}{size}{'  (the standard start ends here)' if a['standard_start'] else ''}"
+
+
+def _check_text(check: dict[str, Any] | None) -> str:
+    if check is None:
+        return ""
+    sides = [f"{c['size']:.5g} {c['unit']} -> {c['mode']}" for c in (check["below"], check["above"]) if c is not None]
+    return "; checked: " + ", ".join(sides) + (": confirmed" if check["confirmed"] else ": NOT confirmed")
+
+
+def margins_summary(result: dict[str, Any]) -> str:
+    """The lines ``python -m shimmy margins`` prints, from ``MarginsResult.to_dict()``: each attractor with the
+    smallest disturbance that ends on it and its two check runs, the saddle cycles, the runs, the warnings."""
+    direction = result["direction"]
+    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: straight rolling "
+             f"{'stable' if result['straight_rolling_stable'] else 'unstable'}, {len(result['attractors'])} "
+             f"attractor{'s' if len(result['attractors']) != 1 else ''}; smallest disturbance "
+             + ("over all directions (energy)" if direction == "energy" else f"along {direction}")]
+    for a in result["attractors"]:
+        lines.append(_attractor_line(a))
+        m = a["min_disturbance"]
+        if not m["reached"]:
+            lines.append(f"      {m['note']}")
+            continue
+        if m["value"] == 0.0:
+            text = f"0 (reached from the smallest size scanned, {m['upper']:.4g} {m['unit']})"
+        else:
+            text = f"{m['value']:.5g} {m['unit']} +- {m['tolerance']:.2g}"
+        if direction == "energy" and m["value"] > 0.0:
+            parts = ", ".join(f"{k} {v:.4g}" for k, v in m["disturbance"].items())
+            text += f" (yaw angle of the same energy {m['equivalent_psi']:.4g} rad: {parts})"
+        lines.append(f"      smallest {direction}: {text}{_check_text(m['check'])}")
+    for s in result["saddles"]:
+        lines.append(f"  saddle cycle ({s['mode']}): psi {s['amplitude']['psi']:.4g} rad, "
+                     f"l_g delta {s['amplitude']['lateral']:.4g} m")
+    unsettled = result["unsettled_runs"]
+    lines.append(f"  {result['runs']} runs in {result['elapsed_s']:.1f} s ({result['executor']})"
+                 + (f"; {unsettled} of them settled on no attractor" if unsettled else ""))
+    lines += [f"  warning: {w}" for w in result["warnings"]]
+    return "\n".join(lines)
+
+
+def basins_summary(result: dict[str, Any]) -> str:
+    """The lines ``python -m shimmy basins`` prints, from ``BasinsResult.to_dict()``: each attractor with its
+    share of the sampled disturbances and the 95 % interval, the runs that settled nowhere, the warnings."""
+    o = result["options"]
+    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {o['samples']} disturbances "
+             f"up to {o['radius']:g} rad of yaw or the same energy ({result['energy_J']:.4g} J), seed {o['seed']}"]
+    for a in result["attractors"]:
+        b = a["basin"]
+        lines.append(_attractor_line(a))
+        lines.append(f"      {b['count']} of {o['samples']}: {100 * b['fraction']:.1f} % "
+                     f"(95 % interval {100 * b['ci95'][0]:.1f} to {100 * b['ci95'][1]:.1f} %)")
+    if result["unsettled"] or result["failed"]:
+        lines.append(f"  on none of them: {result['unsettled']} unsettled, {result['failed']} failed")
+    lines.append(f"  {result['runs']} runs in {result['elapsed_s']:.1f} s ({result['executor']})")
+    lines += [f"  warning: {w}" for w in result["warnings"]]
+    return "\n".join(lines)

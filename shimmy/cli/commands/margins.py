@@ -1,0 +1,58 @@
+"""Disturbances at one operating point: ``margins`` (how large a kick reaches each attractor) and ``basins``
+(the share of kicks up to a size that ends on each)."""
+
+from __future__ import annotations
+
+from ..answers import add_no_cache, answer, design, emit, numbers, request
+from ..common import add_command, add_field, add_operating_point, add_progress, progress
+
+
+def _ask(args, analysis: str, settings: tuple[str, ...], extra: dict | None = None):
+    canonical = request(analysis, {"config": args.config, **numbers(analysis, args, "V", "Fz", *settings),
+                                   **(extra or {}), "params": design(args)})
+    with progress(args) as bar:
+        return answer(args, analysis, canonical, bar)
+
+
+def _cmd_margins(args) -> int:
+    from ...analyses.maps.summaries import margins_summary
+
+    result = _ask(args, "margins", ("max_size", "min_size", "scan_points", "rtol", "t_max"),
+                  {"direction": args.direction})
+    emit(result.result, [result], args.json, margins_summary(result.result))
+    return 0
+
+
+def _cmd_basins(args) -> int:
+    from ...analyses.maps.summaries import basins_summary
+
+    result = _ask(args, "basins", ("radius", "samples", "seed", "t_max"))
+    emit(result.result, [result], args.json, basins_summary(result.result))
+    return 0
+
+
+def add_parsers(commands) -> None:
+    p = add_command(commands, "margins", "disturbance margins at one operating point: its attractors and the "
+                    "smallest kick from straight rolling that ends on each, each checked by two runs", _cmd_margins)
+    add_operating_point(p)
+    add_field(p, "margins", "--direction", "the kicked component (the rest at rest), or energy: all four, the "
+              "smallest energy")
+    add_field(p, "margins", "--max-size", "largest kick scanned, as the yaw angle of the same energy",
+              limits=True)
+    add_field(p, "margins", "--min-size", "smallest kick scanned, as the yaw angle of the same energy",
+              limits=True)
+    add_field(p, "margins", "--scan-points", "sizes of the bracketing scan", limits=True)
+    add_field(p, "margins", "--rtol", "relative tolerance of the bisection", limits=True)
+    add_field(p, "margins", "--t-max", "longest run", limits=True)
+    add_progress(p)
+    add_no_cache(p)
+
+    p = add_command(commands, "basins", "basin fractions at one operating point: the share of kicks up to a size "
+                    "that ends on each attractor, with 95-percent intervals", _cmd_basins)
+    add_operating_point(p)
+    add_field(p, "basins", "--radius", "kicks uniform in the energy ball of this yaw angle", limits=True)
+    add_field(p, "basins", "--samples", "kicks sampled", limits=True)
+    add_field(p, "basins", "--seed", "seed of the samples", limits=True)
+    add_field(p, "basins", "--t-max", "longest run", limits=True)
+    add_progress(p)
+    add_no_cache(p)

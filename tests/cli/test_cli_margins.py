@@ -1,0 +1,56 @@
+"""``python -m shimmy margins`` and ``basins``: the JSON the issue asks for, the text, the shared cache, bad input."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+POINT = ("--config", "original", "--V", "50", "--Fz", "550000")
+
+
+def run(*args, env=None):
+    return subprocess.run([sys.executable, "-m", "shimmy", *args], capture_output=True, text=True, timeout=300,
+                          env=env)
+
+
+def test_margins_json_names_each_attractor_with_its_smallest_kick_and_the_cache_answers_again(tmp_path):
+    env = {**os.environ, "SHIMMY_CACHE_DIR": str(tmp_path)}
+    out = run("margins", *POINT, "--direction", "psi", "--json", "--progress", "none", env=env)
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["cache"] == "miss" and data["direction"] == "psi"
+    by_mode = {a["mode"]: a for a in data["attractors"]}
+    assert set(by_mode) == {"lateral", "torsional"}
+    for a in data["attractors"]:
+        assert {"psi", "delta", "lateral"} <= set(a["amplitude"])
+        assert {"value", "unit", "direction", "method", "tolerance"} <= set(a["min_disturbance"])
+    assert by_mode["lateral"]["standard_start"] and by_mode["lateral"]["min_disturbance"]["value"] == 0.0
+    assert 0.0155 < by_mode["torsional"]["min_disturbance"]["value"] < 0.0175
+    text = run("margins", *POINT, env=env)
+    assert text.returncode == 0 and "smallest psi: 0.01649" in text.stdout and "confirmed" in text.stdout
+    assert text.stdout.rstrip().endswith(f"answered from the shared cache ({tmp_path})")
+
+
+def test_basins_json_counts_every_kick():
+    out = run("basins", *POINT, "--samples", "20", "--seed", "2", "--json", "--progress", "none", "--no-cache")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["cache"] == "off"
+    assert sum(a["basin"]["count"] for a in data["attractors"]) + data["unsettled"] + data["failed"] == 20
+    assert all(a["basin"]["ci95"][0] <= a["basin"]["fraction"] <= a["basin"]["ci95"][1] for a in data["attractors"])
+
+
+@pytest.mark.parametrize("args, needle", [
+    (("margins", *POINT, "--direction", "yaw"), "argument --direction: invalid choice: 'yaw'"),
+    (("margins", *POINT, "--rtol", "0"), "rtol=0.0 is out of range; allowed: a number in [0.0001, 0.1]"),
+    (("margins", *POINT, "--min-size", "0.05", "--max-size", "0.01"), "min_size=0.05 must be below max_size"),
+    (("margins", "--config", "original", "--V", "0", "--Fz", "550000"), "V=0.0 is out of range"),
+    (("basins", *POINT, "--samples", "3"), "samples=3.0 is out of range; allowed: an integer in [10, 5000]"),
+])
+def test_bad_input_exits_2_naming_the_field(args, needle):
+    out = run(*args)
+    assert out.returncode == 2 and needle in out.stderr, out.stderr

@@ -1,0 +1,78 @@
+"""Disturbance margins and basin fractions as service analyses: canonical requests, refusals by field, the
+runner's answer (the package's, cached), the job over HTTP."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from shimmy.analyses.core.executors import InlineExecutor
+from shimmy.analyses.maps.margins import margins
+from shimmy.errors import InvalidParameterError
+from shimmy.service import analyses, cache, schemas
+
+POINT = {"config": "original", "V": 50, "Fz": 550000}
+
+
+def test_canonical_requests_fill_the_defaults_of_the_analysis():
+    a = schemas.validate("margins", POINT)
+    b = schemas.validate("margins", {**POINT, "direction": "psi", "max_size": 0.4, "rtol": 0.005})
+    assert a == b and cache.key("margins", a) == cache.key("margins", b)
+    assert (a["direction"], a["max_size"], a["min_size"], a["scan_points"], a["rtol"], a["t_max"]) == \
+        ("psi", 0.4, 0.001, 12, 0.005, 80.0)
+    basin = schemas.validate("basins", POINT)
+    assert (basin["radius"], basin["samples"], basin["seed"]) == (0.2, 200, 0)
+
+
+@pytest.mark.parametrize("analysis, body, field, message", [
+    ("margins", {"direction": "yaw"}, "direction", "unknown direction 'yaw'; allowed: one of psi, dpsi, delta"),
+    ("margins", {"rtol": 0}, "rtol", r"allowed: a number in \[0.0001, 0.1\]"),
+    ("margins", {"min_size": 0.05, "max_size": 0.01}, "min_size", "must be below max_size"),
+    ("margins", {"scan_points": 100}, "scan_points", r"allowed: an integer in \[4, 40\]"),
+    ("margins", {"max_size": "0.3"}, "max_size", "is not a number"),
+    ("margins", {"V": 600}, "V", r"allowed: a number in \[1, 500\] m/s"),
+    ("basins", {"samples": 1e6}, "samples", r"allowed: an integer in \[10, 5000\]"),
+    ("basins", {"radius": 0}, "radius", r"allowed: a number in \[0.001, 1\] rad"),
+    ("basins", {"kicks": 3}, "kicks", "unknown field"),
+])
+def test_refusals_name_the_field(analysis, body, field, message):
+    with pytest.raises(InvalidParameterError, match=message) as info:
+        schemas.validate(analysis, {**POINT, **body})
+    assert info.value.field == field
+
+
+def test_the_service_answer_is_the_package_answer_and_is_cached(tmp_path, monkeypatch):
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("SHIMMY_WORKERS", "1")
+    result, cached = analyses.run("margins", POINT)
+    assert not cached
+    direct = margins("original", 50.0, 550e3, executor=InlineExecutor()).to_dict()
+    assert result["attractors"] == direct["attractors"]
+    again, cached = analyses.run("margins", POINT)
+    assert cached and again == result
+
+
+def test_margins_and_basins_jobs_over_http(server):
+    jobs = {}
+    for analysis, extra in (("margins", {}), ("basins", {"samples": 20})):
+        status, _, job = server.request("POST", "/api/v1/jobs", {"analysis": analysis, **POINT, **extra})
+        assert status == 202, job
+        jobs[analysis] = job
+    deadline = time.time() + 180
+    for analysis, job in jobs.items():
+        while job["status"] in ("queued", "running") and time.time() < deadline:
+            time.sleep(0.3)
+            _, _, job = server.request("GET", f"/api/v1/jobs/{job['id']}")
+        assert job["status"] == "done", job
+        jobs[analysis] = job["result"]
+    torsional = next(a for a in jobs["margins"]["attractors"] if a["mode"] == "torsional")
+    assert {"value", "unit", "direction", "method", "tolerance"} <= set(torsional["min_disturbance"])
+    assert 0.0155 < torsional["min_disturbance"]["value"] < 0.0175
+    assert sum(a["basin"]["count"] for a in jobs["basins"]["attractors"]) + jobs["basins"]["unsettled"] == 20
+    status, _, answer = server.request("POST", "/api/v1/jobs", {"analysis": "margins", **POINT, "direction": "yaw"})
+    assert status == 422 and answer["field"] == "direction"
+    _, _, doc = server.request("GET", "/api/v1/openapi.json")
+    props = doc["components"]["schemas"]["job_margins"]["properties"]
+    assert props["direction"]["enum"][:5] == ["psi", "dpsi", "delta", "ddelta", "energy"]
+    assert "job_basins" in doc["components"]["schemas"]
