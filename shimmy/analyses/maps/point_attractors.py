@@ -260,7 +260,7 @@ def point_attractors(config: Configuration, V: float, Fz: float, *, params: Para
                      t_max: float) -> PointAttractors:
     """The attractors at (V, Fz) from ``diagram`` (the one-parameter diagram in V at Fz) and the discovery runs
     (module docstring), run through ``run_units(units) -> [each unit's results]`` (side by side on an executor)."""
-    from .stability_map import attractors_at
+    from .map_slices import attractors_at
 
     l_g, k_psi, k_delta = params.gear.l_g, params.gear.k_psi, params.gear.k_delta
     found = attractors_at(diagram, V)
