@@ -147,7 +147,7 @@ def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequen
     """Each row's segments (V_low, V_high, type), merged, covering the speed range; and how many
     row intervals lie in a region no slice crosses (read off the nearest slice at the same speed
     instead). ``slices`` carry ``Fz`` and ``intervals`` (see
-    :class:`~shimmy.analyses.maps.stability_map.SliceResult`)."""
+    :class:`~shimmy.analyses.maps.map_slices.SliceResult`)."""
     regions = labelled(curves, [float(f) for f in fz_rows] + [float(s.Fz) for s in slices], v_range)
     known = _Slices(slices, regions)
     rows, fallbacks = [], 0

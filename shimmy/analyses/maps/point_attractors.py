@@ -2,7 +2,7 @@
 
 * **Attractors** (:func:`point_attractors`): the stable equilibrium and stable limit cycles of the
   one-parameter bifurcation diagram in V at the load, at the point's speed (the map's reading,
-  :func:`~shimmy.analyses.maps.stability_map.attractors_at`), and the diagram's unstable cycles at
+  :func:`~shimmy.analyses.maps.map_slices.attractors_at`), and the diagram's unstable cycles at
   that speed (the saddle cycles between the basins). Then runs from the standard start
   (psi = 0.001 rad), a large yaw angle (0.2 rad) and a large lateral deflection (l_g delta = 0.1 m),
   the diagram's own large starts: each run's end is matched to the attractors; a settled end that
@@ -205,7 +205,7 @@ def run_to_attractor(model, x0: np.ndarray, V: float, Fz: float, attractors: Att
 
 def cycles_at(diagram, V: float) -> list[dict[str, Any]]:
     """Every cycle of the diagram's periodic branches at speed V, stable or not (linear between the drawn
-    points, as :func:`~shimmy.analyses.maps.stability_map.attractors_on` reads them), except the
+    points, as :func:`~shimmy.analyses.maps.map_slices.attractors_on` reads them), except the
     zero-amplitude ends of branches."""
     found = []
     for k, b in enumerate(diagram.branches):
