@@ -38,6 +38,7 @@ from numba import njit
 from .condensed_lu import ChainLayout, CondensedLU, collocation_layout, monodromy
 from .core import condensed_factors
 from .fields import VectorField
+from .scalar import minimum_in
 
 
 @dataclass(frozen=True)
@@ -388,8 +389,6 @@ class PeriodicProblem:
     def peak(self, u: np.ndarray, k: int = 0) -> tuple[float, float, float]:
         """(tau*, sign, A) of the largest |x_k| over the orbit u: the best of 12 samples per mesh
         interval, refined by a bounded search on the collocation polynomial (to 1e-13 in tau)."""
-        from scipy.optimize import minimize_scalar
-
         X = self.unpack(u)[0]
         tau, x = self.sample(u)
         i = int(np.argmax(np.abs(x[:, k])))
@@ -399,10 +398,10 @@ class PeriodicProblem:
             brackets = [(0.0, tau[1]), (tau[-2], 1.0)]
         best = (float(abs(x[i, k])), float(tau[i]))
         for lo, hi in brackets:
-            r = minimize_scalar(lambda t: -sign * float(self.evaluate(X, np.array([t]))[0, k]), bounds=(lo, hi),
-                                method="bounded", options={"xatol": 1e-13})
-            if -r.fun > best[0]:
-                best = (float(-r.fun), float(r.x))
+            t_opt, f_opt = minimum_in(lambda t: -sign * float(self.evaluate(X, np.array([t]))[0, k]), lo, hi,
+                                      xatol=1e-13)
+            if -f_opt > best[0]:
+                best = (float(-f_opt), float(t_opt))
         return best[1], sign, best[0]
 
     def evaluate(self, X: np.ndarray, tau: np.ndarray) -> np.ndarray:

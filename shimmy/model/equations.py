@@ -263,9 +263,10 @@ def _check_states(model: Model, x) -> np.ndarray:
     return x
 
 
-def _evaluate(model: Model, x, V, Fz, want_f: bool, want_derivatives: bool):
+def _evaluate(model: Model, x, V, Fz, want_f: bool, want_derivatives: bool, plain: bool = False):
     """The compiled evaluation at states x (n,) or (n, ...), V and Fz broadcast against them:
-    (shape, f (n, m), J (m, n, n), dV (n, m), dFz (n, m)), m the number of broadcast columns."""
+    (shape, f (n, m), J (m, n, n), dV (n, m), dFz (n, m)), m the number of broadcast columns;
+    ``plain``: the same arithmetic run as plain Python (see :func:`jacobian`)."""
     x = _check_states(model, x)
     n = model.n_states
     if x.ndim <= 2 and x.dtype == float and isinstance(V, (float, int)) and isinstance(Fz, (float, int)):
@@ -285,7 +286,8 @@ def _evaluate(model: Model, x, V, Fz, want_f: bool, want_derivatives: bool):
     J = np.zeros((m, n, n) if want_derivatives else (0, n, n), dtype)
     dV = np.zeros((n, m) if want_derivatives else (n, 0), dtype)
     dFz = np.zeros_like(dV)
-    _evaluate_columns(X, Vs, Fzs, model.coefficients, *model.flags, F, J, dV, dFz, want_f, want_derivatives)
+    columns = _evaluate_columns.py_func if plain else _evaluate_columns
+    columns(X, Vs, Fzs, model.coefficients, *model.flags, F, J, dV, dFz, want_f, want_derivatives)
     return shape, F, J, dV, dFz
 
 
@@ -297,11 +299,17 @@ def rhs(model: Model, x, V, Fz):
     return F.reshape((model.n_states,) + shape)
 
 
-def jacobian(model: Model, x, V, Fz):
-    """Analytic d f / d x: ``(n, n)`` for one state, ``(m, n, n)`` for columns."""
-    if _one_state(model, x, V, Fz):
+def jacobian(model: Model, x, V, Fz, *, plain: bool = False):
+    """Analytic d f / d x: ``(n, n)`` for one state, ``(m, n, n)`` for columns.
+
+    ``plain``: the same arithmetic run as plain Python instead of the compiled kernel, for a few
+    evaluations where loading the compiled kernels (about 0.5 s in a fresh process) would cost more
+    than computing (about 20 us an evaluation here): a Hopf scan of x = 0 as a command. At x = 0 it
+    equals the compiled evaluation bit for bit; elsewhere to rounding (the transcendental functions
+    are numpy's, not LLVM's)."""
+    if _one_state(model, x, V, Fz) and not plain:
         return _evaluate_one(x, float(V), float(Fz), model.coefficients, *model.flags, False, True)[1]
-    shape, _, J, _, _ = _evaluate(model, x, V, Fz, False, True)
+    shape, _, J, _, _ = _evaluate(model, x, V, Fz, False, True, plain)
     return J.reshape(shape + J.shape[1:])
 
 

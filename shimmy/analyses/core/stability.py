@@ -39,10 +39,10 @@ from enum import Enum
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from ...version import __version__
 from ...continuation import lyapunov
+from ...continuation.scalar import minimum_in, root_in
 from ...model.configurations import Configuration
 from ...model.equations import Model, build_model, jacobian
 from ...errors import InvalidParameterError
@@ -70,14 +70,15 @@ def check_speeds_and_load(v_range: Any, Fz: Any) -> tuple[float, float, float]:
 
 
 class Linearisation:
-    """J(V) = J0 + V J1 + J2 / V at x = 0 for one model and load Fz."""
+    """J(V) = J0 + V J1 + J2 / V at x = 0 for one model and load Fz (the Jacobian evaluated as plain
+    Python: four evaluations, no compiled kernel to load; bit for bit the compiled one at x = 0)."""
 
     def __init__(self, model: Model, Fz: float):
         self.model = model
         self.Fz = float(Fz)
         x = np.zeros((model.n_states, 4))
         probe = np.array([1.0, 2.0, 4.0, 7.0])
-        J = jacobian(model, x, probe, self.Fz)
+        J = jacobian(model, x, probe, self.Fz, plain=True)
         # Solve for J0, J1, J2 from V = 1, 2, 4; check with V = 7.
         basis = np.stack([np.ones(3), probe[:3], 1.0 / probe[:3]], axis=1)
         coeffs = np.linalg.solve(basis, J[:3].reshape(3, -1))
@@ -187,7 +188,7 @@ def hopf_points(config: Configuration | str, Fz: float, *, params: Parameters | 
         lo, hi = int(min(count[i], count[i + 1])), int(max(count[i], count[i + 1]))
         k = lo
         while k < hi:
-            v = brentq(ordered(k), grid[i], grid[i + 1], xtol=v_tol, rtol=1e-15)
+            v = root_in(ordered(k), grid[i], grid[i + 1], xtol=v_tol, rtol=1e-15)
             roots.append((v, k, (grid[i], grid[i + 1])))
             k += 2 if _crossing_is_complex(lin, v) else 1  # a complex pair moves two order statistics
     # Hidden double crossings between grid points: near-axis extrema of the ordered real parts.
@@ -200,11 +201,10 @@ def hopf_points(config: Configuration | str, Fz: float, *, params: Parameters | 
         i += 1
         sign = -1.0 if is_max[i - 1, k] else 1.0
         g = ordered(int(k))
-        opt = minimize_scalar(lambda v: sign * g(v), bounds=(grid[i - 1], grid[i + 1]),
-                              method="bounded", options={"xatol": v_tol})
-        if opt.fun < 0:  # the extremum reaches across the imaginary axis
-            for a, b in ((grid[i - 1], opt.x), (opt.x, grid[i + 1])):
-                roots.append((brentq(g, a, b, xtol=v_tol, rtol=1e-15), int(k), (grid[i - 1], grid[i + 1])))
+        v_opt, g_opt = minimum_in(lambda v: sign * g(v), grid[i - 1], grid[i + 1], xatol=v_tol)
+        if g_opt < 0:  # the extremum reaches across the imaginary axis
+            for a, b in ((grid[i - 1], v_opt), (v_opt, grid[i + 1])):
+                roots.append((root_in(g, a, b, xtol=v_tol, rtol=1e-15), int(k), (grid[i - 1], grid[i + 1])))
 
     hopf, branch, warnings = [], [], []
     for v, k, bracket in sorted(roots):
@@ -265,8 +265,9 @@ def _criticality(model: Model, V: float, Fz: float, warnings: list[str]):
 
 
 def first_lyapunov_coefficient(model: Model, V: float, Fz: float, eps: float = 1e-4) -> float:
-    """l1 of x = 0 at a Hopf point (V, Fz) of a smooth configuration; < 0 is supercritical."""
-    return lyapunov.first_lyapunov_coefficient(lambda x: jacobian(model, x, V, Fz), model.n_states,
+    """l1 of x = 0 at a Hopf point (V, Fz) of a smooth configuration; < 0 is supercritical (the
+    Jacobian evaluated as plain Python, a dozen evaluations: see :func:`~shimmy.model.equations.jacobian`)."""
+    return lyapunov.first_lyapunov_coefficient(lambda x: jacobian(model, x, V, Fz, plain=True), model.n_states,
                                                eps=eps)
 
 

@@ -41,9 +41,9 @@ from typing import Any, Sequence
 
 import numpy as np
 import scipy.linalg
-from scipy.optimize import brentq
 
 from ...continuation import ContinuationOptions, HopfCurve, PointKind, TwoParameterField, hopf_curve
+from ...continuation.scalar import root_in
 from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.equations import Model, field_and_derivatives, jacobian, rhs
@@ -342,7 +342,7 @@ def _edge_starts(config: Configuration, params: Parameters, name: str, Fz: float
     out = []
     for i in np.nonzero(count[:-1] != count[1:])[0]:
         k = int(min(count[i], count[i + 1]))
-        out.append(float(brentq(lambda t: ordered(t)[k], thetas[i], thetas[i + 1], xtol=1e-12 * abs(thetas[-1]))))
+        out.append(root_in(lambda t: ordered(t)[k], thetas[i], thetas[i + 1], xtol=1e-12 * abs(thetas[-1])))
     return out
 
 

@@ -41,11 +41,11 @@ from dataclasses import dataclass, replace, field
 from typing import Any, Callable
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ...version import __version__
 from ...continuation.errors import ConvergenceError as EngineConvergenceError
 from ...continuation.collocation import Mesh, PeriodicProblem
+from ...continuation.scalar import minimum_in
 from ...model.configurations import Configuration
 from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch, PointKind, Stop, VectorField,
                              equilibrium_branch, locate, step, tangent, weighted_norm)
@@ -651,8 +651,8 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
             cache[h] = (a, point)
             return -a
 
-        opt = minimize_scalar(minus_amp, bounds=(0.0, span), method="bounded", options={"xatol": 1e-5 * span})
-        a_opt, point = cache.get(opt.x, (0.0, None))
+        h_opt, _ = minimum_in(minus_amp, 0.0, span, xatol=1e-5 * span)
+        a_opt, point = cache.get(h_opt, (0.0, None))
         if point is not None and a_opt >= amp:
             amp, V = a_opt, float(point.u[-1])
             i_point = point
