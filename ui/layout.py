@@ -15,7 +15,7 @@ from . import formats, ids, sessions, state
 #: The design parameters with sliders (the six a device design moves); every other one is in the advanced panel.
 DESIGN = ("r2", "e_p", "k_s", "r3", "a_p", "rho_p")
 ADVANCED = tuple(n for n in PARAMETER_SPECS if n not in DESIGN)
-SLIDER_STEPS = 200
+assert all(PARAMETER_SPECS[n].step for n in DESIGN), "every slider's parameter has an engineering step"
 
 
 def _label(name: str) -> html.Label:
@@ -41,10 +41,13 @@ def _slider(name: str, value: float, problem: str | None = None) -> html.Div:
     return html.Div([
         _label(name),
         html.Div([
-            html.Div(dcc.Slider(id=ids.param(name), min=spec.low, max=spec.high,
-                                step=(spec.high - spec.low) / SLIDER_STEPS, value=value, updatemode="drag",
+            # the parameter's engineering step; the tooltip shows the value without float noise
+            # (assets/sliders.js), and the design keeps it rounded to the step (the sync below)
+            html.Div(dcc.Slider(id=ids.param(name), min=spec.low, max=spec.high, step=spec.step, value=value,
+                                updatemode="drag",
                                 marks={spec.low: formats.compact(spec.low), spec.high: formats.compact(spec.high)},
-                                tooltip={"placement": "bottom", "always_visible": False}), className="slider-track"),
+                                tooltip={"placement": "bottom", "always_visible": False,
+                                         "transform": "shimmyOnStep"}), className="slider-track"),
             _box(name, value),
         ], className="slider-line"),
         _field_error(name, problem),
@@ -203,7 +206,12 @@ dash.clientside_callback(
         } else if (typed) {
             cur[typed] = boxOf[typed];
         } else if (trig && typeof trig === "object" && trig.type === ID.param) {
-            if (boxNames.includes(trig.name)) { outBoxes[boxNames.indexOf(trig.name)] = cur[trig.name]; }
+            const n = trig.name, s = SPEC[n];
+            if (s.step && typeof cur[n] === "number" && isFinite(cur[n])) {  // moved: onto the step grid
+                cur[n] = Number((s.low + Math.round((cur[n] - s.low) / s.step) * s.step).toFixed(s.decimals));
+                outValues[names.indexOf(n)] = cur[n];
+            }
+            if (boxNames.includes(n)) { outBoxes[boxNames.indexOf(n)] = cur[n]; }
         }
         const base = BASE[material], full = Object.assign({}, base), problems = {};
         for (const n of names) {
@@ -239,7 +247,8 @@ dash.clientside_callback(
                 summary, errorIds.map(i => problems[i.name] || ""), openAdvanced];
     }
     """ % {"spec": json.dumps({n: {"low": s.low, "high": s.high, "integer": s.integer, "allowed": s.allowed,
-                                   "unit": s.unit, "range": f"[{s.low:g}, {s.high:g}] {s.unit}".rstrip()}
+                                   "unit": s.unit, "range": f"[{s.low:g}, {s.high:g}] {s.unit}".rstrip(),
+                                   "step": s.step, "decimals": s.decimals}
                                for n, s in PARAMETER_SPECS.items()}),
            "preset": json.dumps(MATERIALS),
            "base": json.dumps({m: state.material_params(m) for m in MATERIALS}),

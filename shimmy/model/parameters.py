@@ -30,10 +30,10 @@ FIXED = "docs/model.md"
 
 
 def _param(default: float, low: float, high: float, unit: str, description: str,
-           provenance: str = PUBLISHED, integer: bool = False):
+           provenance: str = PUBLISHED, integer: bool = False, step: float | None = None):
     return field(default=default, metadata={
         "low": low, "high": high, "unit": unit, "description": description,
-        "provenance": provenance, "integer": integer})
+        "provenance": provenance, "integer": integer, "step": step})
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,23 @@ class ParameterSpec:
     description: str
     provenance: str
     integer: bool = False
+    #: the engineering step a design parameter moves by (its slider's step; values it gives are
+    #: rounded to it), None for the others
+    step: float | None = None
+
+    @property
+    def decimals(self) -> int:
+        """Decimal places of a value on the step grid (values rounded to them print without float
+        noise: 0.0778, not 0.07780000000000001); 0 without a step."""
+        if self.step is None:
+            return 0
+        return max(0, -math.floor(math.log10(self.step) + 1e-9)) + (0 if float(f"{self.step:.0e}") == self.step else 1)
+
+    def on_step(self, value: float) -> float:
+        """``value`` rounded to the step grid from ``low`` (unchanged without a step)."""
+        if self.step is None:
+            return float(value)
+        return round(self.low + round((value - self.low) / self.step) * self.step, self.decimals)
 
     @property
     def allowed(self) -> str:
@@ -145,10 +162,10 @@ class NESParameters:
     """Torsional nonlinear energy sink: roller-spring geometry, inertia and damping."""
 
     r1: float = _param(0.1, 0.05, 0.2, "m", "inner-cylinder radius", ENVELOPE)
-    r2: float = _param(0.08, 0.07, 0.09, "m", "concave-track radius")
-    r3: float = _param(0.01, 0.005, 0.02, "m", "roller radius")
-    k_s: float = _param(1.2e6, 1.0e6, 1.4e6, "N/m", "spring stiffness")
-    e_p: float = _param(0.001, 0.0005, 0.005, "m", "spring pre-stretch")
+    r2: float = _param(0.08, 0.07, 0.09, "m", "concave-track radius", step=1e-4)
+    r3: float = _param(0.01, 0.005, 0.02, "m", "roller radius", step=1e-4)
+    k_s: float = _param(1.2e6, 1.0e6, 1.4e6, "N/m", "spring stiffness", step=1e4)
+    e_p: float = _param(0.001, 0.0005, 0.005, "m", "spring pre-stretch", step=5e-5)
     I_nes: float = _param(4.6746, 0.1, 50.0, "kg m^2", "absorber inertia", CALIBRATED)
     c_nes: float = _param(80.396, 0.0, 1000.0, "N m s/rad", "absorber damping", CALIBRATED)
 
@@ -176,8 +193,8 @@ class PDParameters:
     H: float = _param(0.1, 0.01, 0.5, "m", "ring height (geometry record; h_chamber enters the model)", ENVELOPE)
     d_chamber: float = _param(0.06, 0.01, 0.2, "m", "segment chamber size d", ENVELOPE)
     h_chamber: float = _param(0.1, 0.01, 0.5, "m", "segment chamber height h_c", ENVELOPE)
-    a_p: float = _param(0.9, 0.5, 0.95, "", "mass filling ratio")
-    rho_p: float = _param(7800.0, 7800.0, 17000.0, "kg/m^3", "particle density")
+    a_p: float = _param(0.9, 0.5, 0.95, "", "mass filling ratio", step=0.01)
+    rho_p: float = _param(7800.0, 7800.0, 17000.0, "kg/m^3", "particle density", step=100.0)
     rho_m_frac: float = _param(0.9, 0.8, 0.95, "", "mixture density as a fraction of rho_p")
     g_p: float = _param(5.0, 1.0, 5.0, "", "radial distribution function", CALIBRATED)
     e_r: float = _param(0.8, 0.5, 0.9, "", "coefficient of restitution")
@@ -206,7 +223,7 @@ def _specs() -> dict[str, ParameterSpec]:
         for f in dataclasses.fields(cls):
             m = f.metadata
             specs[f.name] = ParameterSpec(f.name, group, m["unit"], f.default, m["low"], m["high"],
-                                          m["description"], m["provenance"], m["integer"])
+                                          m["description"], m["provenance"], m["integer"], m["step"])
     return specs
 
 

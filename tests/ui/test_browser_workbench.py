@@ -46,6 +46,31 @@ def test_design_box_slider_and_url_stay_in_sync(server, browser):
     assert severe(browser) == []
 
 
+@pytest.mark.parametrize("name, start, moves, expected", [
+    ("r2", "0.0853", 7, "0.0707"),  # 0.0853 -> HOME 0.07 -> 7 steps of 0.1 mm (0.0707, not 0.07070000000000001)
+    ("e_p", "0.00123", 3, "0.00065"),  # 0.0005 + 3 x 0.05 mm
+])
+def test_slider_steps_are_engineering_steps_without_float_noise(server, browser, name, start, moves, expected):
+    """A slider moves by its parameter's engineering step; the box, the tooltip, the address and the
+    design sent with requests carry the value on that grid, as typed; a typed value keeps the
+    precision typed."""
+    open_page(browser, server, f"/?{name}={start}")
+    box = wait_for(lambda: by_id(browser, pattern(name, "param-box")), what=f"the {name} box")
+    assert box.get_attribute("value") == start  # typed (here: in the address) precision kept
+    slider = by_id(browser, pattern(name, "param")).find_element(By.CSS_SELECTOR, "[role='slider']")
+    slider.click()
+    slider.send_keys(Keys.HOME)
+    for _ in range(moves):
+        slider.send_keys(Keys.ARROW_RIGHT)
+    wait_for(lambda: by_id(browser, pattern(name, "param-box")).get_attribute("value") == expected, timeout=10,
+             what=f"the box to read {expected}")
+    wait_for(lambda: f"{name}={expected}&" in browser.current_url + "&", timeout=10, what="the address to follow")
+    assert float(slider.get_attribute("aria-valuenow")) == pytest.approx(float(expected), abs=1e-12)
+    tips = [t.text for t in browser.find_elements(By.CSS_SELECTOR, "[id$='-tooltip']") if t.text]
+    assert all(len(t) <= 8 for t in tips), tips  # no 0.07770000000000001 in a tooltip
+    assert severe(browser) == []
+
+
 def test_refusals_are_at_the_field_in_its_unit_quoting_what_was_typed(server, browser):
     open_page(browser, server, "/")
     browser.find_element(By.CSS_SELECTOR, "#advanced summary").click()
