@@ -84,6 +84,13 @@ def _validate_fields(obj) -> None:
         object.__setattr__(obj, f.name, checked)
 
 
+class _AsTyped(str):
+    """A number as the user typed it, shown in messages without quotes."""
+
+    def __repr__(self) -> str:
+        return str(self)
+
+
 def check_number(name: str, value: Any, low: float, high: float, unit: str = "",
                  integer: bool = False) -> float:
     """Return ``value`` as a float after checking it is a finite number in [low, high].
@@ -94,21 +101,19 @@ def check_number(name: str, value: Any, low: float, high: float, unit: str = "",
     allowed = f"{kind} in [{low:g}, {high:g}] {unit}".rstrip()
     if isinstance(value, bool) or value is None:
         raise InvalidParameterError(name, value, allowed, "is not a number")
-    if isinstance(value, str):
-        try:
-            value = float(value)
-        except ValueError:
-            raise InvalidParameterError(name, value, allowed, "is not a number") from None
+    typed = value
     try:
         number = float(value)
     except (TypeError, ValueError):
-        raise InvalidParameterError(name, value, allowed, "is not a number") from None
+        raise InvalidParameterError(name, typed, allowed, "is not a number") from None
+    if isinstance(value, str):  # a number typed as text is quoted as typed (resolution=100, not 100.0)
+        typed = _AsTyped(value.strip())
     if not math.isfinite(number):
-        raise InvalidParameterError(name, value, allowed, "is not finite")
+        raise InvalidParameterError(name, typed, allowed, "is not finite")
     if integer and number != round(number):
-        raise InvalidParameterError(name, value, allowed, "is not an integer")
+        raise InvalidParameterError(name, typed, allowed, "is not an integer")
     if not low <= number <= high:
-        raise InvalidParameterError(name, value, allowed)
+        raise InvalidParameterError(name, typed, allowed)
     return number
 
 

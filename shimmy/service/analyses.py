@@ -10,9 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
-import numpy as np
 
-from ..model.configurations import Configuration
 from ..errors import InvalidParameterError
 from ..model.parameters import Parameters
 from . import cache, neighbours, schemas
@@ -50,7 +48,7 @@ def _params(request: dict[str, Any]) -> Parameters:
 
 @serves("simulate", sync=True, job=True)
 def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
-    from ..analyses.core.simulation import SimulationOptions, simulate as run_simulation
+    from ..analyses.core.simulation import SimulationOptions, kicked_state, simulate as run_simulation
 
     stride = max(1, int(round(request["series_dt"] / SimulationOptions.dt_out)))
     if request["include_series"]:  # refuse before computing, not after
@@ -61,8 +59,7 @@ def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[
                                         f"{request['t_end']:g} s (at most {MAX_SERIES_POINTS} samples per series)",
                                         "gives too many samples")
     params = _params(request)
-    x0 = np.zeros(Configuration.parse(request["config"]).n_states)
-    x0[0], x0[2] = request["psi0"], request["lateral0"] / params.gear.l_g
+    x0 = kicked_state(request["config"], params, request["psi0"], request["lateral0"])
     result = run_simulation(request["config"], request["V"], request["Fz"], params=params, t_end=request["t_end"],
                             exact_nes=request["exact_nes"], x0=x0)
     out = result.to_dict()

@@ -91,8 +91,8 @@ def test_a_question_the_cli_answered_is_answered_by_the_api_from_the_cache(serve
     status, headers, api = server.request("POST", "/api/v1/simulate",
                                           {"config": "nes", "V": 45, "Fz": 300000, "t_end": 5})
     assert status == 200 and headers["X-Shimmy-Cache"] == "hit"
-    assert api.pop("start") == {"psi0": 0.001, "lateral0": 0.0}  # the standard start, which the CLI always uses
-    assert api == cli
+    assert api["start"] == {"psi0": 0.001, "lateral0": 0.0}  # the standard start, the CLI's default too
+    assert api == cli  # the start included: the CLI takes --psi0 and --lateral0 as the API does
 
 
 @pytest.mark.parametrize("args, csv", [
@@ -178,7 +178,7 @@ def test_questions_the_api_cannot_ask_are_computed_without_the_cache(tmp_path, a
     (["map", "--config", "nes", "--fz-min", "5e5", "--fz-max", "1e5"],
      "fz_max=100000.0 must exceed fz_min"),
     (["ground-run", "--config", "nes", "--profile", "takeoff", "--series-dt", "2"],
-     "series_dt=2.0 is out of range; allowed: a number in [0.001, 1] s"),
+     "series_dt=2 is out of range; allowed: a number in [0.001, 1] s"),
     (["study", "--param", "e_p", "--values", "0.001", "--param2", "r2"],
      "values2 is required when the other of parameter2/values2 is given"),
 ])

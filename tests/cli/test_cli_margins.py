@@ -46,10 +46,10 @@ def test_basins_json_counts_every_kick():
 
 @pytest.mark.parametrize("args, needle", [
     (("margins", *POINT, "--direction", "yaw"), "argument --direction: invalid choice: 'yaw'"),
-    (("margins", *POINT, "--rtol", "0"), "rtol=0.0 is out of range; allowed: a number in [0.0001, 0.1]"),
+    (("margins", *POINT, "--rtol", "0"), "rtol=0 is out of range; allowed: a number in [0.0001, 0.1]"),
     (("margins", *POINT, "--min-size", "0.05", "--max-size", "0.01"), "min_size=0.05 must be below max_size"),
-    (("margins", "--config", "original", "--V", "0", "--Fz", "550000"), "V=0.0 is out of range"),
-    (("basins", *POINT, "--samples", "3"), "samples=3.0 is out of range; allowed: an integer in [10, 5000]"),
+    (("margins", "--config", "original", "--V", "0", "--Fz", "550000"), "V=0 is out of range"),
+    (("basins", *POINT, "--samples", "3"), "samples=3 is out of range; allowed: an integer in [10, 5000]"),
 ])
 def test_bad_input_exits_2_naming_the_field(args, needle):
     out = run(*args)

@@ -192,6 +192,16 @@ def simulate(config: Configuration | str, V: float, Fz: float, *, params: Parame
         elapsed_s=elapsed, **measures)
 
 
+def kicked_state(config: Configuration | str, params: Parameters, psi0: float = DEFAULT_PSI0,
+                 lateral0: float = 0.0) -> np.ndarray:
+    """A start from straight rolling with torsion ``psi0`` (rad) and lateral bending displacement
+    l_g delta = ``lateral0`` (m), the rest at rest: the ``x0`` of :func:`simulate` (the API's and the
+    command line's ``psi0`` and ``lateral0``)."""
+    x0 = np.zeros(Configuration.parse(config).n_states)
+    x0[0], x0[2] = psi0, lateral0 / params.gear.l_g
+    return x0
+
+
 def initial_state(x0, n: int) -> np.ndarray:
     """The integrator's full start vector from ``x0`` (n numbers; None: psi = 0.001 rad, all else zero)."""
     start = np.zeros(integrator.N_FULL)

@@ -54,19 +54,22 @@ def _cmd_eigen(args) -> int:
 def _cmd_simulate(args) -> int:
     from ...analyses.core.summaries import simulation_summary
 
-    canonical = request("simulate", {"config": args.config, **numbers("simulate", args, "V", "Fz", "t_end"),
+    canonical = request("simulate", {"config": args.config,
+                                     **numbers("simulate", args, "V", "Fz", "t_end", "psi0", "lateral0"),
                                      "exact_nes": args.exact_nes, "params": design(args)})
     if args.csv:  # the file needs the time series, which the cache does not hold
-        from ...analyses.core.simulation import simulate
+        from ...analyses.core.simulation import kicked_state, simulate
         from ...model.parameters import Parameters
 
-        result = simulate(args.config, canonical["V"], canonical["Fz"], t_end=canonical["t_end"],
-                          params=Parameters.from_dict(canonical["params"]), exact_nes=canonical["exact_nes"])
+        params = Parameters.from_dict(canonical["params"])
+        result = simulate(args.config, canonical["V"], canonical["Fz"], t_end=canonical["t_end"], params=params,
+                          exact_nes=canonical["exact_nes"],
+                          x0=kicked_state(args.config, params, canonical["psi0"], canonical["lateral0"]))
         result.write_csv(args.csv)
         run = Answer(result.to_dict(), OFF, "--csv needs the time series, which the cache does not hold")
     else:
         run = answer(args, "simulate", canonical)
-    payload = {k: v for k, v in run.result.items() if k != "start"}  # the standard start, which the CLI always uses
+    payload = run.result
     emit_answer(payload, [run], args.json, simulation_summary(payload))
     return 0 if payload["success"] else EXIT_FAILED
 
@@ -88,6 +91,8 @@ def add_parsers(commands) -> None:
     p = add_command(commands, "simulate", "time history at one operating point", _cmd_simulate)
     add_operating_point(p)
     add_field(p, "simulate", "--t-end", "simulated time (s)", limits=True)
+    add_field(p, "simulate", "--psi0", "initial torsion psi (rad; the rest of the state at rest)", limits=True)
+    add_field(p, "simulate", "--lateral0", "initial lateral bending displacement l_g delta (m)", limits=True)
     p.add_argument("--exact-nes", action="store_true", help="use the exact NES torque instead of the cubic")
     p.add_argument("--csv", metavar="FILE", help="write the time series to FILE (computed: the cache holds no series)")
     add_no_cache(p)
