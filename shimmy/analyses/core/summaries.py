@@ -11,10 +11,12 @@ from typing import Any
 
 import numpy as np
 
+from ...model.units import kn, mm
+
 
 def hopf_summary(result: dict[str, Any]) -> str:
     """The short table ``python -m shimmy hopf`` prints, from ``HopfResult.to_dict()``."""
-    lines = [f"{result['config']} at Fz = {result['Fz']:g} N, V in [{result['v_min']:g}, {result['v_max']:g}] m/s"]
+    lines = [f"{result['config']} at Fz = {kn(result['Fz'])}, V in [{result['v_min']:g}, {result['v_max']:g}] m/s"]
     if not result["hopf_points"]:
         lines.append("  no Hopf point")
     for h in result["hopf_points"]:
@@ -29,11 +31,11 @@ def simulation_summary(result: dict[str, Any]) -> str:
     """The short table ``python -m shimmy simulate`` prints, from ``SimulationResult.to_dict()``."""
     amp = result["amplitude"]
     freq = "-" if result["frequency_hz"] is None else f"{result['frequency_hz']:.4f} Hz"
-    return (f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N, "
+    return (f"{result['config']} at V = {result['V']:g} m/s, Fz = {kn(result['Fz'])}, "
             f"{result['options']['t_end']:g} s\n"
             f"  response        {result['response_type']}{'' if result['steady'] else ' (not yet steady)'}\n"
             f"  max |psi|       {amp['psi']:.6g} rad\n"
-            f"  max |l_g delta| {amp['lateral']:.6g} m\n"
+            f"  max |l_g delta| {mm(amp['lateral'])}\n"
             f"  frequency       {freq}\n"
             f"  {result['message']}")
 

@@ -12,6 +12,7 @@ from typing import Any
 from urllib.parse import urlencode
 
 from ...model.parameters import PARAMETER_SPECS
+from ...model.units import kn
 
 #: The columns of a study's rows after its parameters (``StudyResult.COLUMNS``).
 STUDY_COLUMNS = ("config", "hopf_start", "hopf_end", "max_psi", "max_psi_V")
@@ -97,7 +98,7 @@ def study_summary(result: dict[str, Any]) -> str:
     """The table ``python -m shimmy study`` prints, from ``StudyResult.to_dict()``: one row per design and
     configuration."""
     parameters, v_range = result["parameters"], result["v_range"]
-    lines = [f"study at Fz = {result['Fz']:g} N, V {v_range[0]:g}..{v_range[1]:g} m/s "
+    lines = [f"study at Fz = {kn(result['Fz'])}, V {v_range[0]:g}..{v_range[1]:g} m/s "
              f"({result['elapsed_s']:.1f} s, {result['executor']})",
              "".join(f"{p:>12}" for p in parameters)
              + f"  {'config':<8}{'Hopf start':>11}{'Hopf end':>10}{'max psi':>10}{'at V':>8}"]

@@ -37,6 +37,7 @@ from ...continuation.errors import ContinuationError
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.equations import build_model
+from ...model.units import kn, kn_range
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .bifurcation import STATE_SCALE, V_SCALE, BifurcationOptions, bifurcation, orbit_limits
 from .hopf_curves import gear_two_parameter_field, hopf_curves
@@ -175,7 +176,7 @@ class CycleCurvesResult:
         loads, crossings and ends, the codimension-2 points."""
         data = self.to_dict()
         lines = [f"{self.config.value}: cycle-bifurcation curves in V {self.v_range[0]:g}..{self.v_range[1]:g} m/s, "
-                 f"Fz {self.fz_range[0]:g}..{self.fz_range[1]:g} N ({self.elapsed_s:.2f} s, "
+                 f"Fz {kn_range(*self.fz_range)} ({self.elapsed_s:.2f} s, "
                  f"{self.starts_tried} curve starts)"]
         names = {PointKind.FOLD_OF_CYCLES: "fold", PointKind.TORUS: "torus",
                  PointKind.PERIOD_DOUBLING: "period-doubling"}
@@ -183,15 +184,15 @@ class CycleCurvesResult:
             lines.append(f"  {names[kind]} curves: {len(data[KEY_OF_KIND[kind]])}")
         for i, c in enumerate(data["curves"], start=1):
             lines.append(f"  {i}. {names[c['kind']]} curve from {c['origin']}: {c['points']} points, Fz "
-                         f"{c['fz_min']['Fz']:.6g} N (V {c['fz_min']['V']:.5g}) .. {c['fz_max']['Fz']:.6g} N "
+                         f"{kn(c['fz_min']['Fz'])} (V {c['fz_min']['V']:.5g}) .. {kn(c['fz_max']['Fz'])} "
                          f"(V {c['fz_max']['V']:.5g})")
             for x in c["crossings"]:
-                lines.append(f"       at Fz = {x['Fz']:.6g} N: V = {x['V']:.6f} m/s, period {x['period']:.5g} s, "
+                lines.append(f"       at Fz = {kn(x['Fz'])}: V = {x['V']:.6f} m/s, period {x['period']:.5g} s, "
                              f"max |psi| {x['max_psi']:.4g} rad")
             for e in c["stop_reasons"]:
                 lines.append(f"       end: {e}")
         for p in data["codim2_points"]:
-            lines.append(f"  {p['kind']:<5} V = {p['V']:.6g} m/s, Fz = {p['Fz']:.6g} N")
+            lines.append(f"  {p['kind']:<5} V = {p['V']:.6g} m/s, Fz = {kn(p['Fz'])}")
         lines += [f"  warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 
@@ -243,10 +244,10 @@ class CurveSearch:
                 if not any(_close(entry, e, 1e-4) for e in self.hh):
                     self.hh.append(entry)
         units = [BesideUnit(self.config, self.params, g, PointKind.FOLD_OF_CYCLES, self.box,
-                            f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+                            f"beside the GH point at V = {g['V']:.5g} m/s, Fz = {kn(g['Fz'])}")
                  for g in self.gh if PointKind.FOLD_OF_CYCLES in self.kinds]
         units += [BesideUnit(self.config, self.params, g, PointKind.TORUS, self.box,
-                             f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {g['Fz']:.6g} N")
+                             f"beside the double-Hopf point at V = {g['V']:.5g} m/s, Fz = {kn(g['Fz'])}")
                   for g in self.hh if PointKind.TORUS in self.kinds]
         self.hopf_pending = False
         self.beside_order += units
@@ -363,7 +364,7 @@ class ScanUnit:
             diagram = bifurcation(self.config, self.Fz, v_range=self.box[0], params=self.params,
                                   options=BifurcationOptions(mesh_check=False))
         except ContinuationError as exc:
-            return [], [f"diagram at Fz = {self.Fz:.6g} N failed: {exc}"]
+            return [], [f"diagram at Fz = {kn(self.Fz)} failed: {exc}"]
         return starts_of_diagram(diagram, self.Fz), []
 
     def describe(self) -> str:
@@ -561,7 +562,7 @@ def cycle_curves(config: Configuration | str, *, params: Parameters | None = Non
 
 def starts_of_diagram(diagram, Fz: float) -> list[Start]:
     """The located LPC, NS and PD points (with their orbits) of a diagram's periodic branches."""
-    return [Start(s.kind, s, Fz, b.raw.ncol, f"{b.origin}, diagram at Fz = {Fz:.6g} N", from_diagram=True)
+    return [Start(s.kind, s, Fz, b.raw.ncol, f"{b.origin}, diagram at Fz = {kn(Fz)}", from_diagram=True)
             for b in diagram.branches if b.kind == "periodic" and b.raw is not None
             for s in b.raw.special_points if s.kind in KINDS]
 
@@ -574,7 +575,7 @@ def _continue(config: Configuration, params: Parameters, start: Start, box, load
     kappa = math.cos(start.point.data["torus_angle"]) if start.kind == PointKind.TORUS else None
     if kappa is not None and not -1.0 < kappa < 1.0:
         return None, None
-    about = f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {start.Fz:.6g} N ({start.origin})"
+    about = f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {kn(start.Fz)} ({start.origin})"
     try:
         curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box=box, options=CURVE_OPTIONS,
                             scale=STATE_SCALE[:system.n], p_scale=(V_SCALE, FZ_SCALE), kappa=kappa, ncol=start.ncol,

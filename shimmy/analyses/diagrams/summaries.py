@@ -11,13 +11,14 @@ import csv
 from typing import Any
 
 from ...continuation.kinds import PointKind
+from ...model.units import kn, kn_range
 
 
 def bifurcation_summary(result: dict[str, Any]) -> str:
     """The short table ``python -m shimmy bifurcation`` prints, from ``BifurcationResult.to_dict()``: the Hopf
     points, each periodic branch with its special points and end, the largest stable amplitude, the mesh
     check, the warnings."""
-    lines = [f"{result['config']} at Fz = {result['Fz']:g} N, V in [{result['v_min']:g}, {result['v_max']:g}] m/s "
+    lines = [f"{result['config']} at Fz = {kn(result['Fz'])}, V in [{result['v_min']:g}, {result['v_max']:g}] m/s "
              f"({result['elapsed_s']:.2f} s)"]
     for h in result["hopf_points"]:
         lines.append(f"  H    V = {h['V']:10.5f} m/s  {h['frequency_hz']:.4f} Hz  {h['criticality']}")
@@ -60,17 +61,17 @@ def hopf_curves_summary(result: dict[str, Any]) -> str:
     with its GH and double-Hopf points, and the lowest load on a curve."""
     v_range, fz_range = result["v_range"], result["fz_range"]
     lines = [f"{result['config']}: {len(result['curves'])} Hopf curve(s) in V {v_range[0]:g}..{v_range[1]:g} m/s, "
-             f"Fz {fz_range[0]:g}..{fz_range[1]:g} N ({result['elapsed_s']:.2f} s)"]
+             f"Fz {kn_range(*fz_range)} ({result['elapsed_s']:.2f} s)"]
     for i, c in enumerate(result["curves"], start=1):
         speeds, loads = [p["V"] for p in c["points"]], [p["Fz"] for p in c["points"]]
         lines.append(f"  curve {i}: {len(c['points'])} points, V {min(speeds):.4g}..{max(speeds):.4g} m/s, "
-                     f"Fz {min(loads):.5g}..{max(loads):.5g} N, {'closed' if c['closed'] else 'open'}")
+                     f"Fz {kn_range(min(loads), max(loads), 5)}, {'closed' if c['closed'] else 'open'}")
         for g in c["gh_points"]:
-            lines.append(f"      GH  V = {g['V']:.6g} m/s, Fz = {g['Fz']:.6g} N")
+            lines.append(f"      GH  V = {g['V']:.6g} m/s, Fz = {kn(g['Fz'])}")
         for g in c["double_hopf_points"]:
-            lines.append(f"      HH  V = {g['V']:.6g} m/s, Fz = {g['Fz']:.6g} N "
+            lines.append(f"      HH  V = {g['V']:.6g} m/s, Fz = {kn(g['Fz'])} "
                          f"({g['frequency_hz']:.4g} and {g['frequency2_hz']:.4g} Hz)")
     lowest = result["fz_minimum"]
     if lowest:
-        lines.append(f"  lowest load on a Hopf curve: Fz = {lowest['Fz']:.6g} N at V = {lowest['V']:.6g} m/s")
+        lines.append(f"  lowest load on a Hopf curve: Fz = {kn(lowest['Fz'])} at V = {lowest['V']:.6g} m/s")
     return "\n".join(lines)

@@ -26,6 +26,7 @@ from ...version import __version__
 from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
 from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from ..diagrams.cycle_curves import starts_of_diagram
+from ...model.units import kn
 
 SHIMMY_TYPES = tuple(ShimmyType)
 DEFAULT_V_RANGE = DIAGRAM_V_RANGE
@@ -278,7 +279,7 @@ def classify(config: Configuration | str, V: float, Fz: float, *, params: Parame
 def classification_summary(result: dict[str, Any]) -> str:
     """The lines ``python -m shimmy classify`` prints for a :func:`classify` answer: the shimmy type, then
     each stable attractor."""
-    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {result['shimmy_type']}"]
+    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {kn(result['Fz'])}: {result['shimmy_type']}"]
     for a in result["attractors"]:
         if a["kind"] == "equilibrium":
             lines.append("  stable: straight rolling x = 0")

@@ -60,6 +60,7 @@ from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
 from ...model.parameters import DEFAULT_MAP_SLICES, FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .map_slices import DEFAULT_V_RANGE, SliceResult, map_slice
 from .summaries import map_summary, write_map_csv
+from ...model.units import kn
 
 log = logging.getLogger(__name__)
 SHADING_ROWS = 180  # rows of the read-off shading (at least 4 per slice)
@@ -341,7 +342,7 @@ class _MapBuild:
         cycles = self.search.result(self.finished_at).to_dict()
         warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
         for s in slices:
-            warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
+            warnings += [f"Fz = {kn(s.Fz)}: {w}" for w in s.warnings]
         segments, fallbacks = map_shading.row_segments(slices, _boundaries(hopf, self.search), rows, (v_min, v_max))
         V = slices[0].V
         return StabilityMap(self.config, self.params, self.v_range, self.fz_range, V,

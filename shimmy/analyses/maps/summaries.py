@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 from typing import Any
 
+from ...model.units import kn, kn_range, mm
 from ..core.response import ShimmyType
 
 
@@ -22,15 +23,15 @@ def map_summary(result: dict[str, Any]) -> str:
     counts = {t: sum(row.count(t) for row in shading["types"]) for t in ShimmyType}
     v_range, fz_range = result["v_range"], result["fz_range"]
     lines = [f"{result['config']}: {len(result['Fz'])} classified slices, {len(shading['Fz'])} x {len(result['V'])} "
-             f"grid, V {v_range[0]:g}..{v_range[1]:g} m/s, Fz {fz_range[0]:g}..{fz_range[1]:g} "
-             f"N ({result['elapsed_s']:.1f} s, {result['executor']})",
+             f"grid, V {v_range[0]:g}..{v_range[1]:g} m/s, Fz {kn_range(*fz_range)} "
+             f"({result['elapsed_s']:.1f} s, {result['executor']})",
              "  grid points by type: " + ", ".join(f"{t} {n}" for t, n in counts.items())
              + f"; {len(result['regions'])} region polygons",
              f"  Hopf curves {len(result['hopf_curves'])}, GH points {len(result['gh_points'])}, "
              f"fold curves {len(result['fold_curves'])}, torus curves {len(result['torus_curves'])}"]
     lowest = result["min_shimmy"]
     if lowest:
-        lines.append(f"  minimum shimmy load {lowest['Fz']:.6g} N at V = {lowest['V']:.5g} m/s ({lowest['source']})")
+        lines.append(f"  minimum shimmy load {kn(lowest['Fz'])} at V = {lowest['V']:.5g} m/s ({lowest['source']})")
     else:
         lines.append("  no shimmy anywhere in the map")
     metrics = result.get("metrics")
@@ -57,7 +58,7 @@ def _attractor_line(a: dict[str, Any]) -> str:
     amp = a["amplitude"]
     motion = "motion (simulated)" if a["kind"] == "simulation" else "cycle"
     what = "straight rolling" if a["mode"] == "equilibrium" else f"{a['mode']} {motion}"
-    size = "" if a["mode"] == "equilibrium" else f"  psi {amp['psi']:.4g} rad, l_g delta {amp['lateral']:.4g} m"
+    size = "" if a["mode"] == "equilibrium" else f"  psi {amp['psi']:.4g} rad, l_g delta {mm(amp['lateral'], 4)}"
     return f"  {what}{size}{'  (the standard start ends here)' if a['standard_start'] else ''}"
 
 
@@ -72,7 +73,7 @@ def margins_summary(result: dict[str, Any]) -> str:
     """The lines ``python -m shimmy margins`` prints, from ``MarginsResult.to_dict()``: each attractor with the
     smallest disturbance that ends on it and its two check runs, the saddle cycles, the runs, the warnings."""
     direction = result["direction"]
-    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: straight rolling "
+    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {kn(result['Fz'])}: straight rolling "
              f"{'stable' if result['straight_rolling_stable'] else 'unstable'}, {len(result['attractors'])} "
              f"attractor{'s' if len(result['attractors']) != 1 else ''}; smallest disturbance "
              + ("over all directions (energy)" if direction == "energy" else f"along {direction}")]
@@ -92,7 +93,7 @@ def margins_summary(result: dict[str, Any]) -> str:
         lines.append(f"      smallest {direction}: {text}{_check_text(m['check'])}")
     for s in result["saddles"]:
         lines.append(f"  saddle cycle ({s['mode']}): psi {s['amplitude']['psi']:.4g} rad, "
-                     f"l_g delta {s['amplitude']['lateral']:.4g} m")
+                     f"l_g delta {mm(s['amplitude']['lateral'], 4)}")
     unsettled = result["unsettled_runs"]
     lines.append(f"  {result['runs']} runs in {result['elapsed_s']:.1f} s ({result['executor']})"
                  + (f"; {unsettled} of them settled on no attractor" if unsettled else ""))
@@ -104,7 +105,7 @@ def basins_summary(result: dict[str, Any]) -> str:
     """The lines ``python -m shimmy basins`` prints, from ``BasinsResult.to_dict()``: each attractor with its
     share of the sampled disturbances and the 95 % interval, the runs that settled nowhere, the warnings."""
     o = result["options"]
-    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {result['Fz']:g} N: {o['samples']} disturbances "
+    lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {kn(result['Fz'])}: {o['samples']} disturbances "
              f"up to {o['radius']:g} rad of yaw or the same energy ({result['energy_J']:.4g} J), seed {o['seed']}"]
     for a in result["attractors"]:
         b = a["basin"]

@@ -59,6 +59,7 @@ from . import map_shading
 from .map_slices import FINE, SliceResult, speed_grids, type_lengths
 from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, HopfCurvesUnit, SliceUnit, Sketch, StabilityMap,
                             arrangement, curve_boundaries, lowest_shimmy, sketch_of)
+from ...model.units import kn
 
 #: Kinds of a slice's special points that lie on the map's curves (carried to the curves' crossings);
 #: a slice with any other (a period doubling, a branch point of cycles) is not carried.
@@ -361,7 +362,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     cycles = search.result(0.0).to_dict()
     warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
     for s in slices:
-        warnings += [f"Fz = {s.Fz:.6g} N: {w}" for w in s.warnings]
+        warnings += [f"Fz = {kn(s.Fz)}: {w}" for w in s.warnings]
     segments, fallbacks = map_shading.row_segments(slices, boundaries, rows, v_range)
     V = slices[0].V
     elapsed = time.perf_counter() - clock

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from ...model.parameters import PARAMETER_SPECS
+from ...model.units import kn
 from ..answers import OFF, Answer, add_no_cache, answer, design, numbers, request
 from ..answers import emit as emit_answer
 from ..common import (EXIT_FAILED, add_command, add_common, add_config, add_field, add_operating_point, add_plane, emit,
@@ -41,7 +42,7 @@ def _cmd_eigen(args) -> int:
              "damping_ratio": float(-e.real / abs(e)) if abs(e) > 0 else None} for e in ev]
     payload = {"config": args.config, "V": V, "Fz": Fz, "params": design.to_dict(), "eigenvalues": rows,
                "stable": bool(ev.real.max() < 0)}
-    lines = [f"{args.config} at V = {V:g} m/s, Fz = {Fz:g} N: x = 0 is "
+    lines = [f"{args.config} at V = {V:g} m/s, Fz = {kn(Fz)}: x = 0 is "
              f"{'stable' if payload['stable'] else 'unstable'}",
              f"  {'real (1/s)':>14}{'imag (rad/s)':>16}{'f (Hz)':>10}{'zeta':>10}"]
     for r in rows:
