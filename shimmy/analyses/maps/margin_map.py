@@ -226,7 +226,8 @@ class MarginMapResult:
                 "warnings": list(self.warnings), "version": __version__}
 
     def summary_text(self) -> str:
-        """The lines ``python -m shimmy margin-map`` prints (:func:`~shimmy.analyses.maps.summaries.margin_map_summary`)."""
+        """The lines ``python -m shimmy margin-map`` prints
+        (:func:`~shimmy.analyses.maps.summaries.margin_map_summary`)."""
         return margin_map_summary(self.to_dict())
 
 
