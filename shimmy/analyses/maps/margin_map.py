@@ -110,8 +110,8 @@ def worst_of(attractors: list[dict[str, Any]]) -> int | None:
 
 
 def point_record(result: dict[str, Any], shimmy: str) -> dict[str, Any]:
-    """A cell's entry from :meth:`MarginsResult.to_dict` at its centre: its attractors (each with its own smallest
-    kick), the worst, and the margin to it."""
+    """A cell's entry from :meth:`~shimmy.analyses.maps.margins.MarginsResult.to_dict` at its centre: its
+    attractors (each with its own smallest kick), the worst, and the margin to it."""
     attractors = result["attractors"]
     worst = worst_of(attractors)
     out = {"V": result["V"], "Fz": result["Fz"], "type": shimmy,
