@@ -203,8 +203,12 @@ def _margin_csv(results):
             "lower_rad", "upper_rad", "confirmed", "note"], rows
 
 
+MARGINS_STALE = ("Press Compute margins for this configuration and design (any margins shown are of the previous "
+                 "ones).")
 jobs.register(
-    ids.MAPM, "margin_map", requests=_margin_requests, render=lambda results: (margin_table(results[0]),),
+    ids.MAPM, "margin_map", requests=lambda _shade, _design, *states: _margin_requests(*states),
+    render=lambda results: (margin_table(results[0]),), stale=MARGINS_STALE,
+    follow=[Input(ids.MAP_SHADE, "value"), Input(live.settled_id(ids.MAP), "data")],
     outputs=[Output(ids.MAPM_TABLE, "children")],
     states=[State(ids.MAP_SHADE, "value"), State(ids.MAP_FZMIN, "value"), State(ids.MAP_FZMAX, "value"),
             State(ids.MAP_VMIN, "value"), State(ids.MAP_VMAX, "value"), State(ids.MAP_RES, "value"),
@@ -427,10 +431,10 @@ def _kick_text(point, max_size):
             + ("" if point["confirmed"] else "; not confirmed by its check runs"))
 
 
-def margin_figure(result, smap=None):
+def margin_figure(result, smap=None, why=""):
     """The margins of a margin map as coloured markers at the cells' centres (a colour bar in rad: dark, a small
     kick) over the map's regions and curves (``smap``: the shown map of the same configuration, design and plane,
-    if any); crosses where no kick up to the largest reaches torsional shimmy."""
+    if any, else ``why`` not in the title); crosses where no kick up to the largest reaches torsional shimmy."""
     label, colour = style.CONFIG_LABELS[result["config"]], style.CONFIG_COLOURS[result["config"]]
     series = [(label, colour)]
     max_size = result["options"]["max_size"]
@@ -438,7 +442,7 @@ def margin_figure(result, smap=None):
     crossed = [p for p in result["points"] if p["margin"] is None]
     head = (f"{label}: smallest yaw kick from straight rolling to torsional shimmy, in the {len(result['points'])} "
             f"cells where it coexists with another attractor"
-            + ("" if smap is not None else " (compute the map above to see its regions under them)"))
+            + ("" if smap is not None else f" ({why or 'compute the map above to see its regions under them'})"))
     fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
     if smap is not None:
         _regions(fig, smap, MARGIN_REGIONS)
@@ -504,7 +508,8 @@ def draw_margins(margin_requests, map_requests):
         return style.message_figure(MARGIN_WAITING, 360)
     smap = _cached("map", map_requests)
     same = smap is not None and all(smap[k] == result[k] for k in ("config", "params", "v_range", "fz_range"))
-    return margin_figure(result, smap if same else None)
+    why = "" if smap is None else "the map above is of another configuration, plane or design: not drawn under them"
+    return margin_figure(result, smap if same else None, why)
 
 
 @dash.callback(Output(ids.MAPM_NAV, "href"), Output(ids.MAPM_HINT, "children"),

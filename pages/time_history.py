@@ -32,8 +32,7 @@ STARTS = {"standard": ("standard: psi = 0.001 rad", 0.001, 0.0),
           "lateral": ("large lateral: l_g delta = 0.1 m", 0.0, 0.1),
           "typed": ("values typed below", None, None)}
 WAITING = "Choose an operating point and press Run (a result already in the cache is shown at once)"
-MARGINS_STALE = ("The operating point changed: the margins shown are of the previous one. Press Compute margins for "
-                 "this one.")
+MARGINS_STALE = "Press Compute margins for this operating point (any margins shown are of the previous one)."
 ATTRACTOR_WORDS = {"equilibrium": "straight rolling", "torsional": "torsional limit cycle",
                    "lateral": "lateral limit cycle", "both": "limit cycle, torsion and lateral bending both large"}
 
@@ -240,28 +239,34 @@ jobs.register(
 
 
 @dash.callback(Output(ids.TH_PSI0, "value", allow_duplicate=True), Output(ids.TH_LAT0, "value", allow_duplicate=True),
-               Output(ids.TH_TEND, "value"), Output(ids.TH_KICK, "data"), Input(ids.thm_run(dash.ALL), "n_clicks"),
-               State(ids.THM.requests, "data"), State(ids.TH_TEND, "value"), prevent_initial_call=True)
-def run_from_kick(clicks, requests, t_end):
+               Output(ids.TH_TEND, "value"), Output(ids.TH_CONFIG, "value"),
+               Output(ids.TH_V, "value", allow_duplicate=True), Output(ids.TH_FZ, "value", allow_duplicate=True),
+               Output(ids.TH_KICK, "data"), Input(ids.thm_run(dash.ALL), "n_clicks"),
+               State(ids.THM.requests, "data"), State(ids.TH_TEND, "value"), State(ids.TH_CONFIG, "value"),
+               State(ids.TH_V, "value"), State(ids.TH_FZ, "value"), prevent_initial_call=True)
+def run_from_kick(clicks, requests, t_end, config, V, fz_kn):
     """A row's Run: the time history from just above that attractor's smallest yaw kick (the start of its check
-    run), for at least as long as the check ran."""
+    run), for at least as long as the check ran, at the margins' point (the boxes go back to it if they moved)."""
+    nothing = (no_update,) * 7
     trigger = dash.ctx.triggered_id
     if not trigger or not any(clicks) or not isinstance(requests, list) or not requests:
-        return no_update, no_update, no_update, no_update
+        return nothing
     try:
         result = analyses.cached("margins", requests[0])
     except InvalidParameterError:
-        return no_update, no_update, no_update, no_update
+        return nothing
     k = trigger["index"]
     if result is None or not isinstance(k, int) or not 0 <= k < len(result["attractors"]):
-        return no_update, no_update, no_update, no_update
+        return nothing
     m = result["attractors"][k]["min_disturbance"]
     if not m["reached"]:
-        return no_update, no_update, no_update, no_update
+        return nothing
     psi0 = STARTS["standard"][1] if m["value"] == 0.0 else float(f"{m['upper']:.5g}")
     longest = result["options"]["t_max"]
     t = t_end if isinstance(t_end, (int, float)) and t_end >= longest else longest
-    return psi0, 0.0, t, {"attractor": k, "psi0": psi0, "clicks": sum(c or 0 for c in clicks)}
+    point = (result["config"], result["V"], result["Fz"] / 1e3)
+    moved = [new if new != old else no_update for new, old in zip(point, (config, V, fz_kn), strict=True)]
+    return psi0, 0.0, t, *moved, {"attractor": k, "psi0": psi0, "clicks": sum(c or 0 for c in clicks)}
 
 
 # A run asked from the margins' table is drawn at the top of the page: it scrolls up there (the start in the boxes,

@@ -15,7 +15,7 @@ from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 
 from browser import (SHOTS, browser_fixture, by_id, idle, on_figure, open_page, severe, text_of,  # noqa: E402
-                     trace_count, wait_for)
+                     trace_count, type_into, wait_for)
 
 browser = browser_fixture("chromium-margins", "1440,900")
 POINT = "/time-history?config=original&V=50&Fz=550&map_type=Bistable"
@@ -76,10 +76,23 @@ def test_margins_of_a_bistable_point_and_a_run_from_the_torsional_threshold(serv
     browser.save_screenshot(str(SHOTS / "time-history-margins-1024.png"))
     browser.set_window_size(1440, 900)
     # another point: the map's note goes, the margins shown say they are of the previous point
-    browser.find_element(By.ID, "th-v").clear()
-    browser.find_element(By.ID, "th-v").send_keys("51\t")
+    browser.set_window_size(1440, 900)
+    browser.execute_script("window.scrollTo(0, 0)")
+    type_into(browser.find_element(By.ID, "th-v"), "51")
     wait_for(lambda: not text_of(browser, "th-bistable"), timeout=30, what="the map's note to go")
     wait_for(lambda: "previous one" in text_of(browser, "thm-status"), timeout=30, what="the margins' stale status")
+    # a row's Run of the margins shown (of 50 m/s): the boxes go back to their point, and it runs there
+    rows = _rows(browser)
+    k = next(i for i, r in enumerate(rows) if r[0].startswith("torsional limit cycle"))
+    button = by_id(browser, '{"index":%d,"type":"thm-run"}' % k)
+    browser.execute_script("arguments[0].scrollIntoView({block: 'center'})", button)
+    button.click()
+    wait_for(lambda: browser.find_element(By.ID, "th-v").get_attribute("value") == "50", timeout=30,
+             what="the speed back at the margins' point")
+    wait_for(lambda: "V = 50 m/s," in (on_figure(browser, "th-series", "return g.layout.title.text;") or "")
+             and "torsional limit cycle" in text_of(browser, "th-settled")
+             and f"psi0 = {start:g} rad" in text_of(browser, "th-settled"), timeout=240,
+             what="the run from the kick at the margins' point")
     assert severe(browser) == []
 
 
