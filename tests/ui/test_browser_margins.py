@@ -24,6 +24,10 @@ PLANE = ("/stability-map?shade=original&v_min=40&v_max=120&fz_min=500&fz_max=900
          "&margin_nfz=2")
 
 
+#: A figure's title (none on a placeholder figure, while a run is made).
+TITLE = "return (g.layout.title && g.layout.title.text) || '';"
+
+
 def _small(browser) -> None:
     """The window at 1024 x 768, once the page fits it (the figures redrawn to the width)."""
     browser.set_window_size(1024, 768)
@@ -89,7 +93,7 @@ def test_margins_of_a_bistable_point_and_a_run_from_the_torsional_threshold(serv
     button.click()
     wait_for(lambda: browser.find_element(By.ID, "th-v").get_attribute("value") == "50", timeout=30,
              what="the speed back at the margins' point")
-    wait_for(lambda: "V = 50 m/s," in (on_figure(browser, "th-series", "return g.layout.title.text;") or "")
+    wait_for(lambda: "V = 50 m/s," in (on_figure(browser, "th-series", TITLE) or "")
              and "torsional limit cycle" in text_of(browser, "th-settled")
              and f"psi0 = {start:g} rad" in text_of(browser, "th-settled"), timeout=240,
              what="the run from the kick at the margins' point")
@@ -113,7 +117,7 @@ def test_margins_on_the_map_over_its_regions_and_a_click_runs_from_the_kick(serv
     assert hover.startswith("min yaw kick to torsional shimmy: ") and hover.endswith(")")
     # over the map: its regions (filled) and curves drawn under the margins
     assert on_figure(browser, "mapm-graph", "return g.data.filter(t => t.fill === 'toself').length;") > 0
-    assert "compute the map above" not in on_figure(browser, "mapm-graph", "return g.layout.title.text;")
+    assert "compute the map above" not in on_figure(browser, "mapm-graph", TITLE)
     rows = browser.find_elements(By.CSS_SELECTOR, "#mapm-summary tbody tr")
     assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["600", "800"]
     assert not browser.find_element(By.ID, "mapm-csv").get_attribute("disabled")
