@@ -6,9 +6,14 @@ to each attractor (``margins``, direction psi), the smallest energy over all dir
 energy) and basin fractions of 200 kicks up to 0.2 rad. Each with the one-parameter diagram at the load
 kept for the process (as repeated questions at one load have it) and with it computed afresh.
 
-Targets: the yaw margin <= 1 s, over all directions <= 10 s.
+Then margin maps (``margin_map``): for original and nes, the smallest yaw kick to torsional shimmy in every cell of
+the default plane (V 1-200 m/s, Fz 10-900 kN, 20 x 10 cells) where a torsional cycle coexists with another
+attractor, cold (no diagram kept: each load's diagram computed in its unit), on the local pool; then one of them
+on a loopback Dask cluster of 1 and of 2 single-threaded workers (separate processes), and the speed-up 2 vs 1.
 
-    python benchmarks/bench_margins.py [--repeats 5]
+Targets: the yaw margin <= 1 s, over all directions <= 10 s, a margin map of one configuration <= 60 s on 2 cores.
+
+    python benchmarks/bench_margins.py [--repeats 5] [--map-repeats 2] [--skip-dask] [--only-maps]
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import statistics
 import time
 
 from shimmy.analyses.core.executors import describe, open_executor
+from shimmy.analyses.maps.margin_map import margin_map
 from shimmy.analyses.maps.margins import basins, diagram_at, margins
 
 POINT = ("original", 50.0, 550e3)
@@ -34,10 +40,71 @@ def _median(fn, repeats: int, fresh: bool) -> tuple[float, object]:
     return statistics.median(times), result
 
 
+def _fresh_map(config: str, executor) -> tuple[float, object]:
+    """(seconds, result) of a margin map with no diagram kept in this process (the pool's workers keep theirs
+    between calls: a fresh pool per call)."""
+    diagram_at.cache_clear()
+    clock = time.perf_counter()
+    result = margin_map(config, executor=executor)
+    return time.perf_counter() - clock, result
+
+
+def maps(repeats: int) -> None:
+    print(f"\nmargin maps, 20 x 10 cells of V 1-200 m/s, Fz 10-900 kN, cold, a fresh {describe()} per run, "
+          f"medians of {repeats}:")
+    print(f"{'config':<10}{'s':>7}{'cells':>7}{'multistable':>13}{'bistable':>10}{'computed':>10}{'runs':>7}  "
+          "margins (rad)")
+    for config in ("original", "nes"):
+        times, result = [], None
+        for _ in range(repeats):
+            with open_executor() as pool:
+                t, result = _fresh_map(config, pool)
+            times.append(t)
+        c = result.to_dict()["counts"]
+        values = [p["margin"] for p in result.points if p["margin"]]
+        span = f"0 in {c['zero']} cells, {min(values):.3g} to {max(values):.3g} elsewhere" if values else "-"
+        print(f"{config:<10}{statistics.median(times):7.1f}{c['cells']:>7}{c['multistable']:>13}{c['bistable']:>10}"
+              f"{c['computed']:>10}{c['runs']:>7}  {span}; {c['not_reached']} not reached")
+    print("target: <= 60 s per configuration on 2 cores")
+
+
+def _forget() -> None:
+    """Run on each Dask worker: forget the diagrams kept (the next map computes its own)."""
+    diagram_at.cache_clear()
+
+
+def dask_maps(repeats: int) -> None:
+    from shimmy.service.dask_cluster import loopback_cluster
+
+    print("\nmargin map of original on a loopback Dask cluster (single-threaded workers, separate processes):")
+    times = {}
+    for n in (1, 2):
+        with loopback_cluster(n_workers=n) as address, open_executor(scheduler=address) as ex:
+            margin_map("original", executor=ex, n_v=2, n_fz=2, v_range=(40.0, 120.0), fz_range=(5e5, 9e5))  # warm-up
+            runs = []
+            for _ in range(repeats):
+                ex._client.run(_forget)  # the workers' kept diagrams: cold, as on the local pool
+                runs.append(_fresh_map("original", ex)[0])
+        times[n] = statistics.median(runs)
+        print(f"  {n} worker(s): median {times[n]:6.1f} s  (runs {', '.join(f'{t:.1f}' for t in runs)})")
+    print(f"  speed-up 2 vs 1 worker: {times[1] / times[2]:.2f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--map-repeats", type=int, default=2)
+    parser.add_argument("--skip-dask", action="store_true")
+    parser.add_argument("--only-maps", action="store_true", help="only the margin maps (and Dask, unless skipped)")
     args = parser.parse_args()
+    if not args.only_maps:
+        points(args)
+    maps(args.map_repeats)
+    if not args.skip_dask:
+        dask_maps(args.map_repeats)
+
+
+def points(args) -> None:
     with open_executor() as pool:
         clock = time.perf_counter()
         margins(*POINT, executor=pool)

@@ -9,7 +9,7 @@ from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from shimmy.service import neighbours
+from shimmy.service import analyses, neighbours
 from ui import compare, designs, fields, formats, ids, jobs, live, merits
 from ui import components as ui
 from ui import style
@@ -30,14 +30,21 @@ V_MIN = Quantity("map", "v_min", "V from", "m/s")
 V_MAX = Quantity("map", "v_max", "V to", "m/s")
 SLICES = Quantity("map", "resolution", "Fz slices", "")
 METRICS_FZ = Quantity("map", "metrics_Fz", "figures at Fz", "kN", 1e3)
+CELLS_V = Quantity("margin_map", "n_v", "cells in V", "")
+CELLS_FZ = Quantity("margin_map", "n_fz", "cells in Fz", "")
+MAX_KICK = Quantity("margin_map", "max_size", "largest kick", "rad")
 WAITING = "Press Compute: tens of seconds per configuration cold on 2 cores, instant from the cache"
+MARGIN_WAITING = ("Press Compute margins: the smallest yaw kick to torsional shimmy in each cell of the plane where "
+                  "it coexists with another attractor (20 to 40 s for 20 x 10 cells on 2 cores)")
 HEIGHT, BOTTOM = 740, 176
 FAINT, FAINT_REGIONS = 0.35, 0.16  # a previous design's curves and regions under the map being made
+MARGIN_REGIONS = 0.4  # the map's regions under the margins
 
 
 def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | None = None,
            fz_max: str | None = None, v_min: str | None = None, v_max: str | None = None,
-           resolution: str | None = None, compare_config: str | None = None, compare_fz: str | None = None, **query):
+           resolution: str | None = None, compare_config: str | None = None, compare_fz: str | None = None,
+           margin_nv: str | None = None, margin_nfz: str | None = None, margin_max: str | None = None, **query):
     shade, bad_shade = fields.choice("shade", shade, list(CONFIGS), "original", "a configuration")
     compared, bad_compared = fields.choice("compare_config", compare_config, CONFIGS, "nes_pd", "a configuration")
     merit_fz, bad_merit_fz = METRICS_FZ.from_url("compare_fz", compare_fz, 150)
@@ -48,6 +55,11 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
                                  ("v_min", V_MIN, v_min, 1), ("v_max", V_MAX, v_max, 200),
                                  ("resolution", SLICES, resolution, SLICES.spec.default)):
         values[key], problem = q.from_url(key, raw, default)
+        problems.append(problem)
+    cells = {}
+    for key, q, raw in (("margin_nv", CELLS_V, margin_nv), ("margin_nfz", CELLS_FZ, margin_nfz),
+                        ("margin_max", MAX_KICK, margin_max)):
+        cells[key], problem = q.from_url(key, raw, q.spec.default)
         problems.append(problem)
     return page(
         query, ids.MAP,
@@ -74,6 +86,26 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
         *jobs.stores(ids.MAP_GROUP),
         live.settled(ids.MAP),
         dcc.Location(id=ids.MAP_NAV, refresh="callback-nav"),
+        html.H2("Disturbance margins"),
+        html.P("Where two attractors coexist, which one the gear ends on depends on the kick. In each cell of the "
+               "plane above where a torsional limit cycle (the fatigue-critical shimmy) coexists with another "
+               "attractor (the Bistable cells, and any where straight rolling is stable beside a cycle): the "
+               "smallest yaw kick from straight rolling that ends on the torsional cycle, for the shaded "
+               "configuration and this design, each checked by two runs. 0: the standard start (psi = 0.001 rad) "
+               "already ends there. Click a cell to run its time history from just above its kick.", className="hint"),
+        html.Div([ui.field(f"Cells in V ({CELLS_V.low:g}-{CELLS_V.high:g})", CELLS_V.box(ids.MAPM_NV,
+                                                                                          cells["margin_nv"])),
+                  ui.field(f"Cells in Fz ({CELLS_FZ.low:g}-{CELLS_FZ.high:g})", CELLS_FZ.box(ids.MAPM_NFZ,
+                                                                                             cells["margin_nfz"])),
+                  ui.field("Largest kick (rad)", MAX_KICK.box(ids.MAPM_MAX, cells["margin_max"])),
+                  *jobs.controls(ids.MAPM, "Compute margins")], className="controls"),
+        html.Div(id=ids.MAPM.error, className="error", role="alert"),
+        ui.graph(ids.MAPM_GRAPH, figure=style.message_figure(MARGIN_WAITING, 360)),
+        html.Div(id=ids.MAPM_HINT, className="hint"),
+        html.Div(id=ids.MAPM_TABLE, className="table-wrap"),
+        ui.downloads(ids.MAPM),
+        *jobs.stores(ids.MAPM),
+        dcc.Location(id=ids.MAPM_NAV, refresh="callback-nav"),
         html.H2("Compare saved designs"),
         html.P("The designs ticked under Compare in the design panel (2 to 4; the current one may be one of them) "
                "over this page's Fz and V ranges and slices, for one configuration: the Hopf, fold and torus curves "
@@ -154,6 +186,38 @@ jobs.register(
     lock=[ids.MAP_SHADE, ids.MAP_RES, ids.MAP_FZMIN, ids.MAP_FZMAX, ids.MAP_VMIN, ids.MAP_VMAX],
     download=jobs.Download(ids.MAP_GROUP, "stability_map", _csv_rows),
     blank=lambda: (style.message_figure("Refused: see the message above", 600), None))
+
+
+def _margin_requests(shade, fz_min, fz_max, v_min, v_max, resolution, design, n_v, n_fz, max_size):
+    """The margins of the shaded configuration over the page's plane, for the current design."""
+    plane = _requests(shade, [], fz_min, fz_max, v_min, v_max, resolution, design)[0]
+    plane.pop("resolution")
+    return [{**plane, "n_v": CELLS_V.read(n_v), "n_fz": CELLS_FZ.read(n_fz), "max_size": MAX_KICK.read(max_size)}]
+
+
+def _margin_csv(results):
+    r = results[0]
+    rows = [[r["config"], p["V"], p["Fz"], p["type"], "+".join(a["mode"] for a in p["attractors"]), p["margin"],
+             p["tolerance"], p["lower"], p["upper"], p["confirmed"], p["note"]] for p in r["points"]]
+    return ["config", "V_m_s", "Fz_N", "shimmy_type", "attractors", "min_yaw_kick_rad", "tolerance_rad",
+            "lower_rad", "upper_rad", "confirmed", "note"], rows
+
+
+MARGINS_STALE = ("Press Compute margins for this configuration and design (any margins shown are of the previous "
+                 "ones).")
+jobs.register(
+    ids.MAPM, "margin_map", requests=lambda _shade, _design, *states: _margin_requests(*states),
+    render=lambda results: (margin_table(results[0]),), stale=MARGINS_STALE,
+    follow=[Input(ids.MAP_SHADE, "value"), Input(live.settled_id(ids.MAP), "data")],
+    outputs=[Output(ids.MAPM_TABLE, "children")],
+    states=[State(ids.MAP_SHADE, "value"), State(ids.MAP_FZMIN, "value"), State(ids.MAP_FZMAX, "value"),
+            State(ids.MAP_VMIN, "value"), State(ids.MAP_VMAX, "value"), State(ids.MAP_RES, "value"),
+            State(ids.design_store(ids.MAP), "data"), State(ids.MAPM_NV, "value"), State(ids.MAPM_NFZ, "value"),
+            State(ids.MAPM_MAX, "value")],
+    lock=[ids.MAPM_NV, ids.MAPM_NFZ, ids.MAPM_MAX],
+    download=jobs.Download(ids.MAPM, "disturbance_margins", _margin_csv, single=True,
+                           filename=lambda results: f"disturbance_margins_{results[0]['config']}"),
+    blank=lambda: (None,))
 
 
 def _compare_requests(fz_min, fz_max, v_min, v_max, resolution, config, merit_fz, selection, saved, current):
@@ -346,6 +410,132 @@ def summary(results):
                      "fold curves", "torus curves"], rows, ids.MAP_SUMMARY)
 
 
+def _cached(analysis, requests):
+    """The first shown result of a section (its requests store, as the browser sent it back), from the cache."""
+    wanted = requests.get("requests") if isinstance(requests, dict) else requests
+    if not isinstance(wanted, list) or not wanted:
+        return None
+    try:
+        return analyses.cached(analysis, wanted[0])
+    except InvalidParameterError:
+        return None
+
+
+def _kick_text(point, max_size):
+    """A cell's margin in words (the hover text)."""
+    if point["margin"] is None:
+        return f"no yaw kick up to {max_size:g} rad reaches torsional shimmy"
+    if point["margin"] == 0.0:
+        return "0: the standard start (psi = 0.001 rad) already ends on torsional shimmy"
+    return (f"min yaw kick to torsional shimmy: {point['margin']:.3g} rad (± {point['tolerance']:.1g})"
+            + ("" if point["confirmed"] else "; not confirmed by its check runs"))
+
+
+def margin_figure(result, smap=None, why=""):
+    """The margins of a margin map as coloured markers at the cells' centres (a colour bar in rad: dark, a small
+    kick) over the map's regions and curves (``smap``: the shown map of the same configuration, design and plane,
+    if any, else ``why`` not in the title); crosses where no kick up to the largest reaches torsional shimmy."""
+    label, colour = style.CONFIG_LABELS[result["config"]], style.CONFIG_COLOURS[result["config"]]
+    series = [(label, colour)]
+    max_size = result["options"]["max_size"]
+    reached = [p for p in result["points"] if p["margin"] is not None]
+    crossed = [p for p in result["points"] if p["margin"] is None]
+    head = (f"{label}: smallest yaw kick from straight rolling to torsional shimmy, in the {len(result['points'])} "
+            f"cells where it coexists with another attractor"
+            + ("" if smap is not None else f" ({why or 'compute the map above to see its regions under them'})"))
+    fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    if smap is not None:
+        _regions(fig, smap, MARGIN_REGIONS)
+        _curves(fig, [smap], series, "configuration", False)
+    # a marker per cell, as large as the cells allow (the plot is some 500 px high and 600-900 px wide)
+    size = max(6.0, min(18.0, 360.0 / result["grid"]["n_v"], 240.0 / result["grid"]["n_fz"]))
+    fig.add_scatter(x=[p["V"] for p in reached], y=[p["Fz"] / 1e3 for p in reached], mode="markers",
+                    name="min yaw kick", showlegend=False, customdata=[_kick_text(p, max_size) for p in reached],
+                    marker={"size": size, "symbol": "square", "color": [p["margin"] for p in reached],
+                            "colorscale": "Viridis", "cmin": 0.0,
+                            "cmax": max([p["margin"] for p in reached], default=max_size) or max_size,
+                            "line": {"width": 1, "color": "#fff"},
+                            "colorbar": {"title": {"text": "min yaw kick (rad)", "side": "right"}, "thickness": 14,
+                                         "len": 0.6, "y": 0.62}},
+                    hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history"
+                                  "</extra>")
+    if crossed:
+        fig.add_scatter(x=[p["V"] for p in crossed], y=[p["Fz"] / 1e3 for p in crossed], mode="markers",
+                        marker={"symbol": "x-thin", "size": size * 0.8, "line": {"width": 2, "color": "#333"}},
+                        name=f"none up to {max_size:g} rad", legend="legend2",
+                        customdata=[_kick_text(p, max_size) for p in crossed],
+                        hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra></extra>")
+    inside = [(name, v, f) for name, (v, f) in ui.OPERATING_POINTS.items()
+              if result["v_range"][0] <= v <= result["v_range"][1]
+              and result["fz_range"][0] <= f * 1e3 <= result["fz_range"][1]]
+    _finish(fig, series, "configuration", inside, tuple(result["v_range"]),
+            tuple(f / 1e3 for f in result["fz_range"]))
+    return fig
+
+
+def margin_table(result):
+    """Per load: the cells computed, those the standard start already takes to torsional shimmy (margin 0), the
+    smallest margin above 0 and the largest (and where), those not reached, those not confirmed."""
+    rows = []
+    for f in result["Fz"]:
+        here = [p for p in result["points"] if p["Fz"] == f]
+        if not here:
+            continue
+        above = [p for p in here if p["margin"]]
+        low = min(above, key=lambda p: p["margin"]) if above else None
+        high = max(above, key=lambda p: p["margin"]) if above else None
+        rows.append([formats.significant(f / 1e3), len(here), sum(p["margin"] == 0.0 for p in here),
+                     "–" if low is None else f"{formats.significant(low['margin'], 3)} at {low['V']:.4g} m/s",
+                     "–" if high is None else f"{formats.significant(high['margin'], 3)} at {high['V']:.4g} m/s",
+                     sum(p["margin"] is None for p in here), sum(p["confirmed"] is False for p in here)])
+    c = result["counts"]
+    note = html.P(f"{c['multistable']} of {c['cells']} cells hold two or more attractors ({c['bistable']} Bistable); "
+                  f"{c['computed']} with a torsional cycle computed, {c['runs']} runs in {result['elapsed_s']:.0f} s. "
+                  f"Worst shimmy: {result['worst']}. Each margin within {result['options']['rtol']:g} of itself.",
+                  className="hint")
+    return [note, ui.table(["Fz (kN)", "cells", "0: the standard start's", "smallest kick above 0 (rad)",
+                            "largest kick (rad)", f"none up to {result['options']['max_size']:g} rad",
+                            "not confirmed"], rows, ids.MAPM_SUMMARY)]
+
+
+@dash.callback(Output(ids.MAPM_GRAPH, "figure"), Input(ids.MAPM.requests, "data"),
+               Input(ids.MAP_GROUP.requests, "data"))
+def draw_margins(margin_requests, map_requests):
+    """The margins shown (the section's requests store), over the map shown above when it is of the same
+    configuration, design and plane (from the cache: nothing is computed here)."""
+    result = _cached("margin_map", margin_requests)
+    if result is None:
+        return style.message_figure(MARGIN_WAITING, 360)
+    smap = _cached("map", map_requests)
+    same = smap is not None and all(smap[k] == result[k] for k in ("config", "params", "v_range", "fz_range"))
+    why = "" if smap is None else "the map above is of another configuration, plane or design: not drawn under them"
+    return margin_figure(result, smap if same else None, why)
+
+
+@dash.callback(Output(ids.MAPM_NAV, "href"), Output(ids.MAPM_HINT, "children"),
+               Input(ids.MAPM_GRAPH, "clickData"), State(ids.MAPM.requests, "data"), prevent_initial_call=True)
+def open_kick(click, requests):
+    """A click on a cell opens its time history from just above its smallest kick to torsional shimmy (the
+    check run's start, for as long as the check ran), or from the standard start where the margin is 0."""
+    result = _cached("margin_map", requests)
+    if not click or not click.get("points") or result is None:
+        return no_update, no_update
+    V, fz_kn = float(click["points"][0]["x"]), float(click["points"][0]["y"])
+    point = min(result["points"], key=lambda p: abs(p["V"] - V) / 10 + abs(p["Fz"] / 1e3 - fz_kn) / 100,
+                default=None)
+    if point is None or abs(point["V"] - V) > 1e-6 * max(1.0, V) or abs(point["Fz"] / 1e3 - fz_kn) > 1e-6 * fz_kn:
+        return no_update, no_update
+    query = {"config": result["config"], "V": f"{point['V']:.6g}", "Fz": f"{point['Fz'] / 1e3:.6g}", "run": "1",
+             "map_type": point["type"]}
+    kick = ""
+    if point["margin"]:
+        query.update(psi0=f"{point['upper']:.6g}", t_end=f"{result['options']['t_max']:g}")
+        kick = f" from psi0 = {point['upper']:.4g} rad, just above its smallest kick to torsional shimmy"
+    query.update({k: f"{v:.10g}" for k, v in (result.get("params") or {}).items()})
+    return ("/time-history?" + urlencode(query),
+            f"Opening the time history at V = {point['V']:.4g} m/s, Fz = {point['Fz'] / 1e3:.4g} kN{kick}")
+
+
 @dash.callback(Output(ids.MAP_NAV, "href"), Output(ids.MAP_HINT, "children"),
                Input(ids.MAP_GRAPH, "clickData"), State(ids.MAP_GROUP.requests, "data"), prevent_initial_call=True)
 def open_time_history(click, requests):
@@ -356,6 +546,8 @@ def open_time_history(click, requests):
     V, fz_kn = float(point["x"]), float(point["y"])
     request = requests[0]
     query = {"config": request["config"], "V": f"{V:.6g}", "Fz": f"{fz_kn:.6g}", "run": "1"}
+    if point.get("customdata") in TYPES:  # the shading's type there (the time history says if it is Bistable)
+        query["map_type"] = point["customdata"]
     query.update({k: f"{v:.10g}" for k, v in (request.get("params") or {}).items()})
     if request.get("material") not in (None, "steel"):
         query["material"] = request["material"]
@@ -366,8 +558,11 @@ def open_time_history(click, requests):
                Input(ids.MAP_SHADE, "value"), Input(ids.MAP_OVERLAY, "value"), Input(ids.MAP_FZMIN, "value"),
                Input(ids.MAP_FZMAX, "value"), Input(ids.MAP_VMIN, "value"), Input(ids.MAP_VMAX, "value"),
                Input(ids.MAP_RES, "value"), Input(ids.MAPC_CONFIG, "value"), Input(ids.MAPC_FZ, "value"),
+               Input(ids.MAPM_NV, "value"), Input(ids.MAPM_NFZ, "value"), Input(ids.MAPM_MAX, "value"),
                prevent_initial_call=True)
-def remember(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, compared, merit_fz):
+def remember(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, compared, merit_fz, n_v, n_fz, max_size):
     return {"shade": shade, "overlay": ",".join(overlay or []), "fz_min": fz_min, "fz_max": fz_max, "v_min": v_min,
             "v_max": v_max, "resolution": resolution, "compare_config": None if compared == "nes_pd" else compared,
-            "compare_fz": None if merit_fz == 150 else merit_fz}
+            "compare_fz": None if merit_fz == 150 else merit_fz,
+            **{key: None if value == q.spec.default else value for key, q, value in (
+                ("margin_nv", CELLS_V, n_v), ("margin_nfz", CELLS_FZ, n_fz), ("margin_max", MAX_KICK, max_size))}}

@@ -9,7 +9,8 @@ import numpy as np
 from dash import Input, Output, State, dcc, html, no_update
 from plotly.subplots import make_subplots
 
-from shimmy.service import settings
+from shimmy.errors import InvalidParameterError
+from shimmy.service import analyses, settings
 from ui import components as ui
 from ui import fields, ids, jobs
 from ui import style
@@ -31,6 +32,9 @@ STARTS = {"standard": ("standard: psi = 0.001 rad", 0.001, 0.0),
           "lateral": ("large lateral: l_g delta = 0.1 m", 0.0, 0.1),
           "typed": ("values typed below", None, None)}
 WAITING = "Choose an operating point and press Run (a result already in the cache is shown at once)"
+MARGINS_STALE = "Press Compute margins for this operating point (any margins shown are of the previous one)."
+ATTRACTOR_WORDS = {"equilibrium": "straight rolling", "torsional": "torsional limit cycle",
+                   "lateral": "lateral limit cycle", "both": "limit cycle, torsion and lateral bending both large"}
 
 
 def _placeholders(text: str = WAITING) -> tuple:
@@ -43,7 +47,8 @@ def _start_of(psi0, lateral0) -> str:
 
 
 def layout(config: str | None = None, V: str | None = None, Fz: str | None = None, t_end: str | None = None,
-           psi0: str | None = None, lateral0: str | None = None, run: str | None = None, **query):
+           psi0: str | None = None, lateral0: str | None = None, run: str | None = None, map_type: str | None = None,
+           **query):
     config, bad_config = fields.choice("config", config, list(ui.CONFIGS), "nes_pd", "a configuration")
     problems = [bad_config]
     v, problem_v = SPEED.from_url("V", V, 30)
@@ -76,6 +81,7 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
                   *[html.Button(f"{name} ({v} m/s, {f} kN)", id=ids.th_op(name), className="secondary")
                     for name, (v, f) in ui.OPERATING_POINTS.items()]], className="op-buttons"),
         html.Div(" ".join(p for p in problems if p), id=ids.TH_GROUP.error, className="error", role="alert"),
+        html.Div(_bistable_note(map_type), id=ids.TH_BISTABLE, className="note map-note", role="note"),
         html.Div(id=ids.TH_SETTLED, className="settled", role="status"),
         html.Div(id=ids.TH_METRICS, className="metrics"),
         ui.graph(ids.TH_SERIES, figure=series),
@@ -83,6 +89,19 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
                  className="grid-2"),
         ui.downloads(ids.TH_GROUP),
         *jobs.stores(ids.TH_GROUP),
+        dcc.Store(id=ids.TH_KICK),
+        html.H2("Disturbance margins"),
+        html.P("The attractors at this operating point (the stable equilibrium and limit cycles of the bifurcation "
+               "diagram at its load, and any motion the runs from the standard and two large starts settle on), "
+               "and for each the smallest yaw kick psi0 from straight rolling that ends on it, found by a scan of "
+               "kicks and bisection, each checked by two runs just below and just above it. A row's Run button "
+               "runs the time history above from just above its kick: the gear ends on that attractor.",
+               className="hint"),
+        html.Div(jobs.controls(ids.THM, "Compute margins"), className="controls"),
+        html.Div(id=ids.THM.error, className="error", role="alert"),
+        html.Div(id=ids.THM_TABLE, className="table-wrap"),
+        ui.downloads(ids.THM),
+        *jobs.stores(ids.THM),
         # ?run=1 (a click on a map point): run once the page is drawn, as if Run had been pressed.
         dcc.Interval(id=ids.TH_AUTORUN, interval=200, max_intervals=1, disabled=run != "1"),
     )
@@ -109,7 +128,16 @@ def start(choice, psi0, lateral0):
     return _start_of(psi0, lateral0), no_update, no_update
 
 
-def _requests(V, fz_kn, _autorun, config, t_end, psi0, lateral0, design):
+def _bistable_note(map_type):
+    """What the page says when it was opened from a point the map shades Bistable (or Both)."""
+    if map_type == "Bistable":
+        return ("The stability map shades this point Bistable: a torsional and a lateral limit cycle coexist, and "
+                "which one the gear ends on depends on the kick. Compute its disturbance margins below to see how "
+                "large a yaw kick reaches each, and run from there.")
+    return None
+
+
+def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, design):
     t = T_END.read(t_end)
     # The series is thinned for a long run: every t_end the field allows can be drawn.
     series_dt = max(0.002, math.ceil(1000 * t / (settings.MAX_SERIES_POINTS - 1)) / 1000)
@@ -135,10 +163,121 @@ jobs.register(
     notice=lambda results: "" if results[0]["success"] else results[0]["message"],
     outputs=[Output(ids.TH_SERIES, "figure"), Output(ids.TH_SPECTRUM, "figure"), Output(ids.TH_PHASE, "figure"),
              Output(ids.TH_METRICS, "children"), Output(ids.TH_SETTLED, "children")],
-    triggers=[Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_AUTORUN, "n_intervals")],
+    triggers=[Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_AUTORUN, "n_intervals"),
+              Input(ids.TH_KICK, "data")],
     states=[State(ids.TH_CONFIG, "value"), State(ids.TH_TEND, "value"), State(ids.TH_PSI0, "value"),
             State(ids.TH_LAT0, "value"), State(ids.design_store(ids.TH), "data")],
     download=jobs.Download(ids.TH_GROUP, "time_history", _csv_rows, single=True, filename=_file_stem))
+
+
+def _margin_requests(config, V, fz_kn, design):
+    return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "direction": "psi", **design}]
+
+
+def _kick(m, max_size):
+    """An attractor's smallest yaw kick in words."""
+    if not m["reached"]:
+        return f"none up to {max_size:g} rad"
+    if m["value"] == 0.0:
+        return f"0 (already from {m['upper']:g})"
+    return f"{m['value']:.4g} ± {m['tolerance']:.1g}"
+
+
+def _check(m):
+    c = m.get("check")
+    if not c:
+        return "–"
+    sides = [f"{side['size']:.5g} → {side['mode']}" for side in (c["below"], c["above"]) if side is not None]
+    return ("yes" if c["confirmed"] else "NO") + ": " + ", ".join(sides)
+
+
+def margins_table(result):
+    """Each attractor with its amplitudes, smallest yaw kick, its check and a button running from just above it."""
+    rows = []
+    for k, a in enumerate(result["attractors"]):
+        m = a["min_disturbance"]
+        what = ATTRACTOR_WORDS.get(a["mode"], a["mode"]) + (" (simulated)" if a["kind"] == "simulation" else "")
+        if a["standard_start"]:
+            what += " (the standard start ends here)"
+        start = None if not m["reached"] else (STARTS["standard"][1] if m["value"] == 0.0 else m["upper"])
+        button = "–" if start is None else html.Button(f"Run from psi0 = {start:.5g} rad", id=ids.thm_run(k),
+                                                        className="secondary")
+        equilibrium = a["mode"] == "equilibrium"
+        rows.append([what, "0" if equilibrium else f"{a['amplitude']['psi']:.4g}",
+                     "0" if equilibrium else f"{a['amplitude']['lateral']:.4g}",
+                     _kick(m, result["options"]["max_size"]), _check(m), button])
+    saddles = "; ".join(f"{s['mode']}, psi {s['amplitude']['psi']:.4g} rad" for s in result["saddles"])
+    note = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {result['Fz'] / 1e3:g} kN: "
+            f"straight rolling {'stable' if result['straight_rolling_stable'] else 'unstable'}"
+            + (f"; saddle cycles between the basins: {saddles}" if saddles else "")
+            + f". {result['runs']} runs in {result['elapsed_s']:.1f} s.")
+    warnings = [html.P(f"Warning: {w}", className="hint") for w in result["warnings"]]
+    return [html.P(note, className="hint"), ui.table(
+        ["attractor", "max |psi| (rad)", "max |l_g delta| (m)", "min yaw kick psi0 (rad)", "checked (psi0 → end)",
+         "time history"], rows, ids.THM_SUMMARY), *warnings]
+
+
+def _margin_csv(results):
+    r = results[0]
+    rows = [[a["mode"], a["kind"], a["amplitude"]["psi"], a["amplitude"]["lateral"], a["standard_start"],
+             a["min_disturbance"]["value"], a["min_disturbance"]["tolerance"], a["min_disturbance"].get("lower"),
+             a["min_disturbance"].get("upper"), (a["min_disturbance"]["check"] or {}).get("confirmed")]
+            for a in r["attractors"]]
+    return ["mode", "kind", "psi_amplitude_rad", "lateral_amplitude_m", "standard_start", "min_yaw_kick_rad",
+            "tolerance_rad", "lower_rad", "upper_rad", "confirmed"], rows
+
+
+jobs.register(
+    ids.THM, "margins", requests=_margin_requests, render=lambda results: (margins_table(results[0]),),
+    outputs=[Output(ids.THM_TABLE, "children")],
+    follow=[Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value")],
+    states=[State(ids.design_store(ids.TH), "data")], stale=MARGINS_STALE,
+    download=jobs.Download(ids.THM, "disturbance_margins", _margin_csv, single=True,
+                           filename=lambda results: f"margins_{results[0]['config']}_V{results[0]['V']:g}_Fz"
+                                                    f"{results[0]['Fz'] / 1e3:g}kN"),
+    blank=lambda: (None,))
+
+
+@dash.callback(Output(ids.TH_PSI0, "value", allow_duplicate=True), Output(ids.TH_LAT0, "value", allow_duplicate=True),
+               Output(ids.TH_TEND, "value"), Output(ids.TH_CONFIG, "value"),
+               Output(ids.TH_V, "value", allow_duplicate=True), Output(ids.TH_FZ, "value", allow_duplicate=True),
+               Output(ids.TH_KICK, "data"), Input(ids.thm_run(dash.ALL), "n_clicks"),
+               State(ids.THM.requests, "data"), State(ids.TH_TEND, "value"), State(ids.TH_CONFIG, "value"),
+               State(ids.TH_V, "value"), State(ids.TH_FZ, "value"), prevent_initial_call=True)
+def run_from_kick(clicks, requests, t_end, config, V, fz_kn):
+    """A row's Run: the time history from just above that attractor's smallest yaw kick (the start of its check
+    run), for at least as long as the check ran, at the margins' point (the boxes go back to it if they moved)."""
+    nothing = (no_update,) * 7
+    trigger = dash.ctx.triggered_id
+    if not trigger or not any(clicks) or not isinstance(requests, list) or not requests:
+        return nothing
+    try:
+        result = analyses.cached("margins", requests[0])
+    except InvalidParameterError:
+        return nothing
+    k = trigger["index"]
+    if result is None or not isinstance(k, int) or not 0 <= k < len(result["attractors"]):
+        return nothing
+    m = result["attractors"][k]["min_disturbance"]
+    if not m["reached"]:
+        return nothing
+    psi0 = STARTS["standard"][1] if m["value"] == 0.0 else float(f"{m['upper']:.5g}")
+    longest = result["options"]["t_max"]
+    t = t_end if isinstance(t_end, (int, float)) and t_end >= longest else longest
+    point = (result["config"], result["V"], result["Fz"] / 1e3)
+    moved = [new if new != old else no_update for new, old in zip(point, (config, V, fz_kn), strict=True)]
+    return psi0, 0.0, t, *moved, {"attractor": k, "psi0": psi0, "clicks": sum(c or 0 for c in clicks)}
+
+
+# A run asked from the margins' table is drawn at the top of the page: it scrolls up there (the start in the boxes,
+# the run's progress, then where it ends).
+dash.clientside_callback(
+    """
+    function(kick) {
+        if (kick) { window.scrollTo({top: 0, behavior: "smooth"}); }
+    }
+    """,
+    Input(ids.TH_KICK, "data"), prevent_initial_call=True)
 
 
 def _figures(result):
@@ -224,5 +363,13 @@ def _metrics(result):
                Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"), prevent_initial_call=True)
 def remember(config, V, fz, t_end, psi0, lateral0):
     standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
+    moved = dash.ctx.triggered_id in (ids.TH_CONFIG, ids.TH_V, ids.TH_FZ)  # the map's note is of the point opened
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,
-            "lateral0": None if standard else lateral0, "run": None}
+            "lateral0": None if standard else lateral0, "run": None, **({"map_type": None} if moved else {})}
+
+
+@dash.callback(Output(ids.TH_BISTABLE, "children"), Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"),
+               Input(ids.TH_FZ, "value"), prevent_initial_call=True)
+def forget_map_point(_config, _V, _fz):
+    """The note on the map's point goes once another point is chosen."""
+    return None

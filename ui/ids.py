@@ -198,10 +198,21 @@ TH_SERIES = "th-series"
 TH_SPECTRUM = "th-spectrum"
 TH_PHASE = "th-phase"
 TH_AUTORUN = "th-autorun"
+TH_KICK = "th-kick"  # a run asked from the margins' table (its start already in the boxes)
+TH_BISTABLE = "th-bistable"  # the note that the map shades the point Bistable
+THM = Group("thm")  # the point's disturbance margins
+THM_TABLE = "thm-table"
+THM_SUMMARY = "thm-summary"
+THM_RUN_TYPE = "thm-run"  # {"type", "index"}: the run button of an attractor's row
 
 
 def th_op(name: Any) -> dict[str, Any]:
     return {"type": TH_OP_TYPE, "name": name}
+
+
+def thm_run(index: Any) -> dict[str, Any]:
+    """The button that runs the time history from the smallest kick to attractor ``index`` (or ALL)."""
+    return {"type": THM_RUN_TYPE, "index": index}
 
 
 # -- Bifurcation (/bifurcation) ----------------------------------------------------------------------------
@@ -243,6 +254,15 @@ MAPC_FZ = "mapc-fz"
 MAPC_GRAPH = "mapc-graph"
 MAPC_TABLE = "mapc-table"
 MAPC_SUMMARY = "mapc-summary"
+MAPM = Group("mapm")  # the disturbance margins on the map
+MAPM_NV = "mapm-nv"
+MAPM_NFZ = "mapm-nfz"
+MAPM_MAX = "mapm-max"
+MAPM_GRAPH = "mapm-graph"
+MAPM_HINT = "mapm-hint"
+MAPM_TABLE = "mapm-table"
+MAPM_SUMMARY = "mapm-summary"
+MAPM_NAV = "mapm-nav"
 
 # -- Ground run (/ground-run) ------------------------------------------------------------------------------
 

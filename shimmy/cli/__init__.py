@@ -50,6 +50,7 @@ examples:
   python -m shimmy hopf --config nes --Fz 150000
   python -m shimmy simulate --config original --V 50 --Fz 850000 --t-end 60
   python -m shimmy margins --config original --V 50 --Fz 550000 --direction psi
+  python -m shimmy margin-map --config nes --n-v 20 --n-fz 10
   python -m shimmy map --config nes_pd --resolution 10 --json > map.json
   python -m shimmy study --param e_p --values 0.0005,0.001,0.005 --configs nes,nes_pd
 

@@ -227,6 +227,17 @@ def basins(request: dict[str, Any], progress: Progress | None = None) -> dict[st
                       **{name: request[name] for name in ("radius", "samples", "seed", "t_max")}).to_dict()
 
 
+@serves("margin_map", sync=False, job=True)
+def margin_map(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
+    """Margins on the cells of a plane: the loads' diagrams, then the cells, through the executor of this
+    environment."""
+    from ..analyses.maps.margin_map import margin_map as run_margin_map
+
+    return run_margin_map(request["config"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
+                          fz_range=(request["fz_min"], request["fz_max"]), n_v=request["n_v"], n_fz=request["n_fz"],
+                          max_size=request["max_size"], progress=progress).to_dict()
+
+
 def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str, Any]:
     """A ground-run preset's table rows [t, V, Fz], its complete settings, each setting's range and
     its assumptions, for a profile editor (a table of a few hundred points: nothing to cache)."""

@@ -1,4 +1,5 @@
-"""``python -m shimmy margins`` and ``basins``: the JSON the issue asks for, the text, the shared cache, bad input."""
+"""``python -m shimmy margins``, ``basins`` and ``margin-map``: the JSON the issue asks for, the text, the shared
+cache, bad input."""
 
 from __future__ import annotations
 
@@ -10,6 +11,9 @@ import sys
 import pytest
 
 POINT = ("--config", "original", "--V", "50", "--Fz", "550000")
+#: 2 x 2 cells centred on V 60 and 100 m/s, Fz 600 and 800 kN: three bistable, one lateral only.
+PLANE = ("--config", "original", "--v-min", "40", "--v-max", "120", "--fz-min", "500000", "--fz-max", "900000",
+         "--n-v", "2", "--n-fz", "2")
 
 
 def run(*args, env=None):
@@ -44,12 +48,32 @@ def test_basins_json_counts_every_kick():
     assert all(a["basin"]["ci95"][0] <= a["basin"]["fraction"] <= a["basin"]["ci95"][1] for a in data["attractors"])
 
 
+def test_margin_map_json_gives_each_cell_its_margin_and_the_cache_answers_again(tmp_path):
+    env = {**os.environ, "SHIMMY_CACHE_DIR": str(tmp_path)}
+    out = run("margin-map", *PLANE, "--json", "--progress", "none", env=env)
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["cache"] == "miss" and data["direction"] == "psi" and data["unit"] == "rad"
+    assert data["V"] == [60.0, 100.0] and data["Fz"] == [600000.0, 800000.0]
+    assert [(p["V"], p["Fz"]) for p in data["points"]] == [(60.0, 6e5), (100.0, 6e5), (60.0, 8e5)]
+    for p in data["points"]:
+        assert {"margin", "tolerance", "lower", "upper", "confirmed", "attractors", "worst"} <= set(p)
+        assert p["attractors"][p["worst"]]["mode"] == "torsional" and 0 < p["margin"] < 0.4 and p["confirmed"]
+    assert "torsional limit cycle" in data["worst"] and data["counts"]["bistable"] == 3
+    text = run("margin-map", *PLANE, env=env)
+    assert text.returncode == 0 and "3 cells with two or more attractors (3 Bistable)" in text.stdout
+    assert text.stdout.rstrip().endswith(f"answered from the shared cache ({tmp_path})")
+
+
 @pytest.mark.parametrize("args, needle", [
     (("margins", *POINT, "--direction", "yaw"), "argument --direction: invalid choice: 'yaw'"),
     (("margins", *POINT, "--rtol", "0"), "rtol=0 is out of range; allowed: a number in [0.0001, 0.1]"),
     (("margins", *POINT, "--min-size", "0.05", "--max-size", "0.01"), "min_size=0.05 must be below max_size"),
     (("margins", "--config", "original", "--V", "0", "--Fz", "550000"), "V=0 is out of range"),
     (("basins", *POINT, "--samples", "3"), "samples=3 is out of range; allowed: an integer in [10, 5000]"),
+    (("margin-map", "--config", "original", "--n-v", "1"), "n_v=1 is out of range; allowed: an integer in [2, 60]"),
+    (("margin-map", "--config", "original", "--fz-min", "500000", "--fz-max", "400000"), "must exceed fz_min"),
+    (("margin-map", "--config", "original", "--max-size", "3"), "max_size=3 is out of range"),
 ])
 def test_bad_input_exits_2_naming_the_field(args, needle):
     out = run(*args)

@@ -1,4 +1,4 @@
-"""Disturbance margins and basin fractions as service analyses: canonical requests, refusals by field, the
+"""Disturbance margins, basin fractions and margin maps as service analyses: canonical requests, refusals by field, the
 runner's answer (the package's, cached), the job over HTTP."""
 
 from __future__ import annotations
@@ -8,11 +8,14 @@ import time
 import pytest
 
 from shimmy.analyses.core.executors import InlineExecutor
+from shimmy.analyses.maps.margin_map import margin_map
 from shimmy.analyses.maps.margins import margins
 from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses, cache, schemas
 
 POINT = {"config": "original", "V": 50, "Fz": 550000}
+#: 2 x 2 cells centred on V 60 and 100 m/s, Fz 600 and 800 kN.
+PLANE = {"config": "original", "v_min": 40, "v_max": 120, "fz_min": 500000, "fz_max": 900000, "n_v": 2, "n_fz": 2}
 
 
 def test_canonical_requests_fill_the_defaults_of_the_analysis():
@@ -23,6 +26,9 @@ def test_canonical_requests_fill_the_defaults_of_the_analysis():
         ("psi", 0.4, 0.001, 12, 0.005, 80.0)
     basin = schemas.validate("basins", POINT)
     assert (basin["radius"], basin["samples"], basin["seed"]) == (0.2, 200, 0)
+    plane = schemas.validate("margin_map", {"config": "nes"})
+    assert (plane["v_min"], plane["v_max"], plane["fz_min"], plane["fz_max"]) == (1.0, 200.0, 10e3, 900e3)
+    assert (plane["n_v"], plane["n_fz"], plane["max_size"]) == (20, 10, 0.4)
 
 
 @pytest.mark.parametrize("analysis, body, field, message", [
@@ -35,10 +41,16 @@ def test_canonical_requests_fill_the_defaults_of_the_analysis():
     ("basins", {"samples": 1e6}, "samples", r"allowed: an integer in \[10, 5000\]"),
     ("basins", {"radius": 0}, "radius", r"allowed: a number in \[0.001, 1\] rad"),
     ("basins", {"kicks": 3}, "kicks", "unknown field"),
+    ("margin_map", {"n_v": 1}, "n_v", r"allowed: an integer in \[2, 60\]"),
+    ("margin_map", {"n_fz": 41}, "n_fz", r"allowed: an integer in \[2, 40\]"),
+    ("margin_map", {"fz_min": 5e5, "fz_max": 4e5}, "fz_max", "must exceed fz_min"),
+    ("margin_map", {"max_size": 0.001}, "max_size", r"allowed: a number in \[0.002, 1\] rad"),
+    ("margin_map", {"V": 50}, "V", "unknown field"),
 ])
 def test_refusals_name_the_field(analysis, body, field, message):
+    base = PLANE if analysis == "margin_map" else POINT
     with pytest.raises(InvalidParameterError, match=message) as info:
-        schemas.validate(analysis, {**POINT, **body})
+        schemas.validate(analysis, {**base, **body})
     assert info.value.field == field
 
 
@@ -51,6 +63,17 @@ def test_the_service_answer_is_the_package_answer_and_is_cached(tmp_path, monkey
     assert result["attractors"] == direct["attractors"]
     again, cached = analyses.run("margins", POINT)
     assert cached and again == result
+
+
+def test_the_margin_map_of_the_service_is_the_package_map(tmp_path, monkeypatch):
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("SHIMMY_WORKERS", "1")
+    result, cached = analyses.run("margin_map", PLANE)
+    assert not cached
+    direct = margin_map("original", v_range=(40.0, 120.0), fz_range=(5e5, 9e5), n_v=2, n_fz=2,
+                        executor=InlineExecutor()).to_dict()
+    assert result["points"] == direct["points"] and result["counts"] == direct["counts"]
+    assert analyses.run("margin_map", PLANE)[1]
 
 
 def test_margins_and_basins_jobs_over_http(server):
@@ -76,3 +99,18 @@ def test_margins_and_basins_jobs_over_http(server):
     props = doc["components"]["schemas"]["job_margins"]["properties"]
     assert props["direction"]["enum"][:5] == ["psi", "dpsi", "delta", "ddelta", "energy"]
     assert "job_basins" in doc["components"]["schemas"]
+    props = doc["components"]["schemas"]["job_margin_map"]["properties"]
+    assert (props["n_v"]["maximum"], props["n_fz"]["maximum"]) == (60, 40)
+
+
+def test_a_margin_map_job_over_http(server):
+    status, _, job = server.request("POST", "/api/v1/jobs", {"analysis": "margin_map", **PLANE})
+    assert status == 202, job
+    deadline = time.time() + 180
+    while job["status"] in ("queued", "running") and time.time() < deadline:
+        time.sleep(0.3)
+        _, _, job = server.request("GET", f"/api/v1/jobs/{job['id']}")
+    assert job["status"] == "done", job
+    assert [p["V"] for p in job["result"]["points"]] == [60.0, 100.0, 60.0]
+    status, _, answer = server.request("POST", "/api/v1/jobs", {"analysis": "margin_map", **PLANE, "n_v": 100})
+    assert status == 422 and answer["field"] == "n_v"

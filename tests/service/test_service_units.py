@@ -46,7 +46,7 @@ def test_every_analysis_is_declared_once_with_its_schema_and_runner():
         assert a.schema is schemas.SCHEMAS[name] and (a.sync or a.job), name
     assert analyses.SYNC_ANALYSES == ("simulate", "hopf", "stability", "devices", "sensitivity")
     assert analyses.JOB_ANALYSES == ("simulate", "bifurcation", "hopf_curves", "map", "study", "ground_run",
-                                     "sensitivity", "optimise", "robustness", "margins", "basins")
+                                     "sensitivity", "optimise", "robustness", "margins", "basins", "margin_map")
 
 
 def test_openapi_fields_match_the_schemas():

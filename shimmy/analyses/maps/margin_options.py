@@ -17,7 +17,8 @@ DIRECTIONS = (*COMPONENTS, "energy")
 #: (low, high, unit, integer) of every numeric setting.
 LIMITS = {"max_size": (0.002, 1.0, "rad", False), "min_size": (1e-5, 0.1, "rad", False),
           "scan_points": (4, 40, "", True), "rtol": (1e-4, 0.1, "", False), "t_max": (10.0, 600.0, "s", False),
-          "radius": (1e-3, 1.0, "rad", False), "samples": (10, 5000, "", True), "seed": (0, 2 ** 31 - 1, "", True)}
+          "radius": (1e-3, 1.0, "rad", False), "samples": (10, 5000, "", True), "seed": (0, 2 ** 31 - 1, "", True),
+          "n_v": (2, 60, "", True), "n_fz": (2, 40, "", True)}
 
 
 def _check(name: str, value: Any) -> float:
@@ -75,3 +76,19 @@ class BasinOptions:
         return dict(self.__dict__)
 
 
+
+
+@dataclass(frozen=True)
+class MapGrid:
+    """The cells of a margin map (:mod:`shimmy.analyses.maps.margin_map`): ``n_v`` speeds by ``n_fz`` loads, the
+    plane cut into equal cells, each asked at its centre."""
+
+    n_v: int = 20
+    n_fz: int = 10
+
+    def __post_init__(self):
+        object.__setattr__(self, "n_v", _check("n_v", self.n_v))
+        object.__setattr__(self, "n_fz", _check("n_fz", self.n_fz))
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)

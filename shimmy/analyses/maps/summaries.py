@@ -117,3 +117,44 @@ def basins_summary(result: dict[str, Any]) -> str:
     lines.append(f"  {result['runs']} runs in {result['elapsed_s']:.1f} s ({result['executor']})")
     lines += [f"  warning: {w}" for w in result["warnings"]]
     return "\n".join(lines)
+
+
+def _margin_cell(point: dict[str, Any] | None, max_size: float) -> str:
+    if point is None:
+        return "."
+    if point["margin"] is None:
+        return f">{max_size:g}" if point["worst"] is not None else "none"
+    return ("0" if point["margin"] == 0.0 else f"{point['margin']:.3g}") + ("?" if point["confirmed"] is False else "")
+
+
+def margin_map_summary(result: dict[str, Any]) -> str:
+    """The lines ``python -m shimmy margin-map`` prints, from ``MarginMapResult.to_dict()``: the cells, how many
+    hold two or more attractors, and the smallest yaw kick to torsional shimmy in each computed cell, as a table of
+    speeds (rows) by loads (columns)."""
+    c, o = result["counts"], result["options"]
+    v_range, fz_range = result["v_range"], result["fz_range"]
+    lines = [f"{result['config']}: disturbance margins on {result['grid']['n_v']} x {result['grid']['n_fz']} cells, "
+             f"V {v_range[0]:g}..{v_range[1]:g} m/s, Fz {fz_range[0] / 1e3:g}..{fz_range[1] / 1e3:g} kN "
+             f"({result['elapsed_s']:.1f} s, {result['executor']})",
+             f"  {c['multistable']} cells with two or more attractors ({c['bistable']} Bistable); {c['computed']} "
+             f"with a torsional cycle, computed: " + ", ".join(f"{t} {n}" for t, n in c["by_type"].items()),
+             f"  worst shimmy: {result['worst']}",
+             f"  min yaw kick from straight rolling to it (rad): 0 = the smallest kick scanned ({o['min_size']:g} rad) "
+             f"already ends there, >{o['max_size']:g} = none up to {o['max_size']:g} rad, ? = not confirmed, . = one "
+             "attractor or no torsional cycle"]
+    points = {(p["Fz"], p["V"]): p for p in result["points"]}
+    rows = [V for V in result["V"] if any((Fz, V) in points for Fz in result["Fz"])]
+    if rows:
+        corner = "V \\ Fz (kN)"
+        lines.append("  " + f"{corner:>12}" + "".join(f"{Fz / 1e3:>8.4g}" for Fz in result["Fz"]))
+        for V in rows:
+            lines.append("  " + f"{V:>12.4g}" + "".join(f"{_margin_cell(points.get((Fz, V)), o['max_size']):>8}"
+                                                         for Fz in result["Fz"]))
+    smallest = result["smallest"]
+    if smallest is not None:
+        lines.append(f"  smallest margin above 0: {smallest['margin']:.4g} rad +- {smallest['tolerance']:.2g} at "
+                     f"V = {smallest['V']:.4g} m/s, Fz = {smallest['Fz'] / 1e3:.4g} kN")
+    lines.append(f"  {c['reached']} margins ({c['zero']} of them 0), {c['not_reached']} not reached, "
+                 f"{c['unconfirmed']} not confirmed; {c['runs']} runs; each margin within {o['rtol']:g} of itself")
+    lines += [f"  warning: {w}" for w in result["warnings"]]
+    return "\n".join(lines)

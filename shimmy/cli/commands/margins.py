@@ -1,10 +1,12 @@
-"""Disturbances at one operating point: ``margins`` (how large a kick reaches each attractor) and ``basins``
-(the share of kicks up to a size that ends on each)."""
+"""Disturbances: at one operating point ``margins`` (how large a kick reaches each attractor) and ``basins`` (the
+share of kicks up to a size that ends on each); over the plane ``margin-map`` (in each cell where torsional shimmy
+coexists with another attractor, the smallest yaw kick that starts it)."""
 
 from __future__ import annotations
 
 from ..answers import add_no_cache, answer, design, emit, numbers, request
-from ..common import add_command, add_field, add_operating_point, add_progress, progress
+from ..common import (add_command, add_common, add_config, add_field, add_operating_point, add_plane, add_progress,
+                      progress)
 
 
 def _ask(args, analysis: str, settings: tuple[str, ...], extra: dict | None = None):
@@ -31,6 +33,18 @@ def _cmd_basins(args) -> int:
     return 0
 
 
+def _cmd_margin_map(args) -> int:
+    from ...analyses.maps.summaries import margin_map_summary
+
+    canonical = request("margin_map", {"config": args.config, "params": design(args),
+                                       **numbers("margin_map", args, "v_min", "v_max", "fz_min", "fz_max", "n_v",
+                                                 "n_fz", "max_size")})
+    with progress(args) as bar:
+        result = answer(args, "margin_map", canonical, bar)
+    emit(result.result, [result], args.json, margin_map_summary(result.result))
+    return 0
+
+
 def add_parsers(commands) -> None:
     p = add_command(commands, "margins", "disturbance margins at one operating point: its attractors and the "
                     "smallest kick from straight rolling that ends on each, each checked by two runs", _cmd_margins)
@@ -54,5 +68,17 @@ def add_parsers(commands) -> None:
     add_field(p, "basins", "--samples", "kicks sampled", limits=True)
     add_field(p, "basins", "--seed", "seed of the samples", limits=True)
     add_field(p, "basins", "--t-max", "longest run", limits=True)
+    add_progress(p)
+    add_no_cache(p)
+
+    p = add_command(commands, "margin-map", "disturbance margins on the map: in each cell of the plane where a "
+                    "torsional cycle coexists with another attractor, the smallest yaw kick from straight rolling "
+                    "that ends on it", _cmd_margin_map)
+    add_config(p)
+    add_plane(p, "margin_map")
+    add_field(p, "margin_map", "--n-v", "cells in V, each asked at its centre", limits=True)
+    add_field(p, "margin_map", "--n-fz", "cells in Fz, each asked at its centre", limits=True)
+    add_field(p, "margin_map", "--max-size", "largest yaw kick scanned", limits=True)
+    add_common(p)
     add_progress(p)
     add_no_cache(p)
