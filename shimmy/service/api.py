@@ -348,7 +348,8 @@ def openapi_document() -> dict[str, Any]:
                     "whatever was wrong; field: Authorization)",
                     "headers": {"WWW-Authenticate": {"schema": {"type": "string"}}}}
     forbidden = {**refusal, "description": "the credential's scope does not allow this request"}
-    busy_headers = {"Retry-After": {"description": "seconds to wait before trying again", "schema": {"type": "integer"}},
+    busy_headers = {"Retry-After": {"description": "seconds to wait before trying again",
+                                    "schema": {"type": "integer"}},
                     "X-Shimmy-Limit": {"description": "the limit that refused the request: "
                                        + ", ".join(admission.LIMITS), "schema": {"type": "string",
                                                                                   "enum": list(admission.LIMITS)}}}
@@ -412,7 +413,7 @@ def openapi_document() -> dict[str, Any]:
             "responses": guarded({
                 "202": {**job, "description": "accepted"}, "400": err, "408": err, "413": err, "415": err, "422": err,
                 "429": {**refusal, "description": "not queued: the job queue is full, this user has "
-                        f"SHIMMY_MAX_JOBS_PER_USER jobs queued or running, or the last places of the queue are kept "
+                        "SHIMMY_MAX_JOBS_PER_USER jobs queued or running, or the last places of the queue are kept "
                         "for other users' first jobs", "headers": busy_headers}}, "compute")},
         "get": {
             "summary": "every job record with who asked for it, the total, the queue and the jobs per user "

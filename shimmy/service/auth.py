@@ -1,6 +1,6 @@
 """Who may use the service: every request is checked, but ``GET /api/v1/health``.
 
-``SHIMMY_AUTH`` (:func:`shimmy.service.settings.auth_mode`): ``none``, the default while the server
+``SHIMMY_AUTH`` (``shimmy.service.settings.auth_mode``): ``none``, the default while the server
 listens on loopback only, lets every request in as one anonymous user with every right; ``token``,
 the default (and the only choice, unless ``SHIMMY_ALLOW_ANONYMOUS=1``) when it listens beyond
 loopback, asks each request for a credential:

@@ -229,7 +229,8 @@ def test_the_workbench_signs_in_with_a_token_into_a_session_cookie(team):
     assert login(team.tokens["alice"][1], "https://evil.example/")[1]["Location"] == "/"
     value = session["Cookie"]
     tampered = {"Cookie": value[:-2] + ("AA" if not value.endswith("AA") else "BB")}
-    assert raw(team, "POST", "/_dash-update-component", body, {**tampered, "Content-Type": "application/json"})[0] == 401
+    json_type = {"Content-Type": "application/json"}
+    assert raw(team, "POST", "/_dash-update-component", body, {**tampered, **json_type})[0] == 401
     status, headers, _ = raw(team, "POST", "/logout", b"", {**session, **form})
     assert status == 303 and headers["Location"] == "/login" and "shimmy_session=;" in _cookie(headers)
 
