@@ -67,6 +67,8 @@ class Principal:
 
 #: Everyone, when the server does not check (SHIMMY_AUTH=none): one user with every right.
 ANONYMOUS = Principal("anonymous", "admin")
+#: A request the server checks but did not authorise (health, the sign-in page): the least right.
+NOBODY = Principal("nobody", "read", None, "unchecked")
 
 
 def enabled() -> bool:
@@ -81,10 +83,11 @@ def _mode(*_environment) -> str:
 
 
 def current() -> Principal:
-    """The principal of the request being served (ANONYMOUS outside a request or with auth off)."""
+    """The principal of the request being served: ANONYMOUS outside a request or with auth off, NOBODY for a
+    request that was not authorised (health, the sign-in page)."""
     if not flask.has_request_context():
         return ANONYMOUS
-    return flask.g.get("principal") or ANONYMOUS
+    return flask.g.get("principal") or (NOBODY if enabled() else ANONYMOUS)
 
 
 # -- credentials ------------------------------------------------------------------------------------
