@@ -8,14 +8,20 @@ call :mod:`shimmy.service.analyses` for quick answers and submit long ones as jo
 
 from __future__ import annotations
 
+import logging
 import os
 
 from dash import Dash
 
-from shimmy.service import settings
-from shimmy.service.api import api
+from shimmy.service import auth, settings, tokens
+from shimmy.service.api import PREFIX, api
 
 settings.cache_dir()  # refuse to start on a cache directory that is not private to this user
+# refuse to start with SHIMMY_AUTH=none beyond loopback (unless SHIMMY_ALLOW_ANONYMOUS=1), or oidc (not built)
+if settings.auth_mode() == "token" and not tokens.listed():
+    logging.getLogger(__name__).warning("SHIMMY_AUTH=token and no API token yet: every request but health is "
+                                        "refused; create one with python -m shimmy tokens create --user NAME "
+                                        "--scope admin")
 
 
 class Workbench(Dash):
@@ -33,6 +39,7 @@ app = Workbench(__name__, use_pages=True, title="shimmy workbench", suppress_cal
 server = app.server
 server.config["MAX_CONTENT_LENGTH"] = settings.MAX_BODY_BYTES
 server.register_blueprint(api)
+auth.install(server, PREFIX)  # before the callback guard: who may ask is checked before what is asked
 
 from ui import guard, jobs, layout  # noqa: E402  (needs the registered pages)
 

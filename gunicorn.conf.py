@@ -5,9 +5,21 @@ The arbiter becomes the child subreaper of everything started below it: a job wo
 web worker died (killed, timed out, restarted) is adopted by the arbiter instead of PID 1,
 and the arbiter's SIGCHLD handler reaps every child it has (gunicorn reaps unknown children),
 so no job process is left a zombie where PID 1 does not reap (a bare container or sandbox).
+
+Who may use the server depends on where it listens: ``on_starting`` reads gunicorn's ``bind``
+setting (``--bind``, ``GUNICORN_CMD_ARGS`` or this file) and passes it to the app and its workers
+as ``SHIMMY_LISTEN``; an address beyond loopback makes ``SHIMMY_AUTH=token`` the default and
+refuses ``SHIMMY_AUTH=none`` unless ``SHIMMY_ALLOW_ANONYMOUS=1`` (shimmy.service.settings.auth_mode).
+The server refuses to start then, saying why, before it binds anything.
+
+Restarts: ``on_starting`` queues again the jobs whose process ended with the previous server (or
+fails them, saying why, past the restarts allowed); each web worker starts the queued jobs on free
+slots once its kernels are loaded (``post_worker_init``); ``on_exit`` (a graceful stop) ends the
+running jobs' processes and queues them again at the head of the queue (shimmy.service.jobs).
 """
 
 import ctypes
+import os
 import sys
 
 # Slow clients: gunicorn's asyncio worker reads every connection in its event loop and the WSGI
@@ -22,11 +34,39 @@ def on_starting(server):
         libc = ctypes.CDLL(None, use_errno=True)
         if libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) != 0:
             server.log.warning("could not become the child subreaper (errno %d)", ctypes.get_errno())
+    os.environ["SHIMMY_LISTEN"] = ",".join(server.cfg.bind or [])
+    from shimmy.service import cache, jobs, settings
+
+    mode = settings.auth_mode()  # AuthSettingError (a RuntimeError): gunicorn prints it and exits with status 1
+    server.log.info("listening on %s: authentication %s", os.environ["SHIMMY_LISTEN"], mode)
+    recovered = jobs.server_started()
+    if recovered["requeued"] or recovered["failed"]:
+        server.log.warning("jobs whose process ended with the previous server: %d queued again, %d failed",
+                           len(recovered["requeued"]), len(recovered["failed"]))
+    cache.close_all()  # no database connection of the arbiter's is inherited by the workers it forks
 
 
 def post_worker_init(worker):
     """Load the numba kernels before the worker takes requests (shimmy.service.warmup), so that no
-    user's first answer waits for them."""
+    user's first answer waits for them; then start queued jobs on free slots (after a restart)."""
+    from shimmy.service import jobs
     from shimmy.service.warmup import warm_kernels
 
     worker.log.info("kernels loaded in %.1f s", warm_kernels())
+    try:
+        jobs.pump()
+    except Exception as exc:  # noqa: BLE001 - a broken store is reported by health; the worker must serve
+        worker.log.error("queued jobs not started: %s", exc)
+
+
+def on_exit(server):
+    """A graceful stop: the running jobs' processes end and their jobs wait queued for the next start."""
+    from shimmy.service import jobs
+
+    try:
+        again = jobs.server_stopping()
+    except Exception as exc:  # noqa: BLE001 - the server stops anyway; the next start fails them or runs them
+        server.log.error("running jobs not queued again: %s", exc)
+        return
+    if again:
+        server.log.info("%d running job(s) queued again for the next start", len(again))

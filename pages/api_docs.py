@@ -47,7 +47,9 @@ def layout(**query):
     sections = [ui.header("HTTP API", f"JSON over HTTP under {PREFIX}, described by the OpenAPI document at "
                           f"{PREFIX}/openapi.json (generated from the request schemas below). Every bad input gets "
                           "a 4xx answer {\"error\", \"field\", \"allowed\"} naming the field; long analyses run as "
-                          "jobs."),
+                          "jobs. A server that asks for tokens (SHIMMY_AUTH=token) takes every request but health with "
+                          "Authorization: Bearer TOKEN (python -m shimmy tokens create --user NAME --scope compute); "
+                          "401 without a good one, 429 with Retry-After beyond a limit."),
                 ui.table(["method", "path", "what"], endpoint_rows, ids.API_ENDPOINTS),
                 html.P([html.A("openapi.json", href=f"{PREFIX}/openapi.json"), " · limits: body at most "
                         f"{settings.MAX_BODY_BYTES} bytes, t_end at most {settings.MAX_T_END:g} s, ntst at most "

@@ -6,7 +6,7 @@ import dash
 from dash import Input, Output, State, html, no_update
 
 from shimmy.errors import InvalidParameterError
-from shimmy.service import analyses
+from shimmy.service import admission, analyses
 from ui import components as ui
 from ui import ids, style
 from ui.layout import page
@@ -38,6 +38,8 @@ def update(design):
         result, _ = analyses.run("devices", design)
     except InvalidParameterError as exc:
         return no_update, no_update, no_update, no_update, str(exc), True, True
+    except admission.Busy as exc:
+        return no_update, no_update, no_update, no_update, f"The service is busy: {exc}.", no_update, no_update
     nes = result["nes"]
     torque = style.figure("NES restoring torque", "relative rotation a = psi - psis (rad)", "torque M (N m)")
     torque.add_scatter(x=nes["angle"], y=nes["torque_exact"], name="exact geometry", line={"color": "#000"})

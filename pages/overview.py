@@ -6,7 +6,7 @@ import dash
 from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.errors import InvalidParameterError
-from shimmy.service import analyses, neighbours
+from shimmy.service import admission, analyses, neighbours
 from plotly.subplots import make_subplots
 
 from ui import compare, designs, formats, ids, jobs, live
@@ -93,6 +93,8 @@ def update(design, fz_kn, v_max):
         if dash.ctx.triggered_id is None:  # the first drawing: the layout already says what of the address failed
             return no_update, no_update, no_update, no_update, True, True, no_update
         return no_update, no_update, no_update, str(exc), True, True, no_update
+    except admission.Busy as exc:  # the service is busy: say so, keep what is drawn
+        return no_update, no_update, no_update, f"The service is busy: {exc}.", no_update, no_update, no_update
     traces = []
     rows = []
     base = result["configs"]["original"]["unstable_intervals"]
@@ -157,6 +159,8 @@ def compare_designs(selection, saved, current, fz_kn, v_max):
         results = [analyses.run("stability", {**body, **d.request()})[0] for d in chosen]
     except InvalidParameterError as exc:
         return compare.swatches(names), no_update, no_update, str(exc)
+    except admission.Busy as exc:
+        return compare.swatches(names), no_update, no_update, f"The service is busy: {exc}."
     table = designs.comparison(names, results, designs.hopf_figures(CONFIGS, style.CONFIG_LABELS))
     shown = [name for name, _ in compare.series(names)]
     return compare.swatches(names), intervals_figure(results, shown), compare.table(table, ids.OV_CMP_SUMMARY), ""

@@ -5,7 +5,7 @@ from __future__ import annotations
 import dash
 from dash import Input, Output, State, dcc, html, no_update
 
-from shimmy.service import analyses
+from shimmy.service import admission, analyses
 from ui import components as ui
 from ui import formats, ids
 from ui.layout import page
@@ -48,6 +48,16 @@ def _amplitude(config, V, params=None, material=None):
 @dash.callback(Output(ids.VAL_CONTENT, "children"), Output(ids.VAL_DATA, "data"), Output(ids.VAL_GROUP.csv, "disabled"),
                Output(ids.VAL_GROUP.json, "disabled"), Input(ids.VAL_RUN, "n_clicks"))
 def build(_n):
+    """The tables (about ten quick analyses, each answered from the cache or computed under the service's
+    admission control); when the service is too busy, a line saying so and the Recompute button."""
+    try:
+        return _tables()
+    except admission.Busy as exc:
+        return (html.P(f"The service is busy: {exc}. Press Recompute to try again.", className="error",
+                       role="alert"), no_update, True, True)
+
+
+def _tables():
     rows = []
     for config, published in PUBLISHED_HOPF.items():
         computed = _hopf(config)

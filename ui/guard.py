@@ -1,5 +1,6 @@
 """The server's front door: security headers on every response, and a 400 naming what is wrong
-for a malformed request to the Dash callback endpoint.
+for a malformed request to the Dash callback endpoint. (Who may send it is checked before, by
+:func:`shimmy.service.auth.install`: app.py installs it first.)
 
 Headers: ``X-Content-Type-Options: nosniff``, ``X-Frame-Options: DENY``, ``Referrer-Policy:
 no-referrer`` and a Content-Security-Policy under which the pages work: scripts only from this
@@ -24,7 +25,8 @@ from typing import Any
 import flask
 from werkzeug.exceptions import HTTPException
 
-from shimmy.service.api import RequestRefused, parse_json
+from shimmy.service.admission import Busy
+from shimmy.service.api import RequestRefused, error, parse_json
 
 log = logging.getLogger(__name__)
 
@@ -71,6 +73,8 @@ def install(app) -> None:
     def _unexpected(exc: Exception):
         if isinstance(exc, HTTPException):
             return exc
+        if isinstance(exc, Busy):  # a limit of the admission control that a page did not catch itself
+            return error(str(exc), exc.field, exc.allowed, 429, exc.headers())
         if flask.request.path == path:
             log.warning("callback refused its inputs: %s", exc, exc_info=exc)
             return BadCallback(f"the callback could not use the values sent ({type(exc).__name__}: {exc})"[:400],

@@ -41,7 +41,7 @@ import flask
 from dash import ClientsideFunction, Input, Output, State, dcc, html, no_update
 
 from shimmy.errors import InvalidParameterError
-from shimmy.service import cache, jobs, schemas, settings
+from shimmy.service import admission, cache, jobs, schemas, settings
 from shimmy.service.api import RequestRefused, parse_json
 
 from . import components, ids as shell_ids
@@ -208,7 +208,7 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         try:
             for r, done in zip(wanted, results, strict=True):
                 if done is None:
-                    ids.append(jobs.submit_canonical(analysis, r, watcher)["id"])
+                    ids.append(jobs.submit_canonical(analysis, r, watcher, user=admission.requester())["id"])
         except jobs.QueueFull as exc:
             _release(ids, watcher)
             _release(before, before_watcher)

@@ -9,6 +9,7 @@ from dash import ALL, Input, Output, State, dcc, html
 
 from shimmy.errors import InvalidParameterError
 from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS, Parameters
+from shimmy.service import auth
 
 from . import formats, ids, sessions, state
 
@@ -123,8 +124,11 @@ def navigation() -> html.Nav:
              for p in dash.page_registry.values()]
     toggle = html.Button("Design", id=ids.DESIGN_TOGGLE, className="nav-toggle",
                          title="Hide or show the design panel", **{"aria-pressed": "true"})
+    # Signed in (SHIMMY_AUTH=token): a form that ends the session (a POST: no other site's link can).
+    out = [html.Form(html.Button("Sign out", type="submit", className="secondary nav-signout"),
+                     action=auth.LOGOUT_PATH, method="post", className="nav-signout-form")] if auth.enabled() else []
     return html.Nav([toggle, html.Span("shimmy", className="brand"), html.Span("workbench", className="brand-sub"),
-                     *links], className="navbar")
+                     *links, *out], className="navbar")
 
 
 def shell() -> html.Div:

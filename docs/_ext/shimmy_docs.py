@@ -172,6 +172,29 @@ class Limits(SphinxDirective):
             ["heartbeat of a job worker on another host", f"{settings.JOB_STALE_SECONDS:g} s",
              _literal("SHIMMY_JOB_STALE_SECONDS")],
             ["requests per workbench action", f"{settings.MAX_PAGE_REQUESTS}", "–"],
+            ["jobs queued or running per user", f"{settings.MAX_JOBS_PER_USER}",
+             _literal("SHIMMY_MAX_JOBS_PER_USER")],
+            ["jobs running at once per user", "all slots but one (1 of 2)",
+             _literal("SHIMMY_MAX_RUNNING_JOBS_PER_USER")],
+            ["queue places kept for users with no job waiting", "a quarter of the queue (2 of 8)",
+             _literal("SHIMMY_QUEUE_RESERVED")],
+            ["finished job records kept", f"{settings.JOB_RETENTION_HOURS:g} h",
+             _literal("SHIMMY_JOB_RETENTION_HOURS")],
+            ["job records kept at most", f"{settings.MAX_JOB_RECORDS}", _literal("SHIMMY_MAX_JOB_RECORDS")],
+            ["quick computations at once per web worker", f"{settings.MAX_FAST_COMPUTATIONS}",
+             _literal("SHIMMY_MAX_FAST_COMPUTATIONS")],
+            ["quick computations waiting per web worker", "threads less the slots less 4 (26)", "–"],
+            ["longest wait for a computation slot", f"{settings.FAST_WAIT_SECONDS:g} s",
+             _literal("SHIMMY_FAST_WAIT_SECONDS")],
+            ["Retry-After of a refused quick computation", f"{settings.FAST_RETRY_AFTER_SECONDS} s",
+             _literal("SHIMMY_FAST_RETRY_AFTER_SECONDS")],
+            ["quick computations per user and second", f"{settings.FAST_PER_USER_PER_SECOND:g}",
+             _literal("SHIMMY_FAST_PER_USER_PER_SECOND")],
+            ["quick computations per user in a burst", f"{settings.FAST_PER_USER_BURST:g}",
+             _literal("SHIMMY_FAST_PER_USER_BURST")],
+            ["sign-in attempts per address and minute", f"{settings.LOGIN_ATTEMPTS_PER_MINUTE}",
+             _literal("SHIMMY_LOGIN_ATTEMPTS_PER_MINUTE")],
+            ["workbench session", f"{settings.SESSION_HOURS:g} h", _literal("SHIMMY_SESSION_HOURS")],
         ]
         return [table(["limit", "value (default)", "environment variable"], rows, [6, 3, 4])]
 
@@ -200,9 +223,16 @@ class CommandLine(SphinxDirective):
         sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
         helps = {a.dest: a.help for a in sub._get_subactions()}
         out = []
-        for name, p in sub.choices.items():
+        commands = [(name, p, helps.get(name)) for name, p in sub.choices.items()]
+        while commands:
+            name, p, helped = commands.pop(0)
+            nested = [a for a in p._actions if isinstance(a, argparse._SubParsersAction)]
+            if nested:  # a group of actions (tokens create|list|revoke): each action its own entry, in order
+                inner = {a.dest: a.help for a in nested[0]._get_subactions()}
+                commands[:0] = [(f"{name} {action}", q, inner.get(action)) for action, q in nested[0].choices.items()]
+                continue
             out.append(nodes.rubric(text=f"python -m shimmy {name}"))
-            out.append(nodes.paragraph(text=helps.get(name) or ""))
+            out.append(nodes.paragraph(text=helped or ""))
             usage = " ".join(p.format_usage().split())
             out.append(nodes.literal_block(usage, usage))
             rows = []

@@ -26,7 +26,7 @@ from typing import Sequence
 from ..continuation.errors import InvalidInputError
 from ..errors import EXPECTED_ERRORS, GeometryError
 from ..service.settings import CacheDirectoryError, cache_dir_setting
-from .commands import decisions, diagrams, ground, maps, margins, model, point
+from .commands import decisions, diagrams, ground, maps, margins, model, point, service
 from .common import EXIT_BAD_INPUT, EXIT_FAILED
 
 __all__ = ["build_parser", "main"]
@@ -57,7 +57,7 @@ examples:
 'python -m shimmy COMMAND --help' describes a command and its options."""
 
 #: The groups of commands, in the order ``--help`` lists their commands.
-GROUPS = (point, margins, ground, diagrams, maps, decisions, model)
+GROUPS = (point, margins, ground, diagrams, maps, decisions, model, service)
 
 
 def build_parser() -> argparse.ArgumentParser:

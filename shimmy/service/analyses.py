@@ -13,7 +13,7 @@ from typing import Any, Callable
 
 from ..errors import InvalidParameterError
 from ..model.parameters import Parameters
-from . import cache, neighbours, schemas
+from . import admission, cache, neighbours, schemas
 from .settings import MAX_SERIES_POINTS
 
 Progress = Callable[[float, str], None]
@@ -257,9 +257,22 @@ JOB_ANALYSES = tuple(name for name, a in ANALYSES.items() if a.job)
 
 
 def run(analysis: str, body: Any, progress: Progress | None = None) -> tuple[dict[str, Any], bool]:
-    """Validate ``body``, then (result, cached?) from the shared cache or by computing it."""
+    """Validate ``body``, then (result, cached?) from the shared cache or by computing it in the request (the
+    API's quick answers and the pages): a computation takes one of this worker's slots and one of its
+    user's rate (:func:`shimmy.service.admission.fast_slot`; :class:`~shimmy.service.admission.Busy` when
+    none comes); a cached answer takes neither."""
     request = schemas.validate(analysis, body)
-    return run_canonical(analysis, request, progress)
+    k = cache.key(analysis, request)
+    found = cache.get_key(k)
+    if found is not None:
+        return found, True
+    with admission.fast_slot(analysis, admission.requester()):
+        found = cache.get_key(k)  # computed by another request while this one waited for its slot
+        if found is not None:
+            return found, True
+        value = RUNNERS[analysis](request, progress)
+        cache.put(k, value)
+    return value, False
 
 
 def cached(analysis: str, body: Any) -> dict[str, Any] | None:

@@ -2,6 +2,13 @@
 
 JSON in and out; errors as {"error", "field", "allowed"} with a 4xx status. The OpenAPI
 document is generated from the request schemas (:mod:`shimmy.service.schemas`).
+
+Every request but ``GET /health`` is checked (:mod:`shimmy.service.auth`): with ``SHIMMY_AUTH=token``
+it needs ``Authorization: Bearer TOKEN`` (or a workbench session) of the scope the request needs
+(read: GET; compute: the analyses, submitting and deleting one's jobs; admin: every user's jobs),
+else 401 (no or a bad credential) or 403 (a scope too small). A limit of the admission control
+(:mod:`shimmy.service.admission`, the job queue's shares) answers 429 with ``Retry-After`` and
+``X-Shimmy-Limit`` naming the limit.
 """
 
 from __future__ import annotations
@@ -19,7 +26,7 @@ from ..version import __version__
 from ..continuation import errors as engine_errors
 from ..errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
 from ..model.parameters import PARAMETER_SPECS
-from . import analyses, cache, jobs, schemas, settings
+from . import admission, analyses, auth, cache, jobs, schemas, settings
 from .analyses import JOB_ANALYSES, SYNC_ANALYSES
 
 PREFIX = "/api/v1"
@@ -127,6 +134,11 @@ def _refused(exc: RequestRefused):
     return exc.response()
 
 
+@api.errorhandler(admission.Busy)
+def _busy(exc: admission.Busy):
+    return error(str(exc), exc.field, exc.allowed, 429, exc.headers())
+
+
 @api.errorhandler(InvalidParameterError)  # listed with the engine's class: Flask follows the MRO,
 @api.errorhandler(engine_errors.InvalidInputError)  # where ShimmyError comes before the engine's class
 def _invalid(exc: engine_errors.InvalidInputError):
@@ -167,6 +179,37 @@ def _methods_of(subpath: str) -> list[str]:
     """The documented methods of PREFIX/``subpath`` (empty for an unknown path)."""
     route = "/jobs/{id}" if subpath.startswith("jobs/") and subpath.count("/") == 1 else "/" + subpath
     return sorted(_METHODS.get(route, ()))
+
+
+def needed_scope(method: str, subpath: str) -> str | None:
+    """The scope a request needs (None: open to all): health is open; GET /jobs (every user's jobs) is
+    admin; other reads are read; everything else (the analyses, submitting and deleting jobs) compute."""
+    if subpath == "health":
+        return None
+    if method in ("GET", "HEAD", "OPTIONS"):
+        return "admin" if subpath.rstrip("/") == "jobs" else "read"
+    return "compute"
+
+
+@api.before_request
+def _authenticate():
+    """Every request but health needs a credential of the scope it needs (401 / 403 otherwise)."""
+    scope = needed_scope(request.method, request.path.removeprefix(PREFIX + "/"))
+    if scope is None:
+        return None
+    outcome = auth.authorise(request, scope)
+    if isinstance(outcome, auth.Principal):
+        return None
+    status, message = outcome
+    return error(message, "Authorization", "Authorization: Bearer TOKEN (a token of scope "
+                 f"{scope}{'' if scope == 'admin' else ' or above'})", status,
+                 auth.challenge_headers() if status == 401 else {"Cache-Control": "no-store"})
+
+
+def _user() -> str | None:
+    """Who asks, when the server knows its users (None: SHIMMY_AUTH=none, one anonymous user)."""
+    principal = auth.current()
+    return principal.user if principal.identified else None
 
 
 @api.before_request
@@ -237,17 +280,32 @@ def submit_job():
         raise InvalidParameterError("analysis", analysis, "one of " + ", ".join(JOB_ANALYSES),
                                     "is not a string")
     try:
-        job = jobs.submit(analysis, body)
+        job = jobs.submit(analysis, body, user=_user())
     except jobs.QueueFull as exc:
-        return error(f"analysis {analysis!r} not queued: {exc}", "analysis",
-                     f"a job once fewer than {settings.MAX_QUEUED_JOBS} are queued", 429,
-                     {"Retry-After": str(exc.retry_after)})
+        return error(f"analysis {analysis!r} not queued: {exc}", "analysis", exc.allowed, 429, exc.headers())
     return _json(jobs.public(job, with_result=False), 202, headers={"Location": f"{PREFIX}/jobs/{job['id']}"})
+
+
+@api.get("/jobs")
+def list_jobs():
+    """Every job record with who asked for it, the total, the queue and the jobs per user (admin scope)."""
+    status = request.args.get("status")
+    statuses = ("queued", "running", "done", "failed", "cancelled")
+    if status is not None and status not in statuses:
+        return error(f"status={reprlib.repr(status)} is not a job status", "status", "one of " + ", ".join(statuses),
+                     422)
+    raw_limit = request.args.get("limit", "100")
+    if not raw_limit.isdigit() or not 1 <= int(raw_limit) <= 1000:
+        return error(f"limit={reprlib.repr(raw_limit)} is not an integer in [1, 1000]", "limit",
+                     "an integer in [1, 1000]", 422)
+    user = request.args.get("user")
+    return _json(jobs.listing(status, user[:64] if user else None, int(raw_limit)))
 
 
 def _job_or_404(job_id: str):
     job = jobs.get(job_id)
-    if job is None:
+    principal = auth.current()
+    if job is None or not (principal.allows("admin") or jobs.visible_to(job, _user())):
         return None, error(f"no job {job_id!r}", "id", "an id returned by POST /api/v1/jobs", 404)
     return job, None
 
@@ -260,14 +318,21 @@ def get_job(job_id: str):
 
 @api.delete("/jobs/<job_id>")
 def cancel_job(job_id: str):
+    """Cancel and delete the job; a job other users asked for too goes on for them (this user no longer
+    sees it), unless an admin deletes it."""
     job, missing = _job_or_404(job_id)
     if missing:
         return missing
+    user = _user()
+    if user is not None and not auth.current().allows("admin") and set(job.get("users") or []) - {user}:
+        detached = jobs.detach(job_id, user) or job
+        return _json({**jobs.public(detached, with_result=False), "status": "cancelled",
+                      "message": "deleted for you; other users asked for it too and it goes on for them"})
     return _json(jobs.public(jobs.cancel(job_id), with_result=False))
 
 
 _METHODS = {"/health": ("GET",), "/parameters": ("GET",), **{f"/{name}": ("POST",) for name in SYNC_ANALYSES},
-            "/jobs": ("POST",), "/jobs/{id}": ("GET", "DELETE"), "/openapi.json": ("GET",)}
+            "/jobs": ("GET", "POST"), "/jobs/{id}": ("GET", "DELETE"), "/openapi.json": ("GET",)}
 
 
 @api.get("/openapi.json")
@@ -278,27 +343,60 @@ def openapi():
 def openapi_document() -> dict[str, Any]:
     err = {"description": "bad input",
            "content": {"application/json": {"schema": {"$ref": "#/components/schemas/Error"}}}}
+    refusal = {"content": {"application/json": {"schema": {"$ref": "#/components/schemas/Error"}}}}
+    unauthorised = {**refusal, "description": "no credential, or a wrong, expired or revoked one (the same answer "
+                    "whatever was wrong; field: Authorization)",
+                    "headers": {"WWW-Authenticate": {"schema": {"type": "string"}}}}
+    forbidden = {**refusal, "description": "the credential's scope does not allow this request"}
+    busy_headers = {"Retry-After": {"description": "seconds to wait before trying again",
+                                    "schema": {"type": "integer"}},
+                    "X-Shimmy-Limit": {"description": "the limit that refused the request: "
+                                       + ", ".join(admission.LIMITS), "schema": {"type": "string",
+                                                                                  "enum": list(admission.LIMITS)}}}
     comps: dict[str, Any] = {"Error": {"type": "object", "required": ["error", "field", "allowed"], "properties": {
         "error": {"type": "string"}, "field": {"type": ["string", "null"]}, "allowed": {"type": ["string", "null"]}}},
         "Job": {"type": "object", "properties": {
             "id": {"type": "string"}, "analysis": {"type": "string", "enum": list(JOB_ANALYSES)},
             "status": {"type": "string", "enum": ["queued", "running", "done", "failed", "cancelled"]},
             "progress": {"type": "number", "minimum": 0, "maximum": 1}, "message": {"type": "string"},
-            "error": {"type": ["string", "null"]}, "request": {"type": "object"}, "result": {"type": "object"}}}}
+            "error": {"type": ["string", "null"]}, "user": {"type": ["string", "null"]},
+            "request": {"type": "object"}, "result": {"type": "object"}}},
+        "JobList": {"type": "object", "required": ["total", "jobs", "by_user"], "properties": {
+            "total": {"type": "integer", "description": "records matching the filters"},
+            "records": {"type": "integer", "description": "records kept in all"},
+            "jobs": {"type": "array", "items": {"$ref": "#/components/schemas/Job"}},
+            "queue": {"type": "array", "items": {"type": "string"}},
+            "running": {"type": "array", "items": {"type": "string"}},
+            "by_user": {"type": "object", "additionalProperties": {"type": "object", "properties": {
+                "queued": {"type": "integer"}, "running": {"type": "integer"}}}},
+            "draining": {"type": "boolean"}, "limits": {"type": "object"}}}}
+
+    def guarded(responses: dict[str, Any], scope: str) -> dict[str, Any]:
+        return {**responses, "401": unauthorised, "403": {**forbidden, "description": forbidden["description"]
+                                                            + f" (needs {scope})"}}
+
     paths: dict[str, Any] = {
-        "/health": {"get": {"summary": "liveness and a working cache", "responses": {
-            "200": {"description": "ok"}, "503": {"description": "degraded: the cache cannot store results"}}}},
-        "/parameters": {"get": {"summary": "every parameter with unit, default, range and provenance",
-                                "responses": {"200": {"description": "the parameter table"}}}},
+        "/health": {"get": {"summary": "liveness and a working cache (open: no credential, nothing about users)",
+                            "security": [], "responses": {
+                                "200": {"description": "ok"},
+                                "503": {"description": "degraded: the cache cannot store results"}}}},
+        "/parameters": {"get": {"summary": "every parameter with unit, default, range and provenance (scope read)",
+                                "responses": guarded({"200": {"description": "the parameter table"}}, "read")}},
+        "/openapi.json": {"get": {"summary": "this document (scope read)",
+                                  "responses": guarded({"200": {"description": "the OpenAPI document"}}, "read")}},
     }
     for name in SYNC_ANALYSES:
         s = schemas.SCHEMAS[name]
         comps[f"{name}_request"] = s.openapi()
         paths[f"/{name}"] = {"post": {
-            "summary": s.summary, "requestBody": {"required": True, "content": {"application/json": {
-                "schema": {"$ref": f"#/components/schemas/{name}_request"}}}},
-            "responses": {"200": {"description": "the result (X-Shimmy-Cache: hit|miss)"}, "400": err, "408": err,
-                          "413": err, "415": err, "422": err}}}
+            "summary": s.summary + " (scope compute)", "requestBody": {"required": True, "content": {
+                "application/json": {"schema": {"$ref": f"#/components/schemas/{name}_request"}}}},
+            "responses": guarded({
+                "200": {"description": "the result (X-Shimmy-Cache: hit|miss)"}, "400": err, "408": err, "413": err,
+                "415": err, "422": err,
+                "429": {**refusal, "description": "not computed now: the worker's computations are all busy, or "
+                        "this user's share of them or rate is spent (a cached answer is never refused)",
+                        "headers": busy_headers}}, "compute")}}
     job_bodies = []
     for name in JOB_ANALYSES:
         s = schemas.SCHEMAS[name]
@@ -307,21 +405,38 @@ def openapi_document() -> dict[str, Any]:
         body["required"] = ["analysis", *body["required"]]
         comps[f"job_{name}"] = body
         job_bodies.append({"$ref": f"#/components/schemas/job_{name}"})
-    paths["/jobs"] = {"post": {
-        "summary": "start a long analysis (" + ", ".join(JOB_ANALYSES) + ")",
-        "requestBody": {"required": True, "content": {"application/json": {"schema": {"oneOf": job_bodies}}}},
-        "responses": {"202": {"description": "accepted", "content": {"application/json": {
-            "schema": {"$ref": "#/components/schemas/Job"}}}}, "400": err, "408": err, "413": err, "415": err,
-            "422": err, "429": {**err, "description": "the job queue is full",
-                                "headers": {"Retry-After": {"schema": {"type": "integer"}}}}}}}
+    job = {"description": "the job", "content": {"application/json": {"schema": {"$ref": "#/components/schemas/Job"}}}}
+    paths["/jobs"] = {
+        "post": {
+            "summary": "start a long analysis (" + ", ".join(JOB_ANALYSES) + ") (scope compute)",
+            "requestBody": {"required": True, "content": {"application/json": {"schema": {"oneOf": job_bodies}}}},
+            "responses": guarded({
+                "202": {**job, "description": "accepted"}, "400": err, "408": err, "413": err, "415": err, "422": err,
+                "429": {**refusal, "description": "not queued: the job queue is full, this user has "
+                        "SHIMMY_MAX_JOBS_PER_USER jobs queued or running, or the last places of the queue are kept "
+                        "for other users' first jobs", "headers": busy_headers}}, "compute")},
+        "get": {
+            "summary": "every job record with who asked for it, the total, the queue and the jobs per user "
+                       "(scope admin)",
+            "parameters": [{"name": "status", "in": "query", "schema": {"type": "string", "enum": [
+                "queued", "running", "done", "failed", "cancelled"]}},
+                {"name": "user", "in": "query", "schema": {"type": "string"}},
+                {"name": "limit", "in": "query", "schema": {"type": "integer", "minimum": 1, "maximum": 1000,
+                                                            "default": 100}}],
+            "responses": guarded({"200": {"description": "the records", "content": {"application/json": {
+                "schema": {"$ref": "#/components/schemas/JobList"}}}}, "422": err}, "admin")}}
     paths["/jobs/{id}"] = {
         "parameters": [{"name": "id", "in": "path", "required": True, "schema": {"type": "string"}}],
-        "get": {"summary": "status, progress and (when done) the result", "responses": {
-            "200": {"description": "the job", "content": {"application/json": {
-                "schema": {"$ref": "#/components/schemas/Job"}}}}, "404": err}},
-        "delete": {"summary": "cancel the job and delete it (later reads answer 404)", "responses": {
-            "200": {"description": "the job as cancelled", "content": {"application/json": {
-                "schema": {"$ref": "#/components/schemas/Job"}}}}, "404": err}}}
+        "get": {"summary": "status, progress and (when done) the result (scope read; one's own jobs, any with admin)",
+                "responses": guarded({"200": job, "404": err}, "read")},
+        "delete": {"summary": "cancel the job and delete it (later reads answer 404; a job other users asked for "
+                              "too goes on for them) (scope compute)",
+                   "responses": guarded({"200": {**job, "description": "the job as cancelled"}, "404": err},
+                                        "compute")}}
+    comps_security = {"bearer": {"type": "http", "scheme": "bearer", "description": (
+        "An API token (python -m shimmy tokens create --user NAME --scope read|compute|admin) as "
+        "Authorization: Bearer TOKEN. Required when the server runs with SHIMMY_AUTH=token (the default when it "
+        "listens beyond loopback); with SHIMMY_AUTH=none (the default on loopback) every request is let in.")}}
     return {"openapi": "3.1.0",
             "info": {"title": "shimmy API", "version": __version__,
                      "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Limits: "
@@ -330,5 +445,12 @@ def openapi_document() -> dict[str, Any]:
                                     f"{settings.MAX_ROBUSTNESS_SAMPLES}; at most {settings.MAX_RUNNING_JOBS} jobs "
                                     "run and "
                                     f"{settings.MAX_QUEUED_JOBS} wait queued (then 429 with Retry-After); an identical "
-                                    "request already queued or running is that job. POST bodies: application/json."},
-            "servers": [{"url": PREFIX}], "paths": paths, "components": {"schemas": comps}}
+                                    "request already queued or running is that job. POST bodies: application/json. "
+                                    "Authentication: a bearer token (securitySchemes.bearer) when the server asks for "
+                                    "one (401 without a good one, 403 for a scope too small); per user at most "
+                                    f"{settings.MAX_JOBS_PER_USER} jobs queued or running and "
+                                    f"{settings.FAST_PER_USER_PER_SECOND:g} quick computations a second; at most "
+                                    f"{settings.MAX_FAST_COMPUTATIONS} quick computations at once per web worker "
+                                    "(429 with Retry-After and X-Shimmy-Limit beyond any limit)."},
+            "servers": [{"url": PREFIX}], "security": [{"bearer": []}], "paths": paths,
+            "components": {"schemas": comps, "securitySchemes": comps_security}}

@@ -45,10 +45,16 @@ def identity(path: pathlib.Path) -> tuple[int, int]:
     return (st.st_dev, st.st_ino)
 
 
+_OPENED: list[diskcache.Cache] = []
+
+
 @functools.lru_cache(maxsize=64)
 def _open(path: str, ident: tuple[int, int], size_limit: int | None) -> diskcache.Cache:
     kwargs = {} if size_limit is None else {"size_limit": size_limit, "eviction_policy": "least-recently-stored"}
-    return diskcache.Cache(path, **kwargs)
+    handle = diskcache.Cache(path, **kwargs)
+    _OPENED.append(handle)
+    del _OPENED[:-64]
+    return handle
 
 
 def open_store(path: pathlib.Path, size_limit: int | None = None) -> diskcache.Cache:
@@ -163,3 +169,14 @@ def health() -> dict[str, Any]:
     except Exception as exc:  # noqa: BLE001 - whatever is wrong is what health reports
         return {"ok": False, "detail": f"{type(exc).__name__}: {exc}"}
     return {"ok": True, "detail": str(root)}
+
+
+def close_all() -> None:
+    """Close every store this process opened (before it forks: a child must not share a connection)."""
+    for handle in list(_OPENED):
+        try:
+            handle.close()
+        except DAMAGE:
+            pass
+    _OPENED.clear()
+    _open.cache_clear()

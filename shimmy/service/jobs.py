@@ -45,21 +45,24 @@ import diskcache
 import psutil
 
 from ..errors import InvalidParameterError
-from . import analyses, cache, schemas, settings
+from . import admission, analyses, cache, schemas, settings
 
 ACTIVE = ("queued", "running")
 HOST = socket.gethostname()
 log = logging.getLogger(__name__)
 
 
-class QueueFull(Exception):
-    """The queue holds MAX_QUEUED_JOBS jobs already: try again after ``retry_after`` seconds."""
+class QueueFull(admission.Busy):
+    """A job refused by a limit of the queue (``limit``: jobs_queue, jobs_per_user or jobs_queue_reserved):
+    try again after ``retry_after`` seconds."""
 
-    def __init__(self, queued: int, running: int):
+    def __init__(self, queued: int, running: int, limit: str = "jobs_queue", message: str | None = None,
+                 allowed: str | None = None):
         self.queued, self.running = queued, running
-        self.retry_after = settings.JOB_RETRY_AFTER_SECONDS
-        super().__init__(f"the job queue is full ({queued} queued, {running} running); "
-                         f"try again in {self.retry_after} s")
+        retry = settings.JOB_RETRY_AFTER_SECONDS
+        super().__init__(limit, message or f"the job queue is full ({queued} queued, {running} running); "
+                         f"try again in {retry} s", retry,
+                         allowed=allowed or f"a job once fewer than {settings.MAX_QUEUED_JOBS} are queued")
 
 
 def store() -> diskcache.Cache:
@@ -71,8 +74,10 @@ def _now() -> float:
 
 
 def _put(s: diskcache.Cache, job: dict[str, Any]) -> dict[str, Any]:
+    """Store the record; a finished one expires JOB_RETENTION_HOURS from now (an active one never)."""
     job["updated"] = _now()
-    s.set(("job", job["id"]), job)
+    final = job["status"] not in ACTIVE
+    s.set(("job", job["id"]), job, expire=settings.JOB_RETENTION_HOURS * 3600 if final else None)
     return job
 
 
@@ -91,45 +96,80 @@ def update(job_id: str, **changes) -> dict[str, Any] | None:
         return _put(s, job)
 
 
-def submit(analysis: str, body: dict[str, Any]) -> dict[str, Any]:
+def submit(analysis: str, body: dict[str, Any], user: str | None = None) -> dict[str, Any]:
     """The job for ``body`` (an API client's: it runs to the end unless deleted): done at once from the
     cache, the same job when an identical one is queued or running, else a new queued job (QueueFull
-    when the queue is full)."""
+    when the queue, or ``user``'s share of it, is full)."""
     if analysis not in analyses.JOB_ANALYSES:
         from ..model.parameters import unknown_name_error
 
         raise unknown_name_error(analysis, list(analyses.JOB_ANALYSES), "analysis")
     request = schemas.validate(analysis, body, extra=("analysis",))
-    return submit_canonical(analysis, request)
+    return submit_canonical(analysis, request, user=user)
 
 
-def submit_canonical(analysis: str, request: dict[str, Any], watcher: str | None = None) -> dict[str, Any]:
+def submit_canonical(analysis: str, request: dict[str, Any], watcher: str | None = None,
+                     user: str | None = None) -> dict[str, Any]:
     """The job for the canonical ``request``, as :func:`submit`; with ``watcher`` (a page view's token)
-    it waits for the job until :func:`release`, else (an API client) the job is pinned."""
+    it waits for the job until :func:`release`, else (an API client) the job is pinned. ``user``: who
+    asks (None: the server does not know its users; no per-user limit applies)."""
     if watcher is not None:
         _check_watcher(watcher)
     key = cache.key(analysis, request)
     job = {"id": uuid.uuid4().hex, "analysis": analysis, "request": request, "status": "queued",
            "progress": 0.0, "message": "queued", "error": None, "created": _now(), "heartbeat": _now(),
-           "result_key": key, "watchers": [] if watcher is None else [watcher], "pinned": watcher is None}
+           "result_key": key, "watchers": [] if watcher is None else [watcher], "pinned": watcher is None,
+           "user": user, "users": [] if user is None else [user], "restarts": 0}
     s = store()
     if cache.get_key(key) is not None:
         job.update(status="done", progress=1.0, message="from the cache")
-        return _put(s, job)
+        _put(s, job)
+        _bound(s)
+        return job
     _reap(s)
     with s.transact():
         same = s.get(("active", key))
         existing = s.get(("job", same)) if same else None
         if existing is not None and existing["status"] in ACTIVE:
-            return _put(s, _watched_by(existing, watcher))
+            return _put(s, _asked_by(_watched_by(existing, watcher), user))
         queue = s.get("queue", [])
+        running = s.get("running", {})
         if len(queue) >= settings.MAX_QUEUED_JOBS:
-            raise QueueFull(len(queue), len(s.get("running", {})))
+            raise QueueFull(len(queue), len(running))
+        if user is not None:
+            _check_share(s, user, queue, running)
         _put(s, job)
         s.set("queue", [*queue, job["id"]])
         s.set(("active", key), job["id"])
+    _bound(s)
     pump()
     return store().get(("job", job["id"])) or job
+
+
+def _asked_by(job: dict[str, Any], user: str | None) -> dict[str, Any]:
+    """``job`` with ``user`` among those who asked for it (who may read it)."""
+    if user is not None and user not in job.setdefault("users", []):
+        job["users"].append(user)
+    return job
+
+
+def _check_share(s: diskcache.Cache, user: str, queue: list[str], running: dict[str, Any]) -> None:
+    """QueueFull if ``user`` has MAX_JOBS_PER_USER jobs queued or running, or would take one of the last
+    QUEUE_RESERVED places of the queue while a job of theirs is queued or running already."""
+    mine = [j for j in [*queue, *running] if user in ((s.get(("job", j)) or {}).get("users") or [])]
+    if len(mine) >= settings.MAX_JOBS_PER_USER:
+        raise QueueFull(len(queue), len(running), "jobs_per_user",
+                        f"you have {len(mine)} jobs queued or running, the most one user may have "
+                        f"(SHIMMY_MAX_JOBS_PER_USER = {settings.MAX_JOBS_PER_USER}); try again in "
+                        f"{settings.JOB_RETRY_AFTER_SECONDS} s, or delete one",
+                        f"a job once fewer than {settings.MAX_JOBS_PER_USER} of yours are queued or running")
+    free = settings.MAX_QUEUED_JOBS - len(queue)
+    if mine and free <= settings.QUEUE_RESERVED:
+        raise QueueFull(len(queue), len(running), "jobs_queue_reserved",
+                        f"the last {free} places of the job queue are kept for users who have no job waiting "
+                        f"(SHIMMY_QUEUE_RESERVED = {settings.QUEUE_RESERVED}) and you have {len(mine)}; "
+                        f"try again in {settings.JOB_RETRY_AFTER_SECONDS} s",
+                        "a job once the queue has room or none of yours waits")
 
 
 def get(job_id: str) -> dict[str, Any] | None:
@@ -211,17 +251,214 @@ def result(job: dict[str, Any]) -> dict[str, Any] | None:
 
 
 def public(job: dict[str, Any], with_result: bool = True) -> dict[str, Any]:
-    """The job as the API shows it."""
+    """The job as the API shows it (with its owner: the user who asked for it first, or null)."""
     out = {k: job[k] for k in ("id", "analysis", "status", "progress", "message", "error", "created", "updated")}
+    out["user"] = job.get("user")
     out["request"] = job["request"]
     if with_result and job["status"] == "done":
         out["result"] = result(job)
+        if out["result"] is None:
+            out["message"] = ("done, but its result has left the result cache (SHIMMY_CACHE_SIZE_MB); submit the "
+                              "request again to compute it again")
     return out
+
+
+def visible_to(job: dict[str, Any], user: str | None) -> bool:
+    """Whether ``user`` (None: the server does not know its users) asked for ``job`` and so may read it."""
+    return user is None or user in (job.get("users") or [])
+
+
+def detach(job_id: str, user: str) -> dict[str, Any] | None:
+    """``user`` waits for the job no more (DELETE by one of several users who asked for it): the job goes on
+    for the others. (The job as it is then) or None if unknown."""
+    s = store()
+    with s.transact():
+        job = s.get(("job", job_id))
+        if job is None:
+            return None
+        job["users"] = [u for u in job.get("users") or [] if u != user]
+        return _put(s, job)
 
 
 def counts() -> dict[str, int]:
     s = store()
     return {"queued": len(s.get("queue", [])), "running": len(s.get("running", {}))}
+
+
+def listing(status: str | None = None, user: str | None = None, limit: int = 100) -> dict[str, Any]:
+    """Every job record (newest first, at most ``limit`` shown), with who asked for each, the total, the
+    queue in order and the jobs queued and running per user (the admin's view, GET /api/v1/jobs)."""
+    s = store()
+    _reap(s)
+    records = []
+    for key in list(s):
+        if isinstance(key, tuple) and len(key) == 2 and key[0] == "job":
+            job = s.get(key)
+            if job is not None:
+                records.append(job)
+    by_user: dict[str, dict[str, int]] = {}
+    for job in records:
+        if job["status"] in ACTIVE:
+            owner = job.get("user") or "anonymous"
+            counts_of = by_user.setdefault(owner, {"queued": 0, "running": 0})
+            counts_of[job["status"]] += 1
+    chosen = [j for j in records if (status is None or j["status"] == status)
+              and (user is None or user in (j.get("users") or []) or (user == "anonymous" and not j.get("users")))]
+    chosen.sort(key=lambda j: j["created"], reverse=True)
+    shown = []
+    for job in chosen[:limit]:
+        item = public(job, with_result=False)
+        item["users"] = job.get("users") or []
+        item["restarts"] = job.get("restarts", 0)
+        shown.append(item)
+    return {"total": len(chosen), "records": len(records), "shown": len(shown), "jobs": shown,
+            "queue": list(s.get("queue", [])), "running": sorted(s.get("running", {})), "by_user": by_user,
+            "draining": s.get("draining") is not None,
+            "limits": {"max_running": settings.MAX_RUNNING_JOBS, "max_queued": settings.MAX_QUEUED_JOBS,
+                       "max_jobs_per_user": settings.MAX_JOBS_PER_USER,
+                       "max_running_per_user": settings.MAX_RUNNING_JOBS_PER_USER,
+                       "retention_hours": settings.JOB_RETENTION_HOURS,
+                       "max_records": settings.MAX_JOB_RECORDS}}
+
+
+# -- bounded storage ---------------------------------------------------------------------------
+
+#: Entries of the store besides the records: queue, running, draining, the active index, health probes.
+_BOOKKEEPING = 16
+
+
+def _bound(s: diskcache.Cache) -> None:
+    """Keep at most MAX_JOB_RECORDS records: expired ones are removed, then the oldest finished ones.
+    Cheap when under the bound (the store's count is one read)."""
+    limit = settings.MAX_JOB_RECORDS + _BOOKKEEPING + settings.MAX_QUEUED_JOBS + settings.MAX_RUNNING_JOBS
+    if len(s) <= limit:
+        return
+    try:
+        s.expire()
+        prune(s)
+    except cache.DAMAGE as exc:  # pruning is housekeeping: a busy or damaged store must not fail a submission
+        log.warning("job records not pruned: %s", exc)
+
+
+def prune(s: diskcache.Cache | None = None) -> int:
+    """Remove the oldest finished records beyond MAX_JOB_RECORDS (by creation: the store's insertion
+    order); the number removed."""
+    s = s or store()
+    s.expire()
+    keys = [k for k in s if isinstance(k, tuple) and len(k) == 2 and k[0] == "job"]
+    excess = len(keys) - settings.MAX_JOB_RECORDS
+    removed = 0
+    for key in keys:
+        if removed >= excess:
+            break
+        with s.transact():
+            job = s.get(key)
+            if job is not None and job["status"] not in ACTIVE:
+                s.delete(key)
+                removed += 1
+    return removed
+
+
+# -- restarts and upgrades -----------------------------------------------------------------------
+
+
+def drain() -> dict[str, int]:
+    """Start no more jobs (submissions still queue) until :func:`resume` or the server's next start."""
+    s = store()
+    s.set("draining", {"since": _now()})
+    return counts()
+
+
+def resume() -> dict[str, int]:
+    s = store()
+    s.delete("draining")
+    pump()
+    return counts()
+
+
+def draining() -> bool:
+    return store().get("draining") is not None
+
+
+def _requeue(s: diskcache.Cache, job_ids: list[str], message: str, restart: bool) -> list[str]:
+    """Put active jobs back at the head of the queue (in this order), their slots freed (in a transaction)."""
+    back = []
+    running = dict(s.get("running", {}))
+    for job_id in job_ids:
+        running.pop(job_id, None)
+        job = s.get(("job", job_id))
+        if job is None or job["status"] not in ACTIVE:
+            continue
+        job.update(status="queued", progress=0.0, message=message, sketch=None)
+        if restart:
+            job["restarts"] = job.get("restarts", 0) + 1
+        _put(s, job)
+        back.append(job_id)
+    queue = [j for j in s.get("queue", []) if j not in back]
+    s.set("queue", back + queue)
+    s.set("running", running)
+    return back
+
+
+def server_started() -> dict[str, list[str]]:
+    """When the server starts (gunicorn's ``on_starting``, before any web worker): jobs stop draining; a
+    job whose process is gone is queued again, at most JOB_RESTARTS times, then failed saying why. Queued
+    jobs are started by the web workers (:func:`pump`). (What was queued again and what failed, by id.)"""
+    s = store()
+    s.delete("draining")
+    gone = [(job_id, holder) for job_id, holder in list(s.get("running", {}).items())
+            if not _alive(s, job_id, holder)]
+    for _, holder in gone:
+        _signal_group(holder, signal.SIGKILL)  # what is left of its group, if anything
+    requeued, failed = [], []
+    with s.transact():
+        for job_id, holder in gone:
+            job = s.get(("job", job_id))
+            if job is None or job["status"] not in ACTIVE:
+                _release(s, job_id, holder)
+            elif job.get("restarts", 0) < settings.JOB_RESTARTS:
+                requeued += _requeue(s, [job_id], "queued again: its process ended with the server; it starts "
+                                     "again from the beginning", restart=True)
+            else:
+                _release(s, job_id, holder)
+                job.update(status="failed", error=f"the process running this job ended without a result when the "
+                           f"server stopped, {job.get('restarts', 0) + 1} times; submit it again")
+                _put(s, job)
+                if s.get(("active", job["result_key"])) == job_id:
+                    s.delete(("active", job["result_key"]))
+                failed.append(job_id)
+    return {"requeued": requeued, "failed": failed}
+
+
+def server_stopping(grace: float = 5.0) -> list[str]:
+    """When the server stops (gunicorn's ``on_exit``, its web workers gone): end the processes of the jobs
+    running on this host (SIGTERM, then SIGKILL after ``grace`` seconds) and queue those jobs again at
+    the head of the queue, so that they start again when the server does. The ids queued again."""
+    s = store()
+    holders = {job_id: h for job_id, h in s.get("running", {}).items() if h.get("host") == HOST}
+    for holder in holders.values():
+        _signal_group(holder, signal.SIGTERM)
+    deadline = time.time() + grace
+    while time.time() < deadline and any(_group_alive(h) for h in holders.values()):
+        time.sleep(0.1)
+    for holder in holders.values():
+        _signal_group(holder, signal.SIGKILL)
+    pids = {h.get("pid") for h in holders.values()}
+    with s.transact():  # a worker may have taken the next job in its slot meanwhile: every job of those pids
+        held = [job_id for job_id, h in s.get("running", {}).items() if h.get("host") == HOST and h.get("pid") in pids]
+        return _requeue(s, held, "queued again: the server stopped while it ran; it starts again from the "
+                        "beginning when the server starts", restart=False)
+
+
+def _group_alive(holder: dict[str, Any]) -> bool:
+    pid = holder.get("pid")
+    if not pid:
+        return False
+    try:
+        os.killpg(pid, 0)
+        return True
+    except (ProcessLookupError, PermissionError):
+        return False
 
 
 # -- processes -------------------------------------------------------------------------------
@@ -233,19 +470,47 @@ def pump() -> None:
     _reap(s)
     starting = []
     with s.transact():
+        if s.get("draining") is not None:
+            return
         running = dict(s.get("running", {}))
         queue = list(s.get("queue", []))
-        while queue and len(running) < settings.MAX_RUNNING_JOBS:
-            job_id = queue.pop(0)
-            job = s.get(("job", job_id))
-            if job is None or job["status"] != "queued":
-                continue
-            running[job_id] = {"pid": None, "started": None, "host": HOST, "claimed": _now()}
+        while len(running) < settings.MAX_RUNNING_JOBS:
+            job_id, owner = _choose(s, queue, running)
+            if job_id is None:
+                break
+            running[job_id] = {"pid": None, "started": None, "host": HOST, "claimed": _now(), "user": owner}
             starting.append(job_id)
         s.set("queue", queue)
         s.set("running", running)
     for job_id in starting:
         _start(s, job_id)
+
+
+def _choose(s: diskcache.Cache, queue: list[str], running: dict[str, Any]) -> tuple[str | None, str | None]:
+    """Take from ``queue`` (in place) the job to start next: of the queued jobs whose owner runs fewer than
+    MAX_RUNNING_JOBS_PER_USER, the one whose owner runs the fewest, the oldest first (anonymous jobs: no
+    per-user limit). Entries that are no longer queued leave the queue. (job id, owner) or (None, None)."""
+    load: dict[str, int] = {}
+    for holder in running.values():
+        if holder.get("user") is not None:
+            load[holder["user"]] = load.get(holder["user"], 0) + 1
+    best, best_rank = None, None
+    for position, job_id in enumerate(list(queue)):
+        job = s.get(("job", job_id))
+        if job is None or job["status"] != "queued":
+            queue.remove(job_id)
+            continue
+        owner = job.get("user")
+        mine = load.get(owner, 0) if owner is not None else 0
+        if owner is not None and mine >= settings.MAX_RUNNING_JOBS_PER_USER:
+            continue
+        rank = (mine, position)
+        if best_rank is None or rank < best_rank:
+            best, best_rank = (job_id, owner), rank
+    if best is None:
+        return None, None
+    queue.remove(best[0])
+    return best
 
 
 def _start(s: diskcache.Cache, job_id: str) -> None:
@@ -261,7 +526,7 @@ def _start(s: diskcache.Cache, job_id: str) -> None:
     with s.transact():
         running = dict(s.get("running", {}))
         if job_id in running and running[job_id]["pid"] is None:
-            running[job_id] = holder
+            running[job_id] = {**holder, "user": running[job_id].get("user")}
             s.set("running", running)
     threading.Thread(target=_wait, args=(proc, job_id), daemon=True, name=f"job-{job_id[:8]}").start()
 
@@ -409,17 +674,10 @@ def _next(finished: str, me: dict[str, Any]) -> str | None:
         running.pop(finished, None)
         queue = list(s.get("queue", []))
         nxt = None
-        while queue:
-            candidate = queue.pop(0)
-            job = s.get(("job", candidate))
-            if job is not None and job["status"] == "queued":
-                nxt = candidate
-                break
-        if nxt is not None and len(running) < settings.MAX_RUNNING_JOBS:
-            running[nxt] = {**me, "claimed": _now()}
-        elif nxt is not None:
-            queue.insert(0, nxt)
-            nxt = None
+        if s.get("draining") is None and len(running) < settings.MAX_RUNNING_JOBS:
+            nxt, owner = _choose(s, queue, running)
+            if nxt is not None:
+                running[nxt] = {**me, "claimed": _now(), "user": owner}
         s.set("queue", queue)
         s.set("running", running)
     return nxt

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import ipaddress
 import os
 import pathlib
+import socket
 import tempfile
 
 #: Bumped whenever the JSON of any analysis result changes shape: old cache entries then miss.
@@ -11,8 +13,10 @@ SCHEMA_VERSION = 1
 
 #: Limits on what one request may ask for (refused with 4xx naming the limit).
 MAX_BODY_BYTES = 64 * 1024
-#: Threads per web worker that run the WSGI app on complete requests (SHIMMY_WEB_THREADS).
-WEB_THREADS = int(os.environ.get("SHIMMY_WEB_THREADS", "8"))
+#: Threads per web worker that run the WSGI app on complete requests (SHIMMY_WEB_THREADS). Quick
+#: computations take at most MAX_FAST_COMPUTATIONS of them and wait in at most FAST_WAITING more;
+#: the rest (at least FAST_RESERVED_THREADS) stay free for health, cached answers and the pages.
+WEB_THREADS = int(os.environ.get("SHIMMY_WEB_THREADS", "32"))
 #: The headers of a connection's first request must be complete within this many seconds, else it is
 #: closed (SHIMMY_HEADER_READ_SECONDS).
 HEADER_READ_SECONDS = float(os.environ.get("SHIMMY_HEADER_READ_SECONDS", "10"))
@@ -33,6 +37,41 @@ MAX_ROBUSTNESS_SAMPLES = 2048  # samples of one robustness analysis (~1 s per 10
 MAX_RUNNING_JOBS = int(os.environ.get("SHIMMY_MAX_RUNNING_JOBS", "2"))
 MAX_QUEUED_JOBS = int(os.environ.get("SHIMMY_MAX_QUEUED_JOBS", "8"))
 JOB_RETRY_AFTER_SECONDS = int(os.environ.get("SHIMMY_JOB_RETRY_AFTER_SECONDS", "30"))
+#: Per user (per token), when the server knows its users (SHIMMY_AUTH=token): at most this many of
+#: one user's jobs queued or running (SHIMMY_MAX_JOBS_PER_USER), at most this many running at once
+#: (SHIMMY_MAX_RUNNING_JOBS_PER_USER; default: all slots but one, so that another user's first job
+#: starts at once), and a user who already has a job waiting may not take the last QUEUE_RESERVED
+#: places of the queue (they are kept for the first job of somebody else).
+MAX_JOBS_PER_USER = int(os.environ.get("SHIMMY_MAX_JOBS_PER_USER", "4"))
+MAX_RUNNING_JOBS_PER_USER = int(os.environ.get("SHIMMY_MAX_RUNNING_JOBS_PER_USER",
+                                               str(max(1, MAX_RUNNING_JOBS - 1))))
+QUEUE_RESERVED = int(os.environ.get("SHIMMY_QUEUE_RESERVED", str(max(1, MAX_QUEUED_JOBS // 4))))
+#: Bounded storage of job records: a finished job's record (status, request; its result is in the result
+#: cache) is kept this many hours (SHIMMY_JOB_RETENTION_HOURS), and at most this many records are kept,
+#: the oldest finished ones removed first (SHIMMY_MAX_JOB_RECORDS). Queued and running jobs never expire.
+JOB_RETENTION_HOURS = float(os.environ.get("SHIMMY_JOB_RETENTION_HOURS", "168"))
+MAX_JOB_RECORDS = int(os.environ.get("SHIMMY_MAX_JOB_RECORDS", "5000"))
+#: A job whose process was found gone when the server started (killed with the server, the machine
+#: restarted) is queued again this many times, then failed with a message saying so.
+JOB_RESTARTS = 1
+#: Admission control of the quick analyses answered in the request (POST /simulate, /hopf, /stability,
+#: /devices, /sensitivity and the pages that draw them): per web worker at most MAX_FAST_COMPUTATIONS
+#: compute at once (SHIMMY_MAX_FAST_COMPUTATIONS), at most FAST_WAITING more wait up to
+#: FAST_WAIT_SECONDS for one of them (SHIMMY_FAST_WAIT_SECONDS); beyond, 429 with Retry-After
+#: FAST_RETRY_AFTER_SECONDS. A cached answer takes no slot.
+MAX_FAST_COMPUTATIONS = int(os.environ.get("SHIMMY_MAX_FAST_COMPUTATIONS", "2"))
+FAST_RESERVED_THREADS = 4
+FAST_WAITING = max(0, WEB_THREADS - MAX_FAST_COMPUTATIONS - FAST_RESERVED_THREADS)
+FAST_WAIT_SECONDS = float(os.environ.get("SHIMMY_FAST_WAIT_SECONDS", "15"))
+FAST_RETRY_AFTER_SECONDS = int(os.environ.get("SHIMMY_FAST_RETRY_AFTER_SECONDS", "2"))
+#: Per user (SHIMMY_AUTH=token): quick computations (cache misses) per second, on average
+#: (SHIMMY_FAST_PER_USER_PER_SECOND) and in a burst (SHIMMY_FAST_PER_USER_BURST); beyond, 429.
+FAST_PER_USER_PER_SECOND = float(os.environ.get("SHIMMY_FAST_PER_USER_PER_SECOND", "5"))
+FAST_PER_USER_BURST = float(os.environ.get("SHIMMY_FAST_PER_USER_BURST", "20"))
+#: Sign-in: failed attempts per client address and minute before 429 (SHIMMY_LOGIN_ATTEMPTS_PER_MINUTE),
+#: and how long a workbench session lasts (SHIMMY_SESSION_HOURS).
+LOGIN_ATTEMPTS_PER_MINUTE = int(os.environ.get("SHIMMY_LOGIN_ATTEMPTS_PER_MINUTE", "10"))
+SESSION_HOURS = float(os.environ.get("SHIMMY_SESSION_HOURS", "12"))
 #: A worker being started that has not been recorded after this long is taken for dead.
 JOB_START_SECONDS = 60.0
 #: Only for a worker on another host sharing the directory: no heartbeat for this long means it is gone
@@ -73,3 +112,81 @@ def cache_dir() -> pathlib.Path:
 def cache_size_limit() -> int:
     """SHIMMY_CACHE_SIZE_MB (default 2048) in bytes: diskcache evicts least-recently-stored beyond it."""
     return int(float(os.environ.get("SHIMMY_CACHE_SIZE_MB", "2048")) * 1024 * 1024)
+
+
+def tokens_file() -> pathlib.Path:
+    """Where the API tokens are kept (hashed): SHIMMY_TOKENS_FILE, or ``tokens.json`` in the cache directory."""
+    explicit = os.environ.get("SHIMMY_TOKENS_FILE")
+    return pathlib.Path(explicit) if explicit else cache_dir() / "tokens.json"
+
+
+# -- who may use the service -----------------------------------------------------------------
+
+AUTH_MODES = ("token", "oidc", "none")
+
+
+class AuthSettingError(RuntimeError):
+    """SHIMMY_AUTH asks for something this server will not do (the server refuses to start)."""
+
+
+def listen_addresses() -> list[str]:
+    """The addresses the server listens on, as gunicorn.conf.py recorded them from gunicorn's ``bind``
+    setting (SHIMMY_LISTEN, comma-separated); empty if it was not started through it."""
+    return [a.strip() for a in os.environ.get("SHIMMY_LISTEN", "").split(",") if a.strip()]
+
+
+def is_loopback(address: str) -> bool:
+    """Whether a gunicorn bind address is reachable from this machine only: a TCP address whose host is a
+    loopback address or resolves only to loopback addresses. A Unix socket or an inherited file descriptor
+    counts as beyond loopback (a proxy in front of it may serve anyone)."""
+    if address.startswith(("unix:", "fd://")) or "/" in address:
+        return False
+    host = address.removeprefix("tcp://")
+    if host.startswith("["):  # [::1]:8050
+        host = host[1:].partition("]")[0]
+    elif host.count(":") == 1:
+        host = host.partition(":")[0]
+    if host in ("", "0.0.0.0", "::", "*"):
+        return False
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        pass
+    try:
+        found = {info[4][0] for info in socket.getaddrinfo(host, None)}
+    except OSError:
+        return False
+    return bool(found) and all(ipaddress.ip_address(a.split("%")[0]).is_loopback for a in found)
+
+
+def beyond_loopback(addresses: list[str] | None = None) -> bool:
+    """Whether any address the server listens on is reachable from other machines."""
+    addresses = listen_addresses() if addresses is None else addresses
+    return any(not is_loopback(a) for a in addresses)
+
+
+def auth_mode(addresses: list[str] | None = None) -> str:
+    """``token`` or ``none``: SHIMMY_AUTH, by default ``none`` on loopback and ``token`` beyond it.
+    AuthSettingError for an unknown mode, for ``oidc`` (not built) and for ``none`` beyond loopback
+    without SHIMMY_ALLOW_ANONYMOUS=1."""
+    exposed = beyond_loopback(addresses)
+    mode = os.environ.get("SHIMMY_AUTH", "").strip().lower() or ("token" if exposed else "none")
+    if mode not in AUTH_MODES:
+        raise AuthSettingError(f"SHIMMY_AUTH={mode!r} is not one of {', '.join(AUTH_MODES)}")
+    if mode == "oidc":
+        raise AuthSettingError("SHIMMY_AUTH=oidc: single sign-on is not built in this version; use SHIMMY_AUTH=token "
+                               "(API tokens, and a sign-in page taking a token for the workbench)")
+    if mode == "none" and exposed and os.environ.get("SHIMMY_ALLOW_ANONYMOUS", "") != "1":
+        raise AuthSettingError("SHIMMY_AUTH=none while listening beyond loopback (" + ", ".join(
+            listen_addresses() if addresses is None else addresses) + "): anyone who can reach the port could use "
+            "the service; use SHIMMY_AUTH=token, bind 127.0.0.1, or set SHIMMY_ALLOW_ANONYMOUS=1 to waive it")
+    return mode
+
+
+def cookie_secure() -> bool | None:
+    """SHIMMY_COOKIE_SECURE: 1 marks the session cookie Secure always (behind a proxy that ends TLS), 0
+    never; unset (None): Secure when the request came over https."""
+    value = os.environ.get("SHIMMY_COOKIE_SECURE", "").strip()
+    return None if value == "" else value == "1"
