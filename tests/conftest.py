@@ -18,6 +18,30 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
+#: The longest modules, longest first (measured: pytest --durations=0). Under pytest-xdist (the README's
+#: ``-n 2 --dist loadscope --no-loadscope-reorder``) each module goes whole to one worker, in collection
+#: order: the longest ones start first and the short ones fill the gaps at the end. Tests keep their
+#: order within a module; a module not listed keeps its place after these.
+LONGEST_FIRST = [
+    "tests/service/test_image_build.py",
+    "tests/analyses/maps/test_warm_map.py",
+    "tests/analyses/maps/test_stability_map.py",
+    "tests/ui/test_browser.py",
+    "tests/ui/test_browser_workbench.py",
+    "tests/cli/test_cli.py",
+    "tests/service/test_api.py",
+    "tests/cli/test_cli_cache.py",
+    "tests/service/test_neighbours.py",
+    "tests/test_docs.py",
+    "tests/analyses/core/test_executors.py",
+]
+
+
+def pytest_collection_modifyitems(config, items):
+    rank = {path: i for i, path in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))
+
+
 def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -111,6 +135,16 @@ def server(tmp_path_factory):
     srv = start_server(tmp_path_factory.mktemp("shimmy-cache"))
     yield srv
     stop_server(srv)
+
+
+@pytest.fixture(scope="session")
+def browsers():
+    """The Chromium instances of the browser modules (tests/ui/browser.py), by profile, window and
+    downloads folder: each started once per session and quit at its end."""
+    pool: dict = {}
+    yield pool
+    for driver in pool.values():
+        driver.quit()
 
 
 def process_group(pid):
