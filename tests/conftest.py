@@ -34,7 +34,45 @@ LONGEST_FIRST = [
     "tests/service/test_neighbours.py",
     "tests/test_docs.py",
     "tests/analyses/core/test_executors.py",
+    "tests/ui/test_browser_live_map.py",
+    "tests/analyses/diagrams/test_bifurcation.py",
+    "tests/analyses/decisions/test_optimise.py",
+    "tests/ui/test_browser_design.py",
+    "tests/analyses/diagrams/test_gear_cycle_curves.py",
+    "tests/ui/test_browser_designs.py",
+    "tests/analyses/decisions/test_min_shimmy_curve.py",
+    "tests/analyses/decisions/test_studies.py",
+    "tests/analyses/decisions/test_study_curves.py",
+    "tests/service/test_reliability.py",
+    "tests/ui/test_browser_ground_run.py",
+    "tests/analyses/ground/test_ground_run.py",
 ]
+
+
+#: Every compiled kernel the analyses use (integrator, field and Jacobian, collocation, condensed LU), run
+#: once so that numba's on-disk cache holds them: about 40 s of compiling in a fresh checkout, 2 s to load
+#: them from the cache afterwards.
+WARM_KERNELS = """
+import shimmy
+from shimmy.analyses.diagrams.bifurcation import bifurcation
+from shimmy.analyses.diagrams.hopf_curves import hopf_curves
+shimmy.simulate("nes_pd", 30, 150e3, t_end=1)
+shimmy.ground_run("original", "taxi")
+shimmy.hopf_points("nes", 150e3)
+bifurcation("original", 150e3, v_range=(5.0, 16.0))
+hopf_curves("nes", v_range=(1.0, 200.0), fz_range=(1.0e5, 2.0e5), n_slices=3)
+"""
+
+
+def pytest_configure(config):
+    """Under xdist, the controller warms numba's cache before the workers start: in a fresh checkout
+    each worker, its process pools and its servers would otherwise compile the same kernels at once."""
+    if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
+        done = subprocess.run([sys.executable, "-c", WARM_KERNELS], cwd=ROOT, capture_output=True, text=True,
+                              timeout=900)
+        if done.returncode != 0:  # the tests that use these kernels fail on their own, naming the error
+            config.issue_config_time_warning(pytest.PytestWarning(
+                "warming numba's cache failed: " + done.stderr[-1000:]), stacklevel=2)
 
 
 def pytest_collection_modifyitems(config, items):
