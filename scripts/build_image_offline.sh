@@ -90,9 +90,15 @@ command -v buildah >/dev/null 2>&1 || missing+=(buildah)
 command -v debootstrap >/dev/null 2>&1 || missing+=(debootstrap)
 if [ "${#missing[@]}" -gt 0 ]; then
     echo "installing from Debian: ${missing[*]}"
+    # One apt-get at a time with the test suite's other workers (tests/ui/browser.py takes this lock
+    # to install chromium): apt-get refuses to start while another holds apt's lock.
+    exec 9>/tmp/shimmy-tests-apt.lock
+    flock 9
     apt-get update -q || die "apt-get update failed: Debian's package mirror is not reachable"
     DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}" \
         || die "apt-get install ${missing[*]} failed"
+    flock -u 9
+    exec 9>&-
 fi
 buildah --version
 debootstrap --version

@@ -18,6 +18,68 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
+#: The longest modules, longest first (measured: pytest --durations=0). Under pytest-xdist (the README's
+#: ``-n 2 --dist loadscope --no-loadscope-reorder``) each module goes whole to one worker, in collection
+#: order: the longest ones start first and the short ones fill the gaps at the end. Tests keep their
+#: order within a module; a module not listed keeps its place after these.
+LONGEST_FIRST = [
+    "tests/service/test_image_build.py",
+    "tests/analyses/maps/test_warm_map.py",
+    "tests/analyses/maps/test_stability_map.py",
+    "tests/ui/test_browser.py",
+    "tests/ui/test_browser_workbench.py",
+    "tests/cli/test_cli.py",
+    "tests/service/test_api.py",
+    "tests/cli/test_cli_cache.py",
+    "tests/service/test_neighbours.py",
+    "tests/test_docs.py",
+    "tests/analyses/core/test_executors.py",
+    "tests/ui/test_browser_live_map.py",
+    "tests/analyses/diagrams/test_bifurcation.py",
+    "tests/analyses/decisions/test_optimise.py",
+    "tests/ui/test_browser_design.py",
+    "tests/analyses/diagrams/test_gear_cycle_curves.py",
+    "tests/ui/test_browser_designs.py",
+    "tests/analyses/decisions/test_min_shimmy_curve.py",
+    "tests/analyses/decisions/test_studies.py",
+    "tests/analyses/decisions/test_study_curves.py",
+    "tests/service/test_reliability.py",
+    "tests/ui/test_browser_ground_run.py",
+    "tests/analyses/ground/test_ground_run.py",
+]
+
+
+#: Every compiled kernel the analyses use (integrator, field and Jacobian, collocation, condensed LU), run
+#: once so that numba's on-disk cache holds them: about 40 s of compiling in a fresh checkout, 2 s to load
+#: them from the cache afterwards.
+WARM_KERNELS = """
+import shimmy
+from shimmy.analyses.diagrams.bifurcation import bifurcation
+from shimmy.analyses.diagrams.hopf_curves import hopf_curves
+shimmy.simulate("nes_pd", 30, 150e3, t_end=1)
+shimmy.ground_run("original", "taxi")
+shimmy.hopf_points("nes", 150e3)
+bifurcation("original", 150e3, v_range=(5.0, 16.0))
+hopf_curves("nes", v_range=(1.0, 200.0), fz_range=(1.0e5, 2.0e5), n_slices=3)
+"""
+
+
+def pytest_configure(config):
+    """Under xdist, the controller warms numba's cache before the workers start: in a fresh checkout
+    each worker, its process pools and its servers would otherwise compile the same kernels at once."""
+    if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
+        done = subprocess.run([sys.executable, "-c", WARM_KERNELS], cwd=ROOT, capture_output=True, text=True,
+                              timeout=900)
+        if done.returncode != 0:  # the tests that use these kernels fail on their own, naming the error
+            config.issue_config_time_warning(pytest.PytestWarning(
+                "warming numba's cache failed: " + done.stderr[-1000:]), stacklevel=2)
+
+
+def pytest_collection_modifyitems(config, items):
+    rank = {path: i for i, path in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))
+
+
 def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -111,6 +173,16 @@ def server(tmp_path_factory):
     srv = start_server(tmp_path_factory.mktemp("shimmy-cache"))
     yield srv
     stop_server(srv)
+
+
+@pytest.fixture(scope="session")
+def browsers():
+    """The Chromium instances of the browser modules (tests/ui/browser.py), by profile, window and
+    downloads folder: each started once per session and quit at its end."""
+    pool: dict = {}
+    yield pool
+    for driver in pool.values():
+        driver.quit()
 
 
 def process_group(pid):

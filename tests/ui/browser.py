@@ -5,6 +5,7 @@ make of a page. The test modules import it (pytest puts their folder on sys.path
 
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 import subprocess
@@ -21,11 +22,18 @@ from selenium.webdriver.common.keys import Keys  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 SHOTS = ROOT / "screenshots"  # screenshots for a person to look at (not committed)
-DOWNLOADS = ROOT / ".pytest_cache" / "downloads"
+#: pytest-xdist's worker ("gw0", ...; "" without xdist): each worker has its own profiles and downloads
+WORKER = os.environ.get("PYTEST_XDIST_WORKER", "")
+DOWNLOADS = ROOT / ".pytest_cache" / ("downloads-" + WORKER if WORKER else "downloads")
 CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 PAGES = {"overview": "/", "devices": "/devices", "time-history": "/time-history", "bifurcation": "/bifurcation",
          "stability-map": "/stability-map", "ground-run": "/ground-run", "study": "/study", "design": "/design",
          "validation": "/validation", "api": "/api"}
+
+
+#: Held around apt-get, here and in scripts/build_image_offline.sh: two xdist workers (a browser test
+#: and the image build) on a fresh machine would otherwise run apt-get at once, and one fails on apt's lock.
+APT_LOCK = "/tmp/shimmy-tests-apt.lock"
 
 
 def _ensure_chromium() -> None:
@@ -33,15 +41,19 @@ def _ensure_chromium() -> None:
         return
     if os.geteuid() != 0 or not shutil.which("apt-get"):
         pytest.fail("Debian chromium and chromium-driver are needed and cannot be installed here (not root)")
-    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
-    subprocess.run(["apt-get", "update", "-qq"], check=True, env=env)
-    subprocess.run(["apt-get", "install", "-y", "-qq", "chromium", "chromium-driver"], check=True, env=env)
+    with open(APT_LOCK, "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # the other worker may be installing them right now
+        if os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER):
+            return
+        env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
+        subprocess.run(["apt-get", "update", "-qq"], check=True, env=env)
+        subprocess.run(["apt-get", "install", "-y", "-qq", "chromium", "chromium-driver"], check=True, env=env)
 
 
 def chromium(profile: str, window: str, downloads: Path | None = None):
-    """Headless Chromium on a profile of its own (``profile`` under .pytest_cache), started once
-    for a module: a second browser on the same profile, started while the first is still closing,
-    would hand its pages to that one."""
+    """Headless Chromium on a profile of its own (``profile`` under .pytest_cache, one per xdist
+    worker), started once per session (``browser_fixture``): a second browser on the same profile,
+    started while the first is still closing, would hand its pages to that one."""
     _ensure_chromium()
     opts = webdriver.ChromeOptions()
     opts.binary_location = CHROMIUM
@@ -49,7 +61,7 @@ def chromium(profile: str, window: str, downloads: Path | None = None):
                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
                 "--disable-dev-shm-usage", f"--window-size={window}"):
         opts.add_argument(arg)
-    opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / profile}")
+    opts.add_argument(f"--user-data-dir={ROOT / '.pytest_cache' / (profile + '-' + WORKER if WORKER else profile)}")
     opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     if downloads is not None:
         downloads.mkdir(parents=True, exist_ok=True)
@@ -62,13 +74,22 @@ def chromium(profile: str, window: str, downloads: Path | None = None):
 
 
 def browser_fixture(profile: str, window: str, downloads: Path | None = None):
-    """A module's ``browser`` fixture: Chromium on ``profile`` at ``window`` ("W,H"), quit after the module."""
+    """A module's ``browser`` fixture: Chromium on ``profile`` at ``window`` ("W,H"). Started once per
+    session (per xdist worker) for each (profile, window, downloads) and quit at its end (the
+    ``browsers`` fixture of tests/conftest.py); a module that gets one another module used finds it
+    on a blank page at ``window``, its console read."""
 
     @pytest.fixture(scope="module")
-    def browser():
-        driver = chromium(profile, window, downloads)
-        yield driver
-        driver.quit()
+    def browser(browsers):
+        key = (profile, window, str(downloads))
+        driver = browsers.get(key)
+        if driver is None:
+            driver = browsers[key] = chromium(profile, window, downloads)
+        else:
+            driver.set_window_size(*(int(n) for n in window.split(",")))
+            driver.get("about:blank")
+            driver.get_log("browser")
+        return driver
 
     return browser
 
