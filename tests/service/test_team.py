@@ -376,7 +376,9 @@ def test_sign_in_attempts_are_limited(team):
             break
     status, headers, page = answers[-1]
     assert status == 429 and 1 <= int(headers["Retry-After"]) <= 60 and "too many sign-in attempts" in page
-    assert {a[0] for a in answers[:-1]} == {401}
+    # wrong attempts are 401 until the limit: 8 a minute from one address, shared with the sign-ins of
+    # the tests before this one in the same minute (so there may be fewer than 8 here, never more)
+    assert {a[0] for a in answers[:-1]} <= {401} and len(answers) - 1 <= 8
     good = raw(team, "POST", "/login", urllib.parse.urlencode({"token": team.tokens["bob"][1]}).encode(), form)
     assert good[0] == 429  # the limit counts attempts, right or wrong: no guessing behind a good one
     assert team.request("GET", "/api/v1/parameters", headers=team.auth["bob"])[0] == 200  # API tokens go on
