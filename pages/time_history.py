@@ -48,7 +48,7 @@ def _start_of(psi0, lateral0) -> str:
 
 def layout(config: str | None = None, V: str | None = None, Fz: str | None = None, t_end: str | None = None,
            psi0: str | None = None, lateral0: str | None = None, run: str | None = None, map_type: str | None = None,
-           **query):
+           exact_nes: str | None = None, **query):
     config, bad_config = fields.choice("config", config, list(ui.CONFIGS), "nes_pd", "a configuration")
     problems = [bad_config]
     v, problem_v = SPEED.from_url("V", V, 30)
@@ -75,6 +75,7 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
                                                {"label": label, "value": k} for k, (label, _, _) in STARTS.items()])),
             html.Div([ui.field("psi0 (rad)", PSI0.box(ids.TH_PSI0, p0)),
                       ui.field("l_g delta0 (m)", LATERAL0.box(ids.TH_LAT0, l0))], className="pair"),
+            ui.field("NES torque", ui.nes_torque(ids.TH_EXACT, "exact" if exact_nes == "1" else "cubic")),
             *jobs.controls(ids.TH_GROUP, "Run"),
         ], className="controls"),
         html.Div([html.Span("Operating points: ", className="hint"),
@@ -137,12 +138,13 @@ def _bistable_note(map_type):
     return None
 
 
-def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, design):
+def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, torque, design):
     t = T_END.read(t_end)
     # The series is thinned for a long run: every t_end the field allows can be drawn.
     series_dt = max(0.002, math.ceil(1000 * t / (settings.MAX_SERIES_POINTS - 1)) / 1000)
     return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": t, "psi0": PSI0.read(psi0),
-             "lateral0": LATERAL0.read(lateral0), "include_series": True, "series_dt": series_dt, **design}]
+             "lateral0": LATERAL0.read(lateral0), "include_series": True, "series_dt": series_dt,
+             **ui.exact_nes(config, torque), **design}]
 
 
 def _csv_rows(results):
@@ -160,13 +162,13 @@ jobs.register(
     ids.TH_GROUP, "simulate", requests=_requests, blank=lambda: (*_placeholders("Refused: see the message above"), ""),
     running=lambda: (*_placeholders("Running the time history…"), ""), waiting=lambda: (*_placeholders(), ""),
     render=lambda results: (*_figures(results[0]), _metrics(results[0]), settled(results[0])),
-    notice=lambda results: "" if results[0]["success"] else results[0]["message"],
+    notice=ui.result_notice,
     outputs=[Output(ids.TH_SERIES, "figure"), Output(ids.TH_SPECTRUM, "figure"), Output(ids.TH_PHASE, "figure"),
              Output(ids.TH_METRICS, "children"), Output(ids.TH_SETTLED, "children")],
     triggers=[Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_AUTORUN, "n_intervals"),
               Input(ids.TH_KICK, "data")],
     states=[State(ids.TH_CONFIG, "value"), State(ids.TH_TEND, "value"), State(ids.TH_PSI0, "value"),
-            State(ids.TH_LAT0, "value"), State(ids.design_store(ids.TH), "data")],
+            State(ids.TH_LAT0, "value"), State(ids.TH_EXACT, "value"), State(ids.design_store(ids.TH), "data")],
     download=jobs.Download(ids.TH_GROUP, "time_history", _csv_rows, single=True, filename=_file_stem))
 
 
@@ -353,6 +355,7 @@ def _metrics(result):
              ("dominant frequency (Hz)", "–" if f is None else f"{f:.3f}")]
     if "nes_relative" in amp:
         items.append(("NES relative rotation (rad)", f"{amp['nes_relative']:.4g}"))
+        items.append(("NES torque", "exact" if result["options"].get("exact_nes") else "cubic fit"))
     return [html.Div([html.Div(v, className="value"), html.Div(k, className="label")], className="metric")
             for k, v in items]
 
@@ -360,12 +363,14 @@ def _metrics(result):
 @dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),
                Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_TEND,
                                                                                                          "value"),
-               Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"), prevent_initial_call=True)
-def remember(config, V, fz, t_end, psi0, lateral0):
+               Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"), Input(ids.TH_EXACT, "value"),
+               prevent_initial_call=True)
+def remember(config, V, fz, t_end, psi0, lateral0, torque):
     standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
     moved = dash.ctx.triggered_id in (ids.TH_CONFIG, ids.TH_V, ids.TH_FZ)  # the map's note is of the point opened
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,
-            "lateral0": None if standard else lateral0, "run": None, **({"map_type": None} if moved else {})}
+            "lateral0": None if standard else lateral0, "exact_nes": "1" if torque == "exact" else None, "run": None,
+            **({"map_type": None} if moved else {})}
 
 
 @dash.callback(Output(ids.TH_BISTABLE, "children"), Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"),
