@@ -114,4 +114,4 @@ def result_notice(results: list[dict[str, Any]]) -> str:
     every warning (an NES rotation beyond the cubic's range, ...)."""
     said = [f"{r['config']}: {r['message']}" for r in results if r.get("success") is False]
     said += [f"Warning ({r['config']}): {w}" for r in results for w in r.get("warnings", ())]
-    return " ".join(said)
+    return " ".join(dict.fromkeys(said))
