@@ -42,8 +42,9 @@ def band(t, y, buckets: int = ENVELOPE_BUCKETS, min_span: float = 0.0) -> tuple[
     blocks = y[:n].reshape(-1, per)
     mid = t[:n].reshape(-1, per).mean(axis=1)
     low, high = blocks.min(axis=1), blocks.max(axis=1)
-    if n < y.size:  # the last, shorter run
-        mid, low, high = (np.append(mid, t[n:].mean()), np.append(low, y[n:].min()), np.append(high, y[n:].max()))
+    if n < y.size:  # the samples left over join the last run (a shorter run would narrow the band at the end)
+        low[-1], high[-1] = min(low[-1], y[n:].min()), max(high[-1], y[n:].max())
+        mid[-1] = t[n - per:].mean()
     return mid, low, high
 
 
