@@ -54,6 +54,7 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
             html.Div([ui.field("V from (m/s)", V_MIN.box(ids.BIF_VMIN, lo)),
                       ui.field("to (m/s)", V_MAX.box(ids.BIF_VMAX, hi))], className="pair"),
             ui.field("Configurations", ui.configurations(ids.BIF_CONFIGS, chosen, multi=True)),
+            ui.field("NES torque", ui.nes_torque(ids.BIF_EXACT)),
             *jobs.controls(ids.BIF_GROUP),
         ], className="controls"),
         html.Div(problems, id=ids.BIF_GROUP.error, className="error", role="alert"),
@@ -78,7 +79,7 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
     )
 
 
-def _requests(fz_kn, v_min, v_max, configs, design):
+def _requests(fz_kn, v_min, v_max, configs, torque, design):
     if not configs:
         raise InvalidParameterError("configs", "", ", ".join(CONFIGS), "is empty",
                                     "Configurations: none chosen; choose at least one")
@@ -86,7 +87,7 @@ def _requests(fz_kn, v_min, v_max, configs, design):
     if not hi > lo:
         raise InvalidParameterError("v_max", v_max, f"above {v_min:g} m/s",
                                     message=f"highest V = {v_max:g} m/s must exceed lowest V = {v_min:g} m/s")
-    return [{"config": c, "Fz": fz, "v_min": lo, "v_max": hi, **design} for c in configs]
+    return [{"config": c, "Fz": fz, "v_min": lo, "v_max": hi, **ui.exact_nes(c, torque), **design} for c in configs]
 
 
 def _csv_rows(results):
@@ -100,7 +101,8 @@ jobs.register(
     ids.BIF_GROUP, "bifurcation", requests=_requests, render=lambda results: (figure(results), summary(results)),
     outputs=[Output(ids.BIF_GRAPH, "figure"), Output(ids.BIF_TABLE, "children")],
     states=[State(ids.BIF_FZ, "value"), State(ids.BIF_VMIN, "value"), State(ids.BIF_VMAX, "value"),
-            State(ids.BIF_CONFIGS, "value"), State(ids.design_store(ids.BIF), "data")],
+            State(ids.BIF_CONFIGS, "value"), State(ids.BIF_EXACT, "value"), State(ids.design_store(ids.BIF), "data")],
+    notice=ui.result_notice,
     lock=[ids.BIF_FZ, ids.BIF_VMIN, ids.BIF_VMAX], download=jobs.Download(ids.BIF_GROUP, "bifurcation", _csv_rows),
     blank=lambda: (style.message_figure("Refused: see the message above", 520), None))
 
@@ -108,7 +110,7 @@ jobs.register(
 def _compare_requests(fz_kn, v_min, v_max, config, selection, saved, current):
     """The page's request for one configuration, once per compared design (the requests a design's
     own diagram makes: the cache serves a design already drawn)."""
-    common = _requests(fz_kn, v_min, v_max, [config], {})[0]
+    common = _requests(fz_kn, v_min, v_max, [config], "cubic", {})[0]
     return [{**common, **d.request()} for d in compare.chosen(selection, saved, current)]
 
 

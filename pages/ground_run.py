@@ -62,6 +62,7 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
             ui.field("Map and curves of", ui.configurations(ids.GR_CONFIG, config)),
             ui.field("Shimmy threshold |psi| (rad)", PSI_THR.box(ids.GR_PSI_THR, psi_value)),
             ui.field("Shimmy threshold |l_g delta| (mm)", LAT_THR.box(ids.GR_LAT_THR, lat_value)),
+            ui.field("NES torque", ui.nes_torque(ids.GR_EXACT)),
             *jobs.controls(ids.GR_GROUP, "Run"),
         ], className="controls"),
         html.Div([
@@ -154,7 +155,7 @@ def _same(rows, preset_rows) -> bool:
     return True
 
 
-def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, design):
+def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, torque, design):
     """One request per configuration, the one whose map is drawn first."""
     if rows and not (preset_rows and _same(rows, preset_rows)):
         profile = {"profile": [[r.get("t"), r.get("V"), _newtons(r.get("Fz"))] for r in rows]}
@@ -163,7 +164,7 @@ def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, desig
     psi, lateral = PSI_THR.read(psi_thr), LAT_THR.read(lat_thr)  # refused in the box's unit, never defaulted
     order = [config] + [c for c in CONFIGS if c != config]
     return [{"config": c, **profile, "psi_threshold": psi, "lateral_threshold": lateral, "series_dt": SERIES_DT,
-             "hopf_curves": True, **design} for c in order]
+             "hopf_curves": True, **ui.exact_nes(c, torque), **design} for c in order]
 
 
 def _newtons(fz_kn):
@@ -181,13 +182,8 @@ def _file_stem(results):
     return f"ground_run_{results[0]['profile']['name']}"
 
 
-def _notice(results):
-    failed = [f"{r['config']}: {r['message']}" for r in results if not r["success"]]
-    return "; ".join(failed)
-
-
 jobs.register(
-    ids.GR_GROUP, "ground_run", requests=_requests, notice=_notice, running=lambda: _placeholders(RUNNING),
+    ids.GR_GROUP, "ground_run", requests=_requests, notice=ui.result_notice, running=lambda: _placeholders(RUNNING),
     waiting=lambda: _placeholders(WAITING),
     render=lambda results: (plane(results[0]), envelopes(results, "t"), envelopes(results, "V"), summary(results)),
     outputs=[Output(ids.GR_PLANE, "figure"), Output(ids.GR_TIME, "figure"), Output(ids.GR_SPEED, "figure"),
@@ -195,7 +191,7 @@ jobs.register(
     follow=[Input(ids.GR_CONFIG, "value")],  # which of the four runs' Hopf curves are drawn: starts nothing
     states=[State(ids.GR_PRESET, "value"), State(ids.GR_SETTINGS, "data"), State(ids.GR_TABLE, "data"),
             State(ids.GR_PRESET_ROWS, "data"), State(ids.GR_PSI_THR, "value"), State(ids.GR_LAT_THR, "value"),
-            State(ids.design_store(ids.GR), "data")],
+            State(ids.GR_EXACT, "value"), State(ids.design_store(ids.GR), "data")],
     lock=[ids.GR_PRESET],
     download=jobs.Download(ids.GR_GROUP, "ground_run", _csv_rows, filename=_file_stem))
 

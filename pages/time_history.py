@@ -14,7 +14,7 @@ from shimmy.service import analyses, settings
 from ui import components as ui
 from ui import fields, ids, jobs
 from ui import style
-from ui.series import envelope
+from ui.series import DETAIL_SAMPLES, band, detail, last_cycles
 from ui.fields import Quantity
 from ui.layout import page
 
@@ -48,7 +48,7 @@ def _start_of(psi0, lateral0) -> str:
 
 def layout(config: str | None = None, V: str | None = None, Fz: str | None = None, t_end: str | None = None,
            psi0: str | None = None, lateral0: str | None = None, run: str | None = None, map_type: str | None = None,
-           **query):
+           exact_nes: str | None = None, **query):
     config, bad_config = fields.choice("config", config, list(ui.CONFIGS), "nes_pd", "a configuration")
     problems = [bad_config]
     v, problem_v = SPEED.from_url("V", V, 30)
@@ -75,6 +75,7 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
                                                {"label": label, "value": k} for k, (label, _, _) in STARTS.items()])),
             html.Div([ui.field("psi0 (rad)", PSI0.box(ids.TH_PSI0, p0)),
                       ui.field("l_g delta0 (m)", LATERAL0.box(ids.TH_LAT0, l0))], className="pair"),
+            ui.field("NES torque", ui.nes_torque(ids.TH_EXACT, "exact" if exact_nes == "1" else "cubic")),
             *jobs.controls(ids.TH_GROUP, "Run"),
         ], className="controls"),
         html.Div([html.Span("Operating points: ", className="hint"),
@@ -132,17 +133,47 @@ def _bistable_note(map_type):
     """What the page says when it was opened from a point the map shades Bistable (or Both)."""
     if map_type == "Bistable":
         return ("The stability map shades this point Bistable: a torsional and a lateral limit cycle coexist, and "
-                "which one the gear ends on depends on the kick. Compute its disturbance margins below to see how "
-                "large a yaw kick reaches each, and run from there.")
+                "which one the gear ends on depends on the kick. Run runs the start chosen above and the two large "
+                "starts, and says which cycle each ends on; compute the disturbance margins below to see how large "
+                "a yaw kick reaches each, and run from there.")
     return None
 
 
-def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, design):
+def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, torque, bistable, design):
+    """The run from the start in the boxes; at a point the map shades Bistable (its note shown), the runs
+    from the two large starts too, so that the page says which attractor each start ends on."""
     t = T_END.read(t_end)
     # The series is thinned for a long run: every t_end the field allows can be drawn.
     series_dt = max(0.002, math.ceil(1000 * t / (settings.MAX_SERIES_POINTS - 1)) / 1000)
-    return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": t, "psi0": PSI0.read(psi0),
-             "lateral0": LATERAL0.read(lateral0), "include_series": True, "series_dt": series_dt, **design}]
+    common = {"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": t, "include_series": True,
+              "series_dt": series_dt, **ui.exact_nes(config, torque), **design}
+    starts = [(PSI0.read(psi0), LATERAL0.read(lateral0))]
+    if bistable:
+        starts += [(p, q) for key in ("torsional", "lateral") for _, p, q in [STARTS[key]] if (p, q) not in starts]
+    return [{**common, "psi0": p, "lateral0": q} for p, q in starts]
+
+
+def _starts_table(results):
+    """Which attractor each start ended on (the runs of a Bistable map point)."""
+    rows = []
+    for r in results:
+        amp, f = r["amplitude"], r["frequency_hz"]
+        rows.append([f"psi0 = {r['start']['psi0']:g} rad, l_g delta0 = {r['start']['lateral0']:g} m",
+                     MODE_WORDS.get(r["response_type"], r["response_type"])
+                     + ("" if r["steady"] else " (not yet steady)"),
+                     f"{amp['psi']:.4g}", f"{amp['lateral']:.4g}", "–" if f is None else f"{f:.3f}"])
+    return html.Div([
+        html.P("The map shades this point Bistable; the runs from the start above and from the two large starts "
+               "ended on:", className="hint"),
+        ui.table(["start", "settled on", "max |psi| (rad)", "max |l_g delta| (m)", "frequency (Hz)"], rows,
+                 ids.TH_STARTS),
+        html.P("The figures show the first run; choose another start above to draw it (from the cache at once).",
+               className="hint")])
+
+
+def _settled_all(results):
+    first = settled(results[0])
+    return first if len(results) == 1 else html.Div([html.Div(first), _starts_table(results)])
 
 
 def _csv_rows(results):
@@ -159,14 +190,15 @@ def _file_stem(results):
 jobs.register(
     ids.TH_GROUP, "simulate", requests=_requests, blank=lambda: (*_placeholders("Refused: see the message above"), ""),
     running=lambda: (*_placeholders("Running the time history…"), ""), waiting=lambda: (*_placeholders(), ""),
-    render=lambda results: (*_figures(results[0]), _metrics(results[0]), settled(results[0])),
-    notice=lambda results: "" if results[0]["success"] else results[0]["message"],
+    render=lambda results: (*_figures(results[0]), _metrics(results[0]), _settled_all(results)),
+    notice=ui.result_notice,
     outputs=[Output(ids.TH_SERIES, "figure"), Output(ids.TH_SPECTRUM, "figure"), Output(ids.TH_PHASE, "figure"),
              Output(ids.TH_METRICS, "children"), Output(ids.TH_SETTLED, "children")],
     triggers=[Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_AUTORUN, "n_intervals"),
               Input(ids.TH_KICK, "data")],
     states=[State(ids.TH_CONFIG, "value"), State(ids.TH_TEND, "value"), State(ids.TH_PSI0, "value"),
-            State(ids.TH_LAT0, "value"), State(ids.design_store(ids.TH), "data")],
+            State(ids.TH_LAT0, "value"), State(ids.TH_EXACT, "value"), State(ids.TH_BISTABLE, "children"),
+            State(ids.design_store(ids.TH), "data")],
     download=jobs.Download(ids.TH_GROUP, "time_history", _csv_rows, single=True, filename=_file_stem))
 
 
@@ -280,30 +312,116 @@ dash.clientside_callback(
     Input(ids.TH_KICK, "data"), prevent_initial_call=True)
 
 
+#: Where a run's series traces are (three per row: the band's top, its bottom filled to the top, the
+#: detail line), for the detail window's redraw.
+PER_ROW = 3
+
+
+def _rows(result) -> list[tuple[str, list[float], str, str]]:
+    """(legend name, values, colour, axis title) of each row of the series figure."""
+    s = result["series"]
+    rows = [("torsion psi (rad)", s["psi"], style.CONFIG_COLOURS[result["config"]], "psi (rad)"),
+            ("lateral l_g delta (m)", s["lateral"], "#56B4E9", "l_g delta (m)"),
+            ("tyre deformation lam (m)", s["lam"], "#CC79A7", "lam (m)")]
+    if "psis" in s:
+        rows.append(("NES relative rotation psi - psis (rad)", list(np.asarray(s["psi"]) - np.asarray(s["psis"])),
+                     "#D55E00", "psi - psis (rad)"))
+    return rows
+
+
+def _translucent(colour: str, alpha: float = 0.3) -> str:
+    r, g, b = (int(colour[k:k + 2], 16) for k in (1, 3, 5))
+    return f"rgba({r},{g},{b},{alpha})"
+
+
+def _series_figure(result):
+    """The run's rows against time: the whole run as a band (each time bucket's lowest and highest
+    sample; a line through them would be a solid block with aliasing stripes at 10-16 Hz), every sample
+    as a line in the window shown (by default the last cycles; the range slider below moves it over
+    the whole run, and the line follows it from the cached result)."""
+    t = np.asarray(result["series"]["t"])
+    title = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {result['Fz'] / 1e3:g} kN")
+    rows = _rows(result)
+    fig = make_subplots(rows=len(rows), cols=1, shared_xaxes=True, vertical_spacing=0.04)
+    t0, t1 = last_cycles(float(t[-1]), result["frequency_hz"])
+    for k, (name, values, colour, axis) in enumerate(rows, start=1):
+        mid, low, high = band(t, values, min_span=1.25 / result["frequency_hz"] if result["frequency_hz"] else 0.0)
+        fig.add_scatter(x=mid, y=high, mode="lines", line={"width": 0, "color": colour}, hoverinfo="skip",
+                        showlegend=False, legendgroup=name, row=k, col=1)
+        fig.add_scatter(x=mid, y=low, mode="lines", line={"width": 0, "color": colour}, fill="tonexty",
+                        fillcolor=_translucent(colour), hoverinfo="skip", name=f"{name}: range over the run",
+                        showlegend=k == 1, legendgroup="band", row=k, col=1)
+        x, y = detail(t, values, t0, t1) or ([], [])
+        fig.add_scatter(x=list(map(float, x)), y=list(map(float, y)), mode="lines",  # lists, as the redraw sends
+                        line={"width": 1.2, "color": colour}, name=name, row=k, col=1)
+        fig.update_yaxes(title_text=axis, row=k, col=1)
+    start = result.get("start") or {}
+    fig.update_layout(title=style.title(title), height=170 * len(rows) + 170, template="plotly_white",
+                      margin={**style.MARGIN, "l": 70}, legend={"orientation": "h", "y": -0.22},
+                      annotations=[_zoom_note(False)],
+                      # the user's zoom survives the line's redraw (same run), a new run opens on its last cycles
+                      uirevision=f"{title} {start.get('psi0')} {start.get('lateral0')} {result['options']['t_end']}")
+    fig.update_xaxes(range=[t0, t1])
+    fig.update_xaxes(title_text="time t (s): the slider below moves the window over the whole run",
+                     rangeslider={"visible": True, "thickness": 0.07}, row=len(rows), col=1)
+    return fig
+
+
+def _zoom_note(visible: bool) -> dict:
+    return {"text": f"more than {DETAIL_SAMPLES} samples in this window: the band only; zoom in to see every sample",
+            "xref": "paper", "yref": "paper", "x": 1, "y": 1.0, "xanchor": "right", "yanchor": "bottom",
+            "showarrow": False, "font": {"size": 11, "color": "#555"}, "visible": visible}
+
+
+def _window(relayout, t_end: float) -> tuple[float, float] | None:
+    """The time window a zoom, a pan or the range slider asked for (None if the event is not one)."""
+    if not relayout:
+        return None
+    if any(k.endswith(".autorange") and v for k, v in relayout.items() if k.startswith("xaxis")):
+        return 0.0, t_end
+    for key, value in relayout.items():
+        if key.startswith("xaxis") and key.endswith(".range") and isinstance(value, list) and len(value) == 2:
+            return float(value[0]), float(value[1])
+    ends = {k.split(".")[0]: [relayout.get(f"{k.split('.')[0]}.range[0]"), relayout.get(f"{k.split('.')[0]}.range[1]")]
+            for k in relayout if k.startswith("xaxis") and ".range[" in k}
+    for lo, hi in ends.values():
+        if lo is not None and hi is not None:
+            return float(lo), float(hi)
+    return None
+
+
+@dash.callback(Output(ids.TH_SERIES, "figure", allow_duplicate=True), Input(ids.TH_SERIES, "relayoutData"),
+               State(ids.TH_GROUP.requests, "data"), prevent_initial_call=True)
+def follow_window(relayout, requests):
+    """Every sample of the window shown, from the cached result (a zoom, a pan, the range slider)."""
+    if not requests:
+        return no_update
+    try:
+        result = analyses.cached("simulate", requests[0])
+    except InvalidParameterError:
+        return no_update
+    if result is None or "series" not in result:
+        return no_update
+    t = np.asarray(result["series"]["t"])
+    window = _window(relayout, float(t[-1]))
+    if window is None:
+        return no_update
+    patched = dash.Patch()
+    too_many = False
+    for k, (_, values, _, _) in enumerate(_rows(result)):
+        shown = detail(t, values, *window)
+        too_many = too_many or shown is None
+        x, y = shown if shown is not None else ([], [])
+        patched["data"][PER_ROW * k + 2]["x"] = list(map(float, x))
+        patched["data"][PER_ROW * k + 2]["y"] = list(map(float, y))
+    patched["layout"]["annotations"][0]["visible"] = too_many
+    return patched
+
+
 def _figures(result):
     s = result["series"]
-    t = np.asarray(s["t"])
-    title = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {result['Fz'] / 1e3:g} kN")
-    has_nes = "psis" in s
-    rows = 4 if has_nes else 3
-    series = make_subplots(rows=rows, cols=1, shared_xaxes=True, vertical_spacing=0.05)
     colour = style.CONFIG_COLOURS[result["config"]]
-    for row, values, name, c in ((1, s["psi"], "torsion psi (rad)", colour),
-                                 (2, s["lateral"], "lateral l_g delta (m)", "#56B4E9"),
-                                 (3, s["lam"], "tyre deformation lam (m)", "#CC79A7")):
-        x, y = envelope(t, values)
-        series.add_scatter(x=x, y=y, name=name, line={"color": c, "width": 1}, row=row, col=1)
-    if has_nes:
-        x, y = envelope(t, np.asarray(s["psi"]) - np.asarray(s["psis"]))
-        series.add_scatter(x=x, y=y, name="NES relative rotation psi - psis (rad)",
-                           line={"color": "#D55E00", "width": 1}, row=4, col=1)
-        series.update_yaxes(title_text="psi - psis (rad)", row=4, col=1)
-    series.update_layout(title=style.title(title), height=180 * rows + 110, template="plotly_white",
-                         margin={**style.MARGIN, "l": 70}, legend={"orientation": "h", "y": -0.08})
-    series.update_xaxes(title_text="time t (s)", row=rows, col=1)
-    series.update_yaxes(title_text="psi (rad)", row=1, col=1)
-    series.update_yaxes(title_text="l_g delta (m)", row=2, col=1)
-    series.update_yaxes(title_text="lam (m)", row=3, col=1)
+    series = _series_figure(result)
     sp = result["spectrum"]
     spectrum = style.figure("Spectrum of the steady window", "frequency (Hz)", "power (normalised)")
     floor = 1e-6  # six decades below the peak: the tones, not the round-off
@@ -353,6 +471,7 @@ def _metrics(result):
              ("dominant frequency (Hz)", "–" if f is None else f"{f:.3f}")]
     if "nes_relative" in amp:
         items.append(("NES relative rotation (rad)", f"{amp['nes_relative']:.4g}"))
+        items.append(("NES torque", "exact" if result["options"].get("exact_nes") else "cubic fit"))
     return [html.Div([html.Div(v, className="value"), html.Div(k, className="label")], className="metric")
             for k, v in items]
 
@@ -360,12 +479,14 @@ def _metrics(result):
 @dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),
                Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_TEND,
                                                                                                          "value"),
-               Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"), prevent_initial_call=True)
-def remember(config, V, fz, t_end, psi0, lateral0):
+               Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"), Input(ids.TH_EXACT, "value"),
+               prevent_initial_call=True)
+def remember(config, V, fz, t_end, psi0, lateral0, torque):
     standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
     moved = dash.ctx.triggered_id in (ids.TH_CONFIG, ids.TH_V, ids.TH_FZ)  # the map's note is of the point opened
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,
-            "lateral0": None if standard else lateral0, "run": None, **({"map_type": None} if moved else {})}
+            "lateral0": None if standard else lateral0, "exact_nes": "1" if torque == "exact" else None, "run": None,
+            **({"map_type": None} if moved else {})}
 
 
 @dash.callback(Output(ids.TH_BISTABLE, "children"), Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"),

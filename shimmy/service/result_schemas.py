@@ -241,7 +241,10 @@ RESULTS: dict[str, Schema] = {
         "evaluations": INT, "history": arr({"type": "object"}), "feasible": BOOL, "message": STR,
         "link_query": mapping(STR, "the workbench address of the optimum"), "params": ref("Params"),
         "elapsed_s": ELAPSED, "executor": EXECUTOR, "warnings": ref("Warnings"), "version": VERSION},
-        {"at_bounds": {"type": "array"}}),
+        {"at_bounds": arr(obj({"name": STR, "bound": {"type": "string", "enum": ["low", "high"]},
+                                "limit": num("the bound, in the parameter's unit"), "value": NUM}),
+                          "the searched parameters the optimum has on a bound of their range (within 0.1 % of it): "
+                          "the range limits the optimum")}),
     "robustness": obj({
         "config": CONFIG, "Fz": num("N"), "params": ref("Params"),
         "tolerances": arr(obj({"name": STR, "relative": NUM, "distribution": STR}, {"relative_std": NUM})),

@@ -418,6 +418,7 @@ SCHEMAS: dict[str, RequestSchema] = {
         _range("v_max", DIAGRAM_V_RANGE[1], V_RANGE, "m/s", "highest speed"),
         Field("ntst", "integer", "collocation mesh intervals", default=40, low=10, high=settings.MAX_NTST),
         Field("seeds", "boolean", "look for branches not born at a Hopf point by simulation", default=True),
+        Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
         PARAMS, MATERIAL)),
     "hopf_curves": RequestSchema("hopf_curves", "Hopf curves of x = 0 in (V, Fz) with generalised Hopf points", (
         _config(), _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),

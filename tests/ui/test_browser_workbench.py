@@ -344,3 +344,27 @@ def test_paired_fields_share_a_row_and_the_sidebar_collapses(server, browser):
     image = browser.execute_script("return getComputedStyle(document.querySelector('.body')).backgroundImage")
     assert "linear-gradient" in image
     assert severe(browser) == []
+
+
+def test_an_nes_rotation_beyond_the_cubic_is_said_and_the_exact_torque_is_a_choice(server, browser):
+    """Point D with the NES (50 m/s, 350 kN): the NES relative rotation reaches about 0.16 rad, beyond the
+    cubic's 1 % range (0.094 rad for the nominal design); the run says so at once, and the exact torque,
+    chosen on the page, answers without the warning."""
+    open_page(browser, server, "/time-history?config=nes&V=50&Fz=350&t_end=20&run=1")
+    said = wait_for(lambda: text_of(browser, "th-error"), timeout=120, what="the run's warning")
+    assert "NES rotation beyond the cubic's range" in said and "0.0939 rad" in said
+    assert "cubic fit\nNES torque" in text_of(browser, "th-metrics")
+    exact = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#th-exact input[value='exact']"),
+                     what="the exact torque choice")[0]
+    exact.click()
+    wait_for(lambda: "exact_nes=1" in browser.current_url, timeout=10, what="the address to carry the choice")
+    idle(browser)
+    browser.find_element(By.ID, "th-run").click()
+    wait_for(lambda: "exact\nNES torque" in text_of(browser, "th-metrics"), timeout=180, what="the exact run")
+    assert text_of(browser, "th-error") == ""  # within the exact torque's validity: nothing to warn of
+    browser.save_screenshot(str(SHOTS / "time-history-exact-nes-1440.png"))
+    # The bifurcation page offers the same choice and says the same of the cubic's diagram.
+    open_page(browser, server, "/bifurcation")
+    assert browser.find_elements(By.CSS_SELECTOR, "#bif-exact input[value='exact']")
+    assert browser.find_elements(By.CSS_SELECTOR, "#gr-exact input") == []  # one page's ids, not another's
+    assert severe(browser) == []

@@ -94,7 +94,7 @@ def test_ground_run_thresholds_are_refused_in_the_boxes_unit_never_defaulted():
 
     for psi, lateral, text in ((None, 1.0, "threshold |psi| is empty"), (0.01, 5000.0, "5000 mm is outside")):
         with pytest.raises(InvalidParameterError) as err:
-            ground_run._requests("original", "takeoff", [], [], [], psi, lateral, {})
+            ground_run._requests("original", "takeoff", [], [], [], psi, lateral, "cubic", {})
         assert text in str(err.value)
-    request = ground_run._requests("original", "takeoff", [], [], [], 0.02, 2.0, {})[0]
+    request = ground_run._requests("original", "takeoff", [], [], [], 0.02, 2.0, "cubic", {})[0]
     assert request["psi_threshold"] == 0.02 and request["lateral_threshold"] == pytest.approx(0.002)
