@@ -147,13 +147,13 @@ jobs.register(
 PANELS = (("hopf_start", "hopf_V_start", "first Hopf V (m/s)", 1.0),
           ("hopf_end", "hopf_V_end", "last Hopf V (m/s)", 1.0),
           (None, "min_shimmy_Fz", "lowest Hopf Fz (kN)", 1e-3),
-          ("max_psi", None, "max stable |psi| (rad)", 1.0))
+          ("max_psi", "max_psi", "max stable |psi| (rad)", 1.0))
 
 
 def figure(result):
     """Per configuration: the exact curves over the parameter's whole range (lines; the points where
     the picture changes as crosses) with the sampled diagrams' values as markers on them; the largest
-    amplitude from the samples alone (lines between them)."""
+    amplitude on its grid of diagrams over the whole range (small dots joined by lines)."""
     name = result["parameters"][0]
     fig = make_subplots(rows=len(PANELS), cols=1, shared_xaxes=True, vertical_spacing=0.05)
     curves = {(c["config"], c["quantity"]): c for c in result.get("curves") or []}
@@ -166,10 +166,13 @@ def figure(result):
             curve = curves.get((config, quantity))
             hover = f"{label}<br>{name} %{{x:.4g}}<br>%{{y:.6g}}<extra>WHAT</extra>"
             if curve is not None:
+                gridded = quantity == "max_psi"  # exact at its grid values (a diagram each), joined between them
                 fig.add_scatter(x=curve["p"], y=[None if v is None else v * scale for v in curve["values"]],
-                                mode="lines", name=label, legendgroup=config, showlegend=not shown,
-                                line={"color": colour, "width": 2}, hovertemplate=hover.replace("WHAT", "exact curve"),
-                                row=row, col=1)
+                                mode="lines+markers" if gridded else "lines", name=label, legendgroup=config,
+                                showlegend=not shown, line={"color": colour, "width": 2},
+                                marker={"size": 4, "color": colour},
+                                hovertemplate=hover.replace("WHAT", "diagram at a grid value" if gridded
+                                                            else "exact curve"), row=row, col=1)
                 shown = True
                 marks = [q for q in curve["special_points"] if isinstance(q.get("value"), (int, float))]
                 if marks:

@@ -206,7 +206,8 @@ RESULTS: dict[str, Schema] = {
         "curves": arr(obj({"config": CONFIG, "quantity": {"type": "string", "enum": [
             "hopf_V_start", "hopf_V_end", "min_shimmy_Fz", "max_psi"]}, "param": STR,
             "p": NUMBERS, "values": arr(nullable(NUM)),
-            "special_points": arr(obj({"kind": STR, "p": NUM}, {"value": nullable(NUM), "V": {}, "located": BOOL})),
+            "special_points": arr(obj({"kind": STR, "p": NUM}, {"value": nullable(NUM), "V": {}, "located": BOOL,
+                                                               "bracket": PAIR, "why": STR})),
             "unit": STR}), "each figure continued in the parameter (one-parameter studies)")}),
     "ground_run": obj({
         "config": CONFIG, "time_in_shimmy_s": num("s"),
