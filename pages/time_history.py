@@ -10,6 +10,8 @@ from dash import Input, Output, State, dcc, html, no_update
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
+from shimmy.model import units
+from shimmy.model.configurations import STATE_NAMES, STATE_UNITS
 from shimmy.service import analyses, settings
 from ui import components as ui
 from ui import fields, ids, jobs
@@ -21,15 +23,15 @@ from ui.layout import page
 dash.register_page(__name__, path="/time-history", name="Time history", order=2)
 
 SPEED = Quantity("simulate", "V", "V", "m/s")
-FZ = Quantity("simulate", "Fz", "Fz", "kN", 1e3)
+FZ = Quantity("simulate", "Fz", "Fz", "kN", units.KN)
 T_END = Quantity("simulate", "t_end", "simulated time", "s")
 PSI0 = Quantity("simulate", "psi0", "initial psi", "rad")
-LATERAL0 = Quantity("simulate", "lateral0", "initial l_g delta", "m")
+LATERAL0 = Quantity("simulate", "lateral0", "initial l_g delta", "mm", units.MM)  # the address keeps m
 #: The starts offered: the standard one (psi = 0.001 rad), and ones large enough to reach each
-#: attractor of a bistable point.
+#: attractor of a bistable point (psi0 in rad, l_g delta0 in mm: the boxes' units).
 STARTS = {"standard": ("standard: psi = 0.001 rad", 0.001, 0.0),
           "torsional": ("large torsional: psi = 0.2 rad", 0.2, 0.0),
-          "lateral": ("large lateral: l_g delta = 0.1 m", 0.0, 0.1),
+          "lateral": ("large lateral: l_g delta = 100 mm", 0.0, 100.0),
           "typed": ("values typed below", None, None)}
 WAITING = "Choose an operating point and press Run (a result already in the cache is shown at once)"
 MARGINS_STALE = "Press Compute margins for this operating point (any margins shown are of the previous one)."
@@ -55,7 +57,7 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
     fz, problem_fz = FZ.from_url("Fz", Fz, 150)
     t, problem_t = T_END.from_url("t_end", t_end, 60)
     p0, problem_p = PSI0.from_url("psi0", psi0, 0.001)
-    l0, problem_l = LATERAL0.from_url("lateral0", lateral0, 0.0)
+    l0, problem_l = LATERAL0.from_url("lateral0", _mm_of(lateral0), 0.0)
     problems += [problem_v, problem_fz, problem_t, problem_p, problem_l]
     series, spectrum, phase, _ = _placeholders()
     return page(
@@ -67,14 +69,14 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
                   "start. Runs in the background; repeated questions come from the cache."),
         html.Div([
             ui.field("Configuration", ui.configurations(ids.TH_CONFIG, config, width="160px")),
-            ui.field("V (m/s)", SPEED.box(ids.TH_V, v, debounce=True)),
-            ui.field("Fz (kN)", FZ.box(ids.TH_FZ, fz, debounce=True)),
-            ui.field("Simulated time (s)", T_END.box(ids.TH_TEND, t)),
+            SPEED.field("V (m/s)", ids.TH_V, v),
+            FZ.field("Fz (kN)", ids.TH_FZ, fz),
+            T_END.field("Simulated time (s)", ids.TH_TEND, t),
             ui.field("Start", dcc.Dropdown(id=ids.TH_START, value=_start_of(p0, l0), clearable=False,
                                            style={"width": "250px"}, options=[
                                                {"label": label, "value": k} for k, (label, _, _) in STARTS.items()])),
-            html.Div([ui.field("psi0 (rad)", PSI0.box(ids.TH_PSI0, p0)),
-                      ui.field("l_g delta0 (m)", LATERAL0.box(ids.TH_LAT0, l0))], className="pair"),
+            html.Div([PSI0.field("psi0 (rad)", ids.TH_PSI0, p0),
+                      LATERAL0.field("l_g delta0 (mm)", ids.TH_LAT0, l0)], className="pair"),
             *jobs.controls(ids.TH_GROUP, "Run"),
         ], className="controls"),
         html.Div([html.Span("Operating points: ", className="hint"),
@@ -105,6 +107,11 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
         # ?run=1 (a click on a map point): run once the page is drawn, as if Run had been pressed.
         dcc.Interval(id=ids.TH_AUTORUN, interval=200, max_intervals=1, disabled=run != "1"),
     )
+
+
+for _box, _quantity in ((ids.TH_V, SPEED), (ids.TH_FZ, FZ), (ids.TH_TEND, T_END), (ids.TH_PSI0, PSI0),
+                        (ids.TH_LAT0, LATERAL0)):
+    fields.check(_box, _quantity)
 
 
 @dash.callback(Output(ids.TH_V, "value"), Output(ids.TH_FZ, "value"),
@@ -145,15 +152,30 @@ def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, design):
              "lateral0": LATERAL0.read(lateral0), "include_series": True, "series_dt": series_dt, **design}]
 
 
+#: The downloaded series' columns: name with its unit, SI units per unit written (l_g delta in mm).
+CSV_COLUMNS = {"t": ("t_s", 1.0), "lateral": ("lateral_mm", units.MM),
+               **{n: (f"{n}_{u.replace('/', '_')}", 1.0) for n, u in zip(STATE_NAMES, STATE_UNITS, strict=True)}}
+
+
 def _csv_rows(results):
     s = results[0]["series"]
     keys = list(s)
-    return keys, zip(*(s[k] for k in keys), strict=True)
+    columns = [CSV_COLUMNS.get(k, (k, 1.0)) for k in keys]
+    values = [s[k] if scale == 1.0 else [v / scale for v in s[k]] for k, (_, scale) in zip(keys, columns, strict=True)]
+    return [name for name, _ in columns], zip(*values, strict=True)
+
+
+def _mm_of(lateral0_m):
+    """The address's lateral0 (m, as the API takes it) in the box's mm; a value that is no number as it is."""
+    try:
+        return None if lateral0_m is None else float(lateral0_m) / units.MM
+    except (TypeError, ValueError):
+        return lateral0_m
 
 
 def _file_stem(results):
     r = results[0]
-    return f"time_history_{r['config']}_V{r['V']:g}_Fz{r['Fz'] / 1e3:g}kN"
+    return f"time_history_{r['config']}_V{r['V']:g}_Fz{r['Fz'] / units.KN:g}kN"
 
 
 jobs.register(
@@ -204,26 +226,26 @@ def margins_table(result):
                                                         className="secondary")
         equilibrium = a["mode"] == "equilibrium"
         rows.append([what, "0" if equilibrium else f"{a['amplitude']['psi']:.4g}",
-                     "0" if equilibrium else f"{a['amplitude']['lateral']:.4g}",
+                     "0" if equilibrium else f"{units.to_mm(a['amplitude']['lateral']):.4g}",
                      _kick(m, result["options"]["max_size"]), _check(m), button])
     saddles = "; ".join(f"{s['mode']}, psi {s['amplitude']['psi']:.4g} rad" for s in result["saddles"])
-    note = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {result['Fz'] / 1e3:g} kN: "
+    note = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {units.kn(result['Fz'])}: "
             f"straight rolling {'stable' if result['straight_rolling_stable'] else 'unstable'}"
             + (f"; saddle cycles between the basins: {saddles}" if saddles else "")
             + f". {result['runs']} runs in {result['elapsed_s']:.1f} s.")
     warnings = [html.P(f"Warning: {w}", className="hint") for w in result["warnings"]]
     return [html.P(note, className="hint"), ui.table(
-        ["attractor", "max |psi| (rad)", "max |l_g delta| (m)", "min yaw kick psi0 (rad)", "checked (psi0 → end)",
+        ["attractor", "max |psi| (rad)", "max |l_g delta| (mm)", "min yaw kick psi0 (rad)", "checked (psi0 → end)",
          "time history"], rows, ids.THM_SUMMARY), *warnings]
 
 
 def _margin_csv(results):
     r = results[0]
-    rows = [[a["mode"], a["kind"], a["amplitude"]["psi"], a["amplitude"]["lateral"], a["standard_start"],
+    rows = [[a["mode"], a["kind"], a["amplitude"]["psi"], units.to_mm(a["amplitude"]["lateral"]), a["standard_start"],
              a["min_disturbance"]["value"], a["min_disturbance"]["tolerance"], a["min_disturbance"].get("lower"),
              a["min_disturbance"].get("upper"), (a["min_disturbance"]["check"] or {}).get("confirmed")]
             for a in r["attractors"]]
-    return ["mode", "kind", "psi_amplitude_rad", "lateral_amplitude_m", "standard_start", "min_yaw_kick_rad",
+    return ["mode", "kind", "psi_amplitude_rad", "lateral_amplitude_mm", "standard_start", "min_yaw_kick_rad",
             "tolerance_rad", "lower_rad", "upper_rad", "confirmed"], rows
 
 
@@ -234,7 +256,7 @@ jobs.register(
     states=[State(ids.design_store(ids.TH), "data")], stale=MARGINS_STALE,
     download=jobs.Download(ids.THM, "disturbance_margins", _margin_csv, single=True,
                            filename=lambda results: f"margins_{results[0]['config']}_V{results[0]['V']:g}_Fz"
-                                                    f"{results[0]['Fz'] / 1e3:g}kN"),
+                                                    f"{results[0]['Fz'] / units.KN:g}kN"),
     blank=lambda: (None,))
 
 
@@ -264,7 +286,7 @@ def run_from_kick(clicks, requests, t_end, config, V, fz_kn):
     psi0 = STARTS["standard"][1] if m["value"] == 0.0 else float(f"{m['upper']:.5g}")
     longest = result["options"]["t_max"]
     t = t_end if isinstance(t_end, (int, float)) and t_end >= longest else longest
-    point = (result["config"], result["V"], result["Fz"] / 1e3)
+    point = (result["config"], result["V"], result["Fz"] / units.KN)
     moved = [new if new != old else no_update for new, old in zip(point, (config, V, fz_kn), strict=True)]
     return psi0, 0.0, t, *moved, {"attractor": k, "psi0": psi0, "clicks": sum(c or 0 for c in clicks)}
 
@@ -283,26 +305,31 @@ dash.clientside_callback(
 def _figures(result):
     s = result["series"]
     t = np.asarray(s["t"])
-    title = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {result['Fz'] / 1e3:g} kN")
+    title = f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {units.kn(result['Fz'])}"
     has_nes = "psis" in s
     rows = 4 if has_nes else 3
     series = make_subplots(rows=rows, cols=1, shared_xaxes=True, vertical_spacing=0.05)
     colour = style.CONFIG_COLOURS[result["config"]]
     for row, values, name, c in ((1, s["psi"], "torsion psi (rad)", colour),
-                                 (2, s["lateral"], "lateral l_g delta (m)", "#56B4E9"),
+                                 (2, np.asarray(s["lateral"]) / units.MM, "lateral l_g delta (mm)", "#56B4E9"),
                                  (3, s["lam"], "tyre deformation lam (m)", "#CC79A7")):
         x, y = envelope(t, values)
-        series.add_scatter(x=x, y=y, name=name, line={"color": c, "width": 1}, row=row, col=1)
+        angle = row == 1
+        series.add_scatter(x=x, y=y, name=name, line={"color": c, "width": 1}, row=row, col=1,
+                           customdata=style.in_degrees(y) if angle else None,
+                           hovertemplate=f"t %{{x:.4g}} s<br>{style.ANGLE_HOVER if angle else '%{y:.4g}'}"
+                                         "<extra></extra>")
     if has_nes:
         x, y = envelope(t, np.asarray(s["psi"]) - np.asarray(s["psis"]))
         series.add_scatter(x=x, y=y, name="NES relative rotation psi - psis (rad)",
-                           line={"color": "#D55E00", "width": 1}, row=4, col=1)
+                           line={"color": "#D55E00", "width": 1}, row=4, col=1, customdata=style.in_degrees(y),
+                           hovertemplate=f"t %{{x:.4g}} s<br>{style.ANGLE_HOVER}<extra></extra>")
         series.update_yaxes(title_text="psi - psis (rad)", row=4, col=1)
-    series.update_layout(title=style.title(title), height=180 * rows + 110, template="plotly_white",
+    series.update_layout(title=style.title(title), height=180 * rows + 110, template=style.TEMPLATE,
                          margin={**style.MARGIN, "l": 70}, legend={"orientation": "h", "y": -0.08})
     series.update_xaxes(title_text="time t (s)", row=rows, col=1)
     series.update_yaxes(title_text="psi (rad)", row=1, col=1)
-    series.update_yaxes(title_text="l_g delta (m)", row=2, col=1)
+    series.update_yaxes(title_text="l_g delta (mm)", row=2, col=1)
     series.update_yaxes(title_text="lam (m)", row=3, col=1)
     sp = result["spectrum"]
     spectrum = style.figure("Spectrum of the steady window", "frequency (Hz)", "power (normalised)")
@@ -334,12 +361,12 @@ def settled(result):
     o = result.get("options", {})
     start = result.get("start") or {}
     psi0, lat0 = start.get("psi0"), start.get("lateral0")
-    where = "" if psi0 is None else f"From psi0 = {psi0:g} rad, l_g delta0 = {lat0:g} m the run "
+    where = "" if psi0 is None else f"From psi0 = {psi0:g} rad, l_g delta0 = {units.mm(lat0)} the run "
     verb = "settled on" if result["steady"] else "was still approaching (not yet steady at t_end)"
     f = result["frequency_hz"]
     amp = result["amplitude"]
     detail = "" if result["response_type"] == "Stable" else (
-        f": max |psi| {amp['psi']:.3g} rad, max |l_g delta| {amp['lateral']:.3g} m"
+        f": max |psi| {amp['psi']:.3g} rad ({units.degrees(amp['psi'])}), max |l_g delta| {units.mm(amp['lateral'], 3)}"
         + ("" if f is None else f", {f:.2f} Hz"))
     text = f"{where or 'The run '}{verb} {MODE_WORDS.get(result['response_type'], result['response_type'])}{detail}"
     return text + (f" after {o['t_end']:g} s." if "t_end" in o else ".")
@@ -349,7 +376,7 @@ def _metrics(result):
     amp = result["amplitude"]
     f = result["frequency_hz"]
     items = [("response", result["response_type"] + ("" if result["steady"] else " (not yet steady)")),
-             ("max |psi| (rad)", f"{amp['psi']:.4g}"), ("max |l_g delta| (m)", f"{amp['lateral']:.4g}"),
+             ("max |psi| (rad)", f"{amp['psi']:.4g}"), ("max |l_g delta| (mm)", f"{units.to_mm(amp['lateral']):.4g}"),
              ("dominant frequency (Hz)", "–" if f is None else f"{f:.3f}")]
     if "nes_relative" in amp:
         items.append(("NES relative rotation (rad)", f"{amp['nes_relative']:.4g}"))
@@ -364,8 +391,9 @@ def _metrics(result):
 def remember(config, V, fz, t_end, psi0, lateral0):
     standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
     moved = dash.ctx.triggered_id in (ids.TH_CONFIG, ids.TH_V, ids.TH_FZ)  # the map's note is of the point opened
+    lateral_m = lateral0 * units.MM if isinstance(lateral0, (int, float)) else lateral0  # the address keeps m
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,
-            "lateral0": None if standard else lateral0, "run": None, **({"map_type": None} if moved else {})}
+            "lateral0": None if standard else lateral_m, "run": None, **({"map_type": None} if moved else {})}
 
 
 @dash.callback(Output(ids.TH_BISTABLE, "children"), Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"),
