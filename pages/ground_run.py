@@ -122,6 +122,16 @@ def _in_kn(text: str) -> str:
     return re.sub(r"(-?\d+(?:\.\d+)?(?:e[+-]?\d+)?) N\b", lambda m: units.kn(float(m[1])), text)
 
 
+def _setting_refusal(exc: InvalidParameterError, rows) -> str:
+    """A rule across settings refused (the package's message in N), written as the table shows it: a load
+    as typed, in kN."""
+    name = exc.field.removeprefix("preset_options.")
+    row = next((r for r in rows or [] if r.get("name") == name), None)
+    if row is not None and row.get("unit") == "kN":
+        return f"{name} = {row.get('value')} kN is refused; allowed: {_in_kn(exc.allowed)}"
+    return _in_kn(str(exc))
+
+
 @dash.callback(Output(ids.GR_SETTINGS, "data"), Input(ids.GR_PRESET, "value"))
 def preset_settings(name):
     """The preset's settings at their defaults (a new preset starts from its documented defaults), loads in kN."""
@@ -159,7 +169,7 @@ def preset_table(settings, _reset, name):
     try:
         profile = analyses.preset_profile(name, _settings(settings))
     except InvalidParameterError as exc:
-        return no_update, no_update, no_update, _in_kn(str(exc))
+        return no_update, no_update, no_update, _setting_refusal(exc, settings)
     rows = [{"t": round(t, 4), "V": round(v, 4), "Fz": round(f / units.KN, 3)} for t, v, f in profile["rows"]]
     return rows, rows, profile["assumptions"], ""
 
