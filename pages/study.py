@@ -314,8 +314,9 @@ dash.clientside_callback(
         const shapes = others.concat([{name: "current design", type: "line", xref: "x", yref: "paper", x0: value,
                                        x1: value, y0: 0, y1: 1, line: LINE}]);
         const notes = (fig.layout.annotations || []).filter(a => a.name !== "current design").concat([
-            {name: "current design", text: text, xref: "x", yref: "paper", x: value, y: 1, yanchor: "bottom",
-             xanchor: "left", showarrow: false, font: {size: 11, color: LINE.color}}]);
+            {name: "current design", text: text, xref: "x", yref: "paper", x: value, y: 1, yanchor: "top",
+             xanchor: "left", xshift: 3, showarrow: false, bgcolor: "rgba(255,255,255,0.85)",
+             font: {size: 11, color: LINE.color}}]);
         return Object.assign({}, fig, {layout: Object.assign({}, fig.layout, {shapes: shapes, annotations: notes})});
     }
     """ % {"base": json.dumps({m: state.material_params(m) for m in MATERIALS}),

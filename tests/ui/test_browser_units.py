@@ -4,12 +4,14 @@ Screenshots of the pages at 1440x900 and 1024x768 go to screenshots/ for a perso
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
 pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
-from browser import (SHOTS, browser_fixture, idle, on_figure, open_page, severe, text_of, trace_count,  # noqa: E402
-                     type_into, wait_for)
+from browser import (SHOTS, browser_fixture, by_id, idle, on_figure, open_page, pattern, severe,  # noqa: E402
+                     text_of, trace_count, type_into, wait_for)
 
 browser = browser_fixture("chromium-profile-units", "1440,900")
 
@@ -31,11 +33,22 @@ def _read(driver, graph_id):
     return on_figure(driver, graph_id, READ)
 
 
-def _shots(driver, name):
+def _shots(driver, name, graph=None):
+    """The page's top and, if given, its graph at both sizes (after Plotly has redrawn for the width)."""
     for w, h in SIZES:
         driver.set_window_size(w, h)
         idle(driver)
+        time.sleep(1.0)  # Plotly's resize is debounced
+        driver.execute_script("window.scrollTo(0, 0);")
         driver.save_screenshot(str(SHOTS / f"units-{name}-{w}.png"))
+        if graph is not None:  # the whole graph: a window tall enough for it
+            element = driver.find_element(By.ID, graph)
+            driver.set_window_size(w, max(h, element.size["height"] + 260))
+            idle(driver)
+            time.sleep(1.0)
+            driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", element)
+            time.sleep(0.3)
+            element.screenshot(str(SHOTS / f"units-{name}-graph-{w}.png"))
     driver.set_window_size(*SIZES[0])
 
 
@@ -93,7 +106,7 @@ def test_ground_run_refuses_at_its_fields_and_shows_loads_in_kn(server, browser)
     ActionChains(browser).send_keys("2000").send_keys(Keys.ENTER).perform()
     assert wait_for(lambda: text_of(browser, "gr-settings-error"), timeout=10, what="the setting's refusal") == \
         "Fz_static = 2000 kN is outside [20, 900] kN"
-    _shots(browser, "ground-run")
+    _shots(browser, "ground-run", "gr-settings")
     assert severe(browser) == []
 
 
@@ -111,7 +124,7 @@ def test_overview_draws_hopf_diamonds_gh_stars_and_log_speeds_written_out(server
     assert all(symbol == SYMBOLS[kind] for kind, symbol in boundary["marked"])
     assert "vertical load Fz (kN)" in boundary["texts"]
     _no_si_prefix(boundary["texts"] + growth["texts"])
-    _shots(browser, "overview")
+    _shots(browser, "overview", "ov-boundary-graph")
     assert severe(browser) == []
 
 
@@ -134,7 +147,7 @@ def test_bifurcation_draws_its_points_from_the_vocabulary_and_lateral_in_mm(serv
     _no_si_prefix(info["texts"])
     largest = on_figure(browser, "bif-graph", "return g.data.filter(t => t.meta && t.meta.mark).length;")
     assert largest == 2  # the largest stable |psi| of each configuration
-    _shots(browser, "bifurcation")
+    _shots(browser, "bifurcation", "bif-graph")
     assert severe(browser) == []
 
 
@@ -156,7 +169,7 @@ def test_stability_map_draws_gh_stars_and_double_hopf_hexagrams_over_haloes(serv
     torsion = on_figure(browser, "map-graph", "return g.data.filter(t => t.name === 'Torsion' && t.fill)"
                                               ".map(t => t.fillcolor);")
     assert set(torsion) <= {"#F0E442"}
-    _shots(browser, "stability-map")
+    _shots(browser, "stability-map", "map-graph")
     assert severe(browser) == []
 
 
@@ -176,5 +189,24 @@ def test_time_history_shows_lateral_displacements_in_mm(server, browser):
     assert "l_g delta (mm)" in info["texts"]
     _no_si_prefix(info["texts"])
     assert "max |l_g delta| (mm)" in browser.find_element(By.ID, "th-metrics").text
-    _shots(browser, "time-history")
+    _shots(browser, "time-history", "th-series")
+    assert severe(browser) == []
+
+
+def test_study_marks_the_current_design_and_the_largest_stable_amplitude(server, browser):
+    open_page(browser, server, "/study?parameter=e_p&values=0.001,0.003&configs=nes", clear_log=True)
+    type_into(browser.find_element(By.ID, "study-values"), "0.001, 0.003, 0.009")
+    assert "value 3: e_p = 0.009 m is outside" in wait_for(lambda: text_of(browser, "study-values-error"),
+                                                          timeout=10, what="the values' refusal at the box")
+    type_into(browser.find_element(By.ID, "study-values"), "0.001, 0.003")
+    wait_for(lambda: text_of(browser, "study-values-error") == "", timeout=10, what="the refusal to go")
+    browser.find_element(By.ID, "study-run").click()
+    line = "return (g.layout.shapes || []).filter(s => s.name === 'current design').map(s => s.x0);"
+    assert wait_for(lambda: on_figure(browser, "study-graph", line), timeout=240, what="the study") == [0.001]
+    largest = on_figure(browser, "study-graph", "return g.data.filter(t => t.meta && t.meta.mark).length;")
+    assert largest == 1
+    # the line follows the design panel
+    type_into(by_id(browser, pattern("e_p", "param-box")), "0.002")
+    wait_for(lambda: on_figure(browser, "study-graph", line) == [0.002], timeout=20, what="the line to follow e_p")
+    _shots(browser, "study", "study-graph")
     assert severe(browser) == []
