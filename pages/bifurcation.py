@@ -10,7 +10,7 @@ from plotly.subplots import make_subplots
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from shimmy.model import units
+import shimmy.model.units as units
 from ui import compare, designs, fields, ids, jobs, markers
 from ui import components as ui
 from ui import style

@@ -10,7 +10,7 @@ from plotly.subplots import make_subplots
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from shimmy.model import units
+import shimmy.model.units as units
 from shimmy.model.parameters import FZ_RANGE, V_RANGE
 from shimmy.service import analyses
 from ui import components as ui

@@ -7,7 +7,7 @@ from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from shimmy.model import units
+import shimmy.model.units as units
 from shimmy.service import admission, analyses, neighbours
 from plotly.subplots import make_subplots
 

@@ -9,7 +9,7 @@ from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from shimmy.model import units
+import shimmy.model.units as units
 from shimmy.service import analyses, neighbours
 from ui import compare, designs, fields, formats, ids, jobs, live, markers, merits
 from ui import components as ui

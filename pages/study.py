@@ -9,7 +9,7 @@ from dash import ALL, Input, Output, State, dcc, html
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
-from shimmy.model import units
+import shimmy.model.units as units
 from shimmy.model.configurations import affects
 from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS
 from ui import components as ui

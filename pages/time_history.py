@@ -10,7 +10,7 @@ from dash import Input, Output, State, dcc, html, no_update
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
-from shimmy.model import units
+import shimmy.model.units as units
 from shimmy.model.configurations import STATE_NAMES, STATE_UNITS
 from shimmy.service import analyses, settings
 from ui import components as ui
