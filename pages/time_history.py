@@ -168,7 +168,7 @@ def _csv_rows(results):
 def _mm_of(lateral0_m):
     """The address's lateral0 (m, as the API takes it) in the box's mm; a value that is no number as it is."""
     try:
-        return None if lateral0_m is None else float(lateral0_m) / units.MM
+        return None if lateral0_m is None else float(f"{float(lateral0_m) / units.MM:.12g}")  # no float noise
     except (TypeError, ValueError):
         return lateral0_m
 
@@ -391,7 +391,8 @@ def _metrics(result):
 def remember(config, V, fz, t_end, psi0, lateral0):
     standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
     moved = dash.ctx.triggered_id in (ids.TH_CONFIG, ids.TH_V, ids.TH_FZ)  # the map's note is of the point opened
-    lateral_m = lateral0 * units.MM if isinstance(lateral0, (int, float)) else lateral0  # the address keeps m
+    # the address keeps m (as the API), without float noise: 7 mm is lateral0=0.007
+    lateral_m = float(f"{lateral0 * units.MM:.12g}") if isinstance(lateral0, (int, float)) else lateral0
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,
             "lateral0": None if standard else lateral_m, "run": None, **({"map_type": None} if moved else {})}
 
