@@ -2,15 +2,20 @@
 
 from __future__ import annotations
 
+import re
+
 import dash
 from dash import Input, Output, State, dash_table, dcc, html, no_update
 from plotly.subplots import make_subplots
 
+from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
+import shimmy.model.units as units
+from shimmy.model.parameters import FZ_RANGE, V_RANGE
 from shimmy.service import analyses
 from ui import components as ui
-from ui import fields, formats, ids, jobs
-from ui.fields import Quantity
+from ui import fields, formats, ids, jobs, markers
+from ui.fields import Column, Quantity
 from ui import style
 from ui.layout import page
 
@@ -19,7 +24,7 @@ dash.register_page(__name__, path="/ground-run", name="Ground run", order=4.5)
 CONFIGS = ui.CONFIGS
 PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi"}
 SERIES_DT = 0.02  # s: the envelopes are smooth; 1500 points per configuration for a 30 s take-off
-TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overflowX": "auto"},
+TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto"},
                "style_cell": {"fontFamily": "inherit", "fontSize": "13px", "padding": "3px 8px", "textAlign": "left",
                               "whiteSpace": "normal", "height": "auto"},
                "style_header": {"backgroundColor": "#eef2f8", "fontWeight": "600"}}
@@ -36,7 +41,14 @@ def _placeholders(text: str) -> tuple:
     return style.message_figure(text), empty, empty, ""
 
 PSI_THR = Quantity("ground_run", "psi_threshold", "the shimmy threshold |psi|", "rad")
-LAT_THR = Quantity("ground_run", "lateral_threshold", "the shimmy threshold |l_g delta|", "mm", 1e-3)
+LAT_THR = Quantity("ground_run", "lateral_threshold", "the shimmy threshold |l_g delta|", "mm", units.MM)
+#: The units the settings table shows a preset's setting in where they are not the package's: SI units per unit.
+SHOWN_UNITS = {"N": ("kN", units.KN)}
+#: The profile table's columns as the page shows them (the run refuses the same in SI units, by row).
+PROFILE_COLUMNS = [Column("t", "t", "s", -1e5, 1e5), Column("V", "V", "m/s", *V_RANGE),
+                   Column("Fz", "Fz", "kN", FZ_RANGE[0] / units.KN, FZ_RANGE[1] / units.KN)]
+#: A cell keeps what was typed (a number column would drop text silently): the page refuses it, saying why.
+KEEP_TYPED = {"action": "coerce", "failure": "accept"}
 
 
 def layout(preset: str | None = None, config: str | None = None, psi_thr: str | None = None,
@@ -60,8 +72,8 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
                                                     options=[{"label": v, "value": k}
                                                              for k, v in PRESET_LABELS.items()])),
             ui.field("Map and curves of", ui.configurations(ids.GR_CONFIG, config)),
-            ui.field("Shimmy threshold |psi| (rad)", PSI_THR.box(ids.GR_PSI_THR, psi_value)),
-            ui.field("Shimmy threshold |l_g delta| (mm)", LAT_THR.box(ids.GR_LAT_THR, lat_value)),
+            PSI_THR.field("Shimmy threshold |psi| (rad)", ids.GR_PSI_THR, psi_value, bad_psi),
+            LAT_THR.field("Shimmy threshold |l_g delta| (mm)", ids.GR_LAT_THR, lat_value, bad_lat),
             ui.field("NES torque", ui.nes_torque(ids.GR_EXACT)),
             *jobs.controls(ids.GR_GROUP, "Run"),
         ], className="controls"),
@@ -70,7 +82,7 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
                 html.H2("Preset settings"),
                 dash_table.DataTable(id=ids.GR_SETTINGS, editable=True, **TABLE_STYLE, columns=[
                     {"name": "setting", "id": "name", "editable": False},
-                    {"name": "value", "id": "value", "type": "numeric"},
+                    {"name": "value", "id": "value", "type": "numeric", "on_change": KEEP_TYPED},
                     {"name": "unit", "id": "unit", "editable": False},
                     {"name": "range", "id": "range", "editable": False},
                     {"name": "meaning", "id": "description", "editable": False}]),
@@ -80,15 +92,15 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
             html.Div([
                 html.H2("Profile table"),
                 dash_table.DataTable(id=ids.GR_TABLE, editable=True, row_deletable=True, **TABLE_STYLE, columns=[
-                    {"name": "t (s)", "id": "t", "type": "numeric"},
-                    {"name": "V (m/s)", "id": "V", "type": "numeric"},
-                    {"name": "Fz (kN)", "id": "Fz", "type": "numeric"}]),
+                    {"name": f"{c.id} ({c.unit})", "id": c.id, "type": "numeric", "on_change": KEEP_TYPED}
+                    for c in PROFILE_COLUMNS]),
+                html.Div(id=ids.GR_TABLE_ERROR, className="error field-error", role="alert"),  # at the cells
                 html.Div([html.Button("Add row", id=ids.GR_ADD_ROW, className="secondary"),
                           html.Button("Back to the preset", id=ids.GR_RESET, className="secondary")],
                          className="downloads"),
                 html.P(id=ids.GR_SOURCE, className="hint"),
             ]),
-        ], style={"display": "grid", "gridTemplateColumns": "minmax(0, 3fr) minmax(15em, 2fr)", "gap": "16px"}),
+        ], className="gr-tables"),  # side by side where the settings' meanings fit, else stacked
         html.Div(address, id=ids.GR_ADDRESS, className="error", role="alert"),  # what of the address is unusable
         html.Div(id=ids.GR_GROUP.error, className="error", role="alert"),
         html.Div(id=ids.GR_SUMMARY),
@@ -101,27 +113,83 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
     )
 
 
+def _shown(unit: str) -> tuple[str, float]:
+    """(unit shown, SI units per unit shown) of a preset setting in ``unit``."""
+    return SHOWN_UNITS.get(unit, (unit, 1.0))
+
+
+def _in_kn(text: str) -> str:
+    """A message of the package's, with its loads (N) written in kN as the table shows them."""
+    return re.sub(r"(-?\d+(?:\.\d+)?(?:e[+-]?\d+)?) N\b", lambda m: units.kn(float(m[1])), text)
+
+
+def _setting_refusal(exc: InvalidParameterError, rows) -> str:
+    """A rule across settings refused (the package's message in N), written as the table shows it: a load
+    as typed, in kN."""
+    name = exc.field.removeprefix("preset_options.")
+    row = next((r for r in rows or [] if r.get("name") == name), None)
+    if row is not None and row.get("unit") == "kN":
+        return f"{name} = {row.get('value')} kN is refused; allowed: {_in_kn(exc.allowed)}"
+    return _in_kn(str(exc))
+
+
 @dash.callback(Output(ids.GR_SETTINGS, "data"), Input(ids.GR_PRESET, "value"))
 def preset_settings(name):
-    """The preset's settings at their defaults (a new preset starts from its documented defaults)."""
-    fields = analyses.preset_profile(name)["fields"]
-    return [{"name": f["name"], "value": f["default"], "unit": f["unit"], "range": f"{f['low']:g} – {f['high']:g}",
-             "description": f["description"]} for f in fields]
+    """The preset's settings at their defaults (a new preset starts from its documented defaults), loads in kN."""
+    rows = []
+    for f in analyses.preset_profile(name)["fields"]:
+        unit, scale = _shown(f["unit"])
+        rows.append({"name": f["name"], "value": f["default"] / scale, "unit": unit,
+                     "range": f"{f['low'] / scale:g} – {f['high'] / scale:g}", "description": f["description"]})
+    return rows
+
+
+def settings_refusals(rows) -> list[tuple[int, str, str]]:
+    """(row, "value", why) of each setting typed outside its range or not a number, in the table's unit."""
+    out = []
+    for i, r in enumerate(rows or []):
+        low, high = (float(x) for x in r["range"].split(" – "))
+        try:
+            fields.typed_number(r["name"], r["name"], r.get("value"), low, high, r["unit"])
+        except InvalidParameterError as exc:
+            out.append((i, "value", str(exc)))
+    return out
 
 
 @dash.callback(Output(ids.GR_TABLE, "data"), Output(ids.GR_PRESET_ROWS, "data"), Output(ids.GR_ASSUMPTIONS, "children"),
                Output(ids.GR_SETTINGS_ERROR, "children"),
                Input(ids.GR_SETTINGS, "data"), Input(ids.GR_RESET, "n_clicks"), State(ids.GR_PRESET, "value"))
 def preset_table(settings, _reset, name):
-    """The preset's table for its settings (shown in the profile table, which may then be edited)."""
+    """The preset's table for its settings (shown in the profile table, which may then be edited); a setting
+    refused at its cell, in the table's unit (and the rules across settings, loads in kN)."""
     if not settings:
         return no_update, no_update, no_update, no_update
+    refused = settings_refusals(settings)
+    if refused:
+        return no_update, no_update, no_update, "; ".join(why for _, _, why in refused)
     try:
         profile = analyses.preset_profile(name, _settings(settings))
     except InvalidParameterError as exc:
-        return no_update, no_update, no_update, str(exc)
-    rows = [{"t": round(t, 4), "V": round(v, 4), "Fz": round(f / 1e3, 3)} for t, v, f in profile["rows"]]
+        return no_update, no_update, no_update, _setting_refusal(exc, settings)
+    rows = [{"t": round(t, 4), "V": round(v, 4), "Fz": round(f / units.KN, 3)} for t, v, f in profile["rows"]]
     return rows, rows, profile["assumptions"], ""
+
+
+@dash.callback(Output(ids.GR_SETTINGS, "style_data_conditional"), Input(ids.GR_SETTINGS, "data"))
+def mark_settings(settings):
+    return fields.cell_styles(settings_refusals(settings))
+
+
+@dash.callback(Output(ids.GR_TABLE_ERROR, "children"), Output(ids.GR_TABLE, "style_data_conditional"),
+               Input(ids.GR_TABLE, "data"))
+def check_table(rows):
+    """Each cell typed outside its column's range, or not a number, refused at the table, in its unit."""
+    refused = fields.cell_refusals(rows, PROFILE_COLUMNS)
+    return "; ".join(why for _, _, why in refused), fields.cell_styles(refused)
+
+
+fields.check(ids.GR_PSI_THR, PSI_THR)
+fields.check(ids.GR_LAT_THR, LAT_THR)
 
 
 @dash.callback(Output(ids.GR_TABLE, "data", allow_duplicate=True), Input(ids.GR_ADD_ROW, "n_clicks"),
@@ -142,7 +210,15 @@ def source(rows, preset_rows, name):
 
 
 def _settings(rows) -> dict:
-    return {r["name"]: r["value"] for r in rows or [] if r.get("value") not in (None, "")}
+    """The settings in the package's units (loads in N), for the request."""
+    out = {}
+    for r in rows or []:
+        value = r.get("value")
+        if value in (None, ""):
+            continue
+        scale = next((s for u, s in SHOWN_UNITS.values() if u == r.get("unit")), 1.0)
+        out[r["name"]] = value * scale if isinstance(value, (int, float)) and not isinstance(value, bool) else value
+    return out
 
 
 def _same(rows, preset_rows) -> bool:
@@ -168,14 +244,20 @@ def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, torqu
 
 
 def _newtons(fz_kn):
-    return fz_kn * 1e3 if isinstance(fz_kn, (int, float)) and not isinstance(fz_kn, bool) else fz_kn
+    return fz_kn * units.KN if isinstance(fz_kn, (int, float)) and not isinstance(fz_kn, bool) else fz_kn
+
+
+#: The downloaded columns: the result's key, the column's name with its unit, SI units per unit written.
+CSV_COLUMNS = (("t", "t_s", 1.0), ("V", "V_m_s", 1.0), ("Fz", "Fz_kN", units.KN), ("psi", "psi_rad", 1.0),
+               ("lateral", "lateral_mm", units.MM), ("envelope_psi", "envelope_psi_rad", 1.0),
+               ("envelope_lateral", "envelope_lateral_mm", units.MM))
 
 
 def _csv_rows(results):
-    keys = ["t", "V", "Fz", "psi", "lateral", "envelope_psi", "envelope_lateral"]
     rows = [[r["config"], *values] for r in sorted(results, key=lambda r: CONFIGS.index(r["config"]))
-            for values in zip(*(r[k] for k in keys), strict=True)]
-    return ["config", "t_s", "V_m_s", "Fz_N", "psi_rad", "lateral_m", "envelope_psi_rad", "envelope_lateral_m"], rows
+            for values in zip(*([v / scale for v in r[k]] if scale != 1.0 else r[k] for k, _, scale in CSV_COLUMNS),
+                              strict=True)]
+    return ["config", *(name for _, name, _ in CSV_COLUMNS)], rows
 
 
 def _file_stem(results):
@@ -207,11 +289,11 @@ def plane(result):
     fig = style.figure(f"Trajectory over the Hopf curves of {label}",
                        "forward speed V (m/s)", "nose-gear load Fz (kN)", height=460)
     for i, curve in enumerate(result.get("hopf_curves") or []):
-        fig.add_scatter(x=curve["V"], y=[f / 1e3 for f in curve["Fz"]], mode="lines", name=f"Hopf curve ({label})",
+        fig.add_scatter(x=curve["V"], y=[f / units.KN for f in curve["Fz"]], mode="lines", name=f"Hopf curve ({label})",
                         legendgroup="hopf", showlegend=i == 0, line={"color": "#888", "width": 2},
                         hovertemplate="Hopf curve<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN<extra></extra>")
     rows = result["profile"]["rows"]
-    fig.add_scatter(x=[r[1] for r in rows], y=[r[2] / 1e3 for r in rows], mode="lines", name="trajectory",
+    fig.add_scatter(x=[r[1] for r in rows], y=[r[2] / units.KN for r in rows], mode="lines", name="trajectory",
                     line={"color": style.ACCENT, "width": 2}, customdata=[r[0] for r in rows],
                     hovertemplate="t %{customdata:.4g} s<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN<extra></extra>")
     thr_psi, thr_lat = result["options"]["psi_threshold"], result["options"]["lateral_threshold"]
@@ -219,20 +301,21 @@ def plane(result):
     for v, f, a, b in zip(result["V"], result["Fz"], result["envelope_psi"], result["envelope_lateral"], strict=True):
         inside = a > thr_psi or b > thr_lat
         xs.append(v if inside else None)
-        ys.append(f / 1e3 if inside else None)
+        ys.append(f / units.KN if inside else None)
     fig.add_scatter(x=xs, y=ys, mode="lines", name=f"{label} in shimmy", line={"color": colour, "width": 7},
                     opacity=0.55, hoverinfo="skip")
-    fig.add_scatter(x=[rows[0][1]], y=[rows[0][2] / 1e3], mode="markers+text", text=["start"], textposition="top right",
-                    name="start", showlegend=False, marker={"symbol": "circle", "size": 10, "color": style.ACCENT})
+    fig.add_scatter(x=[rows[0][1]], y=[rows[0][2] / units.KN], mode="markers+text", text=["start"],
+                    textposition="top right", name="start", showlegend=False,
+                    marker={"symbol": "circle", "size": 10, "color": style.ACCENT})
     crossings = result["boundary_crossings"]
     if crossings:
-        fig.add_scatter(x=[c["V"] for c in crossings], y=[c["Fz"] / 1e3 for c in crossings], mode="markers",
-                        name="crossings of the Hopf curves", customdata=[c["t"] for c in crossings],
-                        marker={"symbol": "x", "size": 12, "color": "#D55E00", "line": {"width": 2}},
+        fig.add_scatter(x=[c["V"] for c in crossings], y=[c["Fz"] / units.KN for c in crossings], mode="markers",
+                        name="crossings of the Hopf curves (H)", customdata=[c["t"] for c in crossings],
+                        marker=markers.marker(PointKind.HOPF, "#D55E00"), meta={"kind": "H"},
                         hovertemplate="crosses at t %{customdata:.4g} s<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN"
                                       "<extra></extra>")
     v_max = max(r[1] for r in rows)
-    f_max = max(r[2] for r in rows) / 1e3
+    f_max = max(r[2] for r in rows) / units.KN
     fig.update_xaxes(range=[0, max(20.0, 1.25 * v_max)])
     fig.update_yaxes(range=[0, min(900.0, max(50.0, 1.4 * f_max))])
     return fig
@@ -246,17 +329,21 @@ def envelopes(results, against: str):
         config = r["config"]
         common = {"mode": "lines", "line": {"color": style.CONFIG_COLOURS[config], "width": 1.6},
                   "legendgroup": config}
-        fig.add_scatter(x=r[against], y=r["envelope_psi"], name=style.CONFIG_LABELS[config], row=1, col=1, **common)
-        fig.add_scatter(x=r[against], y=[1e3 * v for v in r["envelope_lateral"]], name=style.CONFIG_LABELS[config],
-                        showlegend=False, row=2, col=1, **common)
+        label = style.CONFIG_LABELS[config]
+        fig.add_scatter(x=r[against], y=r["envelope_psi"], name=label, row=1, col=1,
+                        customdata=style.in_degrees(r["envelope_psi"]),
+                        hovertemplate=f"{label}: |psi| {style.ANGLE_HOVER}<extra></extra>", **common)
+        fig.add_scatter(x=r[against], y=[v / units.MM for v in r["envelope_lateral"]], name=label,
+                        showlegend=False, row=2, col=1,
+                        hovertemplate=f"{label}: |l_g delta| %{{y:.4g}} mm<extra></extra>", **common)
     options = results[0]["options"]
     for row, value, text in ((1, options["psi_threshold"], "threshold"),
-                             (2, 1e3 * options["lateral_threshold"], "threshold")):
+                             (2, options["lateral_threshold"] / units.MM, "threshold")):
         fig.add_hline(y=value, line={"color": "#D55E00", "dash": "dash", "width": 1}, annotation_text=text,
                       annotation_position="top left", row=row, col=1)
     title = ("Amplitude envelopes against time" if against == "t" else
              "Amplitude envelopes against forward speed (along the run)")
-    fig.update_layout(title={"text": title, "x": 0.01, "font": {"size": 15}}, height=520, template="plotly_white",
+    fig.update_layout(title={"text": title, "x": 0.01, "font": {"size": 15}}, height=520, template=style.TEMPLATE,
                       margin={"l": 70, "r": 16, "t": 44, "b": 48}, legend={"orientation": "h", "y": -0.14, "x": 0},
                       hovermode="x unified" if against == "t" else "closest")
     fig.update_yaxes(title_text="envelope of |psi| (rad)", row=1, col=1)
@@ -275,7 +362,7 @@ def summary(results):
         speeds = "–" if r["speed_range"] is None else f"{r['speed_range'][0]:.4g} – {r['speed_range'][1]:.4g}"
         p, q = r["peak_psi"], r["peak_lateral"]
         psi = f"{p['value']:.4g} at {p['t']:.3g} s, {p['V']:.3g} m/s"
-        lat = f"{1e3 * q['value']:.4g} at {q['t']:.3g} s"
+        lat = f"{q['value'] / units.MM:.4g} at {q['t']:.3g} s"
         time_in = f"{r['time_in_shimmy_s']:.2f}"
         if base is not None and r is not base:
             time_in += f" ({r['time_in_shimmy_s'] - base['time_in_shimmy_s']:+.2f})"

@@ -465,7 +465,10 @@ def openapi_document() -> dict[str, Any]:
         "listens beyond loopback); with SHIMMY_AUTH=none (the default on loopback) every request is let in.")}}
     return {"openapi": "3.1.0",
             "info": {"title": "shimmy API", "version": __version__,
-                     "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Limits: "
+                     "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Units: every "
+                                    "number of a request and of a result is in SI units (loads Fz in N, lengths and "
+                                    "the lateral displacement in m, angles in rad, speeds in m/s, time in s), "
+                                    "whatever the workbench shows (kN, mm). Limits: "
                                     f"body <= {settings.MAX_BODY_BYTES} bytes, t_end <= {settings.MAX_T_END:g} s, "
                                     f"ntst <= {settings.MAX_NTST}, robustness samples <= "
                                     f"{settings.MAX_ROBUSTNESS_SAMPLES}; at most {settings.MAX_RUNNING_JOBS} jobs "

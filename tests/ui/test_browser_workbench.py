@@ -224,7 +224,7 @@ def test_map_operating_points_colours_cancel_progress_and_cached_return(server, 
         return {op: op ? op.text : null, torsion: key('Torsion'), both: key('Both'),
                 legends: [g.layout.legend.title.text, g.layout.legend2.title.text, g.layout.legend3.title.text]};""")
     assert info["op"] == ["A", "B", "C", "D", "E", "F"]  # inside 100-400 kN, 1-200 m/s
-    assert info["torsion"].lower() == "#e69f00" and info["both"].lower() == "#117733"
+    assert info["torsion"].lower() == "#f0e442" and info["both"].lower() == "#117733"  # Torsion apart from NES orange
     assert info["legends"][0] == "configuration (colour):"
     browser.save_screenshot(str(SHOTS / "stability-map-operating-points.png"))
     # Back on the page later: the cached map is shown without pressing Compute.

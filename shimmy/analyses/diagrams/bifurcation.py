@@ -56,6 +56,7 @@ from ...model.parameters import DIAGRAM_V_RANGE, Parameters
 from ...continuation.periodic_orbits import (PeriodicBranch, hopf_guess, orbit_from_samples,
                               periodic_branch)
 from ..core import nes_range
+from ...model.units import kn
 from ..core.response import mode_of, torsional_share
 from ..core.stability import HopfResult, check_speeds_and_load, hopf_points
 from .summaries import bifurcation_summary, write_bifurcation_csv
@@ -90,7 +91,7 @@ def gear_field(model: Model, Fz: float) -> VectorField:
                        lambda x, V: rhs(model, x, V, Fz),
                        lambda x, V: jacobian(model, x, V, Fz),
                        lambda x, V: parameter_jacobian(model, x, V, Fz)[0],
-                       name=f"{model.config.value} at Fz = {Fz:g} N",
+                       name=f"{model.config.value} at Fz = {kn(Fz)}",
                        evaluate=lambda x, V: field_and_derivatives(model, x, V, Fz)[:3])
 
 
