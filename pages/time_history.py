@@ -93,6 +93,7 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
         ui.downloads(ids.TH_GROUP),
         *jobs.stores(ids.TH_GROUP),
         dcc.Store(id=ids.TH_KICK),
+        dcc.Store(id=ids.TH_WINDOW),
         html.H2("Disturbance margins"),
         html.P("The attractors at this operating point (the stable equilibrium and limit cycles of the bifurcation "
                "diagram at its load, and any motion the runs from the standard and two large starts settle on), "
@@ -382,12 +383,9 @@ def _series_figure(result):
                         hovertemplate=f"t %{{x:.4g}} s<br>{style.ANGLE_HOVER if angle else '%{y:.4g}'}"
                                       "<extra></extra>")
         fig.update_yaxes(title_text=axis, row=k, col=1)
-    start = result.get("start") or {}
     fig.update_layout(title=style.title(title), height=170 * len(rows) + 170, template=style.TEMPLATE,
                       margin={**style.MARGIN, "l": 70}, legend={"orientation": "h", "y": -0.22},
-                      annotations=[_zoom_note(False)],
-                      # the user's zoom survives the line's redraw (same run), a new run opens on its last cycles
-                      uirevision=f"{title} {start.get('psi0')} {start.get('lateral0')} {result['options']['t_end']}")
+                      annotations=[_zoom_note(False)])  # no uirevision: the redraw itself carries the window
     fig.update_xaxes(range=[t0, t1])
     fig.update_xaxes(title_text="time t (s): the slider below moves the window over the whole run",
                      rangeslider={"visible": True, "thickness": 0.07}, row=len(rows), col=1)
@@ -417,7 +415,21 @@ def _window(relayout, t_end: float) -> tuple[float, float] | None:
     return None
 
 
-@dash.callback(Output(ids.TH_SERIES, "figure", allow_duplicate=True), Input(ids.TH_SERIES, "relayoutData"),
+# Only a change of the time window reaches the server: Plotly also reports a redraw's autosize, and a
+# second call of the callback in flight would make Dash drop the first one's answer (the window's line).
+dash.clientside_callback(
+    """
+    function(relayout) {
+        const keys = Object.keys(relayout || {});
+        const window = keys.some(k => k.startsWith('xaxis') && (k.includes('.range') || k.endsWith('.autorange')));
+        return window ? relayout : window_no_update();
+        function window_no_update() { return dash_clientside.no_update; }
+    }
+    """,
+    Output(ids.TH_WINDOW, "data"), Input(ids.TH_SERIES, "relayoutData"), prevent_initial_call=True)
+
+
+@dash.callback(Output(ids.TH_SERIES, "figure", allow_duplicate=True), Input(ids.TH_WINDOW, "data"),
                State(ids.TH_GROUP.requests, "data"), prevent_initial_call=True)
 def follow_window(relayout, requests):
     """Every sample of the window shown, from the cached result (a zoom, a pan, the range slider)."""
@@ -444,6 +456,10 @@ def follow_window(relayout, requests):
         if axis.endswith("(rad)"):
             patched["data"][PER_ROW * k + 2]["customdata"] = style.in_degrees(list(map(float, y)))
     patched["layout"]["annotations"][0]["visible"] = too_many
+    for k in range(len(_rows(result))):  # the figure itself says the window shown: the redraw keeps it
+        axis = patched["layout"][f"xaxis{k + 1 if k else ''}"]
+        axis["autorange"] = False
+        axis["range"] = [float(window[0]), float(window[1])]
     return patched
 
 

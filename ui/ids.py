@@ -201,6 +201,7 @@ TH_AUTORUN = "th-autorun"
 TH_KICK = "th-kick"  # a run asked from the margins' table (its start already in the boxes)
 TH_BISTABLE = "th-bistable"
 TH_EXACT = "th-exact"  # the NES torque choice
+TH_WINDOW = "th-window"  # the time window the series figure was zoomed or panned to
 TH_STARTS = "th-starts"  # which attractor each start ended on (a Bistable map point)  # the note that the map shades the point Bistable
 THM = Group("thm")  # the point's disturbance margins
 THM_TABLE = "thm-table"
