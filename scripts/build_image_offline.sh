@@ -90,8 +90,8 @@ command -v buildah >/dev/null 2>&1 || missing+=(buildah)
 command -v debootstrap >/dev/null 2>&1 || missing+=(debootstrap)
 if [ "${#missing[@]}" -gt 0 ]; then
     echo "installing from Debian: ${missing[*]}"
-    # One apt-get at a time with the test suite's other workers (tests/ui/browser.py takes this lock
-    # to install chromium): apt-get refuses to start while another holds apt's lock.
+    # One apt-get at a time with the test suite's other workers (tests/conftest.py takes this lock
+    # to install chromium and nginx): apt-get refuses to start while another holds apt's lock.
     exec 9>/tmp/shimmy-tests-apt.lock
     flock 9
     apt-get update -q || die "apt-get update failed: Debian's package mirror is not reachable"
