@@ -1,9 +1,8 @@
 """The workbench: a Dash multi-page app with the HTTP API on the same Flask server.
 
 ``python -m shimmy serve`` serves both: gunicorn (``app:server``; gunicorn.conf.py beside this file is read by
-default) behind nginx, which holds slow clients (shimmy.service.nginx). ``gunicorn app:server`` alone serves
-one user on loopback.
-Pages live in ``pages/``; styling in ``assets/`` (no CDN). Numerics never run here: pages
+default) behind nginx, which holds slow clients (shimmy.service.nginx); ``gunicorn app:server`` alone serves
+one user on loopback. Pages live in ``pages/``; styling in ``assets/`` (no CDN). Numerics never run here: pages
 call :mod:`shimmy.service.analyses` for quick answers and submit long ones as jobs through
 :mod:`shimmy.service.jobs` (the API's admission control); Dash starts no process of its own.
 """

@@ -7,12 +7,12 @@ proxy reaches, then nginx listening on ``--listen``. gunicorn is told where the 
 forwarding headers of the socket's clients only (``SHIMMY_TRUSTED_PROXY=unix``).
 
 SIGTERM or SIGINT stops both gracefully at once (nginx: SIGQUIT, it finishes the requests in flight;
-gunicorn: SIGTERM, its workers finish theirs and ``on_exit`` queues the running jobs again), SIGKILL for
-whichever still runs after ``STOP_SECONDS``, and whatever is left of their process groups (each runs in
-its own); exit status 0. SIGHUP is passed to both (gunicorn restarts its
-workers, nginx rereads its configuration). If either exits on its own, the other is stopped the same way
-and the status is 1 (the image's restart policy then starts both again). As the container's first process
-it also reaps any orphan handed to it.
+gunicorn: SIGTERM, its workers finish theirs and ``on_exit`` queues the running jobs again); SIGKILL goes
+to whichever still runs after ``STOP_SECONDS``, and to whatever is left of their process groups (each runs
+in its own: an nginx worker outlives a master that was killed); exit status 0. SIGHUP is passed to both
+(gunicorn restarts its workers, nginx rereads its configuration). If either exits on its own, the other is
+stopped the same way and the status is 1 (a restart policy then starts both again). As a container's first
+process it also reaps any orphan handed to it.
 """
 
 from __future__ import annotations
