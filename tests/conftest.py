@@ -190,17 +190,20 @@ def ensure_nginx() -> str:
     return nginx.binary()
 
 
-def start_proxied_server(cache_dir: Path, env: dict[str, str] | None = None, workers: int = 1) -> Server:
+def start_proxied_server(cache_dir: Path, env: dict[str, str] | None = None, workers: int = 1,
+                         access_log: str | None = None) -> Server:
     """``python -m shimmy serve``: nginx on a free loopback port in front of gunicorn (``workers`` workers) on a
     Unix socket in ``cache_dir/run``, once health answers through both. ``proc`` is the supervisor; nginx's
-    access log is ``run/access.log``, everything else goes to ``gunicorn.log``."""
+    access log is ``access_log`` (default ``run/access.log``; ``-``: serve's output), everything else goes to
+    ``gunicorn.log``."""
     ensure_nginx()
     port = free_port()
     run_dir = cache_dir / "run"
     full_env = {**os.environ, "SHIMMY_CACHE_DIR": str(cache_dir), **(env or {})}
     log = open(cache_dir / "gunicorn.log", "w")
     proc = subprocess.Popen([sys.executable, "-m", "shimmy", "serve", "--listen", f"127.0.0.1:{port}", "--workers",
-                             str(workers), "--run-dir", str(run_dir), "--access-log", str(run_dir / "access.log")],
+                             str(workers), "--run-dir", str(run_dir), "--access-log",
+                             access_log or str(run_dir / "access.log")],
                             cwd=ROOT, env=full_env, stdout=log, stderr=subprocess.STDOUT)
     base = f"http://127.0.0.1:{port}"
     deadline = time.time() + 60

@@ -23,6 +23,7 @@ import stat
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -64,6 +65,31 @@ def gunicorn_command(socket_path: Path, workers: int) -> list[str]:
             "--timeout", str(settings.REQUEST_SECONDS), "--no-control-socket"]
 
 
+class AccessLogRelay:
+    """nginx's access log onto serve's standard output, through a pipe of serve's own: nginx (the same user)
+    may open its write end (``/dev/fd/N``), whereas it may not reopen a standard output that the container
+    runtime made as root (``/dev/stdout``: permission denied)."""
+
+    def __init__(self) -> None:
+        self.read_fd, self.write_fd = os.pipe()
+        self.thread = threading.Thread(target=self._copy, name="access-log", daemon=True)
+        self.thread.start()
+
+    @property
+    def path(self) -> str:
+        return f"/dev/fd/{self.write_fd}"
+
+    def handed_over(self) -> None:
+        """Close serve's copy of the write end once nginx holds it (the relay ends when nginx does)."""
+        os.close(self.write_fd)
+
+    def _copy(self) -> None:
+        with open(self.read_fd, "rb", buffering=0) as source:
+            while chunk := source.read(65536):
+                sys.stdout.buffer.write(chunk)
+                sys.stdout.buffer.flush()
+
+
 class Supervisor:
     """gunicorn and nginx as child processes, reaped here; a stop request from a signal handler."""
 
@@ -73,9 +99,9 @@ class Supervisor:
         self.stop_signal: int | None = None
         self.hangup = False
 
-    def start(self, name: str, argv: list[str], env: dict[str, str], cwd: Path) -> None:
-        try:
-            proc = subprocess.Popen(argv, env=env, cwd=cwd, process_group=0)  # its group: it and its workers
+    def start(self, name: str, argv: list[str], env: dict[str, str], cwd: Path, pass_fds: tuple[int, ...] = ()) -> None:
+        try:  # its own process group: it and its workers
+            proc = subprocess.Popen(argv, env=env, cwd=cwd, process_group=0, pass_fds=pass_fds)
         except OSError as exc:
             raise ServeError(f"cannot start {name} ({argv[0]}): {exc}") from exc
         self.children[name] = proc
@@ -138,9 +164,10 @@ class Supervisor:
 
 
 def serve(listen: str, run_dir: Path | None = None, workers: int = 2, app_dir: Path | None = None,
-          access_log: str = "/dev/stdout") -> int:
+          access_log: str = "-") -> int:
     """Run nginx on ``listen`` in front of gunicorn (``workers`` workers, ``app:server`` from ``app_dir``,
-    default the current folder) until a signal or either ends; the exit status (ServeError before starting)."""
+    default the current folder) until a signal or either ends; the exit status (ServeError before starting).
+    nginx's access log goes to ``access_log``: a file, ``off``, or ``-`` (serve's standard output)."""
     listen = nginx.parse_listen(listen)
     if not 1 <= workers <= 64:
         raise ServeError(f"--workers={workers} is out of range; allowed: 1 to 64 gunicorn workers")
@@ -159,7 +186,9 @@ def serve(listen: str, run_dir: Path | None = None, workers: int = 2, app_dir: P
     socket_path = run_dir / SOCKET_NAME
     socket_path.unlink(missing_ok=True)  # left by a server that was killed
     conf = run_dir / "nginx.conf"
-    conf.write_text(nginx.render(listen, f"unix:{socket_path}", run_dir, access_log=access_log))
+    relay = AccessLogRelay() if access_log == "-" else None
+    conf.write_text(nginx.render(listen, f"unix:{socket_path}", run_dir,
+                                 access_log=relay.path if relay else access_log))
 
     supervisor = Supervisor()
     for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
@@ -168,7 +197,7 @@ def serve(listen: str, run_dir: Path | None = None, workers: int = 2, app_dir: P
     print(f"shimmy serve: nginx on {listen} in front of gunicorn ({workers} workers) on unix:{socket_path}; "
           f"authentication {mode}", file=sys.stderr, flush=True)
     supervisor.start("gunicorn", gunicorn_command(socket_path, workers), env, app_dir)
-    problem = _start_nginx(supervisor, executable, socket_path, conf, env, app_dir)
+    problem = _start_nginx(supervisor, executable, socket_path, conf, env, app_dir, relay)
     while problem is None and supervisor.stop_signal is None and len(supervisor.running()) == 2:
         if supervisor.hangup:
             supervisor.hangup = False
@@ -183,6 +212,8 @@ def serve(listen: str, run_dir: Path | None = None, workers: int = 2, app_dir: P
         print(f"shimmy serve: {problem}; stopping the rest", file=sys.stderr, flush=True)
     supervisor.stop()
     socket_path.unlink(missing_ok=True)
+    if relay:
+        relay.thread.join(timeout=2)  # the last lines nginx logged
     if problem is None:
         print(f"shimmy serve: stopped by {signal.Signals(supervisor.stop_signal).name}", file=sys.stderr, flush=True)
         return 0
@@ -190,7 +221,7 @@ def serve(listen: str, run_dir: Path | None = None, workers: int = 2, app_dir: P
 
 
 def _start_nginx(supervisor: Supervisor, executable: str, socket_path: Path, conf: Path, env: dict[str, str],
-                 app_dir: Path) -> str | None:
+                 app_dir: Path, relay: AccessLogRelay | None) -> str | None:
     """nginx started once gunicorn has made its socket; what went wrong instead (None if nothing did, or if a
     stop was asked for meanwhile)."""
     deadline = time.monotonic() + BIND_SECONDS
@@ -202,7 +233,11 @@ def _start_nginx(supervisor: Supervisor, executable: str, socket_path: Path, con
             return f"gunicorn did not create {socket_path} within {BIND_SECONDS:g} s"
         time.sleep(0.05)
     try:
-        supervisor.start("nginx", nginx.command(executable, socket_path.parent, conf), env, app_dir)
+        supervisor.start("nginx", nginx.command(executable, socket_path.parent, conf), env, app_dir,
+                         (relay.write_fd,) if relay else ())
     except ServeError as exc:
         return str(exc)
+    finally:
+        if relay:
+            relay.handed_over()
     return None

@@ -382,8 +382,12 @@ def test_sigterm_stops_nginx_and_gunicorn_together(proxied):
 
 
 def test_either_process_ending_stops_the_other(tmp_path):
-    server = start_proxied_server(tmp_path, {"SHIMMY_WEB_THREADS": "4"})
+    """With the image's access log (serve's own output, relayed from a pipe nginx may open as any user)."""
+    server = start_proxied_server(tmp_path, {"SHIMMY_WEB_THREADS": "4"}, access_log="-")
     try:
+        assert server.request("GET", "/api/v1/health?from=relay")[0] == 200
+        time.sleep(0.5)
+        assert '"GET /api/v1/health?from=relay HTTP/1.1" 200' in (tmp_path / "gunicorn.log").read_text()
         master = next(p for p in _tree(server.proc.pid) if "nginx: master" in " ".join(p.cmdline()))
         rest = [p for p in _tree(server.proc.pid) if p.pid != master.pid]
         master.kill()

@@ -128,7 +128,8 @@ def add_parsers(commands) -> None:
                     "directory)")
     p0.add_argument("--app-dir", type=Path, default=None, help="folder with app.py and gunicorn.conf.py (default: "
                     "the current one)")
-    p0.add_argument("--access-log", default="/dev/stdout", help="nginx's access log: a file, or off")
+    p0.add_argument("--access-log", default="-", help="nginx's access log: - (serve's standard output), a file, "
+                    "or off")
     c0 = add_command(commands, "nginx-conf", "print the nginx configuration that serve runs (its limits from the "
                      "SHIMMY_* settings), for a proxy of one's own", _cmd_nginx_conf)
     c0.add_argument("--listen", default="127.0.0.1:8050", help="where nginx listens: HOST:PORT or PORT")
