@@ -174,7 +174,7 @@ def _seconds(value: float) -> str:
 def render(listen: str, upstream: str, run_dir: Path | str, access_log: str = "/dev/stdout",
            worker_processes: int = 1, worker_connections: int = 1024) -> str:
     """The configuration of nginx listening on ``listen`` in front of gunicorn at ``upstream``, its pid and
-    temporary files under ``run_dir``, with the limits of :mod:`shimmy.service.settings`. When started by
+    temporary files under ``run_dir``, with the limits of ``shimmy.service.settings``. When started by
     root, its workers run as root too (nginx would take ``nobody``, who may not reach the socket)."""
     user = "" if os.geteuid() != 0 else f"user {pwd.getpwuid(os.geteuid()).pw_name};"
     for name, value in (("SHIMMY_HEADER_READ_SECONDS", settings.HEADER_READ_SECONDS),
