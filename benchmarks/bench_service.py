@@ -38,7 +38,7 @@ import urllib.request
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "ui"), str(ROOT / "tests" / "service")]
 
 
 def start_server(cache_dir: str, port: int) -> subprocess.Popen:
@@ -86,7 +86,8 @@ def throughput(port: int, bodies, seconds: float, threads: int = 8) -> float:
 def slider_latency(base: str, repeats: int) -> list[float]:
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
-    from test_browser import NES_TRACE, _ensure_chromium, _nes_onset  # the tests' own setup
+    from browser import _ensure_chromium  # the tests' own setup
+    from test_browser import NES_TRACE, _nes_onset
 
     _ensure_chromium()
     from selenium import webdriver
