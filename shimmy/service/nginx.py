@@ -107,7 +107,7 @@ http {
             return 413 '{"error": "request body above the limit of %(max_body)d bytes", "field": "body", \
 "allowed": "at most %(max_body)d bytes"}';
         }
-        error_page 502 503 @app_unavailable;
+        error_page 502 503 =503 @app_unavailable;
         location @app_unavailable {
             default_type application/json;
             add_header Retry-After 5 always;

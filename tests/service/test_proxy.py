@@ -124,6 +124,27 @@ def test_nginx_takes_the_configuration_rendered_from_the_settings(tmp_path, monk
     done = subprocess.run([*nginx.command(ensure_nginx(), tmp_path, tmp_path / "nginx.conf"), "-t"],
                           capture_output=True, text=True, timeout=30)
     assert done.returncode == 0 and "test is successful" in done.stderr, done.stderr
+    # With no gunicorn behind it (starting, restarting), the proxy answers 503 in JSON with Retry-After.
+    port = free_port()
+    (tmp_path / "nginx.conf").write_text(nginx.render(f"127.0.0.1:{port}", f"unix:{tmp_path}/none.sock", tmp_path,
+                                                      access_log="off"))
+    alone = subprocess.Popen(nginx.command(ensure_nginx(), tmp_path, tmp_path / "nginx.conf"), stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 20
+        while True:
+            try:
+                conn = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+                conn.request("GET", "/api/v1/health")
+                resp = conn.getresponse()
+                break
+            except OSError:
+                assert time.monotonic() < deadline and alone.poll() is None, "nginx did not start"
+                time.sleep(0.1)
+        answer = json.loads(resp.read())
+        assert resp.status == 503 and resp.headers["Retry-After"] == "5" and "not answering" in answer["error"]
+    finally:
+        alone.terminate()
+        alone.wait(timeout=20)
     for bad, option in (("0.0.0.0:99999", "--listen"), ("8050; user root", "--listen"), ("[::g]:1", "--listen")):
         with pytest.raises(nginx.ProxyConfigError, match=option):
             nginx.render(bad, "unix:/tmp/x.sock", tmp_path)
