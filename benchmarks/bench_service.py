@@ -3,7 +3,8 @@ health under slow clients, time to refuse a job when the queue is full.
 
     python benchmarks/bench_service.py [--seconds 5] [--repeats 5]
 
-Starts gunicorn (app:server, 2 workers, a fresh cache directory) on loopback, then:
+Starts the service as the image runs it (``python -m shimmy serve``: nginx in front of gunicorn, app:server,
+2 workers, a fresh cache directory) on loopback, then:
 
 * cached API answer: median and 95th percentile of POST /api/v1/hopf (a cache hit) over 300
   sequential requests on one keep-alive connection (target median <= 20 ms);
@@ -16,7 +17,7 @@ Starts gunicorn (app:server, 2 workers, a fresh cache directory) on loopback, th
   (target <= 300 ms);
 * health with 50 slow clients open (25 stopped inside their headers, 25 with a body never
   finished): median and max of 20 GET /api/v1/health (target <= 1 s), and how many of the 50 the
-  server has closed after its header/body limits;
+  proxy has closed after its header/body limits;
 * a full job queue: 2 running + 8 queued map jobs (the default limits), then the median time of
   20 further submissions to be refused (429 with Retry-After); every job is cancelled after.
 """
@@ -37,13 +38,14 @@ import urllib.request
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "ui"), str(ROOT / "tests" / "service")]
 
 
 def start_server(cache_dir: str, port: int) -> subprocess.Popen:
-    env = {**os.environ, "SHIMMY_CACHE_DIR": cache_dir}
-    proc = subprocess.Popen([sys.executable, "-m", "gunicorn", "app:server", "--bind", f"127.0.0.1:{port}",
-                             "--workers", "2", "--no-control-socket", "--log-level", "warning"], cwd=ROOT, env=env)
+    """The service as the image runs it: nginx on ``port`` in front of gunicorn (2 workers), its access log off."""
+    env = {**os.environ, "SHIMMY_CACHE_DIR": cache_dir, "GUNICORN_CMD_ARGS": "--log-level warning"}
+    proc = subprocess.Popen([sys.executable, "-m", "shimmy", "serve", "--listen", f"127.0.0.1:{port}", "--workers", "2",
+                             "--run-dir", os.path.join(cache_dir, "run"), "--access-log", "off"], cwd=ROOT, env=env)
     for _ in range(200):
         try:
             urllib.request.urlopen(f"http://127.0.0.1:{port}/api/v1/health", timeout=1)
@@ -51,7 +53,7 @@ def start_server(cache_dir: str, port: int) -> subprocess.Popen:
         except OSError:
             time.sleep(0.2)
     proc.kill()
-    raise RuntimeError("gunicorn did not start")
+    raise RuntimeError("shimmy serve did not start")
 
 
 def post(conn: http.client.HTTPConnection, path: str, body: dict) -> tuple[int, bytes]:
@@ -84,7 +86,8 @@ def throughput(port: int, bodies, seconds: float, threads: int = 8) -> float:
 def slider_latency(base: str, repeats: int) -> list[float]:
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
-    from test_browser import NES_TRACE, _ensure_chromium, _nes_onset  # the tests' own setup
+    from browser import _ensure_chromium  # the tests' own setup
+    from test_browser import NES_TRACE, _nes_onset
 
     _ensure_chromium()
     from selenium import webdriver
@@ -128,8 +131,8 @@ def slider_latency(base: str, repeats: int) -> list[float]:
 
 
 def slow_clients(base: str, n: int = 50) -> tuple[list[float], int]:
-    """Health latencies with ``n`` slow clients open, and how many the server closed (limits 10 s)."""
-    from test_reliability import closed_by_server, open_slow_clients
+    """Health latencies with ``n`` slow clients open, and how many the proxy closed (limits 10 s)."""
+    from test_proxy import closed_by_server, open_slow_clients
 
     socks = open_slow_clients(base, n)
     try:
@@ -203,7 +206,7 @@ def main() -> None:
             n_accepted, refusals = queue_refusal(port)
         finally:
             proc.terminate()
-            proc.wait(timeout=20)
+            proc.wait(timeout=45)
     print(f"{'measure':<52}{'value':>12}{'target':>12}")
     print(f"{'cached POST /hopf median (ms)':<52}{1e3 * statistics.median(lat):>12.2f}{'<= 20':>12}")
     print(f"{'cached POST /hopf 95th percentile (ms)':<52}{1e3 * lat[int(0.95 * len(lat))]:>12.2f}{'':>12}")

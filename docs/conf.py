@@ -46,7 +46,7 @@ autodoc_default_options = {"members": True, "undoc-members": True, "show-inherit
 # inventories of theirs) and the quoted annotations autodoc gives dataclass fields of builtin generic
 # types (tuple[float, float] arrives as 'tuple[float, split at its comma).
 nitpicky = True
-EXTERNAL = "np|numpy|scipy|typing|collections|concurrent|distributed|flask|enum|pathlib|os|argparse"
+EXTERNAL = "np|numpy|scipy|typing|collections|concurrent|distributed|flask|enum|pathlib|os|argparse|subprocess"
 nitpick_ignore_regex = [
     (r"py:.*", rf"({EXTERNAL})\..*"),
     (r"py:class", r"'.*"),

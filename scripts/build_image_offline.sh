@@ -14,9 +14,11 @@
 #      CA bundle and the host's effective pip configuration (`pip config list`: files and
 #      PIP_* variables, merged into one pip.conf) mounted, plus every local path that
 #      configuration names (file:// indexes, find-links folders), so pip inside the build
-#      reaches the same package indexes as pip on the host.
+#      reaches the same package indexes as pip on the host; likewise the host's apt settings
+#      for the Dockerfile's apt-get (nginx) from the same Debian mirror as the base.
 #   5. Smoke test in a container of the image: imports, numba cache warm, and (when the
-#      image has app.py) gunicorn on a loopback port answering /api/v1/health; a Dask
+#      image has app.py) its CMD on a loopback port (nginx in front of gunicorn) answering
+#      /api/v1/health and stopping on SIGTERM; a Dask
 #      scheduler + worker running shimmy.simulate when distributed is installed.
 #
 # Re-runs reuse the debootstrap root, the base image and buildah's layer cache.
@@ -90,8 +92,8 @@ command -v buildah >/dev/null 2>&1 || missing+=(buildah)
 command -v debootstrap >/dev/null 2>&1 || missing+=(debootstrap)
 if [ "${#missing[@]}" -gt 0 ]; then
     echo "installing from Debian: ${missing[*]}"
-    # One apt-get at a time with the test suite's other workers (tests/ui/browser.py takes this lock
-    # to install chromium): apt-get refuses to start while another holds apt's lock.
+    # One apt-get at a time with the test suite's other workers (tests/conftest.py takes this lock
+    # to install chromium and nginx): apt-get refuses to start while another holds apt's lock.
     exec 9>/tmp/shimmy-tests-apt.lock
     flock 9
     apt-get update -q || die "apt-get update failed: Debian's package mirror is not reachable"
@@ -265,6 +267,15 @@ add_mount() {  # $1: host path, mounted read-only at the same path
     echo "    mount: $p"
 }
 add_mount /etc/ssl/certs/ca-certificates.crt
+# The host's apt settings that the base lacks (e.g. a frozen mirror needs Check-Valid-Until false), for the
+# Dockerfile's apt-get (it installs nginx), as for the base's upgrade above.
+for f in /etc/apt/apt.conf.d/*; do
+    b="$(basename "$f")"
+    if [ -f "$f" ] && [ ! -e "$rootfs/etc/apt/apt.conf.d/$b" ]; then
+        volumes+=(-v "$f:/etc/apt/apt.conf.d/$b:ro")
+        echo "    mount: $f"
+    fi
+done
 # Local paths named by the pip configuration: file:// indexes (the folder above .../simple,
 # since index pages link to ../../files/...), find-links folders, cert and client-cert files.
 while read -r p; do add_mount "$p"; done < <(
@@ -308,14 +319,14 @@ step_done
 # A free loopback port on the host (chroot isolation shares the host's network).
 port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 if "${B[@]}" run --isolation chroot "$ctr" -- test -f app.py; then
-    step "smoke test: gunicorn app:server + GET /api/v1/health"
+    step "smoke test: the image's CMD (nginx in front of gunicorn) + GET /api/v1/health, then SIGTERM"
     cat >"$work/smoke_http.py" <<'PY'
-"""Start gunicorn as the image's CMD does (loopback, one port), GET the health URL, stop it."""
-import json, subprocess, sys, time, urllib.request
+"""Start the image's CMD on a loopback port instead of 0.0.0.0:8050 (nginx in front of gunicorn), GET the
+health URL and a page through nginx, stop it with SIGTERM as `docker stop` does: both must end, status 0."""
+import json, signal, subprocess, sys, time, urllib.request
 
 port = sys.argv[1]
-cmd = ["gunicorn", "app:server", "--bind", f"127.0.0.1:{port}", "--workers", "2", "--timeout", "120",
-       "--no-control-socket"]
+cmd = ["python", "-m", "shimmy", "serve", "--listen", f"127.0.0.1:{port}", "--workers", "2", "--run-dir", "/run/shimmy"]
 print("starting:", " ".join(cmd), flush=True)
 t0 = time.perf_counter()
 proc = subprocess.Popen(cmd)
@@ -326,31 +337,36 @@ try:
         try:
             with urllib.request.urlopen(f"http://127.0.0.1:{port}/api/v1/health", timeout=5) as resp:
                 body = resp.read().decode()
-                print(f"GET /api/v1/health -> {resp.status} after {time.perf_counter() - t0:.1f} s: {body[:500]}")
-                ok = resp.status == 200
+                print(f"GET /api/v1/health -> {resp.status} (Server: {resp.headers['Server']}) after "
+                      f"{time.perf_counter() - t0:.1f} s: {body[:500]}")
+                ok = resp.status == 200 and resp.headers["Server"] == "nginx"
                 break
         except OSError:
             time.sleep(0.5)
     if proc.poll() is not None:
-        print(f"gunicorn exited with {proc.returncode} before answering", flush=True)
+        print(f"shimmy serve exited with {proc.returncode} before answering", flush=True)
     elif ok:
         with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=30) as resp:
             print(f"GET / -> {resp.status}, {len(resp.read())} bytes")
 finally:
     if proc.poll() is None:
-        proc.terminate()
+        t1 = time.perf_counter()
+        proc.send_signal(signal.SIGTERM)
         try:
-            proc.wait(30)
+            code = proc.wait(45)
+            print(f"SIGTERM: shimmy serve (nginx and gunicorn) exited {code} after {time.perf_counter() - t1:.1f} s")
+            ok = ok and code == 0
         except subprocess.TimeoutExpired:
             proc.kill()
+            ok = False
 sys.exit(0 if ok else 1)
 PY
     "${B[@]}" run --isolation chroot -v "$work/smoke_http.py:/tmp/smoke_http.py:ro" "$ctr" -- python /tmp/smoke_http.py "$port" \
-        || die "the image's gunicorn did not answer /api/v1/health (see output above)"
+        || die "the image's nginx and gunicorn did not answer /api/v1/health or stop cleanly (see output above)"
     step_done
 else
     echo
-    echo "NOTE: the image has no app.py: smoke test checked the imports only (no gunicorn/health check)."
+    echo "NOTE: the image has no app.py: smoke test checked the imports only (no server/health check)."
 fi
 
 if "${B[@]}" run --isolation chroot "$ctr" -- python -c 'import distributed' 2>/dev/null; then

@@ -1,10 +1,13 @@
-"""Real servers for the service tests: gunicorn serving app:server on a loopback port."""
+"""Real servers for the service tests: gunicorn serving app:server on a loopback port, alone or behind
+nginx as ``python -m shimmy serve`` runs them (the image's command)."""
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import json
 import os
+import shutil
 import socket
 import subprocess
 import sys
@@ -146,14 +149,78 @@ def start_server(cache_dir: Path, env: dict[str, str] | None = None, workers: in
     return server
 
 
-def stop_server(server: Server) -> None:
+def stop_server(server: Server, timeout: float = 15) -> None:
     server.proc.terminate()
     try:
-        server.proc.wait(timeout=15)
+        server.proc.wait(timeout=timeout)
     except subprocess.TimeoutExpired:
         server.proc.kill()
         server.proc.wait(timeout=15)
     server.log.close()
+
+
+#: Held around apt-get by every test that installs a Debian package (here, tests/ui/browser.py) and by
+#: scripts/build_image_offline.sh: two xdist workers on a fresh machine would otherwise run apt-get at once,
+#: and one fails on apt's own lock.
+APT_LOCK = "/tmp/shimmy-tests-apt.lock"
+
+
+def apt_install(packages: list[str], present) -> None:
+    """Debian ``packages`` installed with apt-get unless ``present()`` (under APT_LOCK); pytest.fail if that
+    is needed and cannot be done here (not root, no apt-get)."""
+    if present():
+        return
+    if os.geteuid() != 0 or not shutil.which("apt-get"):
+        pytest.fail(f"Debian {', '.join(packages)} needed and cannot be installed here (not root, or no apt-get)")
+    with open(APT_LOCK, "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # another worker may be installing right now
+        if present():
+            return
+        env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
+        subprocess.run(["apt-get", "update", "-qq"], check=True, env=env, timeout=600)
+        subprocess.run(["apt-get", "install", "-y", "-qq", *packages], check=True,
+                       env=env, timeout=600)
+
+
+def ensure_nginx() -> str:
+    """nginx's executable, Debian's package installed first when missing."""
+    from shimmy.service import nginx
+
+    apt_install(["nginx"], lambda: nginx.binary() is not None)
+    return nginx.binary()
+
+
+def start_proxied_server(cache_dir: Path, env: dict[str, str] | None = None, workers: int = 1,
+                         access_log: str | None = None) -> Server:
+    """``python -m shimmy serve``: nginx on a free loopback port in front of gunicorn (``workers`` workers) on a
+    Unix socket in ``cache_dir/run``, once health answers through both. ``proc`` is the supervisor; nginx's
+    access log is ``access_log`` (default ``run/access.log``; ``-``: serve's output), everything else goes to
+    ``gunicorn.log``."""
+    ensure_nginx()
+    port = free_port()
+    run_dir = cache_dir / "run"
+    full_env = {**os.environ, "SHIMMY_CACHE_DIR": str(cache_dir), **(env or {})}
+    log = open(cache_dir / "gunicorn.log", "w")
+    proc = subprocess.Popen([sys.executable, "-m", "shimmy", "serve", "--listen", f"127.0.0.1:{port}", "--workers",
+                             str(workers), "--run-dir", str(run_dir), "--access-log",
+                             access_log or str(run_dir / "access.log")],
+                            cwd=ROOT, env=full_env, stdout=log, stderr=subprocess.STDOUT)
+    base = f"http://127.0.0.1:{port}"
+    deadline = time.time() + 60
+    while True:
+        try:
+            with urllib.request.urlopen(base + "/api/v1/health", timeout=2) as resp:
+                if resp.status == 200:
+                    break
+        except OSError:
+            pass
+        if proc.poll() is not None or time.time() > deadline:
+            proc.kill()
+            raise RuntimeError("shimmy serve did not start: " + (cache_dir / "gunicorn.log").read_text()[-2000:])
+        time.sleep(0.3)
+    server = Server(base, cache_dir, proc)
+    server.log, server.run_dir = log, run_dir
+    return server
 
 
 @pytest.fixture(scope="session", autouse=True)

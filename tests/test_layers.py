@@ -171,11 +171,12 @@ def test_every_module_sits_in_a_layer():
 #: too: its InvalidInputError is bad input) and of the service its request schemas, its analysis registry
 #: (whose run_canonical answers from the shared cache), its settings (where that cache is) and the cache
 #: itself (``--no-cache`` bypasses it, the nearest cached design included); and, to run the service for a team,
-#: its tokens store (``tokens``) and its job queue (``jobs drain``).
+#: its tokens store (``tokens``), its job queue (``jobs drain``) and the proxy in front of it, which starts
+#: gunicorn as a program (``serve``, ``nginx-conf``: no web library imported).
 CLI_MAY_IMPORT = ("shimmy.cli", "shimmy.analyses", "shimmy.model", "shimmy.errors", "shimmy.continuation.errors",
                   "shimmy.continuation.kinds", "shimmy.service.schemas", "shimmy.service.analyses",
                   "shimmy.service.settings", "shimmy.service.cache", "shimmy.service.tokens",
-                  "shimmy.service.jobs", "shimmy.version")
+                  "shimmy.service.jobs", "shimmy.service.nginx", "shimmy.service.serve", "shimmy.version")
 
 
 def test_cli_imports_only_the_analyses_the_model_the_errors_and_the_schemas():

@@ -17,7 +17,8 @@ same words whatever was wrong (API and callbacks: JSON naming ``Authorization``;
 to the sign-in page); a credential whose scope does not allow the request, 403. Tokens never reach a
 log: they are accepted only in the header, the cookie (which carries no token) and the sign-in
 form's body, never in an address. Sign-in attempts are limited per client address
-(:func:`shimmy.service.admission.take_login_attempt`).
+(:func:`shimmy.service.admission.take_login_attempt`): the connection's, or behind the proxy the one it
+forwards (:mod:`shimmy.service.forwarded`).
 """
 
 from __future__ import annotations
@@ -74,7 +75,7 @@ NOBODY = Principal("nobody", "read", None, "unchecked")
 def enabled() -> bool:
     """Whether requests need a credential (SHIMMY_AUTH resolved once per set of environment values)."""
     return _mode(os.environ.get("SHIMMY_AUTH"), os.environ.get("SHIMMY_LISTEN"),
-                 os.environ.get("SHIMMY_ALLOW_ANONYMOUS")) == "token"
+                 os.environ.get("SHIMMY_PROXY_LISTEN"), os.environ.get("SHIMMY_ALLOW_ANONYMOUS")) == "token"
 
 
 @functools.lru_cache(maxsize=8)

@@ -13,15 +13,29 @@ SCHEMA_VERSION = 1
 
 #: Limits on what one request may ask for (refused with 4xx naming the limit).
 MAX_BODY_BYTES = 64 * 1024
-#: Threads per web worker that run the WSGI app on complete requests (SHIMMY_WEB_THREADS). Quick
-#: computations take at most MAX_FAST_COMPUTATIONS of them and wait in at most FAST_WAITING more;
-#: the rest (at least FAST_RESERVED_THREADS) stay free for health, cached answers and the pages.
+#: Threads per web worker (gunicorn's gthread worker, gunicorn.conf.py) that run the WSGI app
+#: (SHIMMY_WEB_THREADS). Quick computations take at most MAX_FAST_COMPUTATIONS of them and wait in at most
+#: FAST_WAITING more; the rest (at least FAST_RESERVED_THREADS) stay free for health, cached answers and the pages.
 WEB_THREADS = int(os.environ.get("SHIMMY_WEB_THREADS", "32"))
-#: The headers of a connection's first request must be complete within this many seconds, else it is
-#: closed (SHIMMY_HEADER_READ_SECONDS).
+#: Slow clients, held by the buffering proxy in front of gunicorn (nginx, shimmy.service.nginx), which
+#: passes a request on only once it is complete: the headers of a request must be complete within this
+#: many seconds of the connection's first byte being awaited, else the connection is closed
+#: (SHIMMY_HEADER_READ_SECONDS; nginx's client_header_timeout).
 HEADER_READ_SECONDS = float(os.environ.get("SHIMMY_HEADER_READ_SECONDS", "10"))
-#: A request body must arrive within this many seconds of the app asking for it (else 408).
+#: A request body may pause at most this many seconds between two reads, else the connection is closed
+#: (SHIMMY_BODY_READ_SECONDS; nginx's client_body_timeout). The app itself, when a client reaches it
+#: directly (gunicorn alone on loopback), waits at most this long for a body announced longer than sent (408).
 BODY_READ_SECONDS = float(os.environ.get("SHIMMY_BODY_READ_SECONDS", "10"))
+#: A client that stops reading an answer for this many seconds is disconnected (SHIMMY_SEND_SECONDS;
+#: nginx's send_timeout): the proxy holds the answer, never a gunicorn thread.
+SEND_SECONDS = float(os.environ.get("SHIMMY_SEND_SECONDS", "30"))
+#: An idle keep-alive connection is closed after this many seconds (SHIMMY_KEEPALIVE_SECONDS; nginx's
+#: keepalive_timeout), and after KEEPALIVE_REQUESTS requests.
+KEEPALIVE_SECONDS = float(os.environ.get("SHIMMY_KEEPALIVE_SECONDS", "15"))
+KEEPALIVE_REQUESTS = 1000
+#: The longest time the proxy waits for the app's answer (nginx's proxy_read_timeout), the same as
+#: gunicorn's worker --timeout in `python -m shimmy serve` and the image.
+REQUEST_SECONDS = 120
 MAX_T_END = 600.0  # s of simulated time per request
 MAX_SERIES_POINTS = 200_000  # samples per returned time series (t_end / dt_out)
 MAX_NTST = 200
@@ -129,10 +143,41 @@ class AuthSettingError(RuntimeError):
     """SHIMMY_AUTH asks for something this server will not do (the server refuses to start)."""
 
 
+def _listed(name: str) -> list[str]:
+    return [a.strip() for a in os.environ.get(name, "").split(",") if a.strip()]
+
+
 def listen_addresses() -> list[str]:
-    """The addresses the server listens on, as gunicorn.conf.py recorded them from gunicorn's ``bind``
-    setting (SHIMMY_LISTEN, comma-separated); empty if it was not started through it."""
-    return [a.strip() for a in os.environ.get("SHIMMY_LISTEN", "").split(",") if a.strip()]
+    """Where clients reach the server: the addresses gunicorn listens on, as gunicorn.conf.py recorded them
+    from gunicorn's ``bind`` setting (SHIMMY_LISTEN, comma-separated; empty if it was not started through
+    it), and those of the proxy in front of it (SHIMMY_PROXY_LISTEN, set by ``python -m shimmy serve``).
+    With a proxy named, gunicorn's Unix sockets count as reached through it only (the proxy's address
+    stands for them)."""
+    own, proxy = _listed("SHIMMY_LISTEN"), _listed("SHIMMY_PROXY_LISTEN")
+    return [a for a in own if not (proxy and a.startswith("unix:"))] + proxy
+
+
+class ProxySettingError(RuntimeError):
+    """SHIMMY_TRUSTED_PROXY names something that is not an address (the server refuses to start)."""
+
+
+def trusted_proxies() -> frozenset[str]:
+    """The peers whose forwarding headers are believed (SHIMMY_TRUSTED_PROXY, comma-separated): ``unix``
+    (a client of gunicorn's Unix socket: the proxy ``python -m shimmy serve`` starts) and IP addresses.
+    A request from one of them takes its client address from X-Forwarded-For and its scheme from
+    X-Forwarded-Proto, which that proxy sets; from anyone else (and when the setting is empty, the
+    default) those headers are ignored and the client address is the connection's."""
+    out = set()
+    for entry in _listed("SHIMMY_TRUSTED_PROXY"):
+        if entry != "unix":
+            try:
+                entry = str(ipaddress.ip_address(entry))
+            except ValueError:
+                raise ProxySettingError(f"SHIMMY_TRUSTED_PROXY={os.environ['SHIMMY_TRUSTED_PROXY']!r}: {entry!r} is "
+                                        "neither 'unix' nor an IP address; allowed: a comma-separated list of "
+                                        "them (the proxy's own address), or nothing") from None
+        out.add(entry)
+    return frozenset(out)
 
 
 def is_loopback(address: str) -> bool:

@@ -92,20 +92,32 @@ def test_exposes_8050_and_healthcheck_hits_the_health_api():
     assert "curl" not in checks[0] and "wget" not in checks[0]
 
 
-def test_cmd_is_gunicorn_without_debug():
+def test_cmd_is_nginx_in_front_of_gunicorn_without_debug():
     cmds = [exec_form(a) for k, a in instructions() if k == "CMD"]
-    assert cmds == [["gunicorn", "app:server", "--bind", "0.0.0.0:8050", "--workers", "2",
-                     "--timeout", "120", "--no-control-socket"]]
+    assert cmds == [["python", "-m", "shimmy", "serve", "--listen", "0.0.0.0:8050", "--workers", "2",
+                     "--run-dir", "/run/shimmy"]]
+    assert not [k for k, _ in instructions() if k == "ENTRYPOINT"]  # compose's dask services replace the CMD
 
 
-def test_the_image_runs_the_slow_client_safe_worker():
-    """The CMD runs in WORKDIR /app, where gunicorn reads gunicorn.conf.py: it must reach the image."""
-    workdirs = [a for k, a in instructions() if k == "WORKDIR"]
-    assert workdirs[-1] == "/app" and not any(k == "CMD" and "--config" in a for k, a in instructions())
+def test_the_image_holds_slow_clients_in_nginx_in_front_of_gunicorns_documented_worker():
+    """nginx from Debian, installed as root before USER; serve's run directory private to the app user; the CMD runs
+    in WORKDIR /app, where gunicorn reads gunicorn.conf.py (its plain gthread worker): it must reach the image."""
+    ins = instructions()
+    install = [i for i, (k, a) in enumerate(ins) if k == "RUN" and re.search(r"apt-get install [^&]*\bnginx=1\.22\.\*", a)]
+    user = [i for i, (k, _) in enumerate(ins) if k == "USER"]
+    assert install and user and install[0] < user[0]
+    assert "--no-install-recommends" in ins[install[0]][1] and "rm -rf /var/lib/apt/lists/*" in ins[install[0]][1]
+    run = " ".join(a for k, a in ins if k == "RUN")
+    assert re.search(r"install -d -o shimmy -g shimmy -m 0700 /run/shimmy\b", run)
+    workdirs = [a for k, a in ins if k == "WORKDIR"]
+    assert workdirs[-1] == "/app" and not any(k == "CMD" and "--config" in a for k, a in ins)
     ignored = [line.strip() for line in (ROOT / ".dockerignore").read_text().splitlines()
                if line.strip() and not line.startswith("#")]
     assert not any(pattern in ("gunicorn.conf.py", "*.py", "gunicorn*") for pattern in ignored)
-    assert 'worker_class = "shimmy.service.buffered.BufferingWorker"' in (ROOT / "gunicorn.conf.py").read_text()
+    conf = (ROOT / "gunicorn.conf.py").read_text()
+    assert 'worker_class = "gthread"' in conf and "buffered" not in conf
+    assert not (ROOT / "shimmy" / "service" / "buffered.py").exists()
+    assert "gunicorn>=25.1\"" in (ROOT / "pyproject.toml").read_text()  # no upper pin: nothing of gunicorn is patched
 
 
 @pytest.mark.parametrize("path", ["Dockerfile", "compose.yaml", "compose.dask.yaml"])
@@ -177,12 +189,14 @@ def test_compose_defines_web_and_the_dask_services():
         text = COMPOSE.read_text()
         for name in ("web", "scheduler", "worker"):
             assert re.search(rf"^  {name}:\s*$", text, re.M), name
-        assert "shimmy-cache:/var/cache/shimmy" in text and '"8050:8050"' in text
+        assert "shimmy-cache:/var/cache/shimmy" in text and '"8050:8050"' in text and "stop_grace_period: 45s" in text
         return
     services = data["services"]
     assert set(services) >= {"web", "scheduler", "worker"}
     web, scheduler, worker = services["web"], services["scheduler"], services["worker"]
-    assert web["build"] == "." and "8050:8050" in web["ports"]
+    assert web["build"] == "." and web["ports"] == ["8050:8050"]
+    assert "command" not in web and "entrypoint" not in web  # the image's CMD: nginx in front of gunicorn
+    assert web["stop_grace_period"] == "45s"
     assert "shimmy-cache:/var/cache/shimmy" in web["volumes"]
     assert "shimmy-cache" in data["volumes"]
     assert "/api/v1/health" in " ".join(web["healthcheck"]["test"])

@@ -5,14 +5,12 @@ make of a page. The test modules import it (pytest puts their folder on sys.path
 
 from __future__ import annotations
 
-import fcntl
 import os
-import shutil
-import subprocess
 import time
 from pathlib import Path
 
 import pytest
+from conftest import apt_install
 
 pytest.importorskip("selenium")
 from selenium import webdriver  # noqa: E402
@@ -31,23 +29,8 @@ PAGES = {"overview": "/", "devices": "/devices", "time-history": "/time-history"
          "validation": "/validation", "api": "/api"}
 
 
-#: Held around apt-get, here and in scripts/build_image_offline.sh: two xdist workers (a browser test
-#: and the image build) on a fresh machine would otherwise run apt-get at once, and one fails on apt's lock.
-APT_LOCK = "/tmp/shimmy-tests-apt.lock"
-
-
 def _ensure_chromium() -> None:
-    if os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER):
-        return
-    if os.geteuid() != 0 or not shutil.which("apt-get"):
-        pytest.fail("Debian chromium and chromium-driver are needed and cannot be installed here (not root)")
-    with open(APT_LOCK, "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # the other worker may be installing them right now
-        if os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER):
-            return
-        env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
-        subprocess.run(["apt-get", "update", "-qq"], check=True, env=env)
-        subprocess.run(["apt-get", "install", "-y", "-qq", "chromium", "chromium-driver"], check=True, env=env)
+    apt_install(["chromium", "chromium-driver"], lambda: os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER))
 
 
 def chromium(profile: str, window: str, downloads: Path | None = None):

@@ -1,7 +1,8 @@
-"""Running the service for a team: ``tokens`` (who may use it) and ``jobs`` (draining the job queue
-for an upgrade). They act on the server's files in ``SHIMMY_CACHE_DIR`` (the tokens file,
-``SHIMMY_TOKENS_FILE`` if set, and the job store), so run them as the server's user with its
-environment; a running server sees a change at its next request."""
+"""Running the service for a team: ``serve`` (nginx in front of gunicorn, as the image runs it),
+``nginx-conf`` (that proxy's configuration, for a proxy of one's own), ``tokens`` (who may use it) and
+``jobs`` (draining the job queue for an upgrade). ``tokens`` and ``jobs`` act on the server's files in
+``SHIMMY_CACHE_DIR`` (the tokens file, ``SHIMMY_TOKENS_FILE`` if set, and the job store), so run them as
+the server's user with its environment; a running server sees a change at its next request."""
 
 from __future__ import annotations
 
@@ -9,7 +10,32 @@ import json
 import sys
 import time
 
+from pathlib import Path
+
 from ..common import EXIT_BAD_INPUT, add_command
+
+
+def _cmd_serve(args) -> int:
+    from ...service.nginx import ProxyConfigError
+    from ...service.serve import ServeError, serve
+    from ...service.settings import AuthSettingError
+
+    try:
+        return serve(args.listen, args.run_dir, args.workers, args.app_dir, args.access_log)
+    except (ProxyConfigError, ServeError, AuthSettingError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+def _cmd_nginx_conf(args) -> int:
+    from ...service.nginx import ProxyConfigError, render
+
+    try:
+        print(render(args.listen, args.upstream, args.run_dir, access_log=args.access_log), end="")
+    except ProxyConfigError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return 0
 
 
 def _cmd_tokens_create(args) -> int:
@@ -92,6 +118,26 @@ def _cmd_jobs_resume(args) -> int:
 
 
 def add_parsers(commands) -> None:
+    p0 = add_command(commands, "serve", "run the service for a team: nginx on --listen holding slow clients, in front "
+                     "of gunicorn (app:server) on a Unix socket only it reaches; SIGTERM stops both", _cmd_serve)
+    p0.add_argument("--listen", default="127.0.0.1:8050", help="where nginx listens: HOST:PORT or PORT (beyond "
+                    "loopback, authentication is on by default)")
+    p0.add_argument("--workers", type=int, default=2, help="gunicorn's web workers")
+    p0.add_argument("--run-dir", type=Path, default=None, help="private folder (0700) for gunicorn's socket and "
+                    "nginx's configuration, pid and temporary files (default: shimmy-serve-UID in the temporary "
+                    "directory)")
+    p0.add_argument("--app-dir", type=Path, default=None, help="folder with app.py and gunicorn.conf.py (default: "
+                    "the current one)")
+    p0.add_argument("--access-log", default="-", help="nginx's access log: - (serve's standard output), a file, "
+                    "or off")
+    c0 = add_command(commands, "nginx-conf", "print the nginx configuration that serve runs (its limits from the "
+                     "SHIMMY_* settings), for a proxy of one's own", _cmd_nginx_conf)
+    c0.add_argument("--listen", default="127.0.0.1:8050", help="where nginx listens: HOST:PORT or PORT")
+    c0.add_argument("--upstream", default="unix:/tmp/shimmy-serve/gunicorn.sock",
+                    help="gunicorn's address: unix:/PATH or HOST:PORT")
+    c0.add_argument("--run-dir", default="/tmp/shimmy-serve", help="folder for nginx's pid and temporary files")
+    c0.add_argument("--access-log", default="/dev/stdout", help="nginx's access log: a file, or off")
+
     p = add_command(commands, "tokens", "create, list and revoke the API tokens of the service (SHIMMY_AUTH=token)",
                     lambda args: p.print_help() or EXIT_BAD_INPUT)
     sub = p.add_subparsers(dest="tokens_command", metavar="ACTION")
