@@ -1,4 +1,5 @@
-"""Ground runs: a take-off, landing roll, taxi or any (t, V, Fz) table for the four configurations."""
+"""Ground runs: a take-off, landing roll, taxi or any (t, V, Fz) table for the four configurations, with a yaw kick
+(a runway joint, a touchdown with yaw) if asked."""
 
 from __future__ import annotations
 
@@ -10,14 +11,19 @@ from shimmy.errors import InvalidParameterError
 from shimmy.service import analyses
 from ui import components as ui
 from ui import fields, formats, ids, jobs
-from ui.fields import Quantity
+from ui.fields import Quantity, SignedQuantity
 from ui import style
 from ui.layout import page
 
 dash.register_page(__name__, path="/ground-run", name="Ground run", order=4.5)
 
 CONFIGS = ui.CONFIGS
-PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi"}
+#: The scenarios (a profile preset with a kick) by name: label, preset, kick fields, description.
+SCENARIOS = analyses.kick_presets()
+PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi",
+                 **{name: s["label"] for name, s in SCENARIOS.items()}}
+KICK_LABELS = {"none": "none", "psi": "yaw angle psi (rad)", "dpsi": "yaw rate dpsi (rad/s)"}
+AT_LABELS = {"time": "at a time (s)", "speed": "at a speed (m/s)"}
 SERIES_DT = 0.02  # s: the envelopes are smooth; 1500 points per configuration for a 30 s take-off
 TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto", "overflowX": "auto"},
                "style_cell": {"fontFamily": "inherit", "fontSize": "13px", "padding": "3px 8px", "textAlign": "left",
@@ -39,13 +45,27 @@ PSI_THR = Quantity("ground_run", "psi_threshold", "the shimmy threshold |psi|", 
 LAT_THR = Quantity("ground_run", "lateral_threshold", "the shimmy threshold |l_g delta|", "mm", 1e-3)
 
 
+KICK_SIZES = {kind: SignedQuantity("ground_run", "kick_size", f"the kick size ({k['what']} {kind})", k["unit"],
+                             largest=k["largest"]) for kind, k in analyses.kick_kinds().items()}
+KICK_MOMENTS = {"time": Quantity("ground_run", "kick_at_time", "the kick's time", "s"),
+                "speed": Quantity("ground_run", "kick_at_speed", "the kick's speed", "m/s")}
+
+
 def layout(preset: str | None = None, config: str | None = None, psi_thr: str | None = None,
-           lat_thr: str | None = None, **query):
+           lat_thr: str | None = None, kick: str | None = None, kick_size: str | None = None,
+           kick_at: str | None = None, kick_when: str | None = None, **query):
     preset, bad_preset = fields.choice("preset", preset, list(PRESET_LABELS), "takeoff", "a preset")
     config, bad_config = fields.choice("config", config, list(CONFIGS), "original", "a configuration")
     psi_value, bad_psi = PSI_THR.from_url("psi_thr", psi_thr, 0.01)
     lat_value, bad_lat = LAT_THR.from_url("lat_thr", lat_thr, 1.0)
-    address = " ".join(m for m in (bad_preset, bad_config, bad_psi, bad_lat) if m)
+    default = _scenario_boxes(preset)
+    kick, bad_kick = fields.choice("kick", kick, list(KICK_LABELS), default[0], "a kick")
+    kick_at, bad_at = fields.choice("kick_at", kick_at, list(AT_LABELS), default[2], "time or speed")
+    size_value, bad_size = (KICK_SIZES[kick].from_url("kick_size", kick_size, default[1]) if kick in KICK_SIZES
+                            else (default[1], None))
+    when_value, bad_when = KICK_MOMENTS[kick_at].from_url("kick_when", kick_when, default[3])
+    address = " ".join(m for m in (bad_preset, bad_config, bad_psi, bad_lat, bad_kick, bad_at, bad_size, bad_when)
+                       if m)
     plane_figure, by_time, by_speed, _ = _placeholders(WAITING)
     return page(
         query, ids.GR,
@@ -63,6 +83,18 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
             ui.field("Shimmy threshold |psi| (rad)", PSI_THR.box(ids.GR_PSI_THR, psi_value)),
             ui.field("Shimmy threshold |l_g delta| (mm)", LAT_THR.box(ids.GR_LAT_THR, lat_value)),
             *jobs.controls(ids.GR_GROUP, "Run"),
+        ], className="controls"),
+        html.Div([
+            ui.field("Kick (a jump of)", dcc.Dropdown(id=ids.GR_KICK, value=kick, clearable=False,
+                                                      style={"width": "190px"},
+                                                      options=[{"label": v, "value": k}
+                                                               for k, v in KICK_LABELS.items()])),
+            ui.field("Kick size (rad for psi, rad/s for dpsi)", KICK_SIZES["psi"].box(ids.GR_KICK_SIZE, size_value)),
+            ui.field("Kick comes", dcc.Dropdown(id=ids.GR_KICK_AT, value=kick_at, clearable=False,
+                                                style={"width": "160px"},
+                                                options=[{"label": v, "value": k} for k, v in AT_LABELS.items()])),
+            ui.field("Kick time (s) or speed (m/s)", KICK_MOMENTS["time"].box(ids.GR_KICK_WHEN, when_value)),
+            html.P(_scenario_note(preset), id=ids.GR_KICK_NOTE, className="hint"),
         ], className="controls"),
         html.Div([
             html.Div([
@@ -100,10 +132,39 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
     )
 
 
+def _profile_preset(name: str) -> str:
+    """The profile preset of a preset or a scenario."""
+    return SCENARIOS[name]["preset"] if name in SCENARIOS else name
+
+
+def _scenario_boxes(name: str) -> tuple[str, float | None, str, float | None]:
+    """(kick, size, at, time or speed) the kick boxes show for preset ``name``: a scenario's kick, else none."""
+    if name not in SCENARIOS:
+        return "none", None, "time", None
+    k = SCENARIOS[name]["kick"]
+    at = "time" if k.get("kick_at_time") is not None else "speed"
+    return k["kick"], k["kick_size"], at, k["kick_at_time"] if at == "time" else k["kick_at_speed"]
+
+
+def _scenario_note(name: str) -> str:
+    return (f"{PRESET_LABELS[name]}: {SCENARIOS[name]['description']}. The kick boxes hold its kick; change them "
+            "to ask another.") if name in SCENARIOS else ""
+
+
+@dash.callback(Output(ids.GR_KICK, "value"), Output(ids.GR_KICK_SIZE, "value"), Output(ids.GR_KICK_AT, "value"),
+               Output(ids.GR_KICK_WHEN, "value"), Output(ids.GR_KICK_NOTE, "children"), Input(ids.GR_PRESET, "value"),
+               prevent_initial_call=True)
+def scenario_kick(name):
+    """A scenario puts its kick in the boxes; a plain preset leaves them as they are."""
+    if name not in SCENARIOS:
+        return no_update, no_update, no_update, no_update, ""
+    return (*_scenario_boxes(name), _scenario_note(name))
+
+
 @dash.callback(Output(ids.GR_SETTINGS, "data"), Input(ids.GR_PRESET, "value"))
 def preset_settings(name):
     """The preset's settings at their defaults (a new preset starts from its documented defaults)."""
-    fields = analyses.preset_profile(name)["fields"]
+    fields = analyses.preset_profile(_profile_preset(name))["fields"]
     return [{"name": f["name"], "value": f["default"], "unit": f["unit"], "range": f"{f['low']:g} – {f['high']:g}",
              "description": f["description"]} for f in fields]
 
@@ -116,7 +177,7 @@ def preset_table(settings, _reset, name):
     if not settings:
         return no_update, no_update, no_update, no_update
     try:
-        profile = analyses.preset_profile(name, _settings(settings))
+        profile = analyses.preset_profile(_profile_preset(name), _settings(settings))
     except InvalidParameterError as exc:
         return no_update, no_update, no_update, str(exc)
     rows = [{"t": round(t, 4), "V": round(v, 4), "Fz": round(f / 1e3, 3)} for t, v, f in profile["rows"]]
@@ -136,7 +197,8 @@ def add_row(_n, rows):
                State(ids.GR_PRESET, "value"))
 def source(rows, preset_rows, name):
     if rows and preset_rows and _same(rows, preset_rows):
-        return f"Runs the {PRESET_LABELS[name].lower()} preset ({len(rows)} points). Edit a cell to run your own table."
+        what = PRESET_LABELS[_profile_preset(name)].lower()
+        return f"Runs the {what} preset ({len(rows)} points). Edit a cell to run your own table."
     return f"Runs your table ({len(rows or [])} points; t in s, V in m/s, Fz in kN, linearly interpolated)."
 
 
@@ -154,16 +216,26 @@ def _same(rows, preset_rows) -> bool:
     return True
 
 
-def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, design):
+def _kick(kind, size, at, when) -> dict:
+    """The kick's request fields from its boxes (none: no kick), each refused in its box's unit."""
+    if kind not in KICK_SIZES:
+        return {}
+    moment = KICK_MOMENTS[at].read(when)
+    return {"kick": kind, "kick_size": KICK_SIZES[kind].read(size),
+            ("kick_at_time" if at == "time" else "kick_at_speed"): moment}
+
+
+def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, kind, size, at, when, design):
     """One request per configuration, the one whose map is drawn first."""
     if rows and not (preset_rows and _same(rows, preset_rows)):
         profile = {"profile": [[r.get("t"), r.get("V"), _newtons(r.get("Fz"))] for r in rows]}
     else:
-        profile = {"preset": name, "preset_options": _settings(settings)}
+        profile = {"preset": _profile_preset(name), "preset_options": _settings(settings)}
     psi, lateral = PSI_THR.read(psi_thr), LAT_THR.read(lat_thr)  # refused in the box's unit, never defaulted
+    kick = _kick(kind, size, at, when)
     order = [config] + [c for c in CONFIGS if c != config]
     return [{"config": c, **profile, "psi_threshold": psi, "lateral_threshold": lateral, "series_dt": SERIES_DT,
-             "hopf_curves": True, **design} for c in order]
+             "hopf_curves": True, **kick, **design} for c in order]
 
 
 def _newtons(fz_kn):
@@ -195,7 +267,8 @@ jobs.register(
     follow=[Input(ids.GR_CONFIG, "value")],  # which of the four runs' Hopf curves are drawn: starts nothing
     states=[State(ids.GR_PRESET, "value"), State(ids.GR_SETTINGS, "data"), State(ids.GR_TABLE, "data"),
             State(ids.GR_PRESET_ROWS, "data"), State(ids.GR_PSI_THR, "value"), State(ids.GR_LAT_THR, "value"),
-            State(ids.design_store(ids.GR), "data")],
+            State(ids.GR_KICK, "value"), State(ids.GR_KICK_SIZE, "value"), State(ids.GR_KICK_AT, "value"),
+            State(ids.GR_KICK_WHEN, "value"), State(ids.design_store(ids.GR), "data")],
     lock=[ids.GR_PRESET],
     download=jobs.Download(ids.GR_GROUP, "ground_run", _csv_rows, filename=_file_stem))
 
@@ -253,6 +326,13 @@ def envelopes(results, against: str):
         fig.add_scatter(x=r[against], y=r["envelope_psi"], name=style.CONFIG_LABELS[config], row=1, col=1, **common)
         fig.add_scatter(x=r[against], y=[1e3 * v for v in r["envelope_lateral"]], name=style.CONFIG_LABELS[config],
                         showlegend=False, row=2, col=1, **common)
+    kick = results[0].get("kick")
+    if kick is not None:  # the same kick in every run
+        for row in (1, 2):
+            fig.add_vline(x=kick["t"] if against == "t" else kick["V"], line={"color": "#555", "dash": "dot",
+                                                                                "width": 1.5},
+                          annotation_text="kick" if row == 1 else None, annotation_position="top right", row=row,
+                          col=1)
     options = results[0]["options"]
     for row, value, text in ((1, options["psi_threshold"], "threshold"),
                              (2, 1e3 * options["lateral_threshold"], "threshold")):
@@ -287,14 +367,39 @@ def summary(results):
                 psi += f" (×{p['value'] / base['peak_psi']['value']:.2f})"
         crossings = ", ".join(f"{c['V']:.4g} m/s" for c in r["boundary_crossings"]) or "none"
         delay = formats.significant(r["onset_delay_s"], 3)
-        rows.append([style.CONFIG_LABELS[r["config"]], time_in, speeds, psi, lat, crossings, delay])
+        rows.append([style.CONFIG_LABELS[r["config"]], time_in, speeds, psi, lat, crossings, delay,
+                     kick_outcome(r.get("kick"))])
+    kick = ordered[0].get("kick")
+    after = "after the kick" if kick is None else (f"after the kick ({kick['kind']} {kick['size']:+g} {kick['unit']} "
+                                                     f"at {kick['t']:.4g} s, {kick['V']:.4g} m/s)")
     return ui.table(["configuration", "time in shimmy (s, against original)", "speed range in shimmy (m/s)",
-                     "peak |psi| (rad)", "peak |l_g delta| (mm)", "crosses the Hopf curves at", "onset delay (s)"],
-                    rows, ids.GR_SUMMARY_TABLE)
+                     "peak |psi| (rad)", "peak |l_g delta| (mm)", "crosses the Hopf curves at", "onset delay (s)",
+                     after], rows, ids.GR_SUMMARY_TABLE)
+
+
+def kick_outcome(kick) -> str:
+    """What followed the kick, in a few words: the mode of the shimmy it started, or none."""
+    if kick is None:
+        return formats.MISSING + " (no kick)"
+    if not kick.get("applied", True):
+        return "not applied (the run stopped before it)"
+    if kick["shimmy_started"] is None:
+        return "undecided (the run ends first)"
+    other = kick["without_kick"]
+    plain = f"{other['mode']} shimmy" if other["in_shimmy"] else "no shimmy"
+    added = f"; {formats.signed(kick['extra_time_in_shimmy_s'])} s in shimmy against no kick"
+    if not kick["shimmy_started"]:
+        return f"no shimmy started (back on the run without it by {kick['t_judged']:.3g} s){added}"
+    return (f"{kick['mode']} shimmy by {kick['t_judged']:.3g} s ({kick['V_judged']:.3g} m/s), |psi| up to "
+            f"{kick['peak']['psi']:.3g} rad; without the kick: {plain}{added}")
 
 
 @dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True), Input(ids.GR_PRESET, "value"),
                Input(ids.GR_CONFIG, "value"), Input(ids.GR_PSI_THR, "value"), Input(ids.GR_LAT_THR, "value"),
-               prevent_initial_call=True)
-def remember(preset, config, psi_thr, lat_thr):
-    return {"preset": preset, "config": config, "psi_thr": psi_thr, "lat_thr": lat_thr}
+               Input(ids.GR_KICK, "value"), Input(ids.GR_KICK_SIZE, "value"), Input(ids.GR_KICK_AT, "value"),
+               Input(ids.GR_KICK_WHEN, "value"), prevent_initial_call=True)
+def remember(preset, config, psi_thr, lat_thr, kick, kick_size, kick_at, kick_when):
+    kicked = kick != "none"  # without a kick its boxes leave the address (null drops a key)
+    return {"preset": preset, "config": config, "psi_thr": psi_thr, "lat_thr": lat_thr,
+            "kick": kick if kicked else None, "kick_size": kick_size if kicked else None,
+            "kick_at": kick_at if kicked else None, "kick_when": kick_when if kicked else None}

@@ -103,6 +103,22 @@ class Quantity:
         return dcc.Input(id=box_id, type="number", value=value, step="any", **kwargs)
 
 
+@dataclass(frozen=True)
+class SignedQuantity(Quantity):
+    """A request field read within [-``largest``, ``largest``], narrower than the field's own limits: a size whose
+    range depends on a choice beside its box (a ground run's kick: rad for a yaw angle, rad/s for a yaw rate)."""
+
+    largest: float = 0.0
+
+    @property
+    def low(self) -> float:
+        return -self.largest
+
+    @property
+    def high(self) -> float:
+        return self.largest
+
+
 def choice(key: str, raw: Any, choices, default: str, what: str) -> tuple[str, str | None]:
     """A choice from the address and, if it is not one of ``choices``, why the default is shown."""
     if raw is None or raw in choices:
