@@ -207,7 +207,8 @@ def robustness(request: dict[str, Any], progress: Progress | None = None) -> dic
 
     tolerances = [Tolerance(t["name"], t["relative"], t["distribution"]) for t in request["tolerances"]]
     return run_robustness(request["config"], tolerances, samples=request["samples"], Fz=request["Fz"],
-                          params=_params(request), seed=request["seed"], progress=progress).to_dict()
+                          params=_params(request), seed=request["seed"], disturbance=request["disturbance"],
+                          disturbance_direction=request["disturbance_direction"], progress=progress).to_dict()
 
 
 @serves("margins", sync=False, job=True)

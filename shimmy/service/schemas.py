@@ -314,6 +314,10 @@ def _check_robustness(out: dict[str, Any]) -> None:
                                         f"repeats tolerances[{seen[t['name']]}]")
         seen[t["name"]] = k
     out["tolerances"] = tols
+    if out["disturbance"] is not None and out["samples"] > settings.MAX_DISTURBED_SAMPLES:
+        raise InvalidParameterError("samples", out["samples"], f"at most {settings.MAX_DISTURBED_SAMPLES} with a "
+                                    "disturbance", "asks for too many samples with a disturbance (margins at nine "
+                                    "points each)")
 
 
 def _check_margins(out: dict[str, Any]) -> None:
@@ -335,7 +339,7 @@ _RULES = {
                   f"REL a fraction (normal: the standard deviation, at most "
                   f"{design_space.TOLERANCE_LIMITS['normal']:g}; uniform: the half-width, at most "
                   f"{design_space.TOLERANCE_LIMITS['uniform']:g}), each parameter at most once, not a whole-number "
-                  "one.",
+                  f"one; with a disturbance at most {settings.MAX_DISTURBED_SAMPLES} samples.",
 }
 
 _CONSTRAINT_ITEM = {"oneOf": [
@@ -540,6 +544,12 @@ SCHEMAS: dict[str, RequestSchema] = {
               unit="N"),
         Field("seed", "integer", "seed of the samples (the same seed gives the same samples)", default=0, low=0,
               high=2 ** 31 - 1),
+        Field("disturbance", "number", "also P(shimmy) after a disturbance up to this size from straight rolling, "
+              "counting every attractor it reaches (the margins at each sample's nine points: about 5 s per sample "
+              "and core), as the yaw angle of the same energy", low=margin_options.LIMITS["max_size"][0],
+              high=margin_options.LIMITS["max_size"][1], unit="rad"),
+        Field("disturbance_direction", "string", "the disturbed component (psi, dpsi, delta, ddelta; the rest at "
+              "rest), or all four in the energy norm (energy)", default="psi", choices=margin_options.DIRECTIONS),
         PARAMS, MATERIAL)),
     "margins": RequestSchema("margins", "disturbance margins at one operating point: its attractors and the smallest "
                              "disturbance from straight rolling that ends on each, each checked by two runs", (
