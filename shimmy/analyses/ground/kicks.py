@@ -6,7 +6,7 @@ A runway joint or a touchdown with yaw is a short disturbance of the nose wheel'
 of the state (lateral bending, the absorbers) as it is, added to the state the run has reached
 there. The instant is given either as a time on the profile's clock (``at_time``, s) or as a speed
 (``at_speed``, m/s): the first time the profile's speed V(t), linear between its rows, equals it
-(:func:`kick_instant`). :func:`~shimmy.analyses.ground.ground_run.ground_run` splits the
+(:func:`kick_instant`). :func:`shimmy.ground_run` splits the
 integration at that instant and applies the jump there (not at the nearest output sample).
 
 **Whether shimmy starts** (:func:`kick_outcome`): beside the kicked run, the same run from the same
@@ -22,9 +22,11 @@ after the first:
   window before, the margins' decay); two such windows in a row: the kick's disturbance has died
   out, **no shimmy started** (mode ``none``);
 * the kicked run is above a threshold (|psi| or |l_g delta| beyond the run's shimmy thresholds),
-  not back on the other, and not closing in on it (their distance not 1 % or more below the window
-  before), two windows in a row, the second within 10 % of the first (settled, as a margins' run
-  on an attractor): **shimmy started**, in the mode of the second of them (torsional, lateral or both:
+  not back on the other, not closing in on it (their distance not 1 % or more below the window
+  before), not in shimmy of the mode the other is in, and within 10 % of its window before
+  (settled, as a margins' run on an attractor), ``HOLD`` (3) windows in a row (a run lingering for
+  a second or two near the cycle between two basins and then leaving is no start):
+  **shimmy started**, in the mode of the last of them (torsional, lateral or both:
   :func:`~shimmy.analyses.core.response.mode_of` of the torsional energy share, the classification
   of the margins' attractors), with the largest amplitudes of the stretch above the thresholds
   that follows; the run without the kick is described beside (in shimmy or not, its mode), so
@@ -63,14 +65,15 @@ TIME_LIMIT = 1e5  # s
 WINDOW = 1.0  # s: the windows in which the outcome is judged (as the margins' runs)
 DECAY_RATIO = 0.99  # a window 1 % or more below the one before is falling (as the margins' runs)
 MATCH_TOL = 0.1  # a window within 10 % of the run without the kick is on it (as the margins' attractors)
+HOLD = 3  # windows in a row apart from the run without the kick and settled: shimmy started (not a passing transient)
 SAME_INSTANT = 1e-9  # s: closer than this to an output sample, the kick is at that sample
 
 METHOD = (f"beside the kicked run, the run without the kick from the same state; windows of {WINDOW:g} s from the "
           f"kick, each its largest |psi| and |delta| as e = (sqrt(k_psi) psi, sqrt(k_delta) delta): no shimmy "
           f"started at the second window in a row back on the run without the kick (e within {100 * MATCH_TOL:g} % "
           f"of it, or both below the thresholds and falling by {100 * (1 - DECAY_RATIO):g} % or more); shimmy "
-          f"started at the second window in a row above a threshold, apart from that run and not closing in on it, "
-          f"and within {100 * MATCH_TOL:g} % of the window before, in the mode of that window")
+          f"started at the third window in a row above a threshold, apart from that run, not closing in on it, not "
+          f"in shimmy of its mode and within {100 * MATCH_TOL:g} % of the window before, in the mode of that window")
 
 #: Scenarios: a profile preset with a kick (the workbench's and the command line's named kicks).
 KICK_PRESETS: dict[str, dict[str, Any]] = {
@@ -225,14 +228,16 @@ def kick_outcome(kick: Kick, t_kick: float, before: np.ndarray, after: np.ndarra
     def above(w) -> bool:
         return w[1] > psi_threshold or l_g * w[2] > lateral_threshold
 
+    def mode(w) -> str:
+        return str(mode_of(float(torsional_share(w[1], w[2], k_psi, k_delta)))) if above(w) else "none"
+
     def judged(k: int) -> dict[str, Any]:
         w, b = kicked[k], plain[k]
-        mode = str(mode_of(float(torsional_share(b[1], b[2], k_psi, k_delta)))) if above(b) else "none"
         return {"t_judged": w[0], "V_judged": float(np.interp(w[0], t, V)),
-                "without_kick": {"in_shimmy": above(b), "mode": mode,
+                "without_kick": {"in_shimmy": above(b), "mode": mode(b),
                                  "amplitude": {"psi": b[1], "lateral": l_g * b[2]}}}
 
-    back, apart = [False], [False]
+    back, hold = [False], 0
     for k in range(1, min(len(kicked), len(plain))):
         w, previous = kicked[k], kicked[k - 1]
         gap, gap_before = (float(np.linalg.norm(vector(x) - vector(y))) for x, y in ((w, plain[k]),
@@ -240,20 +245,22 @@ def kick_outcome(kick: Kick, t_kick: float, before: np.ndarray, after: np.ndarra
         falling = np.linalg.norm(vector(w)) < DECAY_RATIO * np.linalg.norm(vector(previous))
         back.append(gap <= MATCH_TOL * float(np.linalg.norm(vector(plain[k]))) or (falling and not above(w)
                                                                                     and not above(plain[k])))
-        apart.append(above(w) and not back[-1] and gap >= DECAY_RATIO * gap_before)
+        other = judged(k)["without_kick"]  # the run without the kick in shimmy of the kicked run's mode: not apart
+        same_shimmy = other["in_shimmy"] and other["mode"] == mode(w)
         settled = float(np.linalg.norm(vector(w) - vector(previous))) <= MATCH_TOL * float(np.linalg.norm(vector(w)))
+        apart = above(w) and not back[-1] and gap >= DECAY_RATIO * gap_before and not same_shimmy
+        hold = hold + 1 if apart and settled else 0
         if back[-1] and back[-2]:
             out.update(shimmy_started=False, mode="none", **judged(k))
             return out
-        if apart[-1] and apart[-2] and settled:
+        if hold >= HOLD:
             stretch = [w]
             for later in kicked[k + 1:]:
                 if not above(later):
                     break
                 stretch.append(later)
             peak = max(stretch, key=lambda x: float(np.linalg.norm(vector(x))))
-            share = float(torsional_share(w[1], w[2], k_psi, k_delta))
-            out.update(shimmy_started=True, mode=str(mode_of(share)), **judged(k),
+            out.update(shimmy_started=True, mode=mode(w), **judged(k),
                        amplitude={"psi": w[1], "lateral": l_g * w[2]},
                        peak={"psi": peak[1], "lateral": l_g * peak[2], "t": peak[0]})
             return out
