@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import math
+
 import dash
 from dash import Input, Output, State, html
 from plotly.subplots import make_subplots
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
-from ui import compare, designs, fields, ids, jobs
+import shimmy.model.units as units
+from ui import compare, designs, fields, ids, jobs, markers
 from ui import components as ui
 from ui import style
 from ui.fields import Quantity
@@ -17,17 +20,16 @@ from ui.layout import page
 dash.register_page(__name__, path="/bifurcation", name="Bifurcation", order=3)
 
 CONFIGS = ui.CONFIGS
-#: The special points drawn, each kind with its marker (and the legend in this order).
-SYMBOLS = {PointKind.HOPF: "diamond", PointKind.FOLD_OF_CYCLES: "triangle-up", PointKind.TORUS: "square",
-           PointKind.PERIOD_DOUBLING: "x", PointKind.BRANCH_POINT_OF_CYCLES: "cross",
-           PointKind.BRANCH_POINT: "circle-open"}
+#: The special points drawn (their markers: ui/markers.py, the legend in the vocabulary's order).
+DRAWN = (PointKind.HOPF, PointKind.FOLD_OF_CYCLES, PointKind.TORUS, PointKind.PERIOD_DOUBLING,
+         PointKind.BRANCH_POINT_OF_CYCLES, PointKind.BRANCH_POINT)
 #: What the special points of cycles are (the summary table lists them).
 CYCLE_POINTS = (PointKind.FOLD_OF_CYCLES, PointKind.TORUS, PointKind.PERIOD_DOUBLING,
                 PointKind.BRANCH_POINT_OF_CYCLES)
 
 
 
-FZ = Quantity("bifurcation", "Fz", "Fz", "kN", 1e3)
+FZ = Quantity("bifurcation", "Fz", "Fz", "kN", units.KN)
 V_MIN = Quantity("bifurcation", "v_min", "lowest V", "m/s")
 V_MAX = Quantity("bifurcation", "v_max", "highest V", "m/s")
 WAITING = "Press Compute: about 1 s per configuration cold, instant from the cache"
@@ -50,10 +52,11 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
                   f"({PointKind.PERIOD_DOUBLING}); hover one for its details. "
                   "The bottom strip shows where straight rolling is stable for each configuration."),
         html.Div([
-            ui.field("Fz (kN)", FZ.box(ids.BIF_FZ, fz)),
-            html.Div([ui.field("V from (m/s)", V_MIN.box(ids.BIF_VMIN, lo)),
-                      ui.field("to (m/s)", V_MAX.box(ids.BIF_VMAX, hi))], className="pair"),
+            FZ.field("Fz (kN)", ids.BIF_FZ, fz),
+            html.Div([V_MIN.field("V from (m/s)", ids.BIF_VMIN, lo),
+                      V_MAX.field("to (m/s)", ids.BIF_VMAX, hi)], className="pair"),
             ui.field("Configurations", ui.configurations(ids.BIF_CONFIGS, chosen, multi=True)),
+            ui.field("NES torque", ui.nes_torque(ids.BIF_EXACT)),
             *jobs.controls(ids.BIF_GROUP),
         ], className="controls"),
         html.Div(problems, id=ids.BIF_GROUP.error, className="error", role="alert"),
@@ -78,7 +81,12 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
     )
 
 
-def _requests(fz_kn, v_min, v_max, configs, design):
+fields.check(ids.BIF_FZ, FZ)
+fields.check(ids.BIF_VMIN, V_MIN)
+fields.check(ids.BIF_VMAX, V_MAX)
+
+
+def _requests(fz_kn, v_min, v_max, configs, torque, design):
     if not configs:
         raise InvalidParameterError("configs", "", ", ".join(CONFIGS), "is empty",
                                     "Configurations: none chosen; choose at least one")
@@ -86,21 +94,22 @@ def _requests(fz_kn, v_min, v_max, configs, design):
     if not hi > lo:
         raise InvalidParameterError("v_max", v_max, f"above {v_min:g} m/s",
                                     message=f"highest V = {v_max:g} m/s must exceed lowest V = {v_min:g} m/s")
-    return [{"config": c, "Fz": fz, "v_min": lo, "v_max": hi, **design} for c in configs]
+    return [{"config": c, "Fz": fz, "v_min": lo, "v_max": hi, **ui.exact_nes(c, torque), **design} for c in configs]
 
 
 def _csv_rows(results):
     rows = [[r["config"], i, b["kind"], p["V"], "" if p["period"] is None else p["period"], p["max_psi"],
-             p["max_lateral"], int(p["stable"]), p["mode"] or ""]
+             units.to_mm(p["max_lateral"]), int(p["stable"]), p["mode"] or ""]
             for r in results for i, b in enumerate(r["branches"]) for p in b["points"]]
-    return ["config", "branch", "kind", "V_m_s", "period_s", "max_psi_rad", "max_lateral_m", "stable", "mode"], rows
+    return ["config", "branch", "kind", "V_m_s", "period_s", "max_psi_rad", "max_lateral_mm", "stable", "mode"], rows
 
 
 jobs.register(
     ids.BIF_GROUP, "bifurcation", requests=_requests, render=lambda results: (figure(results), summary(results)),
     outputs=[Output(ids.BIF_GRAPH, "figure"), Output(ids.BIF_TABLE, "children")],
     states=[State(ids.BIF_FZ, "value"), State(ids.BIF_VMIN, "value"), State(ids.BIF_VMAX, "value"),
-            State(ids.BIF_CONFIGS, "value"), State(ids.design_store(ids.BIF), "data")],
+            State(ids.BIF_CONFIGS, "value"), State(ids.BIF_EXACT, "value"), State(ids.design_store(ids.BIF), "data")],
+    notice=ui.result_notice,
     lock=[ids.BIF_FZ, ids.BIF_VMIN, ids.BIF_VMAX], download=jobs.Download(ids.BIF_GROUP, "bifurcation", _csv_rows),
     blank=lambda: (style.message_figure("Refused: see the message above", 520), None))
 
@@ -108,7 +117,7 @@ jobs.register(
 def _compare_requests(fz_kn, v_min, v_max, config, selection, saved, current):
     """The page's request for one configuration, once per compared design (the requests a design's
     own diagram makes: the cache serves a design already drawn)."""
-    common = _requests(fz_kn, v_min, v_max, [config], {})[0]
+    common = _requests(fz_kn, v_min, v_max, [config], "cubic", {})[0]
     return [{**common, **d.request()} for d in compare.chosen(selection, saved, current)]
 
 
@@ -140,9 +149,6 @@ jobs.register(
 compare.register_selection(ids.BIFC, ids.BIF)
 
 
-KIND_NAMES = {PointKind.HOPF: "Hopf", PointKind.FOLD_OF_CYCLES: "fold of cycles", PointKind.TORUS: "torus",
-              PointKind.PERIOD_DOUBLING: "period doubling", PointKind.BRANCH_POINT_OF_CYCLES: "branch point of cycles",
-              PointKind.BRANCH_POINT: "branch point"}
 HEIGHT, BOTTOM = 780, 190
 
 
@@ -151,7 +157,7 @@ def _labelled(results):
     continuation tools label them: [(result, branch, point, label)]."""
     out = []
     for result in results:
-        found = [(b, sp) for b in result["branches"] for sp in b["special_points"] if sp["kind"] in SYMBOLS
+        found = [(b, sp) for b in result["branches"] for sp in b["special_points"] if sp["kind"] in DRAWN
                  and not (sp["kind"] == PointKind.HOPF and b["kind"] != "equilibrium")]
         count: dict[str, int] = {}
         for b, sp in sorted(found, key=lambda item: (item[1]["kind"], item[1]["V"])):
@@ -161,9 +167,10 @@ def _labelled(results):
 
 
 def _hover(label: str, config_label: str, sp: dict, hopf: dict | None) -> str:
-    lines = [f"<b>{config_label}: {label}</b> ({KIND_NAMES.get(sp['kind'], sp['kind'])})", f"V = {sp['V']:.5g} m/s"]
+    lines = [f"<b>{config_label}: {label}</b> ({markers.of(sp['kind']).name})", f"V = {sp['V']:.5g} m/s"]
     if "max_psi" in sp:
-        lines += [f"max |psi| = {sp['max_psi']:.4g} rad", f"max |l_g delta| = {sp['max_lateral']:.4g} m"]
+        lines += [f"max |psi| = {sp['max_psi']:.4g} rad ({units.degrees(sp['max_psi'])})",
+                  f"max |l_g delta| = {units.mm(sp['max_lateral'], 4)}"]
     if sp.get("period"):
         lines.append(f"period = {sp['period']:.4g} s ({1 / sp['period']:.3f} Hz)")
     if hopf is not None:
@@ -196,25 +203,40 @@ def figure(results, series=None, what="configuration"):
                                     hovertemplate=f"{label}: straight rolling x = 0, {kind}<br>V %{{x:.4g}} m/s"
                                                   "<extra></extra>")
                     continue
-                for row, key, unit in ((1, "max_psi", "rad"), (2, "max_lateral", "m")):
-                    fig.add_scatter(x=[p["V"] for p in seg], y=[p[key] for p in seg], mode="lines", line=line,
-                                    legendgroup=group, showlegend=False, row=row, col=1,
-                                    hovertemplate=f"{label}: limit cycle, {kind}<br>V %{{x:.4g}} m/s<br>"
-                                                  f"%{{y:.4g}} {unit}<extra></extra>")
+                psi = [p["max_psi"] for p in seg]
+                fig.add_scatter(x=[p["V"] for p in seg], y=psi, mode="lines", line=line, legendgroup=group,
+                                showlegend=False, row=1, col=1, customdata=style.in_degrees(psi),
+                                hovertemplate=f"{label}: limit cycle, {kind}<br>V %{{x:.4g}} m/s<br>"
+                                              f"max |psi| {style.ANGLE_HOVER}<extra></extra>")
+                fig.add_scatter(x=[p["V"] for p in seg], y=[units.to_mm(p["max_lateral"]) for p in seg], mode="lines",
+                                line=line, legendgroup=group, showlegend=False, row=2, col=1,
+                                hovertemplate=f"{label}: limit cycle, {kind}<br>V %{{x:.4g}} m/s<br>"
+                                              "max |l_g delta| %{y:.4g} mm<extra></extra>")
     index = {id(r): k for k, r in enumerate(results)}
     hopf_of = {(k, round(h["V"], 6)): h for k, r in enumerate(results) for h in r["hopf_points"]}
     for result, branch, sp, name in _labelled(results):
         k = index[id(result)]
         label, colour = series[k]
         hover = _hover(name, label, sp, hopf_of.get((k, round(sp["V"], 6))))
-        marker = {"symbol": SYMBOLS[sp["kind"]], "size": 10, "color": colour, "line": {"width": 1, "color": "#333"}}
+        marker = markers.marker(sp["kind"], colour)
         spots = ([(3, label)] if branch["kind"] == "equilibrium"
-                 else [(1, sp.get("max_psi", 0.0)), (2, sp.get("max_lateral", 0.0))])
+                 else [(1, sp.get("max_psi", 0.0)), (2, units.to_mm(sp.get("max_lateral", 0.0)))])
         for row, y in spots:
             fig.add_scatter(x=[sp["V"]], y=[y], mode="markers+text", text=[name], textposition="top center",
                             textfont={"size": 10, "color": colour}, marker=marker, legendgroup=f"{what}-{k}",
                             showlegend=False, hovertext=[hover], hoverinfo="text", row=row, col=1,
-                            meta={"special_point": name, "config": result["config"], "series": label})
+                            meta={"kind": markers.of(sp["kind"]).label, "special_point": name,
+                                  "config": result["config"], "series": label})
+    for k, result in enumerate(results):  # the largest stable torsional amplitude of each diagram
+        label, colour = series[k]
+        if result.get("max_psi_V") is not None and result.get("max_psi"):
+            fig.add_scatter(x=[result["max_psi_V"]], y=[result["max_psi"]], mode="markers", row=1, col=1,
+                            marker={"symbol": markers.LARGEST_PSI.symbol, "size": markers.LARGEST_PSI.size,
+                                    "color": colour, "line": {"width": 2, "color": colour}},
+                            legendgroup=f"{what}-{k}", showlegend=False, customdata=[math.degrees(result["max_psi"])],
+                            meta={"mark": "largest stable |psi|", "series": label},
+                            hovertemplate=f"<b>{label}: largest stable |psi|</b><br>V %{{x:.4g}} m/s<br>"
+                                          f"{style.ANGLE_HOVER}<extra></extra>")
     for k, (label, colour) in enumerate(series):
         if (label, colour) not in series[:k]:
             style.legend_key(fig, label, "legend", group=f"{what}-{k}", mode="lines",
@@ -222,20 +244,20 @@ def figure(results, series=None, what="configuration"):
     style.legend_key(fig, "stable", "legend2", mode="lines", line={"color": "#555", "width": 2.5})
     style.legend_key(fig, "unstable", "legend2", mode="lines", line={"color": "#555", "width": 1.5, "dash": "dash"})
     present = {sp["kind"] for _, _, sp, _ in _labelled(results)} or {PointKind.HOPF}
-    for kind, symbol in SYMBOLS.items():
-        if kind not in present:
-            continue
-        style.legend_key(fig, f"{kind}: {KIND_NAMES[kind]}", "legend3", mode="markers",
-                         marker={"symbol": symbol, "size": 9, "color": "#777", "line": {"width": 1, "color": "#333"}})
-    fz = results[0]["Fz"] / 1e3 if results else 0
+    markers.legend(fig, present, "legend3")
+    if any(r.get("max_psi_V") is not None and r.get("max_psi") for r in results):
+        style.legend_key(fig, markers.LARGEST_PSI.name, "legend3", mode="markers",
+                         marker={"symbol": markers.LARGEST_PSI.symbol, "size": 11, "color": "#555",
+                                 "line": {"width": 2, "color": "#555"}})
+    fz = units.to_kn(results[0]["Fz"]) if results else 0
     head = ("Bifurcation diagram" if what == "configuration"
             else f"Bifurcation diagrams of {style.CONFIG_LABELS[results[0]['config']]}, {len(results)} designs")
     fig.update_layout(title=style.title(f"{head} at Fz = {fz:g} kN"), height=HEIGHT,
-                      template="plotly_white", margin={**style.MARGIN, "l": 70, "b": BOTTOM}, hovermode="closest")
+                      template=style.TEMPLATE, margin={**style.MARGIN, "l": 70, "b": BOTTOM}, hovermode="closest")
     style.legends(fig, [f"{what} (colour)", "stability (line)", "special points (marker)"], HEIGHT, BOTTOM)
     fig.update_xaxes(title_text="forward speed V (m/s)", row=3, col=1)
     fig.update_yaxes(title_text="max |psi| (rad)", row=1, col=1)
-    fig.update_yaxes(title_text="max |l_g delta| (m)", row=2, col=1)
+    fig.update_yaxes(title_text="max |l_g delta| (mm)", row=2, col=1)
     names = list(dict.fromkeys(label for label, _ in series))[::-1]
     fig.update_yaxes(title_text="x = 0", type="category", row=3, col=1, categoryorder="array", categoryarray=names,
                      tickvals=names, ticktext=[n if len(n) <= 16 else n[:15] + "…" for n in names], automargin=True,

@@ -5,11 +5,13 @@ from __future__ import annotations
 import dash
 from dash import Input, Output, State, dcc, html, no_update
 
+from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
+import shimmy.model.units as units
 from shimmy.service import admission, analyses, neighbours
 from plotly.subplots import make_subplots
 
-from ui import compare, designs, formats, ids, jobs, live
+from ui import compare, designs, fields, formats, ids, jobs, live, markers
 from ui import components as ui
 from ui.fields import Quantity
 from ui.layout import page
@@ -20,7 +22,7 @@ dash.register_page(__name__, path="/", name="Overview", order=0)
 CONFIGS = ui.CONFIGS
 
 
-FZ = Quantity("stability", "Fz", "Fz", "kN", 1e3)
+FZ = Quantity("stability", "Fz", "Fz", "kN", units.KN)
 V_MAX = Quantity("stability", "v_max", "highest speed", "m/s")
 
 
@@ -32,8 +34,8 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
                   "design: the largest eigenvalue real part against speed (shimmy grows where it is positive), the "
                   "Hopf speed interval of each, and the (V, Fz) stability boundary."),
         html.Div([
-            ui.field("Vertical load Fz (kN)", FZ.box(ids.OV_FZ, fz, debounce=True)),
-            ui.field("Highest speed (m/s)", V_MAX.box(ids.OV_VMAX, v_max, debounce=True)),
+            FZ.field("Vertical load Fz (kN)", ids.OV_FZ, fz),
+            V_MAX.field("Highest speed (m/s)", ids.OV_VMAX, v_max),
         ], className="controls"),
         html.Div(" ".join(p for p in (p_fz, p_v) if p), id=ids.OV_GROUP.error, className="error", role="alert"),
         ui.graph(ids.OV_GROWTH),
@@ -73,6 +75,10 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
     ])
 
 
+fields.check(ids.OV_FZ, FZ)
+fields.check(ids.OV_VMAX, V_MAX)
+
+
 def layout_page(query, children):
     return page(query, ids.OV, *children)
 
@@ -106,8 +112,9 @@ def update(design, fz_kn, v_max):
         hv = [h["V"] for h in data["hopf_points"]]
         if hv:
             traces.append({"type": "scatter", "x": hv, "y": [0] * len(hv), "mode": "markers", "showlegend": False,
-                           "marker": {"color": style.CONFIG_COLOURS[config], "size": 9, "symbol": "diamond"},
-                           "hovertext": [f"{style.CONFIG_LABELS[config]} Hopf V = {v:.4g} m/s" for v in hv]})
+                           "marker": markers.marker(PointKind.HOPF, style.CONFIG_COLOURS[config]),
+                           "meta": {"kind": markers.of(PointKind.HOPF).label}, "hoverinfo": "text",
+                           "hovertext": [f"{style.CONFIG_LABELS[config]} Hopf point (H) V = {v:.4g} m/s" for v in hv]})
         intervals = data["unstable_intervals"]
         onset = intervals[0][0] if intervals else None
         end = intervals[-1][1] if intervals else None
@@ -187,25 +194,24 @@ def intervals_figure(results, names):
             hv = [h["V"] for h in data["hopf_points"]]
             if hv:
                 fig.add_scatter(x=hv, y=[name] * len(hv), mode="markers", legendgroup=f"design-{k}", showlegend=False,
-                                marker={"symbol": "diamond", "size": 10, "color": colour,
-                                        "line": {"width": 1, "color": "#fff"}}, row=row, col=1,
+                                marker=markers.marker(PointKind.HOPF, colour, outline="#fff"), row=row, col=1,
+                                meta={"kind": markers.of(PointKind.HOPF).label},
                                 hovertemplate=f"{name}, {style.CONFIG_LABELS[config]}: Hopf point V = %{{x:.4g}} m/s"
                                               "<extra></extra>")
         fig.update_yaxes(type="category", categoryorder="array", categoryarray=names[::-1], tickvals=names,
                          ticktext=shown, automargin=True, row=row, col=1)
     for k, name in enumerate(names):
         style.legend_key(fig, name, group=f"design-{k}", mode="lines", line={"color": compare.colour(k), "width": 6})
-    style.legend_key(fig, "Hopf point", "legend2", mode="markers",
-                     marker={"symbol": "diamond", "size": 9, "color": "#666"})
+    markers.legend(fig, [PointKind.HOPF], "legend2", "#666")
     height = 120 + rows * (34 + 24 * n) + 90
-    fz = results[0]["Fz"] / 1e3
+    fz = units.to_kn(results[0]["Fz"])
     title = {**style.title(f"Where straight rolling is unstable at Fz = {fz:g} kN (thick: between Hopf points)"),
              "yref": "container", "y": 1 - 40 / height, "yanchor": "top"}  # above the first strip's title
-    fig.update_layout(title=title, height=height, template="plotly_white", margin={**style.MARGIN, "t": 100, "b": 110},
+    fig.update_layout(title=title, height=height, template=style.TEMPLATE, margin={**style.MARGIN, "t": 100, "b": 110},
                       hovermode="closest")
     fig.update_annotations(x=0, xanchor="left", font={"size": 13})  # the strips' titles, at their left
     style.legends(fig, ["design (colour)", "marker"], height, 110)
-    fig.update_xaxes(type="log", showline=True, linecolor="#888", mirror=True)
+    fig.update_xaxes(**style.LOG_SPEED_AXIS, showline=True, linecolor="#888", mirror=True)
     fig.update_xaxes(title_text="forward speed V (m/s)", row=rows, col=1)
     return fig
 
@@ -216,25 +222,35 @@ def _boundary_requests(design):
 
 def boundary_figure(results):
     fig = style.figure("Hopf curves of straight rolling", "forward speed V (m/s)", "vertical load Fz (kN)", 460)
+    kinds = set()
     for result in results:
         config = result["config"]
+        label = style.CONFIG_LABELS[config]
         for i, curve in enumerate(result["curves"]):
-            fig.add_scatter(x=[p["V"] for p in curve["points"]], y=[p["Fz"] / 1e3 for p in curve["points"]],
-                            mode="lines", name=style.CONFIG_LABELS[config], legendgroup=config, showlegend=i == 0,
-                            line={"color": style.CONFIG_COLOURS[config], "width": 2})
-        gh = result["gh_points"]
-        if gh:
-            fig.add_scatter(x=[g["V"] for g in gh], y=[g["Fz"] / 1e3 for g in gh], mode="markers",
-                            name=f"{style.CONFIG_LABELS[config]} GH", legendgroup=config,
-                            marker={"color": style.CONFIG_COLOURS[config], "size": 10, "symbol": "star"})
-    fig.update_xaxes(type="log")
+            fig.add_scatter(x=[p["V"] for p in curve["points"]], y=[units.to_kn(p["Fz"]) for p in curve["points"]],
+                            mode="lines", name=label, legendgroup=config, showlegend=i == 0,
+                            line={"color": style.CONFIG_COLOURS[config], "width": 2},
+                            hovertemplate=f"{label} Hopf curve<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
+        for key, kind in (("gh_points", PointKind.GENERALISED_HOPF), ("double_hopf_points", PointKind.DOUBLE_HOPF)):
+            points = result.get(key) or []
+            if points:
+                kinds.add(kind)
+                m = markers.of(kind)
+                fig.add_scatter(x=[g["V"] for g in points], y=[units.to_kn(g["Fz"]) for g in points], mode="markers",
+                                name=f"{label} {m.label}", legendgroup=config, showlegend=False,
+                                marker=markers.marker(kind, style.CONFIG_COLOURS[config]), meta={"kind": m.label},
+                                hovertemplate=f"{label} {m.legend}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN"
+                                              "<extra></extra>")
+    markers.legend(fig, kinds, "legend")
+    fig.update_xaxes(**style.LOG_SPEED_AXIS)
     return fig
 
 
 def _boundary_rows(results):
-    rows = [[r["config"], i, p["V"], p["Fz"], p["frequency_hz"], "" if p["lyapunov"] is None else p["lyapunov"]]
+    rows = [[r["config"], i, p["V"], units.to_kn(p["Fz"]), p["frequency_hz"],
+             "" if p["lyapunov"] is None else p["lyapunov"]]
             for r in results for i, c in enumerate(r["curves"]) for p in c["points"]]
-    return ["config", "curve", "V_m_s", "Fz_N", "frequency_hz", "lyapunov"], rows
+    return ["config", "curve", "V_m_s", "Fz_kN", "frequency_hz", "lyapunov"], rows
 
 
 #: the design once it stood still (a slider released): the boundary and the maps follow it
@@ -264,9 +280,9 @@ def _regions_figure(results):
 
 
 def _region_rows(results):
-    rows = [[r["config"], k, region["type"], V, Fz] for r in results for k, region in enumerate(r["regions"])
-            for V, Fz in zip(region["V"], region["Fz"], strict=True)]
-    return ["config", "region", "shimmy_type", "V_m_s", "Fz_N"], rows
+    rows = [[r["config"], k, region["type"], V, units.to_kn(Fz)] for r in results
+            for k, region in enumerate(r["regions"]) for V, Fz in zip(region["V"], region["Fz"], strict=True)]
+    return ["config", "region", "shimmy_type", "V_m_s", "Fz_kN"], rows
 
 
 jobs.register(

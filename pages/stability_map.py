@@ -9,8 +9,9 @@ from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
+import shimmy.model.units as units
 from shimmy.service import analyses, neighbours
-from ui import compare, designs, fields, formats, ids, jobs, live, merits
+from ui import compare, designs, fields, formats, ids, jobs, live, markers, merits
 from ui import components as ui
 from ui import style
 from ui.fields import Quantity
@@ -71,11 +72,11 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
         html.Div([
             ui.field("Shade by", ui.configurations(ids.MAP_SHADE, shade)),
             ui.field("Overlay curves of", ui.configurations(ids.MAP_OVERLAY, others, multi=True)),
-            html.Div([ui.field("Fz from (kN)", FZ_MIN.box(ids.MAP_FZMIN, values["fz_min"])),
-                      ui.field("to (kN)", FZ_MAX.box(ids.MAP_FZMAX, values["fz_max"]))], className="pair"),
-            html.Div([ui.field("V from (m/s)", V_MIN.box(ids.MAP_VMIN, values["v_min"])),
-                      ui.field("to (m/s)", V_MAX.box(ids.MAP_VMAX, values["v_max"]))], className="pair"),
-            ui.field(f"Fz slices ({SLICES.low:g}-{SLICES.high:g})", SLICES.box(ids.MAP_RES, values["resolution"])),
+            html.Div([FZ_MIN.field("Fz from (kN)", ids.MAP_FZMIN, values["fz_min"]),
+                      FZ_MAX.field("to (kN)", ids.MAP_FZMAX, values["fz_max"])], className="pair"),
+            html.Div([V_MIN.field("V from (m/s)", ids.MAP_VMIN, values["v_min"]),
+                      V_MAX.field("to (m/s)", ids.MAP_VMAX, values["v_max"])], className="pair"),
+            SLICES.field(f"Fz slices ({SLICES.low:g}-{SLICES.high:g})", ids.MAP_RES, values["resolution"]),
             *jobs.controls(ids.MAP_GROUP),
         ], className="controls"),
         html.Div(" ".join(p for p in problems if p), id=ids.MAP_GROUP.error, className="error", role="alert"),
@@ -93,11 +94,10 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
                "smallest yaw kick from straight rolling that ends on the torsional cycle, for the shaded "
                "configuration and this design, each checked by two runs. 0: the standard start (psi = 0.001 rad) "
                "already ends there. Click a cell to run its time history from just above its kick.", className="hint"),
-        html.Div([ui.field(f"Cells in V ({CELLS_V.low:g}-{CELLS_V.high:g})", CELLS_V.box(ids.MAPM_NV,
-                                                                                          cells["margin_nv"])),
-                  ui.field(f"Cells in Fz ({CELLS_FZ.low:g}-{CELLS_FZ.high:g})", CELLS_FZ.box(ids.MAPM_NFZ,
-                                                                                             cells["margin_nfz"])),
-                  ui.field("Largest kick (rad)", MAX_KICK.box(ids.MAPM_MAX, cells["margin_max"])),
+        html.Div([CELLS_V.field(f"Cells in V ({CELLS_V.low:g}-{CELLS_V.high:g})", ids.MAPM_NV, cells["margin_nv"]),
+                  CELLS_FZ.field(f"Cells in Fz ({CELLS_FZ.low:g}-{CELLS_FZ.high:g})", ids.MAPM_NFZ,
+                                 cells["margin_nfz"]),
+                  MAX_KICK.field("Largest kick (rad)", ids.MAPM_MAX, cells["margin_max"]),
                   *jobs.controls(ids.MAPM, "Compute margins")], className="controls"),
         html.Div(id=ids.MAPM.error, className="error", role="alert"),
         ui.graph(ids.MAPM_GRAPH, figure=style.message_figure(MARGIN_WAITING, 360)),
@@ -112,18 +112,23 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
                "of each design in its colour, the shading of the first; their figures of merit below, each with "
                "its change against the first.", className="hint"),
         html.Div([ui.field("Configuration", ui.configurations(ids.MAPC_CONFIG, compared)),
-                  ui.field("Figures at Fz (kN)", METRICS_FZ.box(ids.MAPC_FZ, merit_fz)),
+                  METRICS_FZ.field("Figures at Fz (kN)", ids.MAPC_FZ, merit_fz),
                   *jobs.controls(ids.MAPC, "Compare")], className="controls"),
         html.Div(id=ids.MAPC.designs, className="compare-designs"),
         html.Div(" ".join(p for p in (bad_compared, bad_merit_fz) if p), id=ids.MAPC.error, className="error",
                  role="alert"),
         ui.graph(ids.MAPC_GRAPH, figure=style.message_figure(compare.waiting_text(
             "tens of seconds per design cold on 2 cores, instant from the cache"), 360)),
-        html.H3("Figures of merit"),
-        html.Div(id=ids.MAPC_TABLE, className="table-wrap"),
+        html.Div(id=ids.MAPC_TABLE, className="table-wrap"),  # its heading comes with the table
         ui.downloads(ids.MAPC),
         *jobs.stores(ids.MAPC),
     )
+
+
+for _box, _quantity in ((ids.MAP_FZMIN, FZ_MIN), (ids.MAP_FZMAX, FZ_MAX), (ids.MAP_VMIN, V_MIN),
+                        (ids.MAP_VMAX, V_MAX), (ids.MAP_RES, SLICES), (ids.MAPM_NV, CELLS_V), (ids.MAPM_NFZ, CELLS_FZ),
+                        (ids.MAPM_MAX, MAX_KICK), (ids.MAPC_FZ, METRICS_FZ)):
+    fields.check(_box, _quantity)
 
 
 def _requests(shade, overlay, fz_min, fz_max, v_min, v_max, resolution, design):
@@ -149,9 +154,9 @@ STALE = ("The design changed: the map shown is of the previous design. Press Com
 
 
 def _csv_rows(results):
-    rows = [[r["config"], Fz, V, t] for r in results for Fz, row in zip(r["Fz"], r["types"], strict=True)
+    rows = [[r["config"], units.to_kn(Fz), V, t] for r in results for Fz, row in zip(r["Fz"], r["types"], strict=True)
             for V, t in zip(r["V"], row, strict=True)]
-    return ["config", "Fz_N", "V_m_s", "shimmy_type"], rows
+    return ["config", "Fz_kN", "V_m_s", "shimmy_type"], rows
 
 
 def _warm(requests: list[dict]) -> bool:
@@ -197,9 +202,10 @@ def _margin_requests(shade, fz_min, fz_max, v_min, v_max, resolution, design, n_
 
 def _margin_csv(results):
     r = results[0]
-    rows = [[r["config"], p["V"], p["Fz"], p["type"], "+".join(a["mode"] for a in p["attractors"]), p["margin"],
+    rows = [[r["config"], p["V"], units.to_kn(p["Fz"]), p["type"], "+".join(a["mode"] for a in p["attractors"]),
+             p["margin"],
              p["tolerance"], p["lower"], p["upper"], p["confirmed"], p["note"]] for p in r["points"]]
-    return ["config", "V_m_s", "Fz_N", "shimmy_type", "attractors", "min_yaw_kick_rad", "tolerance_rad",
+    return ["config", "V_m_s", "Fz_kN", "shimmy_type", "attractors", "min_yaw_kick_rad", "tolerance_rad",
             "lower_rad", "upper_rad", "confirmed", "note"], rows
 
 
@@ -239,7 +245,8 @@ def _merits(results, names):
 
 def _compare_render(results, names):
     series = compare.series(names)
-    return figure(results, series, what="design"), compare.table(_merits(results, names), ids.MAPC_SUMMARY)
+    return figure(results, series, what="design"), [html.H3("Figures of merit"),
+                                                     compare.table(_merits(results, names), ids.MAPC_SUMMARY)]
 
 
 jobs.register(
@@ -256,26 +263,26 @@ jobs.register(
 compare.register_selection(ids.MAPC, ids.MAP)
 
 
-MARKERS = {"gh_points": (PointKind.GENERALISED_HOPF, "diamond", 12), "double_hopf_points": ("double Hopf", "star", 13)}
+#: The points of a map's curves (their markers: ui/markers.py).
+POINTS = {"gh_points": PointKind.GENERALISED_HOPF, "double_hopf_points": PointKind.DOUBLE_HOPF}
 
 
 def figure(results, series=None, what="configuration"):
     """The first map shaded by type; the curves of every map in its configuration's colour (or
-    ``series`` [(name, colour)], one per map: compared designs, each curve over a white halo to
-    read on the shading); the operating points A-I. Three legends: configuration or design
+    ``series`` [(name, colour)], one per map: compared designs), each over a white halo to read on
+    every region's colour; the operating points A-I. Three legends: configuration or design
     (colour), curve and point kind (line style, marker), shimmy type (shading)."""
     if series is None:
         series = [(style.CONFIG_LABELS[r["config"]], style.CONFIG_COLOURS[r["config"]]) for r in results]
-    halo = what != "configuration"
     shaded = results[0]
     grid = shaded.get("shading") or shaded  # read off the curves; a map without it: its slices
-    V, Fz = grid["V"], [f / 1e3 for f in grid["Fz"]]
+    V, Fz = grid["V"], [f / units.KN for f in grid["Fz"]]
     codes = [[TYPES.index(t) for t in row] for row in grid["types"]]
     n = len(TYPES)
     scale = []
     for k, t in enumerate(TYPES):  # a stepped scale: code k -> its type's colour
         scale += [[k / n, style.SHIMMY_TYPE_COLOURS[t]], [(k + 1) / n, style.SHIMMY_TYPE_COLOURS[t]]]
-    head = (f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)" if not halo else
+    head = (f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)" if what == "configuration" else
             f"{style.CONFIG_LABELS[shaded['config']]}: curves of {len(results)} designs, shimmy type of "
             f"{series[0][0]} (shaded)")
     fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
@@ -286,37 +293,38 @@ def figure(results, series=None, what="configuration"):
                     opacity=0.0 if regions else 0.6, customdata=grid["types"], name="shimmy type", showlegend=False,
                     hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history</extra>")
     _regions(fig, shaded, 0.6)
-    _curves(fig, results, series, what, halo)
+    _curves(fig, results, series, what)
     inside = [(name, v, f) for name, (v, f) in ui.OPERATING_POINTS.items()
               if min(V) <= v <= max(V) and min(Fz) <= f <= max(Fz)]
     _finish(fig, series, what, inside, (min(V), max(V)), (min(Fz), max(Fz)))
     return fig
 
 
-def _curves(fig, results, series, what, halo, faint=False):
+def _curves(fig, results, series, what, faint=False):
     """Each result's Hopf, fold and torus curves and GH / double-Hopf points in its series' colour
     (``faint``: thin and pale, a previous design's under the one being made)."""
     for k, (result, (label, colour)) in enumerate(zip(results, series, strict=True)):
         group = f"{what}-{k}"
         for key, (kind, dash_style, width) in CURVE_STYLES.items():
             for curve in result[key]:
-                x, y = [p["V"] for p in curve], [p["Fz"] / 1e3 for p in curve]
-                if halo:
+                x, y = [p["V"] for p in curve], [p["Fz"] / units.KN for p in curve]
+                if not faint:  # a halo: the curve reads on every region's colour
                     fig.add_scatter(x=x, y=y, mode="lines", legendgroup=group, showlegend=False, hoverinfo="skip",
-                                    line={"color": "rgba(255,255,255,0.85)", "width": width + 3})
+                                    line=style.halo(width), meta={"halo": kind})
                 fig.add_scatter(x=x, y=y, mode="lines",
                                 name=f"{label}: {kind}", legendgroup=group, showlegend=False,
                                 line={"color": colour, "dash": dash_style, "width": 1.2 if faint else width},
                                 opacity=FAINT if faint else 1.0,
                                 hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
-        for key, (kind, symbol, size) in MARKERS.items():
+        for key, kind in POINTS.items():
             points = result.get(key) or []
             if points and not faint:
-                fig.add_scatter(x=[g["V"] for g in points], y=[g["Fz"] / 1e3 for g in points], mode="markers",
-                                name=f"{label}: {kind}", legendgroup=group, showlegend=False,
-                                marker={"symbol": symbol, "size": size, "color": colour,
-                                        "line": {"width": 1.5, "color": "#fff"}},
-                                hovertemplate=f"{label} {kind}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN<extra></extra>")
+                m = markers.of(kind)
+                fig.add_scatter(x=[g["V"] for g in points], y=[units.to_kn(g["Fz"]) for g in points], mode="markers",
+                                name=f"{label}: {m.name}", legendgroup=group, showlegend=False,
+                                marker=markers.marker(kind, colour, outline="#fff"), meta={"kind": m.label},
+                                hovertemplate=f"{label} {m.legend}<br>V %{{x:.4g}} m/s<br>Fz %{{y:.4g}} kN"
+                                              "<extra></extra>")
 
 
 def _finish(fig, series, what, inside, v_range, fz_range):
@@ -332,9 +340,7 @@ def _finish(fig, series, what, inside, v_range, fz_range):
     for kind, dash_style, width in CURVE_STYLES.values():
         style.legend_key(fig, kind, "legend2", mode="lines",
                          line={"color": "#444", "dash": dash_style, "width": width})
-    for kind, symbol, size in MARKERS.values():
-        style.legend_key(fig, kind, "legend2", mode="markers",
-                         marker={"symbol": symbol, "size": size - 2, "color": "#444"})
+    markers.legend(fig, POINTS.values(), "legend2", "#444")
     for t in TYPES:
         style.legend_key(fig, t, "legend3", mode="markers",
                          marker={"symbol": "square", "size": 13, "color": style.SHIMMY_TYPE_COLOURS[t],
@@ -347,7 +353,7 @@ def _finish(fig, series, what, inside, v_range, fz_range):
 
 def _regions(fig, result, opacity):
     for region in result.get("regions") or []:
-        fig.add_scatter(x=region["V"], y=[f / 1e3 for f in region["Fz"]], mode="lines", fill="toself",
+        fig.add_scatter(x=region["V"], y=[f / units.KN for f in region["Fz"]], mode="lines", fill="toself",
                         fillcolor=style.SHIMMY_TYPE_COLOURS[region["type"]], opacity=opacity, line={"width": 0},
                         hoverinfo="skip", showlegend=False, name=region["type"])
 
@@ -365,15 +371,15 @@ def sketch_figure(sketches, previous=None, live=False):
                  "the shading follows")
     fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
     v_range = known[0]["v_range"]
-    fz_range = [f / 1e3 for f in known[0]["fz_range"]]
+    fz_range = [f / units.KN for f in known[0]["fz_range"]]
     before = [r for r in previous or [] if r.get("config") == known[0]["config"]  # the same map, earlier
               and r.get("v_range") == known[0]["v_range"] and r.get("fz_range") == known[0]["fz_range"]][:1]
     if before:
         _regions(fig, before[0], FAINT_REGIONS)
         _curves(fig, before, [(f"{label} (previous)", colour) for label, colour in
                               ((style.CONFIG_LABELS[r["config"]], style.CONFIG_COLOURS[r["config"]]) for r in before)],
-                "previous", False, faint=True)
-    _curves(fig, known, series, "configuration", False)
+                "previous", faint=True)
+    _curves(fig, known, series, "configuration")
     inside = [(name, v, f) for name, (v, f) in ui.OPERATING_POINTS.items()
               if v_range[0] <= v <= v_range[1] and fz_range[0] <= f <= fz_range[1]]
     _finish(fig, series, "configuration", inside, v_range, fz_range)
@@ -392,7 +398,7 @@ def summary(results):
         m = r["metrics"]
         at = m["at_Fz"]
         hull = at["shimmy_speed_range"]
-        low = None if r["min_shimmy_Fz"] is None else r["min_shimmy_Fz"] / 1e3
+        low = None if r["min_shimmy_Fz"] is None else r["min_shimmy_Fz"] / units.KN
         speeds = "–" if hull is None else f"{hull[0]:.4g} – {hull[1]:.4g}"
         row = [style.CONFIG_LABELS[r["config"]], formats.significant(low), formats.significant(m["torsion_area"], 5),
                speeds, formats.significant(at["max_psi"]), len(r["gh_points"]), len(r["fold_curves"]),
@@ -403,7 +409,7 @@ def summary(results):
             row[2] += f" ({_pct(m['torsion_area'], b['torsion_area'])})"
             row[4] += f" ({_pct(at['max_psi'], b['at_Fz']['max_psi'])})"
         rows.append(row)
-    fz = results[0]["metrics"]["at_Fz"]["Fz"] / 1e3
+    fz = results[0]["metrics"]["at_Fz"]["Fz"] / units.KN
     area = f"{merits.label('torsion_area')} ({merits.unit('torsion_area')})"
     return ui.table(["configuration", "min shimmy Fz (kN)", area, f"shimmy V at {fz:g} kN (m/s)",
                      f"max stable |psi| at {fz:g} kN (rad)", f"{PointKind.GENERALISED_HOPF} points",
@@ -446,10 +452,10 @@ def margin_figure(result, smap=None, why=""):
     fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
     if smap is not None:
         _regions(fig, smap, MARGIN_REGIONS)
-        _curves(fig, [smap], series, "configuration", False)
+        _curves(fig, [smap], series, "configuration")
     # a marker per cell, as large as the cells allow (the plot is some 500 px high and 600-900 px wide)
     size = max(6.0, min(18.0, 360.0 / result["grid"]["n_v"], 240.0 / result["grid"]["n_fz"]))
-    fig.add_scatter(x=[p["V"] for p in reached], y=[p["Fz"] / 1e3 for p in reached], mode="markers",
+    fig.add_scatter(x=[p["V"] for p in reached], y=[p["Fz"] / units.KN for p in reached], mode="markers",
                     name="min yaw kick", showlegend=False, customdata=[_kick_text(p, max_size) for p in reached],
                     marker={"size": size, "symbol": "square", "color": [p["margin"] for p in reached],
                             "colorscale": "Viridis", "cmin": 0.0,
@@ -460,16 +466,16 @@ def margin_figure(result, smap=None, why=""):
                     hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history"
                                   "</extra>")
     if crossed:
-        fig.add_scatter(x=[p["V"] for p in crossed], y=[p["Fz"] / 1e3 for p in crossed], mode="markers",
+        fig.add_scatter(x=[p["V"] for p in crossed], y=[p["Fz"] / units.KN for p in crossed], mode="markers",
                         marker={"symbol": "x-thin", "size": size * 0.8, "line": {"width": 2, "color": "#333"}},
                         name=f"none up to {max_size:g} rad", legend="legend2",
                         customdata=[_kick_text(p, max_size) for p in crossed],
                         hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra></extra>")
     inside = [(name, v, f) for name, (v, f) in ui.OPERATING_POINTS.items()
               if result["v_range"][0] <= v <= result["v_range"][1]
-              and result["fz_range"][0] <= f * 1e3 <= result["fz_range"][1]]
+              and result["fz_range"][0] <= f * units.KN <= result["fz_range"][1]]
     _finish(fig, series, "configuration", inside, tuple(result["v_range"]),
-            tuple(f / 1e3 for f in result["fz_range"]))
+            tuple(f / units.KN for f in result["fz_range"]))
     return fig
 
 
@@ -484,7 +490,7 @@ def margin_table(result):
         above = [p for p in here if p["margin"]]
         low = min(above, key=lambda p: p["margin"]) if above else None
         high = max(above, key=lambda p: p["margin"]) if above else None
-        rows.append([formats.significant(f / 1e3), len(here), sum(p["margin"] == 0.0 for p in here),
+        rows.append([formats.significant(f / units.KN), len(here), sum(p["margin"] == 0.0 for p in here),
                      "–" if low is None else f"{formats.significant(low['margin'], 3)} at {low['V']:.4g} m/s",
                      "–" if high is None else f"{formats.significant(high['margin'], 3)} at {high['V']:.4g} m/s",
                      sum(p["margin"] is None for p in here), sum(p["confirmed"] is False for p in here)])
@@ -521,19 +527,20 @@ def open_kick(click, requests):
     if not click or not click.get("points") or result is None:
         return no_update, no_update
     V, fz_kn = float(click["points"][0]["x"]), float(click["points"][0]["y"])
-    point = min(result["points"], key=lambda p: abs(p["V"] - V) / 10 + abs(p["Fz"] / 1e3 - fz_kn) / 100,
+    point = min(result["points"], key=lambda p: abs(p["V"] - V) / 10 + abs(p["Fz"] / units.KN - fz_kn) / 100,
                 default=None)
-    if point is None or abs(point["V"] - V) > 1e-6 * max(1.0, V) or abs(point["Fz"] / 1e3 - fz_kn) > 1e-6 * fz_kn:
+    if (point is None or abs(point["V"] - V) > 1e-6 * max(1.0, V)
+            or abs(point["Fz"] / units.KN - fz_kn) > 1e-6 * fz_kn):
         return no_update, no_update
-    query = {"config": result["config"], "V": f"{point['V']:.6g}", "Fz": f"{point['Fz'] / 1e3:.6g}", "run": "1",
-             "map_type": point["type"]}
+    query = {"config": result["config"], "V": f"{point['V']:.6g}", "Fz": f"{point['Fz'] / units.KN:.6g}",
+             "run": "1", "map_type": point["type"]}
     kick = ""
     if point["margin"]:
         query.update(psi0=f"{point['upper']:.6g}", t_end=f"{result['options']['t_max']:g}")
         kick = f" from psi0 = {point['upper']:.4g} rad, just above its smallest kick to torsional shimmy"
     query.update({k: f"{v:.10g}" for k, v in (result.get("params") or {}).items()})
     return ("/time-history?" + urlencode(query),
-            f"Opening the time history at V = {point['V']:.4g} m/s, Fz = {point['Fz'] / 1e3:.4g} kN{kick}")
+            f"Opening the time history at V = {point['V']:.4g} m/s, Fz = {point['Fz'] / units.KN:.4g} kN{kick}")
 
 
 @dash.callback(Output(ids.MAP_NAV, "href"), Output(ids.MAP_HINT, "children"),

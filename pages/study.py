@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+import json
+
 import dash
-from dash import Input, Output, State, dcc, html
+from dash import ALL, Input, Output, State, dcc, html
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
+import shimmy.model.units as units
 from shimmy.model.configurations import affects
-from shimmy.model.parameters import PARAMETER_SPECS
+from shimmy.model.parameters import MATERIALS, PARAMETER_SPECS
 from ui import components as ui
-from ui import fields, formats, ids, jobs
+from ui import fields, formats, ids, jobs, markers, state
 from ui import style
 from ui.fields import Quantity
 from ui.layout import page
@@ -26,7 +29,7 @@ def _unit(name: str) -> str:
     return f" ({unit})" if unit else ""
 
 
-FZ = Quantity("study", "Fz", "Fz", "kN", 1e3)
+FZ = Quantity("study", "Fz", "Fz", "kN", units.KN)
 WAITING = "Press Compute: about 0.5-2 s per design and configuration cold, instant from the cache"
 TABLE_VIEWS = {"long": "one row per value and configuration", "pivot": "one row per value, configurations side by side"}
 
@@ -50,9 +53,10 @@ def layout(parameter: str | None = None, values: str = DEFAULT_VALUES, configs: 
                                                style={"width": "170px"},
                                                options=[{"label": f"{n}{_unit(n)}", "value": n}
                                                         for n in PARAMETER_SPECS])),
-            html.Div(ui.field("Values (comma-separated)", dcc.Input(id=ids.STUDY_VALUES, type="text", value=values,
-                                                                    debounce=True)), className="wide"),
-            ui.field("Fz (kN)", FZ.box(ids.STUDY_FZ, fz)),
+            html.Div([ui.field("Values (comma-separated)", dcc.Input(id=ids.STUDY_VALUES, type="text", value=values,
+                                                                     debounce=True)),
+                      fields.field_error(fields.error_id(ids.STUDY_VALUES))], className="wide"),
+            FZ.field("Fz (kN)", ids.STUDY_FZ, fz),
             ui.field("Configurations", ui.configurations(ids.STUDY_CONFIGS, chosen, multi=True)),
             *jobs.controls(ids.STUDY_GROUP),
         ], className="controls"),
@@ -89,8 +93,32 @@ def skipped(name, configs):
             "(its curve would be a flat line).")
 
 
+fields.check(ids.STUDY_FZ, FZ)
+
+
+@dash.callback(Output(fields.error_id(ids.STUDY_VALUES), "children"), Input(ids.STUDY_VALUES, "value"),
+               Input(ids.STUDY_PARAM, "value"), prevent_initial_call=True)
+def check_values(text, parameter):
+    """The values' box says at once (on Enter or leaving it) which value it refuses, as typed, and the range."""
+    return fields.refusal(lambda t: _values(parameter, t), text)
+
+
 def _request(parameter, text, fz_kn, configs, design):
     """The study request; a value that is not a number is reported by its position, like the API does."""
+    values = _values(parameter, text)
+    if not configs:
+        raise InvalidParameterError("configs", "", ", ".join(CONFIGS), message="Configurations: none chosen; "
+                                    "choose at least one")
+    studied = [c for c in configs if affects(parameter, c)]
+    if not studied:
+        raise InvalidParameterError("configs", ",".join(configs), "a configuration the parameter enters",
+                                    message=f"{parameter} enters none of the chosen configurations: choose one "
+                                            "with its device")
+    return {"parameter": parameter, "values": values, "configs": studied, "Fz": FZ.read(fz_kn), **design}
+
+
+def _values(parameter, text) -> list[float]:
+    """The typed values of ``parameter``, each refused by its position, as typed, in the parameter's unit."""
     spec = PARAMETER_SPECS[parameter]
     if not text or not text.strip():
         raise InvalidParameterError("values", text, spec.allowed,
@@ -111,15 +139,7 @@ def _request(parameter, text, fz_kn, configs, design):
             raise InvalidParameterError(f"values[{k}]", values[-1], spec.allowed,
                                         message=f"value {k + 1}: {parameter} = {item}{unit} is outside "
                                                 f"[{spec.low:g}, {spec.high:g}]{unit}")
-    if not configs:
-        raise InvalidParameterError("configs", "", ", ".join(CONFIGS), message="Configurations: none chosen; "
-                                    "choose at least one")
-    studied = [c for c in configs if affects(parameter, c)]
-    if not studied:
-        raise InvalidParameterError("configs", ",".join(configs), "a configuration the parameter enters",
-                                    message=f"{parameter} enters none of the chosen configurations: choose one "
-                                            "with its device")
-    return {"parameter": parameter, "values": values, "configs": studied, "Fz": FZ.read(fz_kn), **design}
+    return values
 
 
 CONTROLS = (State(ids.STUDY_PARAM, "value"), State(ids.STUDY_VALUES, "value"), State(ids.STUDY_FZ, "value"),
@@ -143,20 +163,25 @@ jobs.register(
     blank=lambda: (style.message_figure("Refused: see the message above", 560), None))
 
 
+HEIGHT, BOTTOM = 860, 130
+#: The vertical line at the current design's value of the parameter (drawn in the browser: it follows the panel).
+CURRENT_DESIGN_LINE = {"color": "#555", "dash": "dot", "width": 1.5}
 #: the panels: (key of a sampled row, quantity of an exact curve, axis title, scale of the values)
 PANELS = (("hopf_start", "hopf_V_start", "first Hopf V (m/s)", 1.0),
           ("hopf_end", "hopf_V_end", "last Hopf V (m/s)", 1.0),
-          (None, "min_shimmy_Fz", "lowest Hopf Fz (kN)", 1e-3),
-          ("max_psi", None, "max stable |psi| (rad)", 1.0))
+          (None, "min_shimmy_Fz", "lowest Hopf Fz (kN)", 1 / units.KN),
+          ("max_psi", "max_psi", "max stable |psi| (rad)", 1.0))
 
 
 def figure(result):
     """Per configuration: the exact curves over the parameter's whole range (lines; the points where
     the picture changes as crosses) with the sampled diagrams' values as markers on them; the largest
-    amplitude from the samples alone (lines between them)."""
+    amplitude on its grid of diagrams over the whole range (small dots joined by lines)."""
     name = result["parameters"][0]
     fig = make_subplots(rows=len(PANELS), cols=1, shared_xaxes=True, vertical_spacing=0.05)
     curves = {(c["config"], c["quantity"]): c for c in result.get("curves") or []}
+    kinds: set[str] = set()
+    largest = False
     for config in result["configs"]:
         rows = sorted((r for r in result["rows"] if r["config"] == config), key=lambda r: r[name])
         x = [r[name] for r in rows]
@@ -166,30 +191,58 @@ def figure(result):
             curve = curves.get((config, quantity))
             hover = f"{label}<br>{name} %{{x:.4g}}<br>%{{y:.6g}}<extra>WHAT</extra>"
             if curve is not None:
+                gridded = quantity == "max_psi"  # exact at its grid values (a diagram each), joined between them
                 fig.add_scatter(x=curve["p"], y=[None if v is None else v * scale for v in curve["values"]],
-                                mode="lines", name=label, legendgroup=config, showlegend=not shown,
-                                line={"color": colour, "width": 2}, hovertemplate=hover.replace("WHAT", "exact curve"),
-                                row=row, col=1)
+                                mode="lines+markers" if gridded else "lines", name=label, legendgroup=config,
+                                showlegend=not shown, line={"color": colour, "width": 2},
+                                marker={"size": 4, "color": colour},
+                                hovertemplate=hover.replace("WHAT", "diagram at a grid value" if gridded
+                                                            else "exact curve"), row=row, col=1)
                 shown = True
                 marks = [q for q in curve["special_points"] if isinstance(q.get("value"), (int, float))]
-                if marks:
-                    fig.add_scatter(x=[q["p"] for q in marks], y=[q["value"] * scale for q in marks], mode="markers",
-                                    name=f"{label}: where the picture changes", legendgroup=config, showlegend=False,
-                                    marker={"symbol": "x", "size": 10, "color": colour},
-                                    text=[q["kind"] for q in marks], row=row, col=1,
-                                    hovertemplate=f"{label}: %{{text}}<br>{name} %{{x:.6g}}<br>%{{y:.6g}}"
+                for kind in dict.fromkeys(q["kind"] for q in marks):  # one trace per kind: its own marker
+                    m = markers.of(kind)
+                    kinds.add(kind)
+                    here = [q for q in marks if q["kind"] == kind]
+                    fig.add_scatter(x=[q["p"] for q in here], y=[q["value"] * scale for q in here], mode="markers",
+                                    name=f"{label}: {m.name}", legendgroup=config, showlegend=False,
+                                    marker=markers.marker(kind, colour), meta={"kind": m.label}, row=row, col=1,
+                                    hovertemplate=f"{label}: {m.legend}<br>{name} %{{x:.6g}}<br>%{{y:.6g}}"
                                                   "<extra></extra>")
             if key is not None:
-                fig.add_scatter(x=x, y=[r[key] for r in rows], name=label, legendgroup=config, showlegend=not shown,
+                y = [r[key] for r in rows]
+                angle = key == "max_psi"
+                fig.add_scatter(x=x, y=y, name=label, legendgroup=config, showlegend=not shown,
                                 mode="markers" if curve is not None else "lines+markers",
                                 line={"color": colour, "width": 2},
                                 marker={"size": 8, "color": colour, "line": {"width": 1.5, "color": "#fff"}},
-                                hovertemplate=hover.replace("WHAT", "sampled diagram"), row=row, col=1)
+                                customdata=style.in_degrees(y) if angle else None,
+                                hovertemplate=(f"{label}<br>{name} %{{x:.4g}}<br>{style.ANGLE_HOVER}"
+                                               "<extra>sampled diagram</extra>") if angle else
+                                hover.replace("WHAT", "sampled diagram"), row=row, col=1)
                 shown = True
-    fig.update_layout(title=style.title(f"Study in {name} at Fz = {result['Fz'] / 1e3:g} kN: exact curves (lines), "
-                                        "sampled diagrams (markers)"), height=820,
-                      template="plotly_white", margin={**style.MARGIN, "l": 70},
-                      legend={"orientation": "h", "y": -0.08})
+                best = max((r for r in rows if r["max_psi"] is not None), key=lambda r: r["max_psi"], default=None)
+                if angle and best is not None and best["max_psi"] > 0:  # the largest stable |psi| of the study
+                    largest = True
+                    fig.add_scatter(x=[best[name]], y=[best["max_psi"]], mode="markers", legendgroup=config,
+                                    showlegend=False, customdata=style.in_degrees([best["max_psi"]]),
+                                    marker={"symbol": markers.LARGEST_PSI.symbol, "size": markers.LARGEST_PSI.size,
+                                            "color": colour, "line": {"width": 2, "color": colour}},
+                                    meta={"mark": "largest stable |psi|", "config": config}, row=row, col=1,
+                                    hovertemplate=f"<b>{label}: largest stable |psi|</b><br>{name} %{{x:.6g}}<br>"
+                                                  f"{style.ANGLE_HOVER}<extra></extra>")
+    markers.legend(fig, kinds, "legend2")
+    if largest:
+        style.legend_key(fig, markers.LARGEST_PSI.name, "legend2", mode="markers",
+                         marker={"symbol": markers.LARGEST_PSI.symbol, "size": 11, "color": "#555",
+                                 "line": {"width": 2, "color": "#555"}})
+    style.legend_key(fig, markers.CURRENT_DESIGN.name, "legend2", mode="lines",
+                     line={"color": CURRENT_DESIGN_LINE["color"], "dash": CURRENT_DESIGN_LINE["dash"], "width": 1.5})
+    fig.update_layout(title=style.title(f"Study in {name} at Fz = {units.to_kn(result['Fz']):g} kN: exact curves "
+                                        "(lines), sampled diagrams (markers)"), height=HEIGHT,
+                      template=style.TEMPLATE, margin={**style.MARGIN, "l": 70, "b": BOTTOM},
+                      meta={"study": {"parameter": name, "unit": PARAMETER_SPECS[name].unit}})
+    style.legends(fig, ["configuration (colour)", "points, marks"], HEIGHT, BOTTOM)
     fig.update_xaxes(title_text=f"{name}{_unit(name)}", row=len(PANELS), col=1)
     for row, (_, _, title, _) in enumerate(PANELS, start=1):
         fig.update_yaxes(title_text=title, row=row, col=1)
@@ -243,6 +296,36 @@ dash.clientside_callback(
     Output(ids.STUDY_GRAPH, "figure", allow_duplicate=True), Input(ids.STUDY_LOG, "value"), Input(ids.STUDY_GRAPH,
                                                                                                   "figure"),
     prevent_initial_call=True)
+
+
+# The current design's value of the studied parameter, a dotted vertical line over every panel: drawn in the
+# browser from the design panel's store, so that it follows a slider (the study itself is of the design it was
+# asked for: each row says its values).
+dash.clientside_callback(
+    """
+    function(stores, fig) {
+        const C = window.dash_clientside, BASE = %(base)s, DEFAULT = %(default)s, LINE = %(line)s;
+        if (!fig || !fig.layout || !fig.layout.meta || !fig.layout.meta.study) { return C.no_update; }
+        const design = (stores || [])[0] || {}, study = fig.layout.meta.study, name = study.parameter;
+        const params = design.params || {}, base = BASE[design.material || DEFAULT] || BASE[DEFAULT];
+        const value = params[name] !== undefined ? params[name] : base[name];
+        const others = (fig.layout.shapes || []).filter(s => s.name !== "current design");
+        const old = (fig.layout.shapes || []).find(s => s.name === "current design");
+        if (old && old.x0 === value) { return C.no_update; }
+        const text = "current design: " + name + " = " + Number(value.toPrecision(6)) +
+                     (study.unit ? " " + study.unit : "");
+        const shapes = others.concat([{name: "current design", type: "line", xref: "x", yref: "paper", x0: value,
+                                       x1: value, y0: 0, y1: 1, line: LINE}]);
+        const notes = (fig.layout.annotations || []).filter(a => a.name !== "current design").concat([
+            {name: "current design", text: text, xref: "x", yref: "paper", x: value, y: 1, yanchor: "top",
+             xanchor: "left", xshift: 3, showarrow: false, bgcolor: "rgba(255,255,255,0.85)",
+             font: {size: 11, color: LINE.color}}]);
+        return Object.assign({}, fig, {layout: Object.assign({}, fig.layout, {shapes: shapes, annotations: notes})});
+    }
+    """ % {"base": json.dumps({m: state.material_params(m) for m in MATERIALS}),
+           "default": json.dumps(state.DEFAULT_MATERIAL), "line": json.dumps(CURRENT_DESIGN_LINE)},
+    Output(ids.STUDY_GRAPH, "figure", allow_duplicate=True), Input(ids.design_store(ALL), "data"),
+    Input(ids.STUDY_GRAPH, "figure"), prevent_initial_call=True)
 
 
 @dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),

@@ -10,26 +10,28 @@ from dash import Input, Output, State, dcc, html, no_update
 from plotly.subplots import make_subplots
 
 from shimmy.errors import InvalidParameterError
+import shimmy.model.units as units
+from shimmy.model.configurations import STATE_NAMES, STATE_UNITS
 from shimmy.service import analyses, settings
 from ui import components as ui
 from ui import fields, ids, jobs
 from ui import style
-from ui.series import envelope
+from ui.series import DETAIL_SAMPLES, band, detail, last_cycles
 from ui.fields import Quantity
 from ui.layout import page
 
 dash.register_page(__name__, path="/time-history", name="Time history", order=2)
 
 SPEED = Quantity("simulate", "V", "V", "m/s")
-FZ = Quantity("simulate", "Fz", "Fz", "kN", 1e3)
+FZ = Quantity("simulate", "Fz", "Fz", "kN", units.KN)
 T_END = Quantity("simulate", "t_end", "simulated time", "s")
 PSI0 = Quantity("simulate", "psi0", "initial psi", "rad")
-LATERAL0 = Quantity("simulate", "lateral0", "initial l_g delta", "m")
+LATERAL0 = Quantity("simulate", "lateral0", "initial l_g delta", "mm", units.MM)  # the address keeps m
 #: The starts offered: the standard one (psi = 0.001 rad), and ones large enough to reach each
-#: attractor of a bistable point.
+#: attractor of a bistable point (psi0 in rad, l_g delta0 in mm: the boxes' units).
 STARTS = {"standard": ("standard: psi = 0.001 rad", 0.001, 0.0),
           "torsional": ("large torsional: psi = 0.2 rad", 0.2, 0.0),
-          "lateral": ("large lateral: l_g delta = 0.1 m", 0.0, 0.1),
+          "lateral": ("large lateral: l_g delta = 100 mm", 0.0, 100.0),
           "typed": ("values typed below", None, None)}
 WAITING = "Choose an operating point and press Run (a result already in the cache is shown at once)"
 MARGINS_STALE = "Press Compute margins for this operating point (any margins shown are of the previous one)."
@@ -48,14 +50,14 @@ def _start_of(psi0, lateral0) -> str:
 
 def layout(config: str | None = None, V: str | None = None, Fz: str | None = None, t_end: str | None = None,
            psi0: str | None = None, lateral0: str | None = None, run: str | None = None, map_type: str | None = None,
-           **query):
+           exact_nes: str | None = None, **query):
     config, bad_config = fields.choice("config", config, list(ui.CONFIGS), "nes_pd", "a configuration")
     problems = [bad_config]
     v, problem_v = SPEED.from_url("V", V, 30)
     fz, problem_fz = FZ.from_url("Fz", Fz, 150)
     t, problem_t = T_END.from_url("t_end", t_end, 60)
     p0, problem_p = PSI0.from_url("psi0", psi0, 0.001)
-    l0, problem_l = LATERAL0.from_url("lateral0", lateral0, 0.0)
+    l0, problem_l = LATERAL0.from_url("lateral0", _mm_of(lateral0), 0.0)
     problems += [problem_v, problem_fz, problem_t, problem_p, problem_l]
     series, spectrum, phase, _ = _placeholders()
     return page(
@@ -67,14 +69,15 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
                   "start. Runs in the background; repeated questions come from the cache."),
         html.Div([
             ui.field("Configuration", ui.configurations(ids.TH_CONFIG, config, width="160px")),
-            ui.field("V (m/s)", SPEED.box(ids.TH_V, v, debounce=True)),
-            ui.field("Fz (kN)", FZ.box(ids.TH_FZ, fz, debounce=True)),
-            ui.field("Simulated time (s)", T_END.box(ids.TH_TEND, t)),
+            SPEED.field("V (m/s)", ids.TH_V, v),
+            FZ.field("Fz (kN)", ids.TH_FZ, fz),
+            T_END.field("Simulated time (s)", ids.TH_TEND, t),
             ui.field("Start", dcc.Dropdown(id=ids.TH_START, value=_start_of(p0, l0), clearable=False,
                                            style={"width": "250px"}, options=[
                                                {"label": label, "value": k} for k, (label, _, _) in STARTS.items()])),
-            html.Div([ui.field("psi0 (rad)", PSI0.box(ids.TH_PSI0, p0)),
-                      ui.field("l_g delta0 (m)", LATERAL0.box(ids.TH_LAT0, l0))], className="pair"),
+            html.Div([PSI0.field("psi0 (rad)", ids.TH_PSI0, p0),
+                      LATERAL0.field("l_g delta0 (mm)", ids.TH_LAT0, l0)], className="pair"),
+            ui.field("NES torque", ui.nes_torque(ids.TH_EXACT, "exact" if exact_nes == "1" else "cubic")),
             *jobs.controls(ids.TH_GROUP, "Run"),
         ], className="controls"),
         html.Div([html.Span("Operating points: ", className="hint"),
@@ -107,6 +110,11 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
     )
 
 
+for _box, _quantity in ((ids.TH_V, SPEED), (ids.TH_FZ, FZ), (ids.TH_TEND, T_END), (ids.TH_PSI0, PSI0),
+                        (ids.TH_LAT0, LATERAL0)):
+    fields.check(_box, _quantity)
+
+
 @dash.callback(Output(ids.TH_V, "value"), Output(ids.TH_FZ, "value"),
                Input(ids.th_op(dash.ALL), "n_clicks"), prevent_initial_call=True)
 def operating_point(_clicks):
@@ -132,41 +140,88 @@ def _bistable_note(map_type):
     """What the page says when it was opened from a point the map shades Bistable (or Both)."""
     if map_type == "Bistable":
         return ("The stability map shades this point Bistable: a torsional and a lateral limit cycle coexist, and "
-                "which one the gear ends on depends on the kick. Compute its disturbance margins below to see how "
-                "large a yaw kick reaches each, and run from there.")
+                "which one the gear ends on depends on the kick. Run runs the start chosen above and the two large "
+                "starts, and says which cycle each ends on; compute the disturbance margins below to see how large "
+                "a yaw kick reaches each, and run from there.")
     return None
 
 
-def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, design):
+def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, torque, bistable, design):
+    """The run from the start in the boxes; at a point the map shades Bistable (its note shown), the runs
+    from the two large starts too, so that the page says which attractor each start ends on."""
     t = T_END.read(t_end)
     # The series is thinned for a long run: every t_end the field allows can be drawn.
     series_dt = max(0.002, math.ceil(1000 * t / (settings.MAX_SERIES_POINTS - 1)) / 1000)
-    return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": t, "psi0": PSI0.read(psi0),
-             "lateral0": LATERAL0.read(lateral0), "include_series": True, "series_dt": series_dt, **design}]
+    common = {"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": t, "include_series": True,
+              "series_dt": series_dt, **ui.exact_nes(config, torque), **design}
+    starts = [(PSI0.read(psi0), LATERAL0.read(lateral0))]
+    if bistable:
+        large = [(PSI0.read(p), LATERAL0.read(q)) for key in ("torsional", "lateral") for _, p, q in [STARTS[key]]]
+        starts += [start for start in large if start not in starts]  # in SI, as the requests
+    return [{**common, "psi0": p, "lateral0": q} for p, q in starts]
+
+
+def _starts_table(results):
+    """Which attractor each start ended on (the runs of a Bistable map point)."""
+    rows = []
+    for r in results:
+        amp, f = r["amplitude"], r["frequency_hz"]
+        rows.append([f"psi0 = {r['start']['psi0']:g} rad, l_g delta0 = {units.mm(r['start']['lateral0'])}",
+                     MODE_WORDS.get(r["response_type"], r["response_type"])
+                     + ("" if r["steady"] else " (not yet steady)"),
+                     f"{amp['psi']:.4g}", f"{amp['lateral'] / units.MM:.4g}", "–" if f is None else f"{f:.3f}"])
+    return html.Div([
+        html.P("The map shades this point Bistable; the runs from the start above and from the two large starts "
+               "ended on:", className="hint"),
+        ui.table(["start", "settled on", "max |psi| (rad)", "max |l_g delta| (mm)", "frequency (Hz)"], rows,
+                 ids.TH_STARTS),
+        html.P("The figures show the first run; choose another start above to draw it (from the cache at once).",
+               className="hint")])
+
+
+def _settled_all(results):
+    first = settled(results[0])
+    return first if len(results) == 1 else html.Div([html.Div(first), _starts_table(results)])
+
+
+#: The downloaded series' columns: name with its unit, SI units per unit written (l_g delta in mm).
+CSV_COLUMNS = {"t": ("t_s", 1.0), "lateral": ("lateral_mm", units.MM),
+               **{n: (f"{n}_{u.replace('/', '_')}", 1.0) for n, u in zip(STATE_NAMES, STATE_UNITS, strict=True)}}
 
 
 def _csv_rows(results):
     s = results[0]["series"]
     keys = list(s)
-    return keys, zip(*(s[k] for k in keys), strict=True)
+    columns = [CSV_COLUMNS.get(k, (k, 1.0)) for k in keys]
+    values = [s[k] if scale == 1.0 else [v / scale for v in s[k]] for k, (_, scale) in zip(keys, columns, strict=True)]
+    return [name for name, _ in columns], zip(*values, strict=True)
+
+
+def _mm_of(lateral0_m):
+    """The address's lateral0 (m, as the API takes it) in the box's mm; a value that is no number as it is."""
+    try:
+        return None if lateral0_m is None else float(f"{float(lateral0_m) / units.MM:.12g}")  # no float noise
+    except (TypeError, ValueError):
+        return lateral0_m
 
 
 def _file_stem(results):
     r = results[0]
-    return f"time_history_{r['config']}_V{r['V']:g}_Fz{r['Fz'] / 1e3:g}kN"
+    return f"time_history_{r['config']}_V{r['V']:g}_Fz{r['Fz'] / units.KN:g}kN"
 
 
 jobs.register(
     ids.TH_GROUP, "simulate", requests=_requests, blank=lambda: (*_placeholders("Refused: see the message above"), ""),
     running=lambda: (*_placeholders("Running the time history…"), ""), waiting=lambda: (*_placeholders(), ""),
-    render=lambda results: (*_figures(results[0]), _metrics(results[0]), settled(results[0])),
-    notice=lambda results: "" if results[0]["success"] else results[0]["message"],
+    render=lambda results: (*_figures(results[0]), _metrics(results[0]), _settled_all(results)),
+    notice=ui.result_notice,
     outputs=[Output(ids.TH_SERIES, "figure"), Output(ids.TH_SPECTRUM, "figure"), Output(ids.TH_PHASE, "figure"),
              Output(ids.TH_METRICS, "children"), Output(ids.TH_SETTLED, "children")],
     triggers=[Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_AUTORUN, "n_intervals"),
               Input(ids.TH_KICK, "data")],
     states=[State(ids.TH_CONFIG, "value"), State(ids.TH_TEND, "value"), State(ids.TH_PSI0, "value"),
-            State(ids.TH_LAT0, "value"), State(ids.design_store(ids.TH), "data")],
+            State(ids.TH_LAT0, "value"), State(ids.TH_EXACT, "value"), State(ids.TH_BISTABLE, "children"),
+            State(ids.design_store(ids.TH), "data")],
     download=jobs.Download(ids.TH_GROUP, "time_history", _csv_rows, single=True, filename=_file_stem))
 
 
@@ -204,26 +259,26 @@ def margins_table(result):
                                                         className="secondary")
         equilibrium = a["mode"] == "equilibrium"
         rows.append([what, "0" if equilibrium else f"{a['amplitude']['psi']:.4g}",
-                     "0" if equilibrium else f"{a['amplitude']['lateral']:.4g}",
+                     "0" if equilibrium else f"{units.to_mm(a['amplitude']['lateral']):.4g}",
                      _kick(m, result["options"]["max_size"]), _check(m), button])
     saddles = "; ".join(f"{s['mode']}, psi {s['amplitude']['psi']:.4g} rad" for s in result["saddles"])
-    note = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {result['Fz'] / 1e3:g} kN: "
+    note = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {units.kn(result['Fz'])}: "
             f"straight rolling {'stable' if result['straight_rolling_stable'] else 'unstable'}"
             + (f"; saddle cycles between the basins: {saddles}" if saddles else "")
             + f". {result['runs']} runs in {result['elapsed_s']:.1f} s.")
     warnings = [html.P(f"Warning: {w}", className="hint") for w in result["warnings"]]
     return [html.P(note, className="hint"), ui.table(
-        ["attractor", "max |psi| (rad)", "max |l_g delta| (m)", "min yaw kick psi0 (rad)", "checked (psi0 → end)",
+        ["attractor", "max |psi| (rad)", "max |l_g delta| (mm)", "min yaw kick psi0 (rad)", "checked (psi0 → end)",
          "time history"], rows, ids.THM_SUMMARY), *warnings]
 
 
 def _margin_csv(results):
     r = results[0]
-    rows = [[a["mode"], a["kind"], a["amplitude"]["psi"], a["amplitude"]["lateral"], a["standard_start"],
+    rows = [[a["mode"], a["kind"], a["amplitude"]["psi"], units.to_mm(a["amplitude"]["lateral"]), a["standard_start"],
              a["min_disturbance"]["value"], a["min_disturbance"]["tolerance"], a["min_disturbance"].get("lower"),
              a["min_disturbance"].get("upper"), (a["min_disturbance"]["check"] or {}).get("confirmed")]
             for a in r["attractors"]]
-    return ["mode", "kind", "psi_amplitude_rad", "lateral_amplitude_m", "standard_start", "min_yaw_kick_rad",
+    return ["mode", "kind", "psi_amplitude_rad", "lateral_amplitude_mm", "standard_start", "min_yaw_kick_rad",
             "tolerance_rad", "lower_rad", "upper_rad", "confirmed"], rows
 
 
@@ -234,7 +289,7 @@ jobs.register(
     states=[State(ids.design_store(ids.TH), "data")], stale=MARGINS_STALE,
     download=jobs.Download(ids.THM, "disturbance_margins", _margin_csv, single=True,
                            filename=lambda results: f"margins_{results[0]['config']}_V{results[0]['V']:g}_Fz"
-                                                    f"{results[0]['Fz'] / 1e3:g}kN"),
+                                                    f"{results[0]['Fz'] / units.KN:g}kN"),
     blank=lambda: (None,))
 
 
@@ -264,7 +319,7 @@ def run_from_kick(clicks, requests, t_end, config, V, fz_kn):
     psi0 = STARTS["standard"][1] if m["value"] == 0.0 else float(f"{m['upper']:.5g}")
     longest = result["options"]["t_max"]
     t = t_end if isinstance(t_end, (int, float)) and t_end >= longest else longest
-    point = (result["config"], result["V"], result["Fz"] / 1e3)
+    point = (result["config"], result["V"], result["Fz"] / units.KN)
     moved = [new if new != old else no_update for new, old in zip(point, (config, V, fz_kn), strict=True)]
     return psi0, 0.0, t, *moved, {"attractor": k, "psi0": psi0, "clicks": sum(c or 0 for c in clicks)}
 
@@ -280,30 +335,122 @@ dash.clientside_callback(
     Input(ids.TH_KICK, "data"), prevent_initial_call=True)
 
 
+#: Where a run's series traces are (three per row: the band's top, its bottom filled to the top, the
+#: detail line), for the detail window's redraw.
+PER_ROW = 3
+
+
+def _rows(result) -> list[tuple[str, list[float], str, str]]:
+    """(legend name, values, colour, axis title) of each row of the series figure."""
+    s = result["series"]
+    rows = [("torsion psi (rad)", s["psi"], style.CONFIG_COLOURS[result["config"]], "psi (rad)"),
+            ("lateral l_g delta (mm)", list(np.asarray(s["lateral"]) / units.MM), "#56B4E9", "l_g delta (mm)"),
+            ("tyre deformation lam (m)", s["lam"], "#CC79A7", "lam (m)")]
+    if "psis" in s:
+        rows.append(("NES relative rotation psi - psis (rad)", list(np.asarray(s["psi"]) - np.asarray(s["psis"])),
+                     "#D55E00", "psi - psis (rad)"))
+    return rows
+
+
+def _translucent(colour: str, alpha: float = 0.3) -> str:
+    r, g, b = (int(colour[k:k + 2], 16) for k in (1, 3, 5))
+    return f"rgba({r},{g},{b},{alpha})"
+
+
+def _series_figure(result):
+    """The run's rows against time: the whole run as a band (each time bucket's lowest and highest
+    sample; a line through them would be a solid block with aliasing stripes at 10-16 Hz), every sample
+    as a line in the window shown (by default the last cycles; the range slider below moves it over
+    the whole run, and the line follows it from the cached result)."""
+    t = np.asarray(result["series"]["t"])
+    title = f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {units.kn(result['Fz'])}"
+    rows = _rows(result)
+    fig = make_subplots(rows=len(rows), cols=1, shared_xaxes=True, vertical_spacing=0.04)
+    t0, t1 = last_cycles(float(t[-1]), result["frequency_hz"])
+    for k, (name, values, colour, axis) in enumerate(rows, start=1):
+        mid, low, high = band(t, values, min_span=1.25 / result["frequency_hz"] if result["frequency_hz"] else 0.0)
+        fig.add_scatter(x=mid, y=high, mode="lines", line={"width": 0, "color": colour}, hoverinfo="skip",
+                        showlegend=False, legendgroup=name, row=k, col=1)
+        fig.add_scatter(x=mid, y=low, mode="lines", line={"width": 0, "color": colour}, fill="tonexty",
+                        fillcolor=_translucent(colour), hoverinfo="skip", name=f"{name}: range over the run",
+                        showlegend=k == 1, legendgroup="band", row=k, col=1)
+        x, y = detail(t, values, t0, t1) or ([], [])
+        angle = axis.endswith("(rad)")  # psi and psi - psis: degrees on hover
+        fig.add_scatter(x=list(map(float, x)), y=list(map(float, y)), mode="lines",  # lists, as the redraw sends
+                        line={"width": 1.2, "color": colour}, name=name, row=k, col=1,
+                        customdata=style.in_degrees(y) if angle else None,
+                        hovertemplate=f"t %{{x:.4g}} s<br>{style.ANGLE_HOVER if angle else '%{y:.4g}'}"
+                                      "<extra></extra>")
+        fig.update_yaxes(title_text=axis, row=k, col=1)
+    start = result.get("start") or {}
+    fig.update_layout(title=style.title(title), height=170 * len(rows) + 170, template=style.TEMPLATE,
+                      margin={**style.MARGIN, "l": 70}, legend={"orientation": "h", "y": -0.22},
+                      annotations=[_zoom_note(False)],
+                      # the user's zoom survives the line's redraw (same run), a new run opens on its last cycles
+                      uirevision=f"{title} {start.get('psi0')} {start.get('lateral0')} {result['options']['t_end']}")
+    fig.update_xaxes(range=[t0, t1])
+    fig.update_xaxes(title_text="time t (s): the slider below moves the window over the whole run",
+                     rangeslider={"visible": True, "thickness": 0.07}, row=len(rows), col=1)
+    return fig
+
+
+def _zoom_note(visible: bool) -> dict:
+    return {"text": f"more than {DETAIL_SAMPLES} samples in this window: the band only; zoom in to see every sample",
+            "xref": "paper", "yref": "paper", "x": 1, "y": 1.0, "xanchor": "right", "yanchor": "bottom",
+            "showarrow": False, "font": {"size": 11, "color": "#555"}, "visible": visible}
+
+
+def _window(relayout, t_end: float) -> tuple[float, float] | None:
+    """The time window a zoom, a pan or the range slider asked for (None if the event is not one)."""
+    if not relayout:
+        return None
+    if any(k.endswith(".autorange") and v for k, v in relayout.items() if k.startswith("xaxis")):
+        return 0.0, t_end
+    for key, value in relayout.items():
+        if key.startswith("xaxis") and key.endswith(".range") and isinstance(value, list) and len(value) == 2:
+            return float(value[0]), float(value[1])
+    ends = {k.split(".")[0]: [relayout.get(f"{k.split('.')[0]}.range[0]"), relayout.get(f"{k.split('.')[0]}.range[1]")]
+            for k in relayout if k.startswith("xaxis") and ".range[" in k}
+    for lo, hi in ends.values():
+        if lo is not None and hi is not None:
+            return float(lo), float(hi)
+    return None
+
+
+@dash.callback(Output(ids.TH_SERIES, "figure", allow_duplicate=True), Input(ids.TH_SERIES, "relayoutData"),
+               State(ids.TH_GROUP.requests, "data"), prevent_initial_call=True)
+def follow_window(relayout, requests):
+    """Every sample of the window shown, from the cached result (a zoom, a pan, the range slider)."""
+    if not requests:
+        return no_update
+    try:
+        result = analyses.cached("simulate", requests[0])
+    except InvalidParameterError:
+        return no_update
+    if result is None or "series" not in result:
+        return no_update
+    t = np.asarray(result["series"]["t"])
+    window = _window(relayout, float(t[-1]))
+    if window is None:
+        return no_update
+    patched = dash.Patch()
+    too_many = False
+    for k, (_, values, _, axis) in enumerate(_rows(result)):
+        shown = detail(t, values, *window)
+        too_many = too_many or shown is None
+        x, y = shown if shown is not None else ([], [])
+        patched["data"][PER_ROW * k + 2]["x"] = list(map(float, x))
+        patched["data"][PER_ROW * k + 2]["y"] = list(map(float, y))
+        if axis.endswith("(rad)"):
+            patched["data"][PER_ROW * k + 2]["customdata"] = style.in_degrees(list(map(float, y)))
+    patched["layout"]["annotations"][0]["visible"] = too_many
+    return patched
+
+
 def _figures(result):
     s = result["series"]
-    t = np.asarray(s["t"])
-    title = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {result['Fz'] / 1e3:g} kN")
-    has_nes = "psis" in s
-    rows = 4 if has_nes else 3
-    series = make_subplots(rows=rows, cols=1, shared_xaxes=True, vertical_spacing=0.05)
     colour = style.CONFIG_COLOURS[result["config"]]
-    for row, values, name, c in ((1, s["psi"], "torsion psi (rad)", colour),
-                                 (2, s["lateral"], "lateral l_g delta (m)", "#56B4E9"),
-                                 (3, s["lam"], "tyre deformation lam (m)", "#CC79A7")):
-        x, y = envelope(t, values)
-        series.add_scatter(x=x, y=y, name=name, line={"color": c, "width": 1}, row=row, col=1)
-    if has_nes:
-        x, y = envelope(t, np.asarray(s["psi"]) - np.asarray(s["psis"]))
-        series.add_scatter(x=x, y=y, name="NES relative rotation psi - psis (rad)",
-                           line={"color": "#D55E00", "width": 1}, row=4, col=1)
-        series.update_yaxes(title_text="psi - psis (rad)", row=4, col=1)
-    series.update_layout(title=style.title(title), height=180 * rows + 110, template="plotly_white",
-                         margin={**style.MARGIN, "l": 70}, legend={"orientation": "h", "y": -0.08})
-    series.update_xaxes(title_text="time t (s)", row=rows, col=1)
-    series.update_yaxes(title_text="psi (rad)", row=1, col=1)
-    series.update_yaxes(title_text="l_g delta (m)", row=2, col=1)
-    series.update_yaxes(title_text="lam (m)", row=3, col=1)
+    series = _series_figure(result)
     sp = result["spectrum"]
     spectrum = style.figure("Spectrum of the steady window", "frequency (Hz)", "power (normalised)")
     floor = 1e-6  # six decades below the peak: the tones, not the round-off
@@ -334,12 +481,12 @@ def settled(result):
     o = result.get("options", {})
     start = result.get("start") or {}
     psi0, lat0 = start.get("psi0"), start.get("lateral0")
-    where = "" if psi0 is None else f"From psi0 = {psi0:g} rad, l_g delta0 = {lat0:g} m the run "
+    where = "" if psi0 is None else f"From psi0 = {psi0:g} rad, l_g delta0 = {units.mm(lat0)} the run "
     verb = "settled on" if result["steady"] else "was still approaching (not yet steady at t_end)"
     f = result["frequency_hz"]
     amp = result["amplitude"]
     detail = "" if result["response_type"] == "Stable" else (
-        f": max |psi| {amp['psi']:.3g} rad, max |l_g delta| {amp['lateral']:.3g} m"
+        f": max |psi| {amp['psi']:.3g} rad ({units.degrees(amp['psi'])}), max |l_g delta| {units.mm(amp['lateral'], 3)}"
         + ("" if f is None else f", {f:.2f} Hz"))
     text = f"{where or 'The run '}{verb} {MODE_WORDS.get(result['response_type'], result['response_type'])}{detail}"
     return text + (f" after {o['t_end']:g} s." if "t_end" in o else ".")
@@ -349,10 +496,11 @@ def _metrics(result):
     amp = result["amplitude"]
     f = result["frequency_hz"]
     items = [("response", result["response_type"] + ("" if result["steady"] else " (not yet steady)")),
-             ("max |psi| (rad)", f"{amp['psi']:.4g}"), ("max |l_g delta| (m)", f"{amp['lateral']:.4g}"),
+             ("max |psi| (rad)", f"{amp['psi']:.4g}"), ("max |l_g delta| (mm)", f"{units.to_mm(amp['lateral']):.4g}"),
              ("dominant frequency (Hz)", "–" if f is None else f"{f:.3f}")]
     if "nes_relative" in amp:
         items.append(("NES relative rotation (rad)", f"{amp['nes_relative']:.4g}"))
+        items.append(("NES torque", "exact" if result["options"].get("exact_nes") else "cubic fit"))
     return [html.Div([html.Div(v, className="value"), html.Div(k, className="label")], className="metric")
             for k, v in items]
 
@@ -360,12 +508,16 @@ def _metrics(result):
 @dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True),
                Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"), Input(ids.TH_TEND,
                                                                                                          "value"),
-               Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"), prevent_initial_call=True)
-def remember(config, V, fz, t_end, psi0, lateral0):
+               Input(ids.TH_PSI0, "value"), Input(ids.TH_LAT0, "value"), Input(ids.TH_EXACT, "value"),
+               prevent_initial_call=True)
+def remember(config, V, fz, t_end, psi0, lateral0, torque):
     standard = psi0 == STARTS["standard"][1] and lateral0 == STARTS["standard"][2]
     moved = dash.ctx.triggered_id in (ids.TH_CONFIG, ids.TH_V, ids.TH_FZ)  # the map's note is of the point opened
+    # the address keeps m (as the API), without float noise: 7 mm is lateral0=0.007
+    lateral_m = float(f"{lateral0 * units.MM:.12g}") if isinstance(lateral0, (int, float)) else lateral0
     return {"config": config, "V": V, "Fz": fz, "t_end": t_end, "psi0": None if standard else psi0,
-            "lateral0": None if standard else lateral0, "run": None, **({"map_type": None} if moved else {})}
+            "lateral0": None if standard else lateral_m, "exact_nes": "1" if torque == "exact" else None, "run": None,
+            **({"map_type": None} if moved else {})}
 
 
 @dash.callback(Output(ids.TH_BISTABLE, "children"), Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"),

@@ -175,3 +175,30 @@ def test_the_tests_and_files_the_docs_cite_exist():
     assert cited_files and not [f for f in cited_files if not (ROOT / f).is_file()]
     for name in re.findall(r"`((?:compose|gunicorn)[\w.]*\.(?:yaml|py))`", pages):
         assert (ROOT / name).is_file(), name
+
+
+def _readme_commands() -> list[str]:
+    """The lines of the README's bash blocks, in order."""
+    text = (ROOT / "README.md").read_text()
+    return [line.strip() for block in re.findall(r"```bash\n(.*?)```", text, flags=re.S)
+            for line in block.splitlines() if line.strip()]
+
+
+def test_the_readme_starts_in_a_virtual_environment_with_the_two_commands():
+    """A new user's first lines: a virtual environment, the workbench's command, then the tests' command, which
+    is the one CI runs (.ci/run)."""
+    first = _readme_commands()[:3]
+    assert first[0] == "python3.11 -m venv .venv && . .venv/bin/activate"
+    assert first[1].startswith('python -m pip install -e ".[web]" && python -m gunicorn app:server ')
+    ci = [line for line in (ROOT / ".ci" / "run").read_text().splitlines() if line.startswith("python -m pip")]
+    assert first[2] == ci[0]
+
+
+def test_the_readme_ends_its_first_screen_with_a_five_minute_tour():
+    """The tour is within the README's first screen (50 lines) and walks Overview, a drag of e_p, Bifurcation,
+    the Stability map and a click on a point, in that order."""
+    screen = "\n".join((ROOT / "README.md").read_text().splitlines()[:50])
+    assert "**A five-minute tour**" in screen
+    tour = screen[screen.index("**A five-minute tour**"):]
+    steps = re.findall(r"^\d\. \*\*(.+?)\*\*", tour, flags=re.M)
+    assert steps == ["Overview", "Drag e_p", "Bifurcation", "Stability map", "Click a point"]

@@ -189,7 +189,7 @@ def test_cli_imports_only_the_analyses_the_model_the_errors_and_the_schemas():
 
 #: What the UI may import from the package: definitions and the service layer, never numerics.
 UI_MAY_IMPORT = ("shimmy.service", "shimmy.errors", "shimmy.version", "shimmy.model.parameters",
-                 "shimmy.model.configurations",
+                 "shimmy.model.configurations", "shimmy.model.units",  # the units people read: definitions
                  "shimmy.continuation.kinds")  # a definitions module: the special points' kinds, no numerics
 
 

@@ -9,7 +9,7 @@ from typing import Any, Iterable
 
 from dash import dcc, html
 
-from shimmy.model.configurations import OPERATING_POINTS as _OPERATING_POINTS_N
+from shimmy.model.configurations import OPERATING_POINTS as _OPERATING_POINTS_N, Configuration
 
 from . import style
 from .ids import Group
@@ -89,3 +89,29 @@ def number(raw, default: float) -> float:
     except (TypeError, ValueError):
         return default
 
+
+
+#: The NES torque choices of the pages that integrate or continue the NES (Time history, Ground run,
+#: Bifurcation): the cubic fit the study uses, or the exact torque of the roller on its track.
+NES_TORQUES = {"cubic": "cubic fit (the study's; within 1 % for small NES rotations)",
+               "exact": "exact torque (slower)"}
+
+
+def nes_torque(component_id: str, value: str = "cubic") -> dcc.RadioItems:
+    """The NES torque choice (``value`` "cubic" or "exact")."""
+    return dcc.RadioItems(id=component_id, value=value, inline=True,
+                          options=[{"label": label, "value": k} for k, label in NES_TORQUES.items()])
+
+
+def exact_nes(config: str, torque: str | None) -> dict[str, bool]:
+    """The request's exact_nes for ``config`` with the torque chosen: only a configuration with an NES
+    asks for it (the others' answers do not depend on it and stay one cache entry)."""
+    return {"exact_nes": True} if torque == "exact" and Configuration.parse(config).has_nes else {}
+
+
+def result_notice(results: list[dict[str, Any]]) -> str:
+    """What the results say the user must know, by configuration: a run that failed (its message) and
+    every warning (an NES rotation beyond the cubic's range, ...)."""
+    said = [f"{r['config']}: {r['message']}" for r in results if r.get("success") is False]
+    said += [f"Warning ({r['config']}): {w}" for r in results for w in r.get("warnings", ())]
+    return " ".join(dict.fromkeys(said))

@@ -4,6 +4,11 @@ use), shown and refused in the unit the page shows the field in (Fz in kN), quot
 The boxes carry no ``min``/``max``/``step`` of their own: a browser turns a value outside them into
 "no value", which a page could only mistake for "empty" and replace by a default. The page reads
 the raw number and refuses it here, by name, in the box's unit.
+
+A box refuses at the field, as the design panel does: it sends its value on Enter or on leaving it
+(``debounce``), and the line under it (:func:`field_error`, kept up by :func:`check`) says at once
+what is wrong, quoting what was typed and the allowed range; the page's button refuses the same, by
+the same rules (:meth:`Quantity.read`).
 """
 
 from __future__ import annotations
@@ -12,7 +17,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from dash import dcc
+import dash
+from dash import Input, Output, dcc, html
 
 from shimmy.errors import InvalidParameterError
 from shimmy.service import schemas
@@ -48,34 +54,14 @@ class Quantity:
 
     @property
     def allowed(self) -> str:
-        kind = "an integer" if self.integer else "a number"
-        return f"{kind} in [{significant(self.low, 6)}, {significant(self.high, 6)}] {self.unit}".rstrip()
-
-    def _refuse(self, value: Any, why: str) -> InvalidParameterError:
-        return InvalidParameterError(self.name, value, self.allowed, message=why)
+        return _allowed(self.low, self.high, self.unit, self.integer)
 
     def shown(self, value: Any) -> str:
-        return f"{self.label} = {value:g} {self.unit}".rstrip() if isinstance(value, (int, float)) else \
-            f"{self.label} = {value}"
+        return _shown(self.label, value, self.unit)
 
     def read(self, value: Any) -> float | int:
         """The value typed into the box, in SI units; refused with a message in the box's unit."""
-        if value is None or (isinstance(value, str) and not value.strip()):
-            raise self._refuse(value, f"{self.label} is empty or not a number; enter {self.allowed}")
-        if isinstance(value, bool):
-            raise self._refuse(value, f"{self.label} = {value} is not a number; enter {self.allowed}")
-        try:
-            number = float(value)
-        except (TypeError, ValueError):
-            raise self._refuse(value, f"{self.label} = {value!s} is not a number; enter {self.allowed}") from None
-        if not math.isfinite(number):
-            raise self._refuse(value, f"{self.label} = {value!s} is not finite; enter {self.allowed}")
-        if self.integer and number != round(number):
-            raise self._refuse(value, f"{self.shown(number)} is not a whole number; enter {self.allowed}")
-        if not self.low <= number <= self.high:
-            raise self._refuse(value, f"{self.shown(number)} is outside [{significant(self.low, 6)}, "
-                                      f"{significant(self.high, 6)}] "
-                                      f"{self.unit}".rstrip())
+        number = typed_number(self.name, self.label, value, self.low, self.high, self.unit, self.integer)
         si = number * self.scale
         return int(round(si)) if self.integer else si
 
@@ -99,8 +85,109 @@ class Quantity:
         return number, None
 
     def box(self, box_id: str, value: float | None, **kwargs) -> dcc.Input:
-        """The number box (no browser-side limits: the page refuses a bad value by name)."""
+        """The number box (no browser-side limits: the page refuses a bad value by name), sending its
+        value on Enter or on leaving it."""
+        kwargs.setdefault("debounce", True)
         return dcc.Input(id=box_id, type="number", value=value, step="any", **kwargs)
+
+    def field(self, label: str, box_id: str, value: float | None, problem: str | None = None, **kwargs) -> html.Div:
+        """The labelled box with the line under it that refuses what is typed (:func:`check` keeps it up);
+        ``problem``: what it says when the page opens (a value of the address it cannot use)."""
+        return html.Div([html.Label(label, htmlFor=box_id), self.box(box_id, value, **kwargs),
+                         field_error(error_id(box_id), problem)], className="field")
+
+
+def _allowed(low: float, high: float, unit: str, integer: bool = False) -> str:
+    kind = "an integer" if integer else "a number"
+    return f"{kind} in [{significant(low, 6)}, {significant(high, 6)}] {unit}".rstrip()
+
+
+def _shown(label: str, value: Any, unit: str) -> str:
+    return f"{label} = {value:g} {unit}".rstrip() if isinstance(value, (int, float)) else f"{label} = {value}"
+
+
+def typed_number(name: str, label: str, value: Any, low: float, high: float, unit: str,
+                 integer: bool = False) -> float:
+    """What was typed into a box or a table cell, as a number in its unit (``unit``, range [low, high]);
+    refused by ``name`` with a message quoting what was typed, in that unit, and the range."""
+    allowed = _allowed(low, high, unit, integer)
+
+    def refuse(why: str) -> InvalidParameterError:
+        return InvalidParameterError(name, value, allowed, message=why)
+
+    if value is None or (isinstance(value, str) and not value.strip()):
+        raise refuse(f"{label} is empty or not a number; enter {allowed}")
+    if isinstance(value, bool):
+        raise refuse(f"{label} = {value} is not a number; enter {allowed}")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise refuse(f"{label} = {value!s} is not a number; enter {allowed}") from None
+    if not math.isfinite(number):
+        raise refuse(f"{label} = {value!s} is not finite; enter {allowed}")
+    if integer and number != round(number):
+        raise refuse(f"{_shown(label, number, unit)} is not a whole number; enter {allowed}")
+    if not low <= number <= high:
+        raise refuse(f"{_shown(label, number, unit)} is outside [{significant(low, 6)}, {significant(high, 6)}] "
+                     f"{unit}".rstrip())
+    return number
+
+
+@dataclass(frozen=True)
+class Column:
+    """A numeric column of an editable table as the page shows it: its id, label, unit and range (in that unit)."""
+
+    id: str
+    label: str
+    unit: str
+    low: float
+    high: float
+
+
+def cell_refusals(rows: Any, columns: list[Column]) -> list[tuple[int, str, str]]:
+    """(row index, column id, why) of every cell of ``rows`` that ``columns`` refuse: what was typed, in the
+    column's unit, and the range; the row is named as the table numbers it (from 1)."""
+    out = []
+    for i, row in enumerate(rows or []):
+        for c in columns:
+            try:
+                typed_number(f"row {i + 1}.{c.id}", f"row {i + 1}: {c.label}", (row or {}).get(c.id), c.low, c.high,
+                             c.unit)
+            except InvalidParameterError as exc:
+                out.append((i, c.id, str(exc)))
+    return out
+
+
+def cell_styles(refused: list[tuple[int, str, str]]) -> list[dict]:
+    """The DataTable's style_data_conditional marking each refused cell."""
+    return [{"if": {"row_index": i, "column_id": c}, "backgroundColor": "#fde8e4", "color": "#9b1c00",
+             "fontWeight": "600"} for i, c, _ in refused]
+
+
+def error_id(box_id: str) -> str:
+    """The id of the line under a box that says what is wrong with it."""
+    return f"{box_id}-error"
+
+
+def field_error(element_id: str, text: str | None = None) -> html.Div:
+    """The line under a field that says what is wrong with it."""
+    return html.Div(text, id=element_id, className="error field-error", role="alert")
+
+
+def refusal(read, value) -> str:
+    """Why ``read`` refuses ``value`` ('' if it accepts it)."""
+    try:
+        read(value)
+    except InvalidParameterError as exc:
+        return str(exc)
+    return ""
+
+
+def check(box_id: str, quantity: Quantity, error: str | None = None) -> None:
+    """The box's line says at once (on Enter or leaving the box) what is wrong with what was typed, in the
+    box's unit; empty once it is right (the page's button refuses the same, by the same rules)."""
+    dash.callback(Output(error or error_id(box_id), "children"), Input(box_id, "value"), prevent_initial_call=True)(
+        lambda value: refusal(quantity.read, value))
 
 
 @dataclass(frozen=True)

@@ -2,16 +2,42 @@
 
 from __future__ import annotations
 
+import math
+
 import plotly.graph_objects as go
+import plotly.io as pio
 
 CONFIG_COLOURS = {"original": "#000000", "nes": "#E69F00", "pd": "#0072B2", "nes_pd": "#009E73"}
 CONFIG_LABELS = {"original": "original", "nes": "NES", "pd": "PD", "nes_pd": "NES + PD"}
-SHIMMY_TYPE_COLOURS = {"Stable": "#FFFFFF", "Torsion": "#E69F00", "Lateral": "#56B4E9", "Bistable": "#CC79A7",
-                       "Both": "#117733"}  # Both: a dark green, far from Torsion's orange
+#: The shading of a map's regions. Torsion is Okabe–Ito yellow, not the NES's orange: a NES curve drawn over
+#: the torsion lobe stays visible (and every curve has a halo, :data:`HALO`); Both a dark green.
+SHIMMY_TYPE_COLOURS = {"Stable": "#FFFFFF", "Torsion": "#F0E442", "Lateral": "#56B4E9", "Bistable": "#CC79A7",
+                       "Both": "#117733"}
 #: One colour per compared design (dark and saturated: readable on white and over the map's shading,
 #: apart from the configurations' colours, which stay with the configurations).
 DESIGN_COLOURS = ("#1A1A1A", "#D55E00", "#0057B8", "#A0329A")
 ACCENT = "#0072B2"
+#: The halo under a curve drawn over shading: a white line this much wider (px), so that the curve reads on
+#: every region colour (:func:`halo`).
+HALO = {"color": "rgba(255,255,255,0.9)", "extra": 3.0}
+#: Axes without SI prefixes: an engineering axis in m reads 0.0004, never "400µ" (exponentformat "none"),
+#: on every axis of every figure (a template's layout.xaxis applies to every x axis of the figure).
+_AXIS = {"exponentformat": "none", "separatethousands": False}
+TEMPLATE = go.layout.Template(pio.templates["plotly_white"])
+TEMPLATE.layout.xaxis.update(_AXIS)
+TEMPLATE.layout.yaxis.update(_AXIS)
+TEMPLATE.data.heatmap = [go.Heatmap(colorbar={"exponentformat": "none"})]
+TEMPLATE.data.scatter = [go.Scatter(marker={"colorbar": {"exponentformat": "none"}})]
+#: The same for the plain-dict figures redrawn on every slider move (no template to send each time).
+LIGHT_TEMPLATE = {"layout": {"xaxis": dict(_AXIS), "yaxis": dict(_AXIS)}}
+#: Log-speed axes: the ticks 1, 2, 5, 10, 20, 50, 100, 200 m/s written out (not "2" for 20 and 200).
+LOG_SPEED_TICKS = [1, 2, 5, 10, 20, 50, 100, 200, 500]
+LOG_SPEED_AXIS = {"type": "log", "tickvals": LOG_SPEED_TICKS, "ticktext": [f"{v:g}" for v in LOG_SPEED_TICKS],
+                  "tickformat": "~g"}
+#: The hover text of an angle: rad, then degrees from the trace's customdata (:func:`in_degrees`).
+ANGLE_HOVER = "%{y:.4g} rad (%{customdata:.3g}°)"
+#: Characters a line of a placeholder's text: its plot is some 600 px wide at a 1024 px window.
+MESSAGE_WIDTH = 72
 #: Room above the plot for the figure toolbar and, below it, the title (they never overlap).
 MARGIN = {"l": 64, "r": 16, "t": 76, "b": 52}
 
@@ -28,7 +54,7 @@ _title = title
 def figure(title: str, x: str, y: str, height: int = 380) -> go.Figure:
     """An empty figure with axis titles (units included by the caller) and the house style."""
     fig = go.Figure()
-    fig.update_layout(title=_title(title), height=height, margin=MARGIN, template="plotly_white",
+    fig.update_layout(title=_title(title), height=height, margin=MARGIN, template=TEMPLATE,
                       legend={"orientation": "h", "y": -0.22, "x": 0}, hovermode="closest",
                       font={"family": "system-ui, -apple-system, Segoe UI, Roboto, sans-serif", "size": 12})
     fig.update_xaxes(title_text=x, showline=True, linecolor="#888", mirror=True, zeroline=False)
@@ -38,21 +64,44 @@ def figure(title: str, x: str, y: str, height: int = 380) -> go.Figure:
 
 def message_figure(text: str, height: int = 300) -> go.Figure:
     fig = go.Figure()
-    fig.add_annotation(text=text, showarrow=False, x=0.5, y=0.5, xref="paper", yref="paper",
+    fig.add_annotation(text=wrapped(text, MESSAGE_WIDTH), showarrow=False, x=0.5, y=0.5, xref="paper", yref="paper",
                        font={"size": 14, "color": "#555"})
-    fig.update_layout(height=height, template="plotly_white", xaxis={"visible": False}, yaxis={"visible": False},
+    fig.update_layout(height=height, template=TEMPLATE, xaxis={"visible": False}, yaxis={"visible": False},
                       margin={"l": 10, "r": 10, "t": 10, "b": 10})
     return fig
 
 
+def wrapped(text: str, width: int = 80) -> str:
+    """``text`` broken into lines of at most ``width`` characters with <br> (a Plotly annotation does not
+    wrap: at 1024 px a long line is clipped at the figure's edges)."""
+    lines, line = [], ""
+    for word in text.split():
+        if line and len(line) + 1 + len(word) > width:
+            lines.append(line)
+            line = word
+        else:
+            line = f"{line} {word}" if line else word
+    return "<br>".join(lines + [line] if line else lines)
+
+
+def in_degrees(values) -> list:
+    """Angles (rad) in degrees, for the customdata of :data:`ANGLE_HOVER` (None stays None)."""
+    return [None if v is None else math.degrees(v) for v in values]
+
+
+def halo(width: float) -> dict:
+    """The line drawn under a curve of ``width`` px over shading (same points, no hover, no legend)."""
+    return {"color": HALO["color"], "width": width + HALO["extra"]}
+
+
 def layout(title: str, x: str, y: str, height: int = 380, x_log: bool = False) -> dict:
     """The house layout as a plain dict (for figures rebuilt on every slider move: no validation cost)."""
-    axis = {"showline": True, "linecolor": "#888", "mirror": True, "zeroline": False, "gridcolor": "#e5e8ef"}
-    return {"title": _title(title), "height": height, "margin": dict(MARGIN), "template": "plotly_white",
+    axis = {"showline": True, "linecolor": "#888", "mirror": True, "zeroline": False, "gridcolor": "#e5e8ef", **_AXIS}
+    return {"title": _title(title), "height": height, "margin": dict(MARGIN), "template": LIGHT_TEMPLATE,
             "legend": {"orientation": "h", "y": -0.22, "x": 0}, "hovermode": "closest",
             "font": {"family": "system-ui, -apple-system, Segoe UI, Roboto, sans-serif", "size": 12},
             "plot_bgcolor": "#ffffff", "paper_bgcolor": "#ffffff",
-            "xaxis": {**axis, "title": {"text": x}, "type": "log" if x_log else "linear"},
+            "xaxis": {**axis, "title": {"text": x}, **(LOG_SPEED_AXIS if x_log else {"type": "linear"})},
             "yaxis": {**axis, "title": {"text": y}}}
 
 

@@ -103,3 +103,34 @@ def torque_cubic(a, k1: float, k3: float):
     """The cubic approximation k1 a + k3 a^3 (N m)."""
     a = np.asarray(a, dtype=float)
     return k1 * a + k3 * a ** 3
+
+
+#: The cubic's stated accuracy: within this relative torque error of the exact M(a) (docs/model.md).
+CUBIC_TOLERANCE = 0.01
+
+
+def cubic_range(r1: float, r2: float, r3: float, k_s: float, e_p: float,
+                tolerance: float = CUBIC_TOLERANCE) -> float:
+    """The largest relative rotation a0 (rad) with the cubic's torque within ``tolerance`` (relative)
+    of the exact torque for every 0 < |a| <= a0; the track's end (pi/6) if it never leaves it.
+
+    The error is scanned on 2000 angles up to 0.98 pi/6 (it grows like a^4 from a = 0, the a^5 term
+    the cubic drops) and its first crossing of ``tolerance`` refined by bisection to 1e-10 rad."""
+    A, rho, delta0 = geometry(r1, r2, r3)
+    k1, k3 = cubic_coefficients(r1, r2, r3, k_s, e_p)
+
+    def error(a):
+        exact = torque_core(np.asarray(a, dtype=float), A, rho, delta0, k_s, e_p)
+        return np.abs(torque_cubic(a, k1, k3) - exact) / np.abs(exact)
+
+    grid = np.linspace(0.0, 0.98 * VALID_ANGLE, 2001)[1:]
+    over = np.flatnonzero(error(grid) > tolerance)
+    if over.size == 0:
+        return VALID_ANGLE
+    if over[0] == 0:
+        return 0.0
+    low, high = float(grid[over[0] - 1]), float(grid[over[0]])
+    while high - low > 1e-10:
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if error(mid) <= tolerance else (low, mid)
+    return low

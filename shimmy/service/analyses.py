@@ -104,7 +104,7 @@ def devices(request: dict[str, Any], progress: Progress | None = None) -> dict[s
 def bifurcation(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     from ..analyses.diagrams.bifurcation import BifurcationOptions, bifurcation as run_bifurcation
 
-    options = BifurcationOptions(ntst=request["ntst"], seeds=request["seeds"])
+    options = BifurcationOptions(ntst=request["ntst"], seeds=request["seeds"], exact_nes=request["exact_nes"])
     return run_bifurcation(request["config"], request["Fz"], v_range=(request["v_min"], request["v_max"]),
                            params=_params(request), options=options, progress=progress).to_dict()
 

@@ -26,7 +26,7 @@ from ..version import __version__
 from ..continuation import errors as engine_errors
 from ..errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
 from ..model.parameters import PARAMETER_SPECS
-from . import admission, analyses, auth, cache, jobs, schemas, settings
+from . import admission, analyses, auth, cache, jobs, result_schemas, schemas, settings
 from .analyses import JOB_ANALYSES, SYNC_ANALYSES
 
 PREFIX = "/api/v1"
@@ -274,7 +274,8 @@ def submit_job():
     if not isinstance(body, dict):
         raise InvalidParameterError("body", type(body).__name__, "a JSON object", "is not a JSON object")
     if "analysis" not in body:
-        raise InvalidParameterError("analysis", None, "one of " + ", ".join(JOB_ANALYSES), "is required")
+        allowed = "one of " + ", ".join(JOB_ANALYSES)
+        raise InvalidParameterError("analysis", None, allowed, message=f"analysis is required; allowed: {allowed}")
     analysis = body["analysis"]
     if not isinstance(analysis, str):
         raise InvalidParameterError("analysis", analysis, "one of " + ", ".join(JOB_ANALYSES),
@@ -341,9 +342,15 @@ def openapi():
 
 
 def openapi_document() -> dict[str, Any]:
-    err = {"description": "bad input",
-           "content": {"application/json": {"schema": {"$ref": "#/components/schemas/Error"}}}}
     refusal = {"content": {"application/json": {"schema": {"$ref": "#/components/schemas/Error"}}}}
+    bad = {  # each status's answer as the API gives it (field names the part at fault)
+        "400": {**refusal, "description": "the body is not JSON, not a JSON object, or has an unknown field"},
+        "408": {**refusal, "description": "the body did not arrive within the read deadline"},
+        "413": {**refusal, "description": f"the body is larger than {settings.MAX_BODY_BYTES} bytes"},
+        "415": {**refusal, "description": "the body is not application/json"},
+        "422": {**refusal, "description": "a field is missing, of the wrong type or out of its range (field names "
+                "it, allowed says what is), a rule across fields is broken, or the solver did not converge"}}
+    no_job = {**refusal, "description": "no job with this id (or not one of this user's jobs)"}
     unauthorised = {**refusal, "description": "no credential, or a wrong, expired or revoked one (the same answer "
                     "whatever was wrong; field: Authorization)",
                     "headers": {"WWW-Authenticate": {"schema": {"type": "string"}}}}
@@ -360,7 +367,9 @@ def openapi_document() -> dict[str, Any]:
             "status": {"type": "string", "enum": ["queued", "running", "done", "failed", "cancelled"]},
             "progress": {"type": "number", "minimum": 0, "maximum": 1}, "message": {"type": "string"},
             "error": {"type": ["string", "null"]}, "user": {"type": ["string", "null"]},
-            "request": {"type": "object"}, "result": {"type": "object"}}},
+            "request": {"type": "object", "description": "the canonical request (defaults filled, SI units)"},
+            "result": {"type": "object", "description": "when done: the analysis's result (its schema: "
+                                                          "ANALYSIS_result)"}}},
         "JobList": {"type": "object", "required": ["total", "jobs", "by_user"], "properties": {
             "total": {"type": "integer", "description": "records matching the filters"},
             "records": {"type": "integer", "description": "records kept in all"},
@@ -371,6 +380,13 @@ def openapi_document() -> dict[str, Any]:
                 "queued": {"type": "integer"}, "running": {"type": "integer"}}}},
             "draining": {"type": "boolean"}, "limits": {"type": "object"}}}}
 
+    comps.update(result_schemas.COMPONENTS)
+    comps.update(Health=result_schemas.HEALTH, ParameterTable=result_schemas.PARAMETERS)
+
+    def answer(name: str) -> dict[str, Any]:
+        return {"content": {"application/json": {"schema": {"$ref": f"#/components/schemas/{name}"}}}}
+    comps.update({f"{name}_result": schema for name, schema in result_schemas.RESULTS.items()})
+
     def guarded(responses: dict[str, Any], scope: str) -> dict[str, Any]:
         return {**responses, "401": unauthorised, "403": {**forbidden, "description": forbidden["description"]
                                                             + f" (needs {scope})"}}
@@ -378,12 +394,14 @@ def openapi_document() -> dict[str, Any]:
     paths: dict[str, Any] = {
         "/health": {"get": {"summary": "liveness and a working cache (open: no credential, nothing about users)",
                             "security": [], "responses": {
-                                "200": {"description": "ok"},
-                                "503": {"description": "degraded: the cache cannot store results"}}}},
+                                "200": {"description": "ok", **answer("Health")},
+                                "503": {"description": "degraded: the cache cannot store results", **answer("Health")}}}},
         "/parameters": {"get": {"summary": "every parameter with unit, default, range and provenance (scope read)",
-                                "responses": guarded({"200": {"description": "the parameter table"}}, "read")}},
+                                "responses": guarded({"200": {"description": "the parameter table",
+                                                              **answer("ParameterTable")}}, "read")}},
         "/openapi.json": {"get": {"summary": "this document (scope read)",
-                                  "responses": guarded({"200": {"description": "the OpenAPI document"}}, "read")}},
+                                  "responses": guarded({"200": {"description": "the OpenAPI document", "content": {
+                                      "application/json": {"schema": {"type": "object"}}}}}, "read")}},
     }
     for name in SYNC_ANALYSES:
         s = schemas.SCHEMAS[name]
@@ -392,8 +410,8 @@ def openapi_document() -> dict[str, Any]:
             "summary": s.summary + " (scope compute)", "requestBody": {"required": True, "content": {
                 "application/json": {"schema": {"$ref": f"#/components/schemas/{name}_request"}}}},
             "responses": guarded({
-                "200": {"description": "the result (X-Shimmy-Cache: hit|miss)"}, "400": err, "408": err, "413": err,
-                "415": err, "422": err,
+                "200": {"description": "the result (X-Shimmy-Cache: hit|miss)", "content": {"application/json": {
+                    "schema": {"$ref": f"#/components/schemas/{name}_result"}}}}, **bad,
                 "429": {**refusal, "description": "not computed now: the worker's computations are all busy, or "
                         "this user's share of them or rate is spent (a cached answer is never refused)",
                         "headers": busy_headers}}, "compute")}}
@@ -406,12 +424,19 @@ def openapi_document() -> dict[str, Any]:
         comps[f"job_{name}"] = body
         job_bodies.append({"$ref": f"#/components/schemas/job_{name}"})
     job = {"description": "the job", "content": {"application/json": {"schema": {"$ref": "#/components/schemas/Job"}}}}
+    for name in JOB_ANALYSES:  # a job of each analysis, its result typed (a typed client picks it by analysis)
+        comps[f"Job_{name}"] = {"allOf": [{"$ref": "#/components/schemas/Job"}, {"type": "object", "properties": {
+            "analysis": {"const": name}, "result": {"$ref": f"#/components/schemas/{name}_result"}}}]}
+    job_with_result = {"description": "the job; its result when done", "content": {"application/json": {"schema": {
+        "oneOf": [{"$ref": f"#/components/schemas/Job_{name}"} for name in JOB_ANALYSES],
+        "discriminator": {"propertyName": "analysis", "mapping": {
+            name: f"#/components/schemas/Job_{name}" for name in JOB_ANALYSES}}}}}}
     paths["/jobs"] = {
         "post": {
             "summary": "start a long analysis (" + ", ".join(JOB_ANALYSES) + ") (scope compute)",
             "requestBody": {"required": True, "content": {"application/json": {"schema": {"oneOf": job_bodies}}}},
             "responses": guarded({
-                "202": {**job, "description": "accepted"}, "400": err, "408": err, "413": err, "415": err, "422": err,
+                "202": {**job, "description": "accepted (no result yet)"}, **bad,
                 "429": {**refusal, "description": "not queued: the job queue is full, this user has "
                         "SHIMMY_MAX_JOBS_PER_USER jobs queued or running, or the last places of the queue are kept "
                         "for other users' first jobs", "headers": busy_headers}}, "compute")},
@@ -424,14 +449,15 @@ def openapi_document() -> dict[str, Any]:
                 {"name": "limit", "in": "query", "schema": {"type": "integer", "minimum": 1, "maximum": 1000,
                                                             "default": 100}}],
             "responses": guarded({"200": {"description": "the records", "content": {"application/json": {
-                "schema": {"$ref": "#/components/schemas/JobList"}}}}, "422": err}, "admin")}}
+                "schema": {"$ref": "#/components/schemas/JobList"}}}},
+                "422": {**refusal, "description": "status or limit out of its range"}}, "admin")}}
     paths["/jobs/{id}"] = {
         "parameters": [{"name": "id", "in": "path", "required": True, "schema": {"type": "string"}}],
         "get": {"summary": "status, progress and (when done) the result (scope read; one's own jobs, any with admin)",
-                "responses": guarded({"200": job, "404": err}, "read")},
+                "responses": guarded({"200": job_with_result, "404": no_job}, "read")},
         "delete": {"summary": "cancel the job and delete it (later reads answer 404; a job other users asked for "
                               "too goes on for them) (scope compute)",
-                   "responses": guarded({"200": {**job, "description": "the job as cancelled"}, "404": err},
+                   "responses": guarded({"200": {**job, "description": "the job as cancelled"}, "404": no_job},
                                         "compute")}}
     comps_security = {"bearer": {"type": "http", "scheme": "bearer", "description": (
         "An API token (python -m shimmy tokens create --user NAME --scope read|compute|admin) as "
@@ -439,7 +465,10 @@ def openapi_document() -> dict[str, Any]:
         "listens beyond loopback); with SHIMMY_AUTH=none (the default on loopback) every request is let in.")}}
     return {"openapi": "3.1.0",
             "info": {"title": "shimmy API", "version": __version__,
-                     "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Limits: "
+                     "description": "Nose-landing-gear shimmy with a torsional NES and a particle damper. Units: every "
+                                    "number of a request and of a result is in SI units (loads Fz in N, lengths and "
+                                    "the lateral displacement in m, angles in rad, speeds in m/s, time in s), "
+                                    "whatever the workbench shows (kN, mm). Limits: "
                                     f"body <= {settings.MAX_BODY_BYTES} bytes, t_end <= {settings.MAX_T_END:g} s, "
                                     f"ntst <= {settings.MAX_NTST}, robustness samples <= "
                                     f"{settings.MAX_ROBUSTNESS_SAMPLES}; at most {settings.MAX_RUNNING_JOBS} jobs "

@@ -155,6 +155,7 @@ class Field:
             out["type"] = "array"
             out.pop("minimum", None)
             out.pop("maximum", None)
+            out.pop("enum", None)  # the choices are the items' (an enum here would list arrays)
             out["items"] = {"type": "number"} if self.kind == "numbers" else {"type": "string",
                                                                               "enum": list(self.choices or ())}
             out["minItems"] = 1

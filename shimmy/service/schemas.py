@@ -75,7 +75,8 @@ class RequestSchema:
         out = {"type": "object", "additionalProperties": False, "required": [f.name for f in self.fields if f.required],
                "properties": {f.name: f.openapi() for f in self.fields},
                "description": "Rules across fields (answered 422 naming the field): v_max above v_min, fz_max above "
-                              "fz_min, a design whose NES roller stays on its track (r2 + r3 > (sqrt(3)/4)(r1 + r2))."}
+                              "fz_min, params a design whose NES roller stays on its track (r2 + r3 > "
+                              "(sqrt(3)/4)(r1 + r2), with the defaults for the parameters not given)."}
         if self.name == "ground_run":
             out["description"] += (f" Ground run: profile rows [t, V, Fz] with t increasing, V and Fz within their "
                                    f"ranges, a run of at most {settings.MAX_T_END:g} s (refusals name profile[i].t, "
@@ -90,8 +91,9 @@ class RequestSchema:
             out["description"] += " " + _RULES[self.name]
         if self.name == "study":
             out["dependentRequired"] = {"parameter2": ["values2"], "values2": ["parameter2"]}
-            out["description"] += (f" Study: each value within its parameter's range; at most "
-                                   f"{settings.MAX_STUDY_UNITS} designs x configurations.")
+            out["description"] += (" Study: each of values (values2) within the range of parameter (parameter2); "
+                                   "parameter2 another parameter than parameter, given with values2; values x "
+                                   f"values2 x configs at most {settings.MAX_STUDY_UNITS} designs x configurations.")
         return out
 
 
@@ -244,12 +246,12 @@ def tolerance(field: str, item: Any) -> dict[str, Any]:
         name, sep, rest = item.replace(" ", "").partition("=")
         if not sep:
             raise InvalidParameterError(field, item, TOLERANCE_TEXT, "has no =")
-        text, _, dist = rest.partition(":")
+        text, colon, dist = rest.partition(":")
         try:
             relative: Any = float(text)
         except ValueError:
             relative = text
-        item = {"name": name, "relative": relative, "distribution": dist or "normal"}
+        item = {"name": name, "relative": relative, "distribution": dist if colon else "normal"}
     elif isinstance(item, Mapping):
         _item_keys(field, item, ("name", "relative", "distribution"))
         for key in ("name", "relative"):
@@ -265,8 +267,8 @@ def tolerance(field: str, item: Any) -> dict[str, Any]:
     if PARAMETER_SPECS[name].integer:
         raise InvalidParameterError(f"{field}.name", name, "a parameter that is not a whole number",
                                     "is a whole number: a relative tolerance does not apply")
-    dist = item.get("distribution") or "normal"
-    if dist not in DISTRIBUTIONS:
+    dist = item.get("distribution", "normal")  # absent: normal; a wrong type or an empty name is refused
+    if not isinstance(dist, str) or dist not in DISTRIBUTIONS:
         raise InvalidParameterError(f"{field}.distribution", dist, "normal or uniform", "is not a distribution")
     relative = _number_of(f"{field}.relative", item["relative"], 0.0, design_space.TOLERANCE_LIMITS[dist],
                           f"(a fraction of the value; {dist})")
@@ -329,6 +331,8 @@ _CHECKS = {"sensitivity": _check_sensitivity, "optimise": _check_optimise, "robu
            "margins": _check_margins}
 _RULES = {
     "margins": "Margins: min_size below max_size.",
+    "simulate": f"Simulate: with include_series, at most {settings.MAX_SERIES_POINTS} samples per series "
+                "(t_end / series_dt + 1; series_dt is refused, naming the smallest it may be for this t_end).",
     "optimise": "Optimise: the search parameters are parameters of the configuration (default: those of r2, e_p, "
                 "k_s, r3 it has); local_runs at most starts; method gradient only for figures with derivatives ("
                 + ", ".join(DIFFERENTIABLE) + "); constraints as 'FIGURE<=VALUE', 'FIGURE@Fz>=VALUE' or "
@@ -435,6 +439,7 @@ SCHEMAS: dict[str, RequestSchema] = {
         _range("v_max", DIAGRAM_V_RANGE[1], V_RANGE, "m/s", "highest speed"),
         Field("ntst", "integer", "collocation mesh intervals", default=40, low=10, high=settings.MAX_NTST),
         Field("seeds", "boolean", "look for branches not born at a Hopf point by simulation", default=True),
+        Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
         PARAMS, MATERIAL)),
     "hopf_curves": RequestSchema("hopf_curves", "Hopf curves of x = 0 in (V, Fz) with generalised Hopf points", (
         _config(), _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),

@@ -60,6 +60,27 @@ def test_cubic_fit_accuracy_against_the_exact_torque():
     assert r[1] / r[0] == pytest.approx(16.0, rel=0.1)
 
 
+@pytest.mark.parametrize("r2, e_p", [(0.08, 0.001), (0.07, 0.0005), (0.09, 0.005)])
+def test_cubic_range_ends_where_the_cubic_is_one_percent_off(r2, e_p):
+    """The cubic's range: at its end the relative torque error is 1 % (to the bisection's 1e-10 rad), and
+    below it, on a fine grid of its own, never more; the nominal design's range agrees with the stated
+    'within 1 % up to 0.09 rad, 1.23 % at 0.1 rad'."""
+    p = Parameters().with_overrides(r2=r2, e_p=e_p).nes
+    a0 = nes.cubic_range(p.r1, p.r2, p.r3, p.k_s, p.e_p)
+    k1, k3 = nes.cubic_coefficients(p.r1, p.r2, p.r3, p.k_s, p.e_p)
+
+    def error(a):
+        exact = nes.torque_exact(a, p.r1, p.r2, p.r3, p.k_s, p.e_p)
+        return np.abs(nes.torque_cubic(a, k1, k3) - exact) / np.abs(exact)
+
+    assert 0.05 < a0 < 0.2
+    assert error(a0) == pytest.approx(nes.CUBIC_TOLERANCE, rel=1e-6)
+    assert error(np.linspace(1e-4, a0, 5001)).max() <= nes.CUBIC_TOLERANCE * (1 + 1e-9)
+    assert error(a0 + 1e-4) > nes.CUBIC_TOLERANCE
+    if (r2, e_p) == (0.08, 0.001):
+        assert 0.09 < a0 < 0.1
+
+
 def test_stiffness_is_the_derivative_of_the_torque():
     a = np.linspace(-0.45, 0.45, 37)
     h = 1e-6

@@ -360,3 +360,111 @@ def test_optimise_and_robustness_jobs_complete_with_their_results(server):
     assert result["link_query"]["config"] == "nes" and float(result["link_query"]["k_s"]) == 1.3e6
     assert float(result["link_query"]["e_p"]) == pytest.approx(result["design"]["e_p"])
     assert any(0 < p < 1 for s, p in seen if s == "running")  # progress while it ran
+
+
+# --- The OpenAPI document describes the answers (its response schemas checked against real ones) ---
+# At the end of the module: the job bodies below are those the tests above ran, so most answers come
+# from this server's cache. Each answer is validated (jsonschema, the 2020-12 dialect of OpenAPI 3.1)
+# and every key it has must be declared by the schema (openapi_check.undeclared).
+
+RESULT_JOBS = [
+    {"analysis": "simulate", "config": "nes_pd", "V": 30, "Fz": 150000, "t_end": 20},
+    {"analysis": "bifurcation", "config": "original", "Fz": 150000, "v_min": 1, "v_max": 200},
+    {"analysis": "hopf_curves", "config": "nes"},
+    {"analysis": "map", "config": "original", "fz_min": 100000, "fz_max": 400000, "resolution": 4, "n_v": 20},
+    {"analysis": "study", "parameter": "e_p", "values": [0.0005, 0.005], "configs": ["nes"]},
+    {"analysis": "study", "parameter": "e_p", "values": [0.0005, 0.005], "parameter2": "k_s",
+     "values2": [1.2e6, 1.4e6], "configs": ["nes"]},
+    {"analysis": "ground_run", "config": "original", "preset": "takeoff", "hopf_curves": True},
+    {"analysis": "sensitivity", "config": "nes", "names": ["r2", "k_s"]},
+    {"analysis": "optimise", "config": "nes", "parameters": ["e_p"], "starts": 2, "local_runs": 1,
+     "constraints": ["max_psi<=0.5"], "params": {"k_s": 1.3e6}},
+    {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05", "k_s=0.05:uniform"], "samples": 16},
+    {"analysis": "margins", "config": "original", "V": 50, "Fz": 550000},
+    {"analysis": "basins", "config": "original", "V": 50, "Fz": 550000, "samples": 10},
+    {"analysis": "margin_map", "config": "original", "n_v": 4, "n_fz": 3},
+]
+
+
+def _answer_schema(doc, path, method, status):
+    return doc["paths"][path][method]["responses"][str(status)]["content"]["application/json"]["schema"]
+
+
+def _check_answer(doc, schema, answer, result_schema=None, result=None):
+    from openapi_check import errors, undeclared
+
+    assert errors(doc, schema, answer) == []
+    if result_schema is not None:
+        assert undeclared(doc, result_schema, result) == []
+    else:
+        assert undeclared(doc, schema, answer) == []
+
+
+def test_openapi_document_is_valid_openapi_3_1(server):
+    from openapi_spec_validator import validate
+
+    _, _, doc = server.request("GET", "/api/v1/openapi.json")
+    validate(doc)  # raises on the first fault, naming it
+    for path, item in doc["paths"].items():
+        for method, op in item.items():
+            if method == "parameters":
+                continue
+            ok = [s for s in op["responses"] if s.startswith("2")]
+            assert all("content" in op["responses"][s] for s in ok), (path, method)
+    for path in ("/health", "/parameters"):
+        status, _, answer = server.request("GET", "/api/v1" + path)
+        assert status == 200
+        _check_answer(doc, _answer_schema(doc, path, "get", 200), answer)
+
+
+def test_every_quick_answer_matches_its_response_schema(server):
+    _, _, doc = server.request("GET", "/api/v1/openapi.json")
+    bodies = {**OK_BODIES, "/api/v1/sensitivity": {"config": "nes", "names": ["r2"]},
+              "/api/v1/simulate": {**OK_BODIES["/api/v1/simulate"], "include_series": True, "series_dt": 0.005}}
+    assert {p.removeprefix("/api/v1") for p in bodies} == {p for p, i in doc["paths"].items()
+                                                           if "post" in i and p != "/jobs"}
+    for path, body in bodies.items():
+        status, _, answer = server.request("POST", path, body, timeout=120)
+        assert status == 200, answer
+        _check_answer(doc, _answer_schema(doc, path.removeprefix("/api/v1"), "post", 200), answer)
+
+
+def test_every_job_result_matches_its_response_schema(server):
+    _, _, doc = server.request("GET", "/api/v1/openapi.json")
+    from shimmy.service.analyses import JOB_ANALYSES
+
+    assert {b["analysis"] for b in RESULT_JOBS} == set(JOB_ANALYSES)
+    schema = _answer_schema(doc, "/jobs/{id}", "get", 200)
+    for body in RESULT_JOBS:
+        status, _, job = server.request("POST", "/api/v1/jobs", body)
+        assert status == 202, job
+        done, _ = _wait(server, job["id"], timeout=240)
+        assert done["status"] == "done", done
+        own = {"$ref": f"#/components/schemas/Job_{body['analysis']}"}  # the same as the oneOf, with clearer errors
+        _check_answer(doc, own, done, {"$ref": f"#/components/schemas/{body['analysis']}_result"}, done["result"])
+        _check_answer(doc, schema, done, {"$ref": f"#/components/schemas/{body['analysis']}_result"}, done["result"])
+        broken = {**done, "result": {**done["result"], "version": 1}}  # the check can fail: a wrong type is seen
+        from openapi_check import errors
+        assert errors(doc, schema, broken)
+
+
+def test_refusals_match_the_documented_status_and_error_schema(server):
+    _, _, doc = server.request("GET", "/api/v1/openapi.json")
+    error = {"$ref": "#/components/schemas/Error"}
+    cases = [("POST", "/simulate", {"config": "nes", "V": 30}, None, 422, "Fz"),
+             ("POST", "/simulate", None, b"{not json", 400, "body"),
+             ("POST", "/simulate", None, b"[1, 2]", 400, "body"),
+             ("POST", "/jobs", {"config": "nes"}, None, 422, "analysis"),
+             ("POST", "/jobs", {"analysis": "robustness", "config": "nes",
+                                "tolerances": [{"name": "r2", "relative": 0.05, "distribution": {}}]}, None, 422,
+              "tolerances[0].distribution"),
+             ("GET", "/jobs/doesnotexist", None, None, 404, "id")]
+    for method, path, body, raw, status, field in cases:
+        got, _, answer = server.request(method, "/api/v1" + path, body, raw=raw)
+        assert (got, answer["field"]) == (status, field), answer
+        documented = doc["paths"]["/jobs/{id}" if path.startswith("/jobs/") else path][method.lower()]["responses"]
+        assert str(status) in documented and documented[str(status)]["content"]["application/json"]["schema"] == error
+        _check_answer(doc, error, answer)
+    _, _, answer = server.request("POST", "/api/v1/jobs", {"config": "nes"})
+    assert answer["error"].startswith("analysis is required; allowed: one of simulate")
+    assert "no job" in doc["paths"]["/jobs/{id}"]["get"]["responses"]["404"]["description"]

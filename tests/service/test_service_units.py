@@ -69,6 +69,45 @@ def test_openapi_fields_match_the_schemas():
     assert "Retry-After" in doc["paths"]["/jobs"]["post"]["responses"]["429"]["headers"]
 
 
+# Requests the document's JSON Schema admits but a rule across fields refuses: each refusal names a field
+# that the request schema's description states the rule for (an outside client that generates requests
+# from the document meets no unstated rule).
+ACROSS_FIELDS = [
+    ("hopf", {"config": "nes", "Fz": 150000, "v_min": 100, "v_max": 50}, "v_max"),
+    ("map", {"config": "nes", "fz_min": 500000, "fz_max": 100000}, "fz_max"),
+    ("simulate", {"config": "nes", "V": 30, "Fz": 150000, "params": {"r2": 0.07, "r3": 0.0095, "r1": 0.13}},
+     "params"),
+    ("simulate", {"config": "nes", "V": 30, "Fz": 150000, "t_end": 600, "include_series": True,
+                  "series_dt": 0.001}, "series_dt"),
+    ("study", {"parameter": "r2", "values": [0.07], "parameter2": "r2", "values2": [0.08]}, "parameter2"),
+    ("study", {"parameter": "r2", "values": [0.5]}, "values[0]"),
+    ("optimise", {"config": "nes", "starts": 2, "local_runs": 3}, "local_runs"),
+    ("optimise", {"config": "nes", "parameters": ["a_p"]}, "parameters[0]"),
+    ("robustness", {"config": "nes", "tolerances": ["r2=0.05", "r2=0.01"]}, "tolerances[1].name"),
+    ("margins", {"config": "nes", "V": 50, "Fz": 550000, "min_size": 0.05, "max_size": 0.04}, "min_size"),
+]
+
+
+@pytest.mark.parametrize("analysis, body, field", ACROSS_FIELDS)
+def test_rules_across_fields_are_stated_in_the_document(analysis, body, field):
+    import jsonschema
+    from shimmy.errors import GeometryError, InvalidParameterError
+    from shimmy.service.api import openapi_document
+
+    doc = openapi_document()
+    named_schemas = doc["components"]["schemas"]
+    request_schema = named_schemas.get(f"{analysis}_request") or named_schemas[f"job_{analysis}"]
+    as_sent = body if f"{analysis}_request" in named_schemas else {"analysis": analysis, **body}
+    jsonschema.validate(as_sent, request_schema)  # valid by the document
+    with pytest.raises((InvalidParameterError, GeometryError)) as refused:
+        from shimmy.service import analyses
+
+        analyses.RUNNERS[analysis](schemas.validate(analysis, body), None)
+    named = getattr(refused.value, "field", None) or "params"
+    assert named.startswith(field.split("[")[0]) or named == field, (named, field)
+    assert field.split("[")[0].split(".")[0] in request_schema["description"]
+
+
 def test_url_design_state_round_trip_and_bad_keys():
     from ui import state
 

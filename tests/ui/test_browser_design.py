@@ -106,8 +106,18 @@ def test_a_small_optimiser_run_shows_the_optimum_and_opens_it_in_the_workbench(s
                                    ".map(r => [...r.cells].map(c => c.innerText));")
     assert len(cells) == 1 and cells[0][0] == "e_p"
     optimum = float(cells[0][4])
-    figures = text_of(browser, "opt-figures-table")
+    on_bound = min(abs(optimum - 0.0005), abs(optimum - 0.005)) <= 1e-3 * (0.005 - 0.0005)
+    assert ("the range limits it" in cells[0][6]) == on_bound and (cells[0][6] == "inside the range") != on_bound
+    assert ("the range limits the optimum" in text_of(browser, "opt-summary")) == on_bound
+    figures = text_of(browser, "opt-figures-table")  # every figure of merit, for optimum, current and original
     assert "minimum shimmy load (kN)" in figures and "largest stable torsional amplitude at 150 kN (rad)" in figures
+    assert "shimmy speed interval width at 150 kN" in figures and "pure-torsion area" in figures
+    rows = browser.execute_script("return [...document.querySelectorAll('#opt-figures-table tbody tr')]"
+                                  ".map(r => [...r.cells].map(c => c.innerText));")
+    assert len(rows) == 4 and all(len(r) == 4 and "–" not in r[1:] for r in rows)
+    browser.execute_script("document.getElementById('opt-summary').scrollIntoView({block: 'start'});")
+    time.sleep(0.3)
+    browser.save_screenshot(str(SHOTS / "design-optimiser-tables.png"))
     assert "evaluations (gradient)" in text_of(browser, "opt-result-line")
     history = wait_for(lambda: on_figure(browser, "opt-history", "return g.data.map(t => t.name);"), timeout=20,
                        what="the convergence history")

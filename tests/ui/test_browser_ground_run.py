@@ -69,7 +69,7 @@ def test_ground_run_page_runs_the_presets_and_a_table(server, browser):
     path = DOWNLOADS / "ground_run_takeoff.csv"
     wait_for(lambda: path.exists() and path.stat().st_size > 0, timeout=20, what="the CSV download")
     table = list(csv.reader(io.StringIO(path.read_text())))
-    assert table[0][:4] == ["config", "t_s", "V_m_s", "Fz_N"]
+    assert table[0][:4] == ["config", "t_s", "V_m_s", "Fz_kN"]
     assert {r[0] for r in table[1:]} == {"original", "nes", "pd", "nes_pd"}
 
     # An edited table runs instead of the preset: start at 30 m/s (inside the unstable region).

@@ -7,6 +7,7 @@ point, a 2 x 2 plane; waits, no timing assertions."""
 from __future__ import annotations
 
 import re
+import time
 
 import pytest
 
@@ -143,4 +144,53 @@ def test_margins_on_the_map_over_its_regions_and_a_click_runs_from_the_kick(serv
     wait_for(lambda: "torsional limit cycle" in text_of(browser, "th-settled"), timeout=240,
              what="the run from the cell's kick to end torsional")
     assert "Bistable" in text_of(browser, "th-bistable")
+    assert severe(browser) == []
+
+
+def test_a_bistable_map_point_runs_every_start_and_the_series_shows_the_last_cycles(server, browser):
+    """Opened from a Bistable map point with run=1: the standard start and the two large starts are run and
+    tabulated with the attractor each ends on (lateral from the standard start, torsional from a large
+    yaw); the series figure opens on the last cycles, every sample as a line there and the whole run as
+    a band, and the line follows a zoom from the cached result."""
+    open_page(browser, server, POINT + "&run=1", clear_log=True)
+    wait_for(lambda: len(browser.find_elements(By.CSS_SELECTOR, "#th-starts tbody tr")) == 3, timeout=300,
+             what=lambda: "the three starts (" + text_of(browser, "th-status") + text_of(browser, "th-error") + ")")
+    rows = [[td.text for td in tr.find_elements(By.TAG_NAME, "td")]
+            for tr in browser.find_elements(By.CSS_SELECTOR, "#th-starts tbody tr")]
+    assert rows[0][0].startswith("psi0 = 0.001 rad") and "lateral limit cycle" in rows[0][1]
+    assert rows[1][0].startswith("psi0 = 0.2 rad") and "torsional limit cycle" in rows[1][1]
+    assert float(rows[1][2]) == pytest.approx(0.187, rel=0.03)
+    idle(browser)
+    shape = on_figure(browser, "th-series", "return [g.layout.xaxis.range, g.data.length, g.data[2].x.length, "
+                                            "g.data[1].fill, (g.layout.xaxis3 || {}).rangeslider.visible, "
+                                            "g.data[2].x[0], g.data[2].x[g.data[2].x.length - 1]];")
+    (t0, t1), traces, samples, fill, slider, first, last = shape
+    assert traces == 9 and fill == "tonexty" and slider is True  # three rows: band top, band, line
+    assert 55 < t0 < t1 == pytest.approx(60) and t1 - t0 < 1.5  # the last 8 cycles at ~12 Hz
+    assert samples <= 800 and first <= t0 + 0.01 and last >= t1 - 0.01  # every sample of the window
+    browser.execute_script("Plotly.relayout(document.querySelector('#th-series .js-plotly-plot'), "
+                           "{'xaxis.range': [10, 11]});")
+    wait_for(lambda: on_figure(browser, "th-series", "return g.data[2].x[0];") is not None
+             and 9.9 < on_figure(browser, "th-series", "return g.data[2].x[0];") <= 10.0, timeout=20,
+             what="the line to follow the zoom")
+    browser.execute_script("Plotly.relayout(document.querySelector('#th-series .js-plotly-plot'), "
+                           "{'xaxis.autorange': true});")
+    wait_for(lambda: on_figure(browser, "th-series", "return g.layout.annotations[0].visible;") is True, timeout=20,
+             what="the note that the whole run is too long for a line")
+    assert on_figure(browser, "th-series", "return g.data[2].x.length;") == 0
+    browser.execute_script("Plotly.relayout(document.querySelector('#th-series .js-plotly-plot'), "
+                           "{'xaxis.range': [52, 60]});")
+    wait_for(lambda: on_figure(browser, "th-series", "return g.layout.annotations[0].visible;") is False, timeout=20,
+             what="the line back for 8 s")
+    idle(browser)
+    time.sleep(0.5)  # the redraw has landed: the view stays where the user put it
+    assert on_figure(browser, "th-series", "return g.layout.xaxis.range;") == pytest.approx([52, 60], abs=1e-6)
+    browser.execute_script("document.getElementById('th-series').scrollIntoView({block: 'start'})")
+    idle(browser)
+    browser.save_screenshot(str(SHOTS / "time-history-series-1440.png"))
+    browser.execute_script("window.scrollTo(0, 0)")
+    browser.save_screenshot(str(SHOTS / "time-history-bistable-starts-1440.png"))
+    _small(browser)
+    browser.save_screenshot(str(SHOTS / "time-history-bistable-starts-1024.png"))
+    browser.set_window_size(1440, 900)
     assert severe(browser) == []

@@ -224,7 +224,7 @@ def test_map_operating_points_colours_cancel_progress_and_cached_return(server, 
         return {op: op ? op.text : null, torsion: key('Torsion'), both: key('Both'),
                 legends: [g.layout.legend.title.text, g.layout.legend2.title.text, g.layout.legend3.title.text]};""")
     assert info["op"] == ["A", "B", "C", "D", "E", "F"]  # inside 100-400 kN, 1-200 m/s
-    assert info["torsion"].lower() == "#e69f00" and info["both"].lower() == "#117733"
+    assert info["torsion"].lower() == "#f0e442" and info["both"].lower() == "#117733"  # Torsion apart from NES orange
     assert info["legends"][0] == "configuration (colour):"
     browser.save_screenshot(str(SHOTS / "stability-map-operating-points.png"))
     # Back on the page later: the cached map is shown without pressing Compute.
@@ -343,4 +343,28 @@ def test_paired_fields_share_a_row_and_the_sidebar_collapses(server, browser):
     open_page(browser, server, "/bifurcation", (1024, 768))
     image = browser.execute_script("return getComputedStyle(document.querySelector('.body')).backgroundImage")
     assert "linear-gradient" in image
+    assert severe(browser) == []
+
+
+def test_an_nes_rotation_beyond_the_cubic_is_said_and_the_exact_torque_is_a_choice(server, browser):
+    """Point D with the NES (50 m/s, 350 kN): the NES relative rotation reaches about 0.16 rad, beyond the
+    cubic's 1 % range (0.094 rad for the nominal design); the run says so at once, and the exact torque,
+    chosen on the page, answers without the warning."""
+    open_page(browser, server, "/time-history?config=nes&V=50&Fz=350&t_end=20&run=1")
+    said = wait_for(lambda: text_of(browser, "th-error"), timeout=120, what="the run's warning")
+    assert "NES rotation beyond the cubic's range" in said and "0.0939 rad" in said
+    assert "cubic fit\nNES torque" in text_of(browser, "th-metrics")
+    exact = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#th-exact input[value='exact']"),
+                     what="the exact torque choice")[0]
+    exact.click()
+    wait_for(lambda: "exact_nes=1" in browser.current_url, timeout=10, what="the address to carry the choice")
+    idle(browser)
+    browser.find_element(By.ID, "th-run").click()
+    wait_for(lambda: "exact\nNES torque" in text_of(browser, "th-metrics"), timeout=180, what="the exact run")
+    assert text_of(browser, "th-error") == ""  # within the exact torque's validity: nothing to warn of
+    browser.save_screenshot(str(SHOTS / "time-history-exact-nes-1440.png"))
+    # The bifurcation page offers the same choice and says the same of the cubic's diagram.
+    open_page(browser, server, "/bifurcation")
+    assert browser.find_elements(By.CSS_SELECTOR, "#bif-exact input[value='exact']")
+    assert browser.find_elements(By.CSS_SELECTOR, "#gr-exact input") == []  # one page's ids, not another's
     assert severe(browser) == []

@@ -95,9 +95,9 @@ def test_ground_run_thresholds_are_refused_in_the_boxes_unit_never_defaulted():
     no_kick = ("none", None, "time", None)
     for psi, lateral, text in ((None, 1.0, "threshold |psi| is empty"), (0.01, 5000.0, "5000 mm is outside")):
         with pytest.raises(InvalidParameterError) as err:
-            ground_run._requests("original", "takeoff", [], [], [], psi, lateral, *no_kick, {})
+            ground_run._requests("original", "takeoff", [], [], [], psi, lateral, "cubic", *no_kick, {})
         assert text in str(err.value)
-    request = ground_run._requests("original", "takeoff", [], [], [], 0.02, 2.0, *no_kick, {})[0]
+    request = ground_run._requests("original", "takeoff", [], [], [], 0.02, 2.0, "cubic", *no_kick, {})[0]
     assert request["psi_threshold"] == 0.02 and request["lateral_threshold"] == pytest.approx(0.002)
     assert "kick" not in request
 
@@ -112,10 +112,103 @@ def test_ground_run_kick_boxes_are_refused_in_their_unit_and_a_scenario_fills_th
                        (("psi", 0.1, "speed", "abc"), "the kick's speed = abc is not a number"),
                        (("psi", 0.1, "speed", 600), "the kick's speed = 600 m/s is outside [1, 500] m/s")):
         with pytest.raises(InvalidParameterError) as err:
-            ground_run._requests("original", "takeoff", [], [], [], 0.01, 1.0, *kick, {})
+            ground_run._requests("original", "takeoff", [], [], [], 0.01, 1.0, "cubic", *kick, {})
         assert text in str(err.value)
-    request = ground_run._requests("nes", "runway_joint", [], [], [], 0.01, 1.0, "dpsi", 2.0, "speed", 50.0, {})[0]
+    request = ground_run._requests("nes", "runway_joint", [], [], [], 0.01, 1.0, "cubic", "dpsi", 2.0, "speed", 50.0,
+                                   {})[0]
     assert request["preset"] == "takeoff"  # the page sends the scenario's preset and the boxes' kick
     assert (request["kick"], request["kick_size"], request["kick_at_speed"]) == ("dpsi", 2.0, 50.0)
     assert ground_run.scenario_kick("touchdown_yaw")[:4] == ("psi", 0.05, "time", 0.0)
     assert ground_run.kick_outcome(None) == "– (no kick)"
+    assert ground_run.kick_size_refusal("psi", 0.8).startswith("the kick size (yaw angle psi) = 0.8 rad is outside")
+    assert ground_run.kick_size_refusal("dpsi", 0.8) == "" and ground_run.kick_size_refusal("none", "abc") == ""
+    assert "the kick's time = -1e+06 s is outside" in ground_run.kick_moment_refusal("psi", "time", -1e6)
+
+
+def _number_boxes(component):
+    """Every number box of a layout (a Dash component tree)."""
+    from dash import dcc
+
+    found = []
+
+    def walk(c):
+        if isinstance(c, dcc.Input) and getattr(c, "type", None) == "number":
+            found.append(c)
+        children = getattr(c, "children", None)
+        for child in children if isinstance(children, (list, tuple)) else [children]:
+            if child is not None and hasattr(child, "to_plotly_json"):
+                walk(child)
+
+    walk(component)
+    return found
+
+
+@pytest.mark.parametrize("module", ["ground_run", "time_history", "bifurcation", "stability_map", "study", "overview"])
+def test_every_number_box_refuses_at_its_field_on_enter_or_leaving_it(module):
+    """Each box of the page sends its value on Enter or blur (debounce) and has the line under it that a
+    callback fills with the refusal, in the box's unit (the design panel's boxes have their own)."""
+    import importlib
+
+    import app  # noqa: F401 - registers the pages
+    import dash
+
+    page = importlib.import_module(f"pages.{module}")
+    boxes = [b for b in _number_boxes(page.layout()) if isinstance(b.id, str)]
+    assert boxes, module
+    callbacks = {**app.app.callback_map, **dash._callback.GLOBAL_CALLBACK_MAP}
+    outputs = {o for cb in callbacks for o in cb.strip(".").split("..")}
+    for box in boxes:
+        assert box.debounce is True, box.id
+        assert f"{fields.error_id(box.id)}.children" in outputs, box.id
+
+
+def test_a_ground_run_threshold_is_refused_at_its_box_in_its_unit():
+    import app  # noqa: F401 - registers the pages
+    from pages import ground_run
+
+    assert fields.refusal(ground_run.PSI_THR.read, 5) == \
+        "the shimmy threshold |psi| = 5 rad is outside [1e-06, 1] rad"
+    assert fields.refusal(ground_run.LAT_THR.read, 5000) == \
+        "the shimmy threshold |l_g delta| = 5000 mm is outside [0.0001, 1000] mm"
+    assert fields.refusal(ground_run.PSI_THR.read, 0.02) == ""
+
+
+def test_table_cells_are_refused_by_row_and_column_as_typed_in_the_columns_unit():
+    import app  # noqa: F401 - registers the pages
+    from pages import ground_run
+
+    rows = [{"t": 0, "V": 10, "Fz": 150}, {"t": 1, "V": 600, "Fz": "abc"}, {"t": 2, "V": 20, "Fz": 5}]
+    refused = fields.cell_refusals(rows, ground_run.PROFILE_COLUMNS)
+    assert refused == [(1, "V", "row 2: V = 600 m/s is outside [1, 500] m/s"),
+                       (1, "Fz", "row 2: Fz = abc is not a number; enter a number in [10, 900] kN"),
+                       (2, "Fz", "row 3: Fz = 5 kN is outside [10, 900] kN")]
+    message, marks = ground_run.check_table(rows)
+    assert "row 2: V = 600 m/s" in message and {"row_index": 2, "column_id": "Fz"} in [m["if"] for m in marks]
+
+
+def test_the_ground_run_settings_show_and_refuse_loads_in_kn():
+    import app  # noqa: F401 - registers the pages
+    from pages import ground_run
+
+    rows = ground_run.preset_settings("takeoff")
+    static = next(r for r in rows if r["name"] == "Fz_static")
+    assert (static["value"], static["unit"], static["range"]) == (150.0, "kN", "20 – 900")
+    assert ground_run._settings(rows)["Fz_static"] == 150e3  # the request keeps N
+    static["value"] = 5000
+    assert ground_run.preset_table(rows, None, "takeoff")[3] == "Fz_static = 5000 kN is outside [20, 900] kN"
+    static["value"] = 150
+    next(r for r in rows if r["name"] == "Fz_rotate")["value"] = 200
+    assert ground_run.preset_table(rows, None, "takeoff")[3] == (
+        "Fz_rotate = 200 kN is refused; allowed: a number up to Fz_static = 150 kN")
+
+
+def test_a_preset_table_steps_by_exactly_its_dt():
+    import numpy as np
+
+    from shimmy.analyses.ground.ground_profiles import preset
+
+    for name in ("takeoff", "landing", "taxi"):
+        p = preset(name)
+        steps = np.diff(p.t)
+        assert np.allclose(steps[:-1], 0.5) and 0 < steps[-1] <= 0.5 + 1e-12, name
+    assert preset("landing").t[-1] == pytest.approx((65 - 8) / 2.5)  # ends where the roll ends

@@ -4,15 +4,14 @@ line that says a shown result no longer answers the page's controls."""
 
 from __future__ import annotations
 
-import dash
-from dash import Input, Output, html
+from dash import html
 
 from shimmy.errors import InvalidParameterError
 from shimmy.model.parameters import PARAMETER_SPECS
 from shimmy.service import schemas
 from ui import components as ui
-from ui import merits, style
-from ui.fields import Quantity
+from ui import fields, merits, style
+from ui.fields import Quantity, field_error, refusal  # noqa: F401 - the sections' names for them
 
 CONFIGS = ui.CONFIGS
 FZ = Quantity("sensitivity", "Fz", "Fz", "kN", 1e3)
@@ -38,29 +37,14 @@ def unit_suffix(name: str) -> str:
     return f" ({unit})" if unit else ""
 
 
-def field_error(element_id: str, text: str | None = None) -> html.Div:
-    """The line under a field that says what is wrong with it."""
-    return html.Div(text, id=element_id, className="error field-error", role="alert")
-
-
 def placeholder(text: str) -> html.P:
     """What stands where a result will be drawn."""
     return html.P(text, className="hint placeholder")
 
 
-def refusal(read, value) -> str:
-    """Why ``read`` refuses ``value`` ('' if it accepts it)."""
-    try:
-        read(value)
-    except InvalidParameterError as exc:
-        return str(exc)
-    return ""
-
-
 def check_field(box: str, error_id: str, quantity: Quantity) -> None:
-    """The field says at once what is wrong with it, in its unit (the run refuses the same, by the same rules)."""
-    dash.callback(Output(error_id, "children"), Input(box, "value"), prevent_initial_call=True)(
-        lambda value: refusal(quantity.read, value))
+    """The field says at once what is wrong with it, in its unit (:func:`ui.fields.check`)."""
+    fields.check(box, quantity, error_id)
 
 
 def stale(shown, config, fz_kn, design) -> str:

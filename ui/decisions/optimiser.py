@@ -221,14 +221,18 @@ def opt_summary(result):
 
 def opt_design(result):
     base = result["params"]
+    bounds = {b["name"]: b["bound"] for b in result.get("at_bounds", ())}
     rows = []
     for name in result["parameters"]:
         spec = PARAMETER_SPECS[name]
         old, new = base[name], result["design"][name]
         rows.append([name, spec.unit or "–", f"{formats.compact(spec.low)} – {formats.compact(spec.high)}",
                      formats.compact(old), formats.compact(new),
-                     formats.signed_percent(100 * (new - old) / old if old else None)])
-    return ui.table(["parameter", "unit", "range", "current design", "optimum", "change"], rows, ids.OPT_DESIGN_TABLE)
+                     formats.signed_percent(100 * (new - old) / old if old else None),
+                     {"low": "lower bound: the range limits it", "high": "upper bound: the range limits it"}.get(
+                         bounds.get(name), "inside the range")])
+    return ui.table(["parameter", "unit", "range", "current design", "optimum", "change", "optimum in the range"],
+                    rows, ids.OPT_DESIGN_TABLE)
 
 
 def opt_figures(result):

@@ -20,6 +20,7 @@ from ...model.configurations import STATE_NAMES, Configuration
 from ...model.equations import build_model
 from ...errors import InvalidParameterError
 from ...model.parameters import Parameters, check_number, check_operating_point
+from . import nes_range
 from .summaries import simulation_summary
 from .response import (DECAYED_FRACTION, ResponseType, classify_run, dominant_frequency, peak_amplitude,
                        power_spectra)
@@ -96,6 +97,7 @@ class SimulationResult:
     message: str
     counters: dict[str, int] = field(default_factory=dict)
     elapsed_s: float = 0.0
+    warnings: list[str] = field(default_factory=list)
 
     def state(self, name: str) -> np.ndarray:
         return self.states[STATE_NAMES.index(name)]
@@ -113,7 +115,7 @@ class SimulationResult:
             "response_type": self.response_type.value, "steady": self.steady,
             "success": self.success, "message": self.message,
             "counters": dict(self.counters), "options": self.options.to_dict(),
-            "params": self.params.to_dict(), "version": __version__,
+            "params": self.params.to_dict(), "warnings": list(self.warnings), "version": __version__,
         }
         if include_series:
             out["series"] = self.series()
@@ -185,11 +187,12 @@ def simulate(config: Configuration | str, V: float, Fz: float, *, params: Parame
     t = np.arange(written) * options.dt_out
     states = np.ascontiguousarray(out[:written, :n].T)
     measures = _steady_measures(states, start[:n], params, options, frequency)
+    beyond = nes_range.warning(config, params, nes_range.rotation_peak(states), options.exact_nes)
     return SimulationResult(
         config=config, V=V, Fz=Fz, params=params, options=options, t=t, states=states,
         success=status == integrator.SUCCESS, status=int(status), message=STATUS_MESSAGES[status],
         counters={"steps": int(accepted), "rejected": int(rejected), "rhs_calls": int(calls)},
-        elapsed_s=elapsed, **measures)
+        elapsed_s=elapsed, warnings=[beyond] if beyond else [], **measures)
 
 
 def kicked_state(config: Configuration | str, params: Parameters, psi0: float = DEFAULT_PSI0,

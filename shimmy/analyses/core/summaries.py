@@ -37,7 +37,8 @@ def simulation_summary(result: dict[str, Any]) -> str:
             f"  max |psi|       {amp['psi']:.6g} rad\n"
             f"  max |l_g delta| {mm(amp['lateral'])}\n"
             f"  frequency       {freq}\n"
-            f"  {result['message']}")
+            f"  {result['message']}"
+            + "".join(f"\n  warning: {w}" for w in result.get("warnings", ())))
 
 
 def devices_summary(devices: dict[str, Any]) -> str:

@@ -316,6 +316,8 @@ class OptimisationResult:
     elapsed_s: float
     executor: str
     warnings: list[str] = field(default_factory=list)
+    #: the searched parameters the optimum has on a bound of their range (:func:`bounds_reached`)
+    at_bounds: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def evaluations(self) -> int:
@@ -341,7 +343,7 @@ class OptimisationResult:
                 "figures": self.figures, "evaluations": self.evaluations, "history": self.history,
                 "feasible": self.feasible, "message": self.message, "link_query": self.link_query,
                 "params": self.params.to_dict(), "elapsed_s": self.elapsed_s, "executor": self.executor,
-                "warnings": self.warnings, "version": __version__}
+                "warnings": self.warnings, "at_bounds": self.at_bounds, "version": __version__}
 
     def summary_text(self) -> str:
         """The lines ``python -m shimmy optimise`` prints
@@ -476,10 +478,14 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz", *,
     if best is None:
         raise ConvergenceError("no design could be evaluated: " + history[0].get("reason", "unknown reason"))
     design = best["design"]
+    at_bounds = bounds_reached(design)
+    if at_bounds:
+        warnings.append("the range limits the optimum: " + "; ".join(
+            f"{b['name']} at its {'lower' if b['bound'] == 'low' else 'upper'} bound {b['limit']:g} "
+            f"{PARAMETER_SPECS[b['name']].unit}".rstrip() for b in at_bounds)
+            + ". A wider range (or another parameter) could improve it further.")
     report(0.96, "figures of the optimum, the nominal design and original")
-    keys = problem.wanted
-    if ("min_shimmy_Fz", None) not in keys:
-        keys = keys + [("min_shimmy_Fz", None)]
+    keys = list(dict.fromkeys(problem.wanted + _all_figures(Fz)))  # every figure of merit, the asked ones first
     optimum_params = params.with_overrides(design)
     tables = run_units(_evaluate_unit, [(config.value, optimum_params.to_dict(), names, list(design.values()),
                                          keys, False),
@@ -498,4 +504,27 @@ def optimise(config: Configuration | str, objective: str = "min_shimmy_Fz", *,
     report(1.0, "done")
     return OptimisationResult(config, objective, Fz, names, cons, chosen, design, best["objective"], nominal, figures,
                               history, bool(feasible), message, params, time.perf_counter() - clock,
-                              type(executor).__name__, warnings)
+                              type(executor).__name__, warnings, at_bounds)
+
+
+#: How close to a range bound (a fraction of the range) an optimum's parameter counts as on it: the
+#: local search (SLSQP) stops on a bound to round-off, differential evolution within its tolerance 1e-3.
+BOUND_TOLERANCE = 1e-3
+
+
+def bounds_reached(design: dict[str, float]) -> list[dict[str, Any]]:
+    """The parameters of ``design`` on a bound of their range: [{name, bound ("low" | "high"), limit,
+    value}], in the design's order."""
+    out = []
+    for name, value in design.items():
+        spec = PARAMETER_SPECS[name]
+        width = spec.high - spec.low
+        for bound, limit in (("low", spec.low), ("high", spec.high)):
+            if abs(value - limit) <= BOUND_TOLERANCE * width:
+                out.append({"name": name, "bound": bound, "limit": limit, "value": value})
+    return out
+
+
+def _all_figures(Fz: float) -> list[tuple[str, float | None]]:
+    """Every figure of merit, those taken at a load at ``Fz``: the table of optimum, nominal and original."""
+    return [(name, Fz if f.at_load else None) for name, f in FIGURES.items()]

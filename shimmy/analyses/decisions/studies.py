@@ -17,7 +17,8 @@ from ...version import __version__
 from ..diagrams.bifurcation import BifurcationOptions, bifurcation
 from ...model.configurations import CONFIGURATION_NAMES, Configuration
 from ...errors import ConvergenceError, InvalidParameterError
-from ..core.executors import name_of, run_units
+from ..core.executors import name_of, open_executor, run_units
+from .max_psi_curve import grid as max_psi_grid, max_psi_curve
 from .min_shimmy_curve import min_shimmy_curve
 from .study_curves import hopf_speed_curves
 from .summaries import STUDY_COLUMNS, study_summary, write_study_csv
@@ -122,7 +123,13 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
     hopf_V_start and hopf_V_end (m/s) over the parameter's whole range
     (:func:`~shimmy.analyses.decisions.study_curves.hopf_speed_curves`), through the sampled values,
     and min_shimmy_Fz (N), the lowest point of the Hopf curves in (V, Fz) over the plane V in the
-    study's range, Fz 10-900 kN (:func:`~shimmy.analyses.decisions.min_shimmy_curve.min_shimmy_curve`)."""
+    study's range, Fz 10-900 kN (:func:`~shimmy.analyses.decisions.min_shimmy_curve.min_shimmy_curve`), and
+    max_psi (rad), the largest stable torsional amplitude at Fz, on a grid over the whole range with the
+    sampled values (:func:`~shimmy.analyses.decisions.max_psi_curve.max_psi_curve`)."""
+    if executor is None:  # one pool for the sampled rows and the curve's grid
+        with open_executor() as own:
+            return study(parameter, values, configs=configs, Fz=Fz, params=params, v_range=v_range, options=options,
+                         executor=own, progress=progress)
     base = params if params is not None else Parameters()
     checked = _check_values(parameter, values, base)
     result = _run([parameter], [{parameter: v} for v in checked], configs, Fz, v_range, base, executor, progress,
@@ -139,6 +146,15 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
         else:
             result.curves.append(lowest.to_dict())
             result.warnings += [f"{config}, min_shimmy_Fz in {parameter}: {w}" for w in notes]
+    extra = [theta for theta in max_psi_grid(parameter, base, checked) if theta not in checked]
+    tasks = [(c, {parameter: theta}, result.Fz, *result.v_range, base, options or BifurcationOptions(mesh_check=False))
+             for theta in extra for c in result.configs]
+    more = run_units(_unit, tasks, executor, None, lambda t: f"{t[0]} at {parameter} = {t[1][parameter]:g}")
+    for config in result.configs:
+        rows = [r for r in result.rows + more if r["config"] == config]
+        result.curves.append(max_psi_curve(config, parameter, rows, result.v_range).to_dict())
+    result.warnings += [f"{r['config']} at {parameter} = {r[parameter]:g} (max_psi curve): {w}"
+                        for r in more for w in r["warnings"]]
     result.elapsed_s += time.perf_counter() - clock
     return result
 

@@ -49,6 +49,7 @@ from ...model.configurations import Configuration
 from ...model.equations import Model, field_and_derivatives, jacobian, rhs
 from ...model.parameters import (DEFAULT_FZ, DIAGRAM_V_RANGE, FZ_RANGE, PARAMETER_SPECS, V_RANGE, Parameters,
                                  check_number, check_range, unknown_name_error)
+from ...model.units import kn
 from ..core.polylines import near_polyline
 from ..core.stability import Linearisation, hopf_points
 from .sensitivity import model_with
@@ -124,7 +125,7 @@ def design_two_parameter_field(config: Configuration, params: Parameters, name: 
 
     return TwoParameterField(config.n_states, lambda x, p: rhs(model(p[1]), x, p[0], Fz),
                              lambda x, p: jacobian(model(p[1]), x, p[0], Fz), dfdp,
-                             f"{config.value} in (V, {name}) at Fz = {Fz:g} N", evaluate, smooth=False)
+                             f"{config.value} in (V, {name}) at Fz = {kn(Fz)}", evaluate, smooth=False)
 
 
 @dataclass

@@ -51,10 +51,12 @@ from ...continuation import (ContinuationOptions, CurvePoint, EquilibriumBranch,
                              equilibrium_branch, locate, step, tangent, weighted_norm)
 from ...model.equations import Model, build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...errors import ConvergenceError
-from ...model.nes import VALID_ANGLE
+from ...model.nes import VALID_ANGLE, cubic_range
 from ...model.parameters import DIAGRAM_V_RANGE, Parameters
 from ...continuation.periodic_orbits import (PeriodicBranch, hopf_guess, orbit_from_samples,
                               periodic_branch)
+from ..core import nes_range
+from ...model.units import kn
 from ..core.response import mode_of, torsional_share
 from ..core.stability import HopfResult, check_speeds_and_load, hopf_points
 from .summaries import bifurcation_summary, write_bifurcation_csv
@@ -89,7 +91,7 @@ def gear_field(model: Model, Fz: float) -> VectorField:
                        lambda x, V: rhs(model, x, V, Fz),
                        lambda x, V: jacobian(model, x, V, Fz),
                        lambda x, V: parameter_jacobian(model, x, V, Fz)[0],
-                       name=f"{model.config.value} at Fz = {Fz:g} N",
+                       name=f"{model.config.value} at Fz = {kn(Fz)}",
                        evaluate=lambda x, V: field_and_derivatives(model, x, V, Fz)[:3])
 
 
@@ -248,6 +250,13 @@ def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | 
 
     report(0.97, "maximum torsional amplitude")
     max_psi, max_v, max_any, mesh_check = _maximum(system, branches, options, scale, warnings, params.gear.l_g)
+    if config.has_nes and not options.exact_nes:
+        n = params.nes
+        peak, is_bound = _nes_rotation(system, branches, scale, cubic_range(n.r1, n.r2, n.r3, n.k_s, n.e_p))
+        beyond = nes_range.warning(config, params, peak, options.exact_nes, bound=is_bound,
+                                   where="on the stable cycles of this diagram")
+        if beyond:
+            warnings.append(beyond)
     report(1.0, "done")
     return BifurcationResult(config, Fz, v_min, v_max, params, hopf, branches, max_psi, max_v, max_any,
                              mesh_check, options, time.perf_counter() - clock, warnings)
@@ -617,6 +626,34 @@ def _draw_located(branches: list[Branch], raw: PeriodicBranch, problem: Periodic
                               stable=np.insert(b.stable, j + 1, True),
                               mode=b.mode[:j + 1] + [b.mode[j]] + b.mode[j + 1:])
         return
+
+
+#: Stable cycles whose NES rotation :func:`_nes_rotation` samples at most (largest bound first).
+NES_ROTATION_SAMPLES = 12
+
+
+def _nes_rotation(system, branches: list[Branch], scale, limit: float) -> tuple[float, bool]:
+    """(largest |psi - psi_s| over the stable cycles, whether it is only a bound) as far as it matters for
+    the cubic's range ``limit``: the bound max(psi_max - psis_min, psis_max - psi_min) of every stored
+    cycle first (exact enough when it stays within ``limit``); the cycles whose bound exceeds it are
+    sampled on their collocation polynomials, largest bound first, and the largest value found is given
+    when one exceeds ``limit``; else the largest bound not sampled, flagged as a bound."""
+    candidates = []
+    for b in branches:
+        raw = b.raw
+        if b.kind != "periodic" or raw is None or raw.p.size == 0 or raw.x_max.shape[1] < 6:
+            continue
+        bound = np.maximum(raw.x_max[:, 0] - raw.x_min[:, 5], raw.x_max[:, 5] - raw.x_min[:, 0])
+        candidates += [(float(bound[i]), raw, int(i)) for i in np.flatnonzero(raw.stable & (bound > limit))]
+    candidates.sort(key=lambda c: -c[0])
+    found = 0.0
+    for _, raw, i in candidates[:NES_ROTATION_SAMPLES]:
+        mesh_points, u = raw.solutions[i]
+        _, x = PeriodicProblem(system, Mesh(mesh_points, raw.ncol), scale, T_SCALE, V_SCALE).sample(u)
+        found = max(found, float(np.abs(x[:, 0] - x[:, 5]).max()))
+    if found > limit or len(candidates) <= NES_ROTATION_SAMPLES:
+        return found, False
+    return candidates[NES_ROTATION_SAMPLES][0], True
 
 
 def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale, warnings, l_g: float):

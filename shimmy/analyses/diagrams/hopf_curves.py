@@ -23,6 +23,7 @@ from ...model.configurations import Configuration
 from ...continuation import ContinuationOptions, HopfCurve, PointKind, TwoParameterField, hopf_curve
 from ...model.equations import build_model, field_and_derivatives, jacobian, parameter_jacobian, rhs
 from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_number, check_range
+from ...model.units import kn
 from ..core.polylines import near_polyline
 from ..core.response import Mode, dominant_mode, torsional_share
 from ..core.stability import hopf_points
@@ -170,7 +171,7 @@ def hopf_curves(config: Configuration | str, *, params: Parameters | None = None
                 curve = hopf_curve(system, np.zeros(n), np.array([h.V, float(Fz)]), box=box, options=options,
                                    scale=X_SCALE[:n], p_scale=np.array([V_SCALE, FZ_SCALE]))
             except ValueError as exc:
-                warnings.append(f"Hopf point V = {h.V:.6g} m/s, Fz = {Fz:.6g} N not continued: {exc}")
+                warnings.append(f"Hopf point V = {h.V:.6g} m/s, Fz = {kn(Fz)} not continued: {exc}")
                 continue
             curves.append(curve)
     report(1.0, "done")

@@ -165,9 +165,14 @@ def _not_above(name: str, value: float, other: str, other_value: float, unit: st
 
 
 def _grid(duration: float, dt: float) -> np.ndarray:
-    """0, dt, 2 dt, ... and exactly ``duration`` at the end (a last interval shorter than dt/2 is merged)."""
-    n = max(1, int(math.ceil(duration / dt - 0.5)))
-    return np.linspace(0.0, duration, n + 1)
+    """0, dt, 2 dt, ... (steps of exactly ``dt``, as the preset's setting says) and ``duration`` at the end: the
+    last step is the rest, at most dt (a rest below dt/100 stretches the step before to at most 1.01 dt)."""
+    n = max(1, int(math.floor(duration / dt + 1e-9)))
+    t = dt * np.arange(n + 1, dtype=float)
+    if duration - t[-1] > 1e-2 * dt:
+        return np.append(t, duration)
+    t[-1] = duration
+    return t
 
 
 @dataclass(frozen=True, eq=False)

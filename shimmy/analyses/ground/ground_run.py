@@ -55,6 +55,7 @@ from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, 
 from .ground_profiles import GroundProfile, as_profile
 from .kicks import KICK_PRESETS, SAME_INSTANT, Kick, kick_instant, kick_outcome, scenario
 from .summaries import comparison_dict, comparison_summary, comparison_table, ground_run_summary
+from ..core import nes_range
 from ..core.response import dominant_mode, torsional_share
 from ..core.simulation import STATUS_MESSAGES, SimulationOptions, initial_state
 
@@ -247,6 +248,9 @@ def ground_run(config: Configuration | str, profile: Any, *, params: Parameters 
         except Exception as exc:  # noqa: BLE001 - the run stands without them; say why they are missing
             warnings.append(f"fold and torus crossings not computed: {exc}")
         crossings.sort(key=lambda c: c["t"])
+    beyond = nes_range.warning(config, params, nes_range.rotation_peak(states), options.exact_nes)
+    if beyond:
+        warnings.append(beyond)
     above = (np.abs(states[0]) > options.psi_threshold) | (np.abs(lateral) > options.lateral_threshold)
     onsets = _onsets(crossings, above, shimmy, t, V, Fz)
     outcome = None

@@ -37,6 +37,7 @@ import numpy as np
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_range
+from ...model.units import kn
 from ...version import __version__
 from ..core.executors import InlineExecutor, name_of, open_executor, run_dynamic, run_work_unit
 from ..core.response import Mode, shimmy_type
@@ -288,8 +289,8 @@ def margin_map(config: Configuration | str, *, params: Parameters | None = None,
     run_dynamic(run_work_unit, build.first_units(), executor, build.done, report, lambda unit: unit.describe(),
                 lambda unit: "loads" if isinstance(unit, LoadUnit) else "points")
     loads = [build.loads[float(f)] for f in Fz]
-    warnings = [f"Fz = {r.Fz:.6g} N: {w}" for r in loads for w in r.diagram.warnings]
-    warnings += [f"V = {p['V']:.4g} m/s, Fz = {p['Fz']:.6g} N: the margin is not confirmed by its check runs"
+    warnings = [f"Fz = {kn(r.Fz)}: {w}" for r in loads for w in r.diagram.warnings]
+    warnings += [f"V = {p['V']:.4g} m/s, Fz = {kn(p['Fz'])}: the margin is not confirmed by its check runs"
                  for p in build.points.values() if p["confirmed"] is False]
     report(1.0, "done")
     return MarginMapResult(config, params, v_range, fz_range, grid, options, V, Fz,

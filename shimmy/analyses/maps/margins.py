@@ -37,6 +37,7 @@ from ...version import __version__
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.parameters import DIAGRAM_V_RANGE, Parameters, check_operating_point
+from ...model.units import kn
 from ..core.basins import (FAILED, UNSETTLED, Ray, Threshold, geometric_sizes, refine, sample_ball, scan,
                            smallest_over_directions, sweep_directions, wilson)
 from ..core.executors import describe_work_unit, executor_width, name_of, open_executor, run_units, run_work_unit
@@ -180,8 +181,8 @@ def _prepare(config, V, Fz, params, diagram, executor, t_max, report, expected) 
         report(0.0, f"bifurcation diagram at {Fz / 1e3:g} kN")
         diagram = diagram_at(config, Fz, params, max(DIAGRAM_V_RANGE[1], V))
     elif abs(diagram.Fz - Fz) > 1e-9 * Fz or not diagram.v_min <= V <= diagram.v_max:
-        raise InvalidParameterError("diagram", f"Fz = {diagram.Fz:g} N, V {diagram.v_min:g}..{diagram.v_max:g} m/s",
-                                    f"a diagram at Fz = {Fz:g} N whose speeds include V = {V:g} m/s")
+        raise InvalidParameterError("diagram", f"Fz = {kn(diagram.Fz)}, V {diagram.v_min:g}..{diagram.v_max:g} m/s",
+                                    f"a diagram at Fz = {kn(Fz)} whose speeds include V = {V:g} m/s")
     report(0.05, "attractors")
     runs.found = point_attractors(config, V, Fz, params=params, diagram=diagram, run_units=runs.units, t_max=t_max)
     return runs

@@ -17,16 +17,16 @@ def _cmd_bifurcation(args) -> int:
 
     canonical = request("bifurcation", {"config": args.config, **numbers("bifurcation", args, "Fz", "v_min", "v_max",
                                                                          "ntst"),
-                                        "seeds": not args.no_seeds, "params": design(args)})
+                                        "seeds": not args.no_seeds, "exact_nes": args.exact_nes,
+                                        "params": design(args)})
     ds_max = check_number("ds_max", args.ds_max, 1e-3, 10.0)
-    beyond = [flag for flag, given in (("--ds-max", ds_max != BifurcationOptions.ds_max),
-                                       ("--exact-nes", args.exact_nes)) if given]
+    beyond = [flag for flag, given in (("--ds-max", ds_max != BifurcationOptions.ds_max),) if given]
     with progress(args) as bar:
         if beyond:  # options the API's request does not take: not the question it caches
             from ...analyses.diagrams.bifurcation import bifurcation
 
             options = BifurcationOptions(ntst=canonical["ntst"], ds=min(BifurcationOptions.ds, ds_max), ds_max=ds_max,
-                                         exact_nes=args.exact_nes, seeds=canonical["seeds"])
+                                         exact_nes=canonical["exact_nes"], seeds=canonical["seeds"])
             result = bifurcation(args.config, canonical["Fz"], v_range=(canonical["v_min"], canonical["v_max"]),
                                  params=params(args), options=options, progress=bar)
             diagram = Answer(result.to_dict(), OFF, f"{' and '.join(beyond)}: not in the API's request")
@@ -78,8 +78,8 @@ def add_parsers(commands) -> None:
                         "without the cache (the API's request has no such field)")
     p.add_argument("--no-seeds", action="store_true", help="do not look for branches by simulation")
     p.add_argument("--exact-nes", action="store_true",
-                   help="use the exact NES torque instead of the cubic (computed without the cache: the API's "
-                        "diagram request has no such field)")
+                   help="use the exact NES torque instead of the cubic (the cubic is within 1 %% of it only for "
+                        "small NES rotations; a result beyond that range says so)")
     p.add_argument("--csv", metavar="FILE", help="write the branch points to FILE")
     add_common(p)
     add_progress(p)

@@ -93,6 +93,28 @@ def test_gear_optimum_is_recomputed_from_scratch_and_beats_the_nominal_design():
         result.design["e_p"])
     d = result.to_dict()
     assert {"design", "objective", "nominal_objective", "evaluations"} <= set(d)
+    # Every figure of merit for the optimum, the nominal design and original (those at a load at Fz).
+    for which in ("optimum", "nominal", "original"):
+        assert set(result.figures[which]) == {"min_shimmy_Fz", "interval@150000", "max_psi@150000", "torsion_area"}
+    nominal = figures_of("nes", Parameters(), [("max_psi", 150000.0)])[("max_psi", 150000.0)]["value"]
+    assert result.figures["nominal"]["max_psi@150000"] == pytest.approx(nominal, rel=1e-9)
+    # The flag says which parameters ended on a bound, and only those.
+    flagged = {b["name"]: b["bound"] for b in result.at_bounds}
+    for name, value in result.design.items():
+        spec = PARAMETER_SPECS[name]
+        on = {"low": abs(value - spec.low), "high": abs(value - spec.high)}
+        near = [k for k, gap in on.items() if gap <= 1e-3 * (spec.high - spec.low)]
+        assert flagged.get(name) == (near[0] if near else None)
+    assert ("the range limits the optimum" in " ".join(result.warnings)) == bool(flagged)
+
+
+def test_bounds_reached_names_the_parameters_on_a_bound():
+    from shimmy.analyses.decisions.optimise import bounds_reached
+
+    assert bounds_reached({"r2": 0.09, "e_p": 0.003, "k_s": 1.0e6 + 300.0}) == [
+        {"name": "r2", "bound": "high", "limit": 0.09, "value": 0.09},
+        {"name": "k_s", "bound": "low", "limit": 1.0e6, "value": 1.0e6 + 300.0}]  # within 0.1 % of the range
+    assert bounds_reached({"k_s": 1.0e6 + 500.0}) == []  # 0.125 % of the range: inside
 
 
 def test_constraints_and_options_are_checked_naming_the_field():

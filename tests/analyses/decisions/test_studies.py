@@ -45,6 +45,35 @@ def test_the_nes_pre_stretch_changes_nes_rows_only(e_p_study):
     assert rows["nes", 0.005]["max_psi"] < rows["nes", 0.0005]["max_psi"]
 
 
+def test_the_max_psi_curve_passes_through_the_sampled_rows_and_is_a_diagram_at_each_grid_value(e_p_study):
+    from shimmy.analyses.decisions.max_psi_curve import N_GRID
+
+    for config in ("original", "nes"):
+        curve = next(c for c in e_p_study.curves if c["config"] == config and c["quantity"] == "max_psi")
+        assert curve["unit"] == "rad" and curve["p"] == sorted(curve["p"]) and len(curve["p"]) >= N_GRID
+        assert curve["p"][0] == 0.0005 and curve["p"][-1] == 0.005  # the whole range, ends included
+        for row in (r for r in e_p_study.rows if r["config"] == config):
+            assert curve["values"][curve["p"].index(row["e_p"])] == row["max_psi"]  # the sampled row itself
+    nes = next(c for c in e_p_study.curves if c["config"] == "nes" and c["quantity"] == "max_psi")
+    k = len(nes["p"]) // 2
+    direct = bifurcation("nes", 150e3, v_range=(1.0, 200.0), params=Parameters().with_overrides({"e_p": nes["p"][k]}),
+                         options=BifurcationOptions(mesh_check=False))
+    assert nes["values"][k] == pytest.approx(direct.max_psi, rel=1e-9)  # an exact value between the samples
+    assert np.all(np.diff(nes["values"]) < 0)  # more pre-stretch, a stiffer NES: a smaller amplitude throughout
+    original = next(c for c in e_p_study.curves if c["config"] == "original" and c["quantity"] == "max_psi")
+    assert len(set(original["values"])) == 1 and original["special_points"] == []  # e_p is not in original
+
+
+def test_max_psi_switches_are_marked_where_the_maximum_jumps_or_cycles_vanish():
+    from shimmy.analyses.decisions.max_psi_curve import max_psi_curve
+
+    rows = [{"x": 0.0, "max_psi": 0.1, "max_psi_V": 10.0}, {"x": 1.0, "max_psi": 0.12, "max_psi_V": 12.0},
+            {"x": 2.0, "max_psi": 0.15, "max_psi_V": 60.0}, {"x": 3.0, "max_psi": 0.0, "max_psi_V": None}]
+    curve = max_psi_curve("nes", "x", rows[::-1], (1.0, 200.0))
+    assert curve.p == [0.0, 1.0, 2.0, 3.0] and curve.values == [0.1, 0.12, 0.15, 0.0]
+    assert [(s["bracket"], s["located"]) for s in curve.special_points] == [([1.0, 2.0], False), ([2.0, 3.0], False)]
+
+
 def test_two_parameter_grid_has_a_row_per_pair_and_configuration():
     result = study_grid(("e_p", "k_s"), ([0.0005, 0.005], [1.0e6, 1.4e6]), configs=["nes"], Fz=150e3,
                         executor=InlineExecutor())
