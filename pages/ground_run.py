@@ -1,4 +1,5 @@
-"""Ground runs: a take-off, landing roll, taxi or any (t, V, Fz) table for the four configurations."""
+"""Ground runs: a take-off, landing roll, taxi or any (t, V, Fz) table for the four configurations, with a yaw kick
+(a runway joint, a touchdown with yaw) if asked."""
 
 from __future__ import annotations
 
@@ -15,14 +16,19 @@ from shimmy.model.parameters import FZ_RANGE, V_RANGE
 from shimmy.service import analyses
 from ui import components as ui
 from ui import fields, formats, ids, jobs, markers
-from ui.fields import Column, Quantity
+from ui.fields import Column, Quantity, SignedQuantity
 from ui import style
 from ui.layout import page
 
 dash.register_page(__name__, path="/ground-run", name="Ground run", order=4.5)
 
 CONFIGS = ui.CONFIGS
-PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi"}
+#: The scenarios (a profile preset with a kick) by name: label, preset, kick fields, description.
+SCENARIOS = analyses.kick_presets()
+PRESET_LABELS = {"takeoff": "Take-off", "landing": "Landing roll", "taxi": "Taxi",
+                 **{name: s["label"] for name, s in SCENARIOS.items()}}
+KICK_LABELS = {"none": "none", "psi": "yaw angle psi (rad)", "dpsi": "yaw rate dpsi (rad/s)"}
+AT_LABELS = {"time": "at a time (s)", "speed": "at a speed (m/s)"}
 SERIES_DT = 0.02  # s: the envelopes are smooth; 1500 points per configuration for a 30 s take-off
 TABLE_STYLE = {"style_table": {"maxHeight": "290px", "overflowY": "auto"},
                "style_cell": {"fontFamily": "inherit", "fontSize": "13px", "padding": "3px 8px", "textAlign": "left",
@@ -49,15 +55,28 @@ PROFILE_COLUMNS = [Column("t", "t", "s", -1e5, 1e5), Column("V", "V", "m/s", *V_
                    Column("Fz", "Fz", "kN", FZ_RANGE[0] / units.KN, FZ_RANGE[1] / units.KN)]
 #: A cell keeps what was typed (a number column would drop text silently): the page refuses it, saying why.
 KEEP_TYPED = {"action": "coerce", "failure": "accept"}
+#: The kick's size as its box reads it, per kind: within that kind's range (rad for psi, rad/s for dpsi).
+KICK_SIZES = {kind: SignedQuantity("ground_run", "kick_size", f"the kick size ({k['what']} {kind})", k["unit"],
+                                   largest=k["largest"]) for kind, k in analyses.kick_kinds().items()}
+#: When the kick comes, as its box reads it: a time on the profile's clock or a speed.
+KICK_MOMENTS = {"time": Quantity("ground_run", "kick_at_time", "the kick's time", "s"),
+                "speed": Quantity("ground_run", "kick_at_speed", "the kick's speed", "m/s")}
 
 
 def layout(preset: str | None = None, config: str | None = None, psi_thr: str | None = None,
-           lat_thr: str | None = None, **query):
+           lat_thr: str | None = None, kick: str | None = None, kick_size: str | None = None,
+           kick_at: str | None = None, kick_when: str | None = None, **query):
     preset, bad_preset = fields.choice("preset", preset, list(PRESET_LABELS), "takeoff", "a preset")
     config, bad_config = fields.choice("config", config, list(CONFIGS), "original", "a configuration")
     psi_value, bad_psi = PSI_THR.from_url("psi_thr", psi_thr, 0.01)
     lat_value, bad_lat = LAT_THR.from_url("lat_thr", lat_thr, 1.0)
-    address = " ".join(m for m in (bad_preset, bad_config, bad_psi, bad_lat) if m)
+    default = _scenario_boxes(preset)
+    kick, bad_kick = fields.choice("kick", kick, list(KICK_LABELS), default[0], "a kick")
+    kick_at, bad_at = fields.choice("kick_at", kick_at, list(AT_LABELS), default[2], "time or speed")
+    size_value, bad_size = (KICK_SIZES[kick].from_url("kick_size", kick_size, default[1]) if kick in KICK_SIZES
+                            else (default[1], None))
+    when_value, bad_when = KICK_MOMENTS[kick_at].from_url("kick_when", kick_when, default[3])
+    address = " ".join(m for m in (bad_preset, bad_config, bad_psi, bad_lat, bad_kick, bad_at) if m)
     plane_figure, by_time, by_speed, _ = _placeholders(WAITING)
     return page(
         query, ids.GR,
@@ -76,6 +95,18 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
             LAT_THR.field("Shimmy threshold |l_g delta| (mm)", ids.GR_LAT_THR, lat_value, bad_lat),
             ui.field("NES torque", ui.nes_torque(ids.GR_EXACT)),
             *jobs.controls(ids.GR_GROUP, "Run"),
+        ], className="controls"),
+        html.Div([
+            ui.field("Kick (a jump of)", dcc.Dropdown(id=ids.GR_KICK, value=kick, clearable=False,
+                                                      style={"width": "190px"},
+                                                      options=[{"label": v, "value": k}
+                                                               for k, v in KICK_LABELS.items()])),
+            KICK_SIZES["psi"].field("Kick size (rad for psi, rad/s for dpsi)", ids.GR_KICK_SIZE, size_value, bad_size),
+            ui.field("Kick comes", dcc.Dropdown(id=ids.GR_KICK_AT, value=kick_at, clearable=False,
+                                                style={"width": "160px"},
+                                                options=[{"label": v, "value": k} for k, v in AT_LABELS.items()])),
+            KICK_MOMENTS["time"].field("Kick time (s) or speed (m/s)", ids.GR_KICK_WHEN, when_value, bad_when),
+            html.P(_scenario_note(preset), id=ids.GR_KICK_NOTE, className="hint"),
         ], className="controls"),
         html.Div([
             html.Div([
@@ -113,6 +144,53 @@ def layout(preset: str | None = None, config: str | None = None, psi_thr: str | 
     )
 
 
+def _profile_preset(name: str) -> str:
+    """The profile preset of a preset or a scenario."""
+    return SCENARIOS[name]["preset"] if name in SCENARIOS else name
+
+
+def _scenario_boxes(name: str) -> tuple[str, float | None, str, float | None]:
+    """(kick, size, at, time or speed) the kick boxes show for preset ``name``: a scenario's kick, else none."""
+    if name not in SCENARIOS:
+        return "none", None, "time", None
+    k = SCENARIOS[name]["kick"]
+    at = "time" if k.get("kick_at_time") is not None else "speed"
+    return k["kick"], k["kick_size"], at, k["kick_at_time"] if at == "time" else k["kick_at_speed"]
+
+
+def _scenario_note(name: str) -> str:
+    return (f"{PRESET_LABELS[name]}: {SCENARIOS[name]['description']}. The kick boxes hold its kick; change them "
+            "to ask another.") if name in SCENARIOS else ""
+
+
+@dash.callback(Output(ids.GR_KICK, "value"), Output(ids.GR_KICK_SIZE, "value"), Output(ids.GR_KICK_AT, "value"),
+               Output(ids.GR_KICK_WHEN, "value"), Output(ids.GR_KICK_NOTE, "children"), Input(ids.GR_PRESET, "value"),
+               prevent_initial_call=True)
+def scenario_kick(name):
+    """A scenario puts its kick in the boxes; a plain preset leaves them as they are."""
+    if name not in SCENARIOS:
+        return no_update, no_update, no_update, no_update, ""
+    return (*_scenario_boxes(name), _scenario_note(name))
+
+
+def kick_size_refusal(kind, value) -> str:
+    """Why the size box's value is refused for a kick of ``kind`` (its unit and range), '' if it is not."""
+    return fields.refusal(KICK_SIZES[kind].read, value) if kind in KICK_SIZES else ""
+
+
+def kick_moment_refusal(kind, at, value) -> str:
+    """Why the time or speed box's value is refused, '' if it is not (or there is no kick)."""
+    return fields.refusal(KICK_MOMENTS[at].read, value) if kind in KICK_SIZES and at in KICK_MOMENTS else ""
+
+
+# The kick's boxes refuse at the field as the thresholds do, by the rules of the kick's kind and instant.
+dash.callback(Output(fields.error_id(ids.GR_KICK_SIZE), "children"), Input(ids.GR_KICK, "value"),
+              Input(ids.GR_KICK_SIZE, "value"), prevent_initial_call=True)(kick_size_refusal)
+dash.callback(Output(fields.error_id(ids.GR_KICK_WHEN), "children"), Input(ids.GR_KICK, "value"),
+              Input(ids.GR_KICK_AT, "value"), Input(ids.GR_KICK_WHEN, "value"),
+              prevent_initial_call=True)(kick_moment_refusal)
+
+
 def _shown(unit: str) -> tuple[str, float]:
     """(unit shown, SI units per unit shown) of a preset setting in ``unit``."""
     return SHOWN_UNITS.get(unit, (unit, 1.0))
@@ -137,7 +215,7 @@ def _setting_refusal(exc: InvalidParameterError, rows) -> str:
 def preset_settings(name):
     """The preset's settings at their defaults (a new preset starts from its documented defaults), loads in kN."""
     rows = []
-    for f in analyses.preset_profile(name)["fields"]:
+    for f in analyses.preset_profile(_profile_preset(name))["fields"]:
         unit, scale = _shown(f["unit"])
         rows.append({"name": f["name"], "value": f["default"] / scale, "unit": unit,
                      "range": f"{f['low'] / scale:g} – {f['high'] / scale:g}", "description": f["description"]})
@@ -168,7 +246,7 @@ def preset_table(settings, _reset, name):
     if refused:
         return no_update, no_update, no_update, "; ".join(why for _, _, why in refused)
     try:
-        profile = analyses.preset_profile(name, _settings(settings))
+        profile = analyses.preset_profile(_profile_preset(name), _settings(settings))
     except InvalidParameterError as exc:
         return no_update, no_update, no_update, _setting_refusal(exc, settings)
     rows = [{"t": round(t, 4), "V": round(v, 4), "Fz": round(f / units.KN, 3)} for t, v, f in profile["rows"]]
@@ -205,7 +283,8 @@ def add_row(_n, rows):
                State(ids.GR_PRESET, "value"))
 def source(rows, preset_rows, name):
     if rows and preset_rows and _same(rows, preset_rows):
-        return f"Runs the {PRESET_LABELS[name].lower()} preset ({len(rows)} points). Edit a cell to run your own table."
+        what = PRESET_LABELS[_profile_preset(name)].lower()
+        return f"Runs the {what} preset ({len(rows)} points). Edit a cell to run your own table."
     return f"Runs your table ({len(rows or [])} points; t in s, V in m/s, Fz in kN, linearly interpolated)."
 
 
@@ -231,16 +310,26 @@ def _same(rows, preset_rows) -> bool:
     return True
 
 
-def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, torque, design):
+def _kick(kind, size, at, when) -> dict:
+    """The kick's request fields from its boxes (none: no kick), each refused in its box's unit."""
+    if kind not in KICK_SIZES:
+        return {}
+    moment = KICK_MOMENTS[at].read(when)
+    return {"kick": kind, "kick_size": KICK_SIZES[kind].read(size),
+            ("kick_at_time" if at == "time" else "kick_at_speed"): moment}
+
+
+def _requests(config, name, settings, rows, preset_rows, psi_thr, lat_thr, torque, kind, size, at, when, design):
     """One request per configuration, the one whose map is drawn first."""
     if rows and not (preset_rows and _same(rows, preset_rows)):
         profile = {"profile": [[r.get("t"), r.get("V"), _newtons(r.get("Fz"))] for r in rows]}
     else:
-        profile = {"preset": name, "preset_options": _settings(settings)}
+        profile = {"preset": _profile_preset(name), "preset_options": _settings(settings)}
     psi, lateral = PSI_THR.read(psi_thr), LAT_THR.read(lat_thr)  # refused in the box's unit, never defaulted
+    kick = _kick(kind, size, at, when)
     order = [config] + [c for c in CONFIGS if c != config]
     return [{"config": c, **profile, "psi_threshold": psi, "lateral_threshold": lateral, "series_dt": SERIES_DT,
-             "hopf_curves": True, **ui.exact_nes(c, torque), **design} for c in order]
+             "hopf_curves": True, **ui.exact_nes(c, torque), **kick, **design} for c in order]
 
 
 def _newtons(fz_kn):
@@ -273,7 +362,8 @@ jobs.register(
     follow=[Input(ids.GR_CONFIG, "value")],  # which of the four runs' Hopf curves are drawn: starts nothing
     states=[State(ids.GR_PRESET, "value"), State(ids.GR_SETTINGS, "data"), State(ids.GR_TABLE, "data"),
             State(ids.GR_PRESET_ROWS, "data"), State(ids.GR_PSI_THR, "value"), State(ids.GR_LAT_THR, "value"),
-            State(ids.GR_EXACT, "value"), State(ids.design_store(ids.GR), "data")],
+            State(ids.GR_EXACT, "value"), State(ids.GR_KICK, "value"), State(ids.GR_KICK_SIZE, "value"),
+            State(ids.GR_KICK_AT, "value"), State(ids.GR_KICK_WHEN, "value"), State(ids.design_store(ids.GR), "data")],
     lock=[ids.GR_PRESET],
     download=jobs.Download(ids.GR_GROUP, "ground_run", _csv_rows, filename=_file_stem))
 
@@ -336,6 +426,13 @@ def envelopes(results, against: str):
         fig.add_scatter(x=r[against], y=[v / units.MM for v in r["envelope_lateral"]], name=label,
                         showlegend=False, row=2, col=1,
                         hovertemplate=f"{label}: |l_g delta| %{{y:.4g}} mm<extra></extra>", **common)
+    kick = results[0].get("kick")
+    if kick is not None:  # the same kick in every run
+        for row in (1, 2):
+            fig.add_vline(x=kick["t"] if against == "t" else kick["V"], line={"color": "#555", "dash": "dot",
+                                                                                "width": 1.5},
+                          annotation_text="kick" if row == 1 else None, annotation_position="top right", row=row,
+                          col=1)
     options = results[0]["options"]
     for row, value, text in ((1, options["psi_threshold"], "threshold"),
                              (2, options["lateral_threshold"] / units.MM, "threshold")):
@@ -370,14 +467,39 @@ def summary(results):
                 psi += f" (×{p['value'] / base['peak_psi']['value']:.2f})"
         crossings = ", ".join(f"{c['V']:.4g} m/s" for c in r["boundary_crossings"]) or "none"
         delay = formats.significant(r["onset_delay_s"], 3)
-        rows.append([style.CONFIG_LABELS[r["config"]], time_in, speeds, psi, lat, crossings, delay])
+        rows.append([style.CONFIG_LABELS[r["config"]], time_in, speeds, psi, lat, crossings, delay,
+                     kick_outcome(r.get("kick"))])
+    kick = ordered[0].get("kick")
+    after = "after the kick" if kick is None else (f"after the kick ({kick['kind']} {kick['size']:+g} {kick['unit']} "
+                                                     f"at {kick['t']:.4g} s, {kick['V']:.4g} m/s)")
     return ui.table(["configuration", "time in shimmy (s, against original)", "speed range in shimmy (m/s)",
-                     "peak |psi| (rad)", "peak |l_g delta| (mm)", "crosses the Hopf curves at", "onset delay (s)"],
-                    rows, ids.GR_SUMMARY_TABLE)
+                     "peak |psi| (rad)", "peak |l_g delta| (mm)", "crosses the Hopf curves at", "onset delay (s)",
+                     after], rows, ids.GR_SUMMARY_TABLE)
+
+
+def kick_outcome(kick) -> str:
+    """What followed the kick, in a few words: the mode of the shimmy it started, or none."""
+    if kick is None:
+        return formats.MISSING + " (no kick)"
+    if not kick.get("applied", True):
+        return "not applied (the run stopped before it)"
+    if kick["shimmy_started"] is None:
+        return "undecided (the run ends first)"
+    other = kick["without_kick"]
+    plain = f"{other['mode']} shimmy" if other["in_shimmy"] else "no shimmy"
+    added = f"; {formats.signed(kick['extra_time_in_shimmy_s'])} s in shimmy against no kick"
+    if not kick["shimmy_started"]:
+        return f"no shimmy started (back on the run without it by {kick['t_judged']:.3g} s){added}"
+    return (f"{kick['mode']} shimmy by {kick['t_judged']:.3g} s ({kick['V_judged']:.3g} m/s), |psi| up to "
+            f"{kick['peak']['psi']:.3g} rad; without the kick: {plain}{added}")
 
 
 @dash.callback(Output(ids.URL_UPDATE, "data", allow_duplicate=True), Input(ids.GR_PRESET, "value"),
                Input(ids.GR_CONFIG, "value"), Input(ids.GR_PSI_THR, "value"), Input(ids.GR_LAT_THR, "value"),
-               prevent_initial_call=True)
-def remember(preset, config, psi_thr, lat_thr):
-    return {"preset": preset, "config": config, "psi_thr": psi_thr, "lat_thr": lat_thr}
+               Input(ids.GR_KICK, "value"), Input(ids.GR_KICK_SIZE, "value"), Input(ids.GR_KICK_AT, "value"),
+               Input(ids.GR_KICK_WHEN, "value"), prevent_initial_call=True)
+def remember(preset, config, psi_thr, lat_thr, kick, kick_size, kick_at, kick_when):
+    kicked = kick != "none"  # without a kick its boxes leave the address (null drops a key)
+    return {"preset": preset, "config": config, "psi_thr": psi_thr, "lat_thr": lat_thr,
+            "kick": kick if kicked else None, "kick_size": kick_size if kicked else None,
+            "kick_at": kick_at if kicked else None, "kick_when": kick_when if kicked else None}

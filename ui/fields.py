@@ -190,6 +190,22 @@ def check(box_id: str, quantity: Quantity, error: str | None = None) -> None:
         lambda value: refusal(quantity.read, value))
 
 
+@dataclass(frozen=True)
+class SignedQuantity(Quantity):
+    """A request field read within [-``largest``, ``largest``], narrower than the field's own limits: a size whose
+    range depends on a choice beside its box (a ground run's kick: rad for a yaw angle, rad/s for a yaw rate)."""
+
+    largest: float = 0.0
+
+    @property
+    def low(self) -> float:
+        return -self.largest
+
+    @property
+    def high(self) -> float:
+        return self.largest
+
+
 def choice(key: str, raw: Any, choices, default: str, what: str) -> tuple[str, str | None]:
     """A choice from the address and, if it is not one of ``choices``, why the default is shown."""
     if raw is None or raw in choices:

@@ -292,6 +292,11 @@ GR_PLANE = "gr-plane"
 GR_TIME = "gr-time"
 GR_SPEED = "gr-speed"
 GR_PRESET_ROWS = "gr-preset-rows"
+GR_KICK = "gr-kick"  # the kick's kind (none, psi, dpsi)
+GR_KICK_SIZE = "gr-kick-size"
+GR_KICK_AT = "gr-kick-at"  # at a time or at a speed
+GR_KICK_WHEN = "gr-kick-when"  # that time (s) or speed (m/s)
+GR_KICK_NOTE = "gr-kick-note"  # what the chosen scenario is
 
 # -- Parametric study (/study) -----------------------------------------------------------------------------
 

@@ -158,8 +158,10 @@ def ground_run(request: dict[str, Any], progress: Progress | None = None) -> dic
     options = GroundRunOptions(psi_threshold=request["psi_threshold"], lateral_threshold=request["lateral_threshold"],
                                exact_nes=request["exact_nes"], cycle_curves=request["fold_torus"])
     report(0.0, f"ground run of {request['config']}")
+    kick = {name: request[name] for name in ("kick", "kick_size", "kick_at_time", "kick_at_speed")}
     result = run_ground_run(request["config"], profile, params=_params(request), options=options,
-                            preset_options=request["preset_options"] if request["profile"] is None else None)
+                            preset_options=request["preset_options"] if request["profile"] is None else None,
+                            kick=kick)
     stride = max(1, int(round(request["series_dt"] / options.dt_out)))
     out = result.to_dict(stride)
     if request["hopf_curves"]:
@@ -205,7 +207,8 @@ def robustness(request: dict[str, Any], progress: Progress | None = None) -> dic
 
     tolerances = [Tolerance(t["name"], t["relative"], t["distribution"]) for t in request["tolerances"]]
     return run_robustness(request["config"], tolerances, samples=request["samples"], Fz=request["Fz"],
-                          params=_params(request), seed=request["seed"], progress=progress).to_dict()
+                          params=_params(request), seed=request["seed"], disturbance=request["disturbance"],
+                          disturbance_direction=request["disturbance_direction"], progress=progress).to_dict()
 
 
 @serves("margins", sync=False, job=True)
@@ -236,6 +239,20 @@ def margin_map(request: dict[str, Any], progress: Progress | None = None) -> dic
     return run_margin_map(request["config"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
                           fz_range=(request["fz_min"], request["fz_max"]), n_v=request["n_v"], n_fz=request["n_fz"],
                           max_size=request["max_size"], progress=progress).to_dict()
+
+
+def kick_kinds() -> dict[str, dict[str, Any]]:
+    """What a ground run's kick may be: per kind (psi, dpsi) its unit, the largest size either way and what it is."""
+    from ..analyses.ground.kicks import KINDS
+
+    return {kind: {"unit": unit, "largest": largest, "what": what} for kind, (_, unit, largest, what) in KINDS.items()}
+
+
+def kick_presets() -> dict[str, dict[str, Any]]:
+    """The ground-run scenarios (a profile preset with a kick): label, preset, kick fields, description."""
+    from ..analyses.ground.kicks import KICK_PRESETS
+
+    return {name: {**s, "kick": dict(s["kick"])} for name, s in KICK_PRESETS.items()}
 
 
 def preset_profile(name: str, options: dict[str, Any] | None = None) -> dict[str, Any]:

@@ -18,6 +18,7 @@ from . import settings
 from .request_fields import Field, field_key as _key, huge as _huge
 from ..analyses.decisions import design_space
 from ..analyses.ground.ground_profiles import MAX_PROFILE_POINTS, PRESETS
+from ..analyses.ground import kicks
 from ..analyses.maps import margin_options
 from ..model.parameters import (DEFAULT_FZ, DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, MATERIALS,
                                 PARAMETER_SPECS, V_RANGE, Parameters, check_number, unknown_name_error)
@@ -80,7 +81,12 @@ class RequestSchema:
             out["description"] += (f" Ground run: profile rows [t, V, Fz] with t increasing, V and Fz within their "
                                    f"ranges, a run of at most {settings.MAX_T_END:g} s (refusals name profile[i].t, "
                                    ".V or .Fz); without a profile, the preset with preset_options (its settings: "
-                                   "python -m shimmy ground-run --help, shimmy.analyses.ground.ground_profiles).")
+                                   "python -m shimmy ground-run --help, shimmy.analyses.ground.ground_profiles). "
+                                   "A kick: kick (psi or dpsi) with kick_size (rad within [-0.5, 0.5] for psi, rad/s "
+                                   "within [-50, 50] for dpsi) and exactly one of kick_at_time (s, within the run) "
+                                   "and kick_at_speed (m/s, a speed the run reaches); kick_size, kick_at_time and "
+                                   "kick_at_speed only with kick; a scenario preset (runway_joint, touchdown_yaw) "
+                                   "only without a profile table.")
         if self.name in _RULES:
             out["description"] += " " + _RULES[self.name]
         if self.name == "study":
@@ -119,6 +125,14 @@ def _check_ground_run(out: dict[str, Any]) -> None:
     within the service's limits."""
     from ..analyses.ground.ground_profiles import preset, profile_from_table
 
+    given = {name: out[name] for name in kicks.FIELDS}
+    if out["profile"] is not None and out["preset"] in kicks.KICK_PRESETS:
+        raise InvalidParameterError("preset", out["preset"], "a profile preset (" + ", ".join(PRESETS) + ") or none "
+                                    "with a profile table", "is a scenario (a preset with a kick): with a profile "
+                                    "table, give the kick's fields")
+    if out["preset"] in kicks.KICK_PRESETS:  # a scenario: its preset, and its kick where the request gives none
+        out["preset"], given = kicks.scenario(out["preset"], given)
+    kick = kicks.Kick.of(given)
     if out["profile"] is not None:
         if out["preset_options"]:
             raise InvalidParameterError("preset_options", out["preset_options"], "only with a preset (no profile)",
@@ -135,6 +149,9 @@ def _check_ground_run(out: dict[str, Any]) -> None:
     if profile.duration > settings.MAX_T_END:
         raise InvalidParameterError("profile" if out["preset"] is None else "preset_options", profile.duration,
                                     f"a run of at most {settings.MAX_T_END:g} s", "makes the run too long (s)")
+    if kick is not None:
+        kicks.kick_instant(kick, profile)  # within the run
+        out.update(kick=kick.kind, kick_size=kick.size, kick_at_time=kick.at_time, kick_at_speed=kick.at_speed)
     if profile.duration / out["series_dt"] > settings.MAX_SERIES_POINTS:
         raise InvalidParameterError("series_dt", out["series_dt"],
                                     f"at least {profile.duration / settings.MAX_SERIES_POINTS:g} s for a "
@@ -299,6 +316,10 @@ def _check_robustness(out: dict[str, Any]) -> None:
                                         f"repeats tolerances[{seen[t['name']]}]")
         seen[t["name"]] = k
     out["tolerances"] = tols
+    if out["disturbance"] is not None and out["samples"] > settings.MAX_DISTURBED_SAMPLES:
+        raise InvalidParameterError("samples", out["samples"], f"at most {settings.MAX_DISTURBED_SAMPLES} with a "
+                                    "disturbance", "asks for too many samples with a disturbance (margins at nine "
+                                    "points each)")
 
 
 def _check_margins(out: dict[str, Any]) -> None:
@@ -322,7 +343,7 @@ _RULES = {
                   f"REL a fraction (normal: the standard deviation, at most "
                   f"{design_space.TOLERANCE_LIMITS['normal']:g}; uniform: the half-width, at most "
                   f"{design_space.TOLERANCE_LIMITS['uniform']:g}), each parameter at most once, not a whole-number "
-                  "one.",
+                  f"one; with a disturbance at most {settings.MAX_DISTURBED_SAMPLES} samples.",
 }
 
 _CONSTRAINT_ITEM = {"oneOf": [
@@ -455,8 +476,10 @@ SCHEMAS: dict[str, RequestSchema] = {
         _config(),
         Field("profile", "table", "rows [t (s), V (m/s), Fz (N)], linearly interpolated (instead of a preset)",
               high=MAX_PROFILE_POINTS),
-        Field("preset", "string", "preset profile, used when no profile table is given", default="takeoff",
-              choices=tuple(PRESETS)),
+        Field("preset", "string", "preset profile, used when no profile table is given; runway_joint and "
+              "touchdown_yaw: the take-off and the landing roll with a kick (a runway joint at 60 m/s, a touchdown "
+              "with yaw), the kick's fields given taking the place of theirs", default="takeoff",
+              choices=(*PRESETS, *kicks.KICK_PRESETS)),
         Field("preset_options", "object", "the preset's settings {name: value}; the rest at their defaults",
               default={}),
         Field("psi_threshold", "number", "torsional amplitude counted as shimmy", default=0.01, low=1e-6, high=1.0,
@@ -469,6 +492,15 @@ SCHEMAS: dict[str, RequestSchema] = {
               "configuration)", default=False),
         Field("hopf_curves", "boolean", "include the configuration's Hopf curves (V 1-500 m/s, Fz 10-900 kN)",
               default=False),
+        Field("kick", "string", "a kick during the run: a jump of the yaw angle psi or of the yaw rate dpsi (none: "
+              "no kick)", choices=tuple(kicks.KINDS)),
+        Field("kick_size", "number", "the kick's size: rad for psi (at most 0.5 either way), rad/s for dpsi (at most "
+              "50 either way)", low=-max(k[2] for k in kicks.KINDS.values()),
+              high=max(k[2] for k in kicks.KINDS.values()), unit="rad or rad/s"),
+        Field("kick_at_time", "number", "when the kick comes, on the profile's clock (within the run); or "
+              "kick_at_speed", low=-kicks.TIME_LIMIT, high=kicks.TIME_LIMIT, unit="s"),
+        Field("kick_at_speed", "number", "the speed at which the kick comes (the first time the run reaches it); or "
+              "kick_at_time", low=V_RANGE[0], high=V_RANGE[1], unit="m/s"),
         Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
         PARAMS, MATERIAL)),
     "sensitivity": RequestSchema("sensitivity", "sensitivities: derivatives of the Hopf speeds and the largest "
@@ -517,6 +549,12 @@ SCHEMAS: dict[str, RequestSchema] = {
               unit="N"),
         Field("seed", "integer", "seed of the samples (the same seed gives the same samples)", default=0, low=0,
               high=2 ** 31 - 1),
+        Field("disturbance", "number", "also P(shimmy) after a disturbance up to this size from straight rolling, "
+              "counting every attractor it reaches (the margins at each sample's nine points: about 5 s per sample "
+              "and core), as the yaw angle of the same energy", low=margin_options.LIMITS["max_size"][0],
+              high=margin_options.LIMITS["max_size"][1], unit="rad"),
+        Field("disturbance_direction", "string", "the disturbed component (psi, dpsi, delta, ddelta; the rest at "
+              "rest), or all four in the energy norm (energy)", default="psi", choices=margin_options.DIRECTIONS),
         PARAMS, MATERIAL)),
     "margins": RequestSchema("margins", "disturbance margins at one operating point: its attractors and the smallest "
                              "disturbance from straight rolling that ends on each, each checked by two runs", (

@@ -44,6 +44,7 @@ MAX_MAP_SPEEDS = 400  # speeds per slice on a map's output grid
 MAX_STUDY_VALUES = 50  # values per study parameter
 MAX_STUDY_UNITS = 200  # diagrams per study (designs x configurations, ~0.5-2 s each)
 MAX_ROBUSTNESS_SAMPLES = 2048  # samples of one robustness analysis (~1 s per 100 on 2 cores)
+MAX_DISTURBED_SAMPLES = 256  # with a disturbance (margins at nine points: ~5 s per sample and core)
 #: Admission control of jobs, shared by the API and the workbench pages (SHIMMY_MAX_RUNNING_JOBS,
 #: SHIMMY_MAX_QUEUED_JOBS): at most this many run at once on this host, each in its own process;
 #: at most this many more wait queued, holding no process; beyond that a submission is refused

@@ -244,6 +244,14 @@ def test_sensitivity_optimise_robustness_commands_give_the_documented_json():
     (("optimise", "--config", "original"), "it has no device"),
     (("robustness", "--config", "nes", "--tolerance", "k_s=2"), "tolerances[0].relative=2.0 is out of range"),
     (("robustness", "--config", "nes"), "tolerance"),
+    (("robustness", "--config", "nes", "--tolerance", "k_s=0.05", "--disturbance", "0.0010"),
+     "disturbance=0.0010 is out of range; allowed: a number in [0.002, 1] rad"),
+    (("robustness", "--config", "nes", "--tolerance", "k_s=0.05", "--disturbance", "0.1", "--samples", "300"),
+     "samples=300 asks for too many samples with a disturbance"),
+    (("ground-run", "--config", "nes", "--profile", "takeoff", "--kick", "psi", "--kick-size", "0.80",
+      "--kick-at-time", "3"), "kick_size=0.80 is out of range; allowed: a number in [-0.5, 0.5] rad"),
+    (("ground-run", "--config", "nes", "--profile", "landing", "--kick", "dpsi", "--kick-size", "2",
+      "--kick-at-speed", "70"), "kick_at_speed=70 m/s is never reached by the landing profile"),
 ])
 def test_bad_design_command_input_exits_2_naming_the_field(args, needle):
     out = run(*args)

@@ -140,6 +140,15 @@ BAD = [
      "tolerances[0].distribution"),
     ("/api/v1/jobs", {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05"], "samples": 10 ** 6},
      422, "samples"),
+    # A disturbance in the robustness, a kick in a ground run (issue 29).
+    ("/api/v1/jobs", {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05"], "disturbance": 5},
+     422, "disturbance"),
+    ("/api/v1/jobs", {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05"], "disturbance": 0.1,
+                      "samples": 512}, 422, "samples"),
+    ("/api/v1/jobs", {"analysis": "ground_run", "config": "nes", "kick": "psi", "kick_size": 0.7,
+                      "kick_at_time": 1}, 422, "kick_size"),
+    ("/api/v1/jobs", {"analysis": "ground_run", "config": "nes", "preset": "landing", "kick": "dpsi", "kick_size": 1,
+                      "kick_at_speed": 100}, 422, "kick_at_speed"),
 ]
 
 

@@ -43,6 +43,38 @@ def test_refusals_name_the_field(body, field, message):
     assert e.value.field == field
 
 
+def test_a_kick_is_canonical_and_a_scenario_is_its_preset_with_its_kick():
+    joint = schemas.validate("ground_run", {"config": "nes", "preset": "runway_joint"})
+    plain = schemas.validate("ground_run", {"config": "nes", "preset": "takeoff", "kick": "dpsi", "kick_size": 1,
+                                            "kick_at_speed": 60})
+    assert joint == plain and cache.key("ground_run", joint) == cache.key("ground_run", plain)
+    assert (joint["preset"], joint["kick"], joint["kick_size"], joint["kick_at_time"], joint["kick_at_speed"]) == \
+        ("takeoff", "dpsi", 1.0, None, 60.0)
+    moved = schemas.validate("ground_run", {"config": "nes", "preset": "runway_joint", "kick_at_time": 5})
+    assert (moved["kick"], moved["kick_at_time"], moved["kick_at_speed"]) == ("dpsi", 5.0, None)
+    none = schemas.validate("ground_run", {"config": "nes"})
+    assert none["kick"] is None and none["kick_size"] is None
+    text = schemas.SCHEMAS["ground_run"].openapi()
+    assert text["properties"]["kick"]["enum"] == ["psi", "dpsi", None] and "kick_at_speed" in text["description"]
+
+
+@pytest.mark.parametrize("body, field, message", [
+    ({"kick": "psi", "kick_size": 0.7, "kick_at_time": 1}, "kick_size", r"\[-0.5, 0.5\] rad"),
+    ({"kick": "dpsi", "kick_size": "2", "kick_at_time": 1}, "kick_size", "is not a number"),
+    ({"kick": "dpsi", "kick_size": 2, "kick_at_time": 1, "kick_at_speed": 30}, "kick_at_time", "both"),
+    ({"kick_at_speed": 30}, "kick_at_speed", "is given without a kick"),
+    ({"kick": "dpsi", "kick_size": 2, "kick_at_speed": 100}, "kick_at_speed", r"never reached .* \[5, 80\] m/s"),
+    ({"preset": "touchdown_yaw", "kick_at_time": 40}, "kick_at_time", r"outside the landing profile's run"),
+    ({"preset": "runway_joint", "profile": [[0, 10, 150000], [10, 20, 150000]]}, "preset", "is a scenario"),
+    ({"profile": [[0, 10, 150000], [10, 20, 150000]], "kick": "psi", "kick_size": 0.1, "kick_at_speed": 25},
+     "kick_at_speed", r"never reached by the table profile; allowed: a speed the run reaches: \[10, 20\]"),
+])
+def test_kick_refusals_name_the_field(body, field, message):
+    with pytest.raises(InvalidParameterError, match=message) as e:
+        schemas.validate("ground_run", {"config": "original", **body})
+    assert e.value.field == field
+
+
 def test_the_service_result_is_the_package_result_with_the_hopf_curves(tmp_path, monkeypatch):
     monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
     body = {"config": "pd", "preset": "takeoff", "preset_options": {"V_rotate": 70}, "hopf_curves": True,
@@ -58,6 +90,11 @@ def test_the_service_result_is_the_package_result_with_the_hopf_curves(tmp_path,
     assert result["hopf_curves"] and all(len(c["V"]) == len(c["Fz"]) > 2 for c in result["hopf_curves"])
     again, cached = analyses.run("ground_run", body)
     assert cached and again == result
+    kicked, _ = analyses.run("ground_run", {**body, "hopf_curves": False, "kick": "psi", "kick_size": 0.05,
+                                            "kick_at_time": 3.0})
+    direct = ground_run("pd", "takeoff", params=Parameters().with_overrides(a_p=0.8), preset_options={"V_rotate": 70},
+                        kick={"kick": "psi", "kick_size": 0.05, "kick_at_time": 3.0})
+    assert kicked["kick"] == direct.kick and kicked["kick"]["t"] == 3.0
 
 
 def test_ground_run_job_over_http(server):

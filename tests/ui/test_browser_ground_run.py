@@ -12,7 +12,8 @@ from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
-from browser import DOWNLOADS, SHOTS, browser_fixture, idle, severe, text_of, trace_count, wait_for  # noqa: E402
+from browser import (DOWNLOADS, SHOTS, browser_fixture, idle, severe, text_of, trace_count, type_into,  # noqa: E402
+                     wait_for)
 
 browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)  # the profile of test_browser.py
 
@@ -117,3 +118,27 @@ def test_ground_run_address_values_are_refused_not_replaced(server, browser):
                        what="the refused run")
     assert "threshold |psi|" in refusal and "rad" in refusal
     assert browser.find_element(By.ID, "gr-psi-thr").get_attribute("value") == ""
+
+
+def test_ground_run_page_runs_a_kick_and_refuses_it_in_its_unit(server, browser):
+    """The touchdown scenario from the address fills the kick boxes; Run shows what followed the kick in the
+    table's last column; a yaw kick beyond 0.5 rad is refused in the box's unit."""
+    browser.get(server.base + "/ground-run?preset=touchdown_yaw")
+    wait_for(lambda: "Touchdown with yaw" in text_of(browser, "gr-kick-note"), timeout=30, what="the scenario's note")
+    assert browser.find_element(By.ID, "gr-kick-size").get_attribute("value") == "0.05"
+    assert browser.find_element(By.ID, "gr-kick-when").get_attribute("value") == "0"
+    assert "landing roll preset" in text_of(browser, "gr-source")
+    idle(browser)
+    browser.find_element(By.ID, "gr-run").click()
+    rows = wait_for(lambda: (s := _summary(browser)) and len(s) == 4 and s, timeout=JOB_WAIT,
+                    what="the landing roll with the touchdown yaw")
+    header = browser.execute_script("return Array.from(document.querySelectorAll('#gr-summary-table th'))"
+                                    ".map(c => c.innerText);")
+    assert header[-1] == "after the kick (psi +0.05 rad at 0 s, 65 m/s)"
+    assert all("shimmy" in r[-1] and "s in shimmy against no kick" in r[-1] for r in rows)
+    assert severe(browser) == []
+    box = browser.find_element(By.ID, "gr-kick-size")
+    type_into(box, "0.8")
+    browser.find_element(By.ID, "gr-run").click()
+    message = wait_for(lambda: text_of(browser, "gr-error"), timeout=20, what="the refusal")
+    assert "kick size (yaw angle psi) = 0.8 rad is outside [-0.5, 0.5] rad" in message

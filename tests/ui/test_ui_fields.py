@@ -92,12 +92,37 @@ def test_ground_run_thresholds_are_refused_in_the_boxes_unit_never_defaulted():
     import app  # noqa: F401 - registers the pages
     from pages import ground_run
 
+    no_kick = ("none", None, "time", None)
     for psi, lateral, text in ((None, 1.0, "threshold |psi| is empty"), (0.01, 5000.0, "5000 mm is outside")):
         with pytest.raises(InvalidParameterError) as err:
-            ground_run._requests("original", "takeoff", [], [], [], psi, lateral, "cubic", {})
+            ground_run._requests("original", "takeoff", [], [], [], psi, lateral, "cubic", *no_kick, {})
         assert text in str(err.value)
-    request = ground_run._requests("original", "takeoff", [], [], [], 0.02, 2.0, "cubic", {})[0]
+    request = ground_run._requests("original", "takeoff", [], [], [], 0.02, 2.0, "cubic", *no_kick, {})[0]
     assert request["psi_threshold"] == 0.02 and request["lateral_threshold"] == pytest.approx(0.002)
+    assert "kick" not in request
+
+
+def test_ground_run_kick_boxes_are_refused_in_their_unit_and_a_scenario_fills_them():
+    import app  # noqa: F401 - registers the pages
+    from pages import ground_run
+
+    for kick, text in ((("psi", 0.8, "time", 3.0), "kick size (yaw angle psi) = 0.8 rad is outside [-0.5, 0.5] rad"),
+                       (("dpsi", 80, "time", 3.0), "= 80 rad/s is outside [-50, 50] rad/s"),
+                       (("dpsi", None, "time", 3.0), "kick size (yaw rate dpsi) is empty"),
+                       (("psi", 0.1, "speed", "abc"), "the kick's speed = abc is not a number"),
+                       (("psi", 0.1, "speed", 600), "the kick's speed = 600 m/s is outside [1, 500] m/s")):
+        with pytest.raises(InvalidParameterError) as err:
+            ground_run._requests("original", "takeoff", [], [], [], 0.01, 1.0, "cubic", *kick, {})
+        assert text in str(err.value)
+    request = ground_run._requests("nes", "runway_joint", [], [], [], 0.01, 1.0, "cubic", "dpsi", 2.0, "speed", 50.0,
+                                   {})[0]
+    assert request["preset"] == "takeoff"  # the page sends the scenario's preset and the boxes' kick
+    assert (request["kick"], request["kick_size"], request["kick_at_speed"]) == ("dpsi", 2.0, 50.0)
+    assert ground_run.scenario_kick("touchdown_yaw")[:4] == ("psi", 0.05, "time", 0.0)
+    assert ground_run.kick_outcome(None) == "– (no kick)"
+    assert ground_run.kick_size_refusal("psi", 0.8).startswith("the kick size (yaw angle psi) = 0.8 rad is outside")
+    assert ground_run.kick_size_refusal("dpsi", 0.8) == "" and ground_run.kick_size_refusal("none", "abc") == ""
+    assert "the kick's time = -1e+06 s is outside" in ground_run.kick_moment_refusal("psi", "time", -1e6)
 
 
 def _number_boxes(component):

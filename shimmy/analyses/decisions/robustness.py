@@ -14,6 +14,21 @@ whether straight rolling is unstable there (an eigenvalue with positive real par
 shimmy; a point in a bistable region (x = 0 stable beside a stable cycle) is not counted, so
 ``p_shimmy`` is the probability that shimmy starts from any disturbance.
 
+**With a disturbance** (``disturbance``: a size as the yaw angle of the same energy, rad; along
+``disturbance_direction``, psi by default: a yaw kick of that angle): at each sample's nine points the
+margins (:func:`shimmy.analyses.maps.margins.margins`: the attractors of the bifurcation diagram at
+the point's load and of runs from large starts, the bracketing scan up to the size and bisection)
+say which shimmy attractors a disturbance from straight rolling no larger than the size reaches
+(the standard start's among them where x = 0 is unstable: its threshold is 0). Shimmy follows the
+disturbance where x = 0 is unstable or one of them is reached, so ``p_shimmy_disturbed`` >=
+``p_shimmy`` at every point (equal where no stable straight rolling coexists with a cycle); beside
+it, the share of samples in which each mode (torsional, the fatigue-critical one; lateral; both) is
+reached: where a torsional and a lateral cycle coexist (the map's Bistable), the linear figure says
+shimmy and this one says which. The shares come with 95 % Wilson intervals (the Sobol samples are
+spread more evenly than independent ones: the intervals are conservative). A basin thinner than the
+scan's grid along the direction can be missed (:mod:`shimmy.analyses.core.basins`). About 5 s per
+sample on one core (four diagrams and nine margins).
+
 Linear propagation beside it: std = sqrt(sum_i (dQ/dtheta_i sigma_i)^2) with the sensitivities of
 :mod:`shimmy.analyses.decisions.sensitivity` and sigma_i = theta_i0 r_i (normal) or theta_i0 r_i / sqrt 3 (uniform);
 at an operating point the growth rate g = max Re lambda is propagated the same way and
@@ -46,6 +61,7 @@ from ..core.stability import Linearisation, hopf_points
 
 FZ_BOX = FZ_RANGE  # N: where the lowest point of the Hopf curves is looked for
 CHUNK = 16  # samples per executor unit
+CHUNK_DISTURBED = 2  # samples per unit with a disturbance (a diagram per load and margins per stable point)
 
 
 @dataclass(frozen=True)
@@ -97,10 +113,32 @@ def _same_turning_point(found: tuple[float, float, float], nominal: tuple[float,
             and abs(V / V0 - 1.0) < 0.5 and abs(Fz / Fz0 - 1.0) < 0.5)
 
 
+def _disturbed(config: str, params: Parameters, disturbance: tuple[float, str]) -> dict[str, dict[str, Any]]:
+    """At each operating point the modes of the shimmy attractors a disturbance up to the size reaches (margins on
+    the point's diagram, in this process): {point: {"modes": [...], "unsettled": runs}}."""
+    from ..core.executors import InlineExecutor
+    from ..maps.margins import diagram_at, margins
+    from ...model.parameters import DIAGRAM_V_RANGE
+
+    size, direction = disturbance
+    out: dict[str, dict[str, Any]] = {}
+    diagrams: dict[float, Any] = {}
+    for point, (V, Fz) in OPERATING_POINTS.items():
+        if Fz not in diagrams:  # each sample's own, asked only here: not kept in the process's cache
+            v_max = max(DIAGRAM_V_RANGE[1], *(v for v, f in OPERATING_POINTS.values() if f == Fz))
+            diagrams[Fz] = diagram_at.__wrapped__(Configuration.parse(config), Fz, params, v_max)
+        found = margins(config, V, Fz, params=params, diagram=diagrams[Fz], executor=InlineExecutor(),
+                        direction=direction, max_size=size)
+        modes = [a["mode"] for a in found.attractors if a["kind"] != "equilibrium" and a["min_disturbance"]["reached"]]
+        out[point] = {"modes": modes, "unsettled": found.unsettled}
+    return out
+
+
 def _sample_unit(task: tuple) -> list[dict[str, Any]]:
     """Figures of a chunk of samples: (config, base params, names, rows of values, Fz, nominal lowest point of
-    the Hopf curves (V, Fz, omega) or None)."""
-    config, base, names, rows, Fz, low = task
+    the Hopf curves (V, Fz, omega) or None[, disturbance (size, direction) or None])."""
+    config, base, names, rows, Fz, low, *rest = task
+    disturbance = rest[0] if rest else None
     out = []
     for values in rows:
         try:  # samples may reach past a design range (not past physics): the statistics are not truncated
@@ -132,6 +170,8 @@ def _sample_unit(task: tuple) -> list[dict[str, Any]]:
                 entry["min_shimmy_Fz"] = None if found is None else found["Fz"]
                 entry["min_recomputed"] = True
         entry["unstable"] = {p: _growth(model, V, F) > 0.0 for p, (V, F) in OPERATING_POINTS.items()}
+        if disturbance is not None:
+            entry["disturbed"] = _disturbed(config, params, disturbance)
         out.append(entry)
     return out
 
@@ -165,6 +205,26 @@ def _stats(values: np.ndarray, nominal: float, linear_std: float | None) -> dict
             "samples": values.tolist()}
 
 
+def _share(count: int, n: int) -> dict[str, Any]:
+    from ..core.basins import wilson
+
+    return {"p": count / n, "count": count, "samples": n, "ci95": list(wilson(count, n))}
+
+
+def _disturbed_shares(ok: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """Per point: P(shimmy after a disturbance up to the size: x = 0 unstable or a shimmy attractor reached) and
+    P(each mode reached), with their intervals, and the samples linearly unstable there."""
+    n = len(ok)
+    out = {}
+    for p in OPERATING_POINTS:
+        reached = [set(e["disturbed"][p]["modes"]) for e in ok]
+        shimmy = sum(e["unstable"][p] or bool(r) for e, r in zip(ok, reached, strict=True))
+        modes = {m: _share(sum(m in r for r in reached), n) for m in ("torsional", "lateral", "both")}
+        modes |= {m: _share(sum(m in r for r in reached), n) for m in sorted(set().union(*reached)) if m not in modes}
+        out[p] = {**_share(shimmy, n), "linearly_unstable": sum(e["unstable"][p] for e in ok), "modes": modes}
+    return out
+
+
 @dataclass
 class RobustnessResult:
     config: Configuration
@@ -181,19 +241,33 @@ class RobustnessResult:
     elapsed_s: float
     executor: str
     warnings: list[str] = field(default_factory=list)
+    p_shimmy_ci95: dict[str, list[float]] = field(default_factory=dict)
+    disturbance: dict[str, Any] | None = None  # size, unit, direction
+    p_shimmy_disturbed: dict[str, dict[str, Any]] | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        methods = {}
+        if self.disturbance is not None:
+            methods["p_shimmy_disturbed"] = (
+                f"share of samples where straight rolling is unstable at the point or a shimmy attractor is reached "
+                f"by a disturbance from straight rolling along {self.disturbance['direction']} of at most "
+                f"{self.disturbance['size']:g} rad (as the yaw angle of the same energy), and of those where each "
+                "mode is reached: the margins at the point (bracketing scan of 12 sizes up to it, bisection, each "
+                "run classified by the attractors of the sample's bifurcation diagram at the load); 95 % Wilson "
+                "intervals")
         return {"config": self.config.value, "Fz": self.Fz, "params": self.params.to_dict(),
                 "tolerances": [t.to_dict() for t in self.tolerances], "samples": self.samples, "seed": self.seed,
                 "hopf_points": self.hopf_points, "min_shimmy_Fz": self.min_shimmy, "p_shimmy": self.p_shimmy,
-                "p_shimmy_linear": self.p_shimmy_linear,
+                "p_shimmy_ci95": self.p_shimmy_ci95, "p_shimmy_linear": self.p_shimmy_linear,
+                "disturbance": self.disturbance, "p_shimmy_disturbed": self.p_shimmy_disturbed,
                 "operating_points": {k: {"V": v[0], "Fz": v[1]} for k, v in OPERATING_POINTS.items()},
                 "refused_samples": self.refused, "elapsed_s": self.elapsed_s, "executor": self.executor,
                 "warnings": self.warnings,
                 "methods": {"samples": "scrambled Sobol sequence (seeded), inverse normal CDF for normal tolerances",
                             "p_shimmy": "share of samples where straight rolling is unstable at the point "
-                                        "(linear shimmy; bistable points not counted)",
-                            "linear": "first-order propagation of the implicit-differentiation sensitivities"},
+                                        "(linear shimmy; bistable points not counted), 95 % Wilson intervals",
+                            "linear": "first-order propagation of the implicit-differentiation sensitivities",
+                            **methods},
                 "version": __version__}
 
     def summary_text(self) -> str:
@@ -204,15 +278,26 @@ class RobustnessResult:
 
 def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str] | Mapping[str, float],
                *, samples: int = 128, Fz: float = DEFAULT_FZ, params: Parameters | None = None, seed: int = 0,
+               disturbance: float | None = None, disturbance_direction: str = "psi",
                executor=None, progress: Callable[[float, str], None] | None = None) -> RobustnessResult:
     """Distributions of the Hopf speeds at ``Fz``, of the minimum shimmy load and of shimmy at the nine
-    operating points under ``tolerances``, sampled and by linear propagation."""
+    operating points under ``tolerances``, sampled and by linear propagation; with ``disturbance`` (rad, as the
+    yaw angle of the same energy, along ``disturbance_direction``) also P(shimmy) counting every shimmy attractor
+    a disturbance up to that size reaches (module docstring)."""
+    from ..maps.margin_options import DIRECTIONS, LIMITS
+
     clock = time.perf_counter()
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
     Fz = check_number("Fz", Fz, *FZ_RANGE, "N")
     samples = int(check_number("samples", samples, 2, 4096, integer=True))
     seed = int(check_number("seed", seed, 0, 2 ** 31 - 1, integer=True))
+    if disturbance is not None:
+        low, high, unit, _ = LIMITS["max_size"]
+        disturbance = check_number("disturbance", disturbance, low, high, f"{unit} (as the yaw angle of the same "
+                                                                          "energy)")
+        if disturbance_direction not in DIRECTIONS:
+            raise unknown_name_error(str(disturbance_direction), DIRECTIONS, "disturbance_direction")
     if isinstance(tolerances, Mapping):
         tols = [Tolerance.make(k, v) for k, v in tolerances.items()]
     else:
@@ -226,8 +311,8 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     warnings = [f"{n} is not fitted in configuration {config.value}: its tolerance has no effect" for n in unused]
     if executor is None:
         with open_executor() as own:
-            return robustness(config, tols, samples=samples, Fz=Fz, params=params, seed=seed, executor=own,
-                              progress=progress)
+            return robustness(config, tols, samples=samples, Fz=Fz, params=params, seed=seed, disturbance=disturbance,
+                              disturbance_direction=disturbance_direction, executor=own, progress=progress)
     report = progress or (lambda fraction, message: None)
     model = build_model(config, params)
     pairs = coefficient_pairs(config, params, names)
@@ -251,9 +336,11 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     if low is not None:
         start = ((low["V"], low["Fz"], 2 * math.pi * low["frequency_hz"])
                  if low["source"] == "lowest point of the Hopf curves" else "curves")
-    chunks = [rows[k:k + CHUNK] for k in range(0, len(rows), CHUNK)]
+    size = CHUNK if disturbance is None else CHUNK_DISTURBED
+    chunks = [rows[k:k + size] for k in range(0, len(rows), size)]
     report(0.02, f"{samples} samples in {len(chunks)} units")
-    results = run_units(_sample_unit, [(config.value, params.to_dict(), names, c, Fz, start) for c in chunks],
+    extra = () if disturbance is None else ((disturbance, disturbance_direction),)
+    results = run_units(_sample_unit, [(config.value, params.to_dict(), names, c, Fz, start, *extra) for c in chunks],
                         executor, lambda f, msg: report(0.02 + 0.93 * f, f"samples: {msg}"),
                         lambda t: f"{len(t[3])} samples")
     flat = [e for chunk in results for e in chunk]
@@ -289,7 +376,18 @@ def robustness(config: Configuration | str, tolerances: Sequence[Tolerance | str
     if low and lows.size:
         low_out = _stats(lows, low["Fz"], linear_std(low["dFz_dp"]) if low["dFz_dp"] is not None else None)
     p_sampled = {p: float(np.mean([e["unstable"][p] for e in ok])) for p in OPERATING_POINTS}
+    p_ci = {p: _share(sum(e["unstable"][p] for e in ok), len(ok))["ci95"] for p in OPERATING_POINTS}
     p_linear = {p: _linear_probability(model, V, F, pairs, names, sigma) for p, (V, F) in OPERATING_POINTS.items()}
+    disturbed = None
+    if disturbance is not None:
+        disturbed = _disturbed_shares(ok)
+        unsettled = sum(d["unsettled"] for e in ok for d in e["disturbed"].values())
+        if unsettled:
+            warnings.append(f"{unsettled} runs of the margins settled on no attractor in the time allowed (counted "
+                            "as not reaching one)")
     report(1.0, "done")
     return RobustnessResult(config, Fz, params, tols, samples, seed, hopf_out, low_out, p_sampled, p_linear, refused,
-                            time.perf_counter() - clock, type(executor).__name__, warnings)
+                            time.perf_counter() - clock, type(executor).__name__, warnings, p_ci,
+                            None if disturbance is None else {"size": disturbance, "unit": "rad",
+                                                              "direction": disturbance_direction},
+                            disturbed)

@@ -77,7 +77,7 @@ def optimise_summary(result: dict[str, Any]) -> str:
 def robustness_summary(result: dict[str, Any]) -> str:
     """The table ``python -m shimmy robustness`` prints, from ``RobustnessResult.to_dict()``: the tolerances,
     each distribution's nominal value, mean, spread and percentiles, sampled and linear, and the
-    probability of shimmy at the operating points."""
+    probability of shimmy at the operating points; with a disturbance, that of shimmy and of each mode after it."""
     lines = [f"{result['config']} at Fz = {result['Fz'] / 1e3:g} kN, {result['samples']} samples "
              f"(seed {result['seed']}): "
              + ", ".join(f"{t['name']} {100 * t['relative']:g} % {t['distribution']}" for t in result["tolerances"]),
@@ -90,6 +90,16 @@ def robustness_summary(result: dict[str, Any]) -> str:
                      f"{h['p05'] * k:>10.4g}{h['p95'] * k:>10.4g}{h['linear_std'] * k:>12.3g}")
     sampled, linear = result["p_shimmy"], result["p_shimmy_linear"]
     lines.append("  P(shimmy) sampled / linear: " + ", ".join(f"{p} {sampled[p]:.3f}/{linear[p]:.3f}" for p in sampled))
+    disturbed = result.get("p_shimmy_disturbed")
+    if disturbed:
+        d = result["disturbance"]
+        lines.append(f"  after a disturbance up to {d['size']:g} {d['unit']} along {d['direction']} (every attractor "
+                     "reached; 95 % intervals):")
+        lines.append(f"    {'':<4}{'P(shimmy)':>22}{'P(torsional)':>24}{'P(lateral)':>24}{'linear':>9}")
+        for p, share in disturbed.items():
+            cells = [share, share["modes"]["torsional"], share["modes"]["lateral"]]
+            lines.append(f"    {p:<4}" + "".join(f"{c['p']:>8.3f} [{c['ci95'][0]:.3f}, {c['ci95'][1]:.3f}]"
+                                                   for c in cells) + f"{sampled[p]:>9.3f}")
     lines += [f"  warning: {w}" for w in result["warnings"]]
     return "\n".join(lines)
 

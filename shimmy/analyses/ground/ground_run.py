@@ -25,6 +25,10 @@ profile gives the same history) and reports what a landing-gear engineer asks of
   first moment |psi| or |l_g delta| itself exceeds its threshold. A slowly varying parameter
   delays the onset well past the static Hopf point (the oscillation grows from the small
   amplitude left by the stable stretch before it), and a faster ramp moves it further in V.
+* **A kick** (optional, :class:`~shimmy.analyses.ground.kicks.Kick`): a jump of the yaw angle or
+  the yaw rate at a chosen time or speed (a runway joint, a touchdown with yaw). The integration
+  is split at that instant and the jump applied there, and the run says whether shimmy started
+  after it and in which mode (:func:`~shimmy.analyses.ground.kicks.kick_outcome`).
 
 :func:`ground_runs` runs one profile for several configurations and compares them with
 ``original``.
@@ -49,6 +53,7 @@ from ...model.configurations import ALL_CONFIGURATIONS, Configuration
 from ...model.equations import build_model, jacobian
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, V_RANGE, Parameters, check_number
 from .ground_profiles import GroundProfile, as_profile
+from .kicks import KICK_PRESETS, SAME_INSTANT, Kick, kick_instant, kick_outcome, scenario
 from .summaries import comparison_dict, comparison_summary, comparison_table, ground_run_summary
 from ..core import nes_range
 from ..core.response import dominant_mode, torsional_share
@@ -122,6 +127,7 @@ class GroundRunResult:
     counters: dict[str, int] = field(default_factory=dict)
     elapsed_s: float = 0.0
     warnings: list[str] = field(default_factory=list)
+    kick: dict[str, Any] | None = None  # the kick and what followed it (kicks.kick_outcome), None without one
 
     @property
     def psi(self) -> np.ndarray:
@@ -153,7 +159,8 @@ class GroundRunResult:
                 "shimmy_intervals": self.shimmy_intervals, "speed_range": self.speed_range,
                 "peak_psi": self.peak_psi, "peak_lateral": self.peak_lateral,
                 "boundary_crossings": self.boundary_crossings, "onsets": self.onsets,
-                "onset_delay_s": self.onset_delay_s, "success": self.success, "message": self.message}
+                "onset_delay_s": self.onset_delay_s, "kick": self.kick, "success": self.success,
+                "message": self.message}
 
     def to_dict(self, series_stride: int = 1, include_series: bool = True) -> dict[str, Any]:
         out = {**self.summary(), "profile": self.profile.to_dict(), "options": self.options.to_dict(),
@@ -172,20 +179,25 @@ class GroundRunResult:
 
 def ground_run(config: Configuration | str, profile: Any, *, params: Parameters | None = None, x0=None,
                options: GroundRunOptions | None = None, preset_options: dict[str, Any] | None = None,
-               **option_overrides) -> GroundRunResult:
+               kick: Kick | dict[str, Any] | None = None, **option_overrides) -> GroundRunResult:
     """Integrate the gear through ``profile`` (a :class:`GroundProfile`, a preset name "takeoff" /
-    "landing" / "taxi" with ``preset_options``, or rows [t (s), V (m/s), Fz (N)]).
+    "landing" / "taxi" with ``preset_options``, a scenario "runway_joint" / "touchdown_yaw": a preset with
+    a kick, or rows [t (s), V (m/s), Fz (N)]).
 
-    ``x0`` defaults to psi = 0.001 rad, all else zero (as :func:`simulate`). Bad profiles and
-    options raise :class:`InvalidParameterError` before any work; integration failures come back
-    as ``success=False`` with a message and the part computed.
+    ``x0`` defaults to psi = 0.001 rad, all else zero (as :func:`simulate`). ``kick``: a
+    :class:`~shimmy.analyses.ground.kicks.Kick`, or its request fields {kick, kick_size, kick_at_time |
+    kick_at_speed}; the jump is added to the state at its instant. Bad profiles, kicks and options raise
+    :class:`InvalidParameterError` before any work; integration failures come back as ``success=False``
+    with a message and the part computed.
     """
     config = Configuration.parse(config)
+    profile, kick = _with_scenario(profile, kick)
     profile = as_profile(profile, preset_options)
     params = params if params is not None else Parameters()
     options = options or GroundRunOptions()
     if option_overrides:
         options = GroundRunOptions(**{**options.to_dict(), **option_overrides})
+    t_kick = kick_instant(kick, profile) if kick is not None else None
     model = build_model(config, params, exact_nes=options.exact_nes)
     n = model.n_states
     start = initial_state(x0, n)
@@ -194,9 +206,25 @@ def ground_run(config: Configuration | str, profile: Any, *, params: Parameters 
     t0 = float(profile.t[0])
     n_out = int(math.floor(profile.duration / options.dt_out + 1e-9)) + 1
     out = np.empty((n_out, integrator.N_FULL))
-    status, accepted, rejected, calls, written = integrator.integrate_profile(
-        start, profile.duration, options.dt_out, profile.t - t0, profile.V, profile.Fz, model.coefficients,
-        *model.flags, options.rtol, options.atol, options.max_steps, out)
+    run = _Integration(profile, model, options)
+    before = after = without = None
+    if kick is None:
+        written = run.grid(start, t0, out)
+    else:
+        # the samples before the kick and the state at it (the same steps: the kick is a row of both tables),
+        # then the run from the kicked state, and beside it the run from the same state without the kick
+        span = t_kick - t0
+        first = 0 if span <= SAME_INSTANT else min(n_out, int(math.ceil(span / options.dt_out - 1e-9)))
+        written = run.grid(start, t0, out[:first], stop=span)
+        before = run.exact(start, t0, t_kick) if written == first else None
+        if before is not None:
+            after = before.copy()
+            after[kick.index] += kick.size
+            written += run.onward(after, t_kick, first, out[first:])
+            base = _Integration(profile, model, options)
+            rows = np.empty((n_out - first, integrator.N_FULL))
+            without = np.concatenate([out[:first, :n], rows[:base.onward(before, t_kick, first, rows), :n]]).T
+    status, (accepted, rejected, calls) = run.status, run.counters
     integration_s = time.perf_counter() - clock
 
     t = t0 + np.arange(written) * options.dt_out
@@ -207,7 +235,7 @@ def ground_run(config: Configuration | str, profile: Any, *, params: Parameters 
     envelope_psi = maximum_filter1d(np.abs(states[0]), width, mode="nearest")
     envelope_lateral = maximum_filter1d(np.abs(lateral), width, mode="nearest")
 
-    shimmy = (envelope_psi > options.psi_threshold) | (envelope_lateral > options.lateral_threshold)
+    shimmy = _in_shimmy(states, params.gear.l_g, width, options)
     intervals = _intervals(shimmy, t, V, options.dt_out)
     in_shimmy = float(np.count_nonzero(shimmy) * options.dt_out)
     speed_range = [float(V[shimmy].min()), float(V[shimmy].max())] if shimmy.any() else None
@@ -225,6 +253,21 @@ def ground_run(config: Configuration | str, profile: Any, *, params: Parameters 
         warnings.append(beyond)
     above = (np.abs(states[0]) > options.psi_threshold) | (np.abs(lateral) > options.lateral_threshold)
     onsets = _onsets(crossings, above, shimmy, t, V, Fz)
+    outcome = None
+    if kick is not None:
+        if before is None:  # the integration failed before the kick
+            outcome = {**kick.to_dict(), "t": t_kick, "applied": False, "shimmy_started": None, "mode": None,
+                       "note": "not applied: the integration stopped before the kick"}
+        else:
+            # time in shimmy from the kick on, with the kick against without it (as far as both got)
+            i, m = min(first, written), min(written, without.shape[1])
+            extra = (np.count_nonzero(shimmy[i:m]) - np.count_nonzero(_in_shimmy(without, params.gear.l_g, width,
+                                                                                  options)[i:m])) * options.dt_out
+            outcome = {**kick_outcome(kick, t_kick, before, after, t, V, Fz, states, without,
+                                      k_psi=params.gear.k_psi, k_delta=params.gear.k_delta, l_g=params.gear.l_g,
+                                      psi_threshold=options.psi_threshold,
+                                      lateral_threshold=options.lateral_threshold),
+                       "applied": True, "extra_time_in_shimmy_s": float(extra)}
     return GroundRunResult(
         config=config, profile=profile, params=params, options=options, t=t, V=V, Fz=Fz, states=states,
         envelope_psi=envelope_psi, envelope_lateral=envelope_lateral, time_in_shimmy_s=in_shimmy,
@@ -234,7 +277,92 @@ def ground_run(config: Configuration | str, profile: Any, *, params: Parameters 
         message=STATUS_MESSAGES[status],
         counters={"steps": int(accepted), "rejected": int(rejected), "rhs_calls": int(calls),
                   "integration_ms": int(round(1e3 * integration_s))},
-        elapsed_s=time.perf_counter() - clock, warnings=warnings)
+        elapsed_s=time.perf_counter() - clock, warnings=warnings, kick=outcome)
+
+
+def _with_scenario(profile: Any, kick: Kick | dict[str, Any] | None) -> tuple[Any, Kick | None]:
+    """A scenario's name (:data:`~shimmy.analyses.ground.kicks.KICK_PRESETS`) as its profile preset and its kick (a
+    kick given as fields replacing the scenario's fields); a kick given as fields as a :class:`Kick`."""
+    if isinstance(profile, str) and profile in KICK_PRESETS:
+        if isinstance(kick, Kick):
+            return KICK_PRESETS[profile]["preset"], kick
+        profile, kick = scenario(profile, kick)
+    return profile, Kick.of(kick) if isinstance(kick, dict) else kick
+
+
+class _Integration:
+    """The compiled integrator through a profile in pieces on the output grid t0 + k dt_out (k = 0, 1, ...): runs
+    on the grid from a sample, and the state at any instant with the last step ending on it, so that a jump of
+    the state is applied at its instant however it falls on the grid. Counts the steps of every piece; after a
+    failure, ``status`` says which and nothing more is integrated."""
+
+    def __init__(self, profile: GroundProfile, model, options: GroundRunOptions):
+        self.profile, self.model, self.options = profile, model, options
+        self.t0 = float(profile.t[0])
+        self.status = integrator.SUCCESS
+        self.counters = (0, 0, 0)
+
+    def _table(self, t_from: float, stop: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The profile's rows after ``t_from`` on a clock starting there, with a row at ``stop`` (that clock) that
+        is never the last (the integrator ends a step on every interior row)."""
+        p = self.profile
+        later = p.t > t_from + SAME_INSTANT
+        V_from, Fz_from = p.at(t_from)
+        local = np.concatenate([[0.0], p.t[later] - t_from])
+        V, Fz = np.concatenate([[V_from], p.V[later]]), np.concatenate([[Fz_from], p.Fz[later]])
+        if stop is not None:
+            keep = np.abs(local - stop) > SAME_INSTANT
+            local, V, Fz = local[keep], V[keep], Fz[keep]
+            V_stop, Fz_stop = p.at(t_from + stop)
+            i = int(np.searchsorted(local, stop))
+            local, V, Fz = np.insert(local, i, stop), np.insert(V, i, V_stop), np.insert(Fz, i, Fz_stop)
+            if i == local.size - 1:
+                local, V, Fz = np.append(local, stop + 1.0), np.append(V, V_stop), np.append(Fz, Fz_stop)
+        return local, V, Fz
+
+    def _integrate(self, x: np.ndarray, table, dt: float, out: np.ndarray) -> int:
+        o = self.options
+        status, accepted, rejected, calls, written = integrator.integrate_profile(
+            x, dt * (out.shape[0] - 1), dt, *table, self.model.coefficients, *self.model.flags, o.rtol, o.atol,
+            o.max_steps, out)
+        a, r, c = self.counters
+        self.counters = (a + int(accepted), r + int(rejected), c + int(calls))
+        if status != integrator.SUCCESS:
+            self.status = status
+        return int(written)
+
+    def grid(self, x: np.ndarray, t_from: float, out: np.ndarray, stop: float | None = None) -> int:
+        """The samples at ``t_from`` + k dt_out from state ``x`` there, into the rows of ``out``; how many were
+        written. ``stop`` as in :meth:`_table` (a run sharing this one's steps ends a step there)."""
+        if out.shape[0] == 0 or self.status != integrator.SUCCESS:
+            return 0
+        return self._integrate(x, self._table(t_from, stop), self.options.dt_out, out)
+
+    def exact(self, x: np.ndarray, t_from: float, t_to: float) -> np.ndarray | None:
+        """The state at ``t_to`` from ``x`` at ``t_from``, the last step ending on it (no interpolation); None after
+        a failure."""
+        span = t_to - t_from
+        if span <= SAME_INSTANT:
+            return x.copy()
+        if self.status != integrator.SUCCESS:
+            return None
+        pair = np.empty((2, integrator.N_FULL))
+        return pair[1].copy() if self._integrate(x, self._table(t_from, span), span, pair) == 2 else None
+
+    def onward(self, x: np.ndarray, t_at: float, first: int, out: np.ndarray) -> int:
+        """From state ``x`` at ``t_at`` (at or before sample ``first``), the samples ``first``, ``first`` + 1, ...
+        into the rows of ``out``; how many were written."""
+        sample = self.t0 + first * self.options.dt_out
+        y = self.exact(x, t_at, sample) if out.shape[0] else None
+        return 0 if y is None else self.grid(y, sample, out)
+
+
+def _in_shimmy(states: np.ndarray, l_g: float, width: int, options: GroundRunOptions) -> np.ndarray:
+    """Where either envelope (the running maximum over ``width`` samples) is above its threshold."""
+    if states.shape[1] == 0:
+        return np.zeros(0, dtype=bool)
+    return ((maximum_filter1d(np.abs(states[0]), width, mode="nearest") > options.psi_threshold)
+            | (maximum_filter1d(np.abs(l_g * states[2]), width, mode="nearest") > options.lateral_threshold))
 
 
 def _peak(a: np.ndarray, t, V, Fz) -> dict[str, float]:
@@ -404,10 +532,15 @@ class GroundRunComparison:
 def ground_runs(profile: Any, *, configs: Sequence[Configuration | str] = ALL_CONFIGURATIONS,
                 params: Parameters | None = None, x0=None,
                 options: GroundRunOptions | None = None, preset_options: dict[str, Any] | None = None,
-                progress: Callable[[float, str], None] | None = None, **option_overrides) -> GroundRunComparison:
-    """:func:`ground_run` of one profile for each configuration (``x0`` must suit every one, or be None)."""
+                kick: Kick | dict[str, Any] | None = None, progress: Callable[[float, str], None] | None = None,
+                **option_overrides) -> GroundRunComparison:
+    """:func:`ground_run` of one profile for each configuration (``x0`` must suit every one, or be None), each with
+    the same ``kick`` (if any)."""
     clock = time.perf_counter()
+    profile, kick = _with_scenario(profile, kick)
     profile = as_profile(profile, preset_options)
+    if kick is not None:
+        kick_instant(kick, profile)  # refused before any run
     configs = [Configuration.parse(c) for c in configs]
     if not configs:
         raise InvalidParameterError("configs", [], "a non-empty list of configurations")
@@ -415,6 +548,7 @@ def ground_runs(profile: Any, *, configs: Sequence[Configuration | str] = ALL_CO
     runs = {}
     for k, c in enumerate(configs):
         report(k / len(configs), f"ground run of {c.value}")
-        runs[c.value] = ground_run(c, profile, params=params, x0=x0, options=options, **option_overrides)
+        runs[c.value] = ground_run(c, profile, params=params, x0=x0, options=options, kick=kick,
+                                   **option_overrides)
     report(1.0, "done")
     return GroundRunComparison(profile, runs, time.perf_counter() - clock)

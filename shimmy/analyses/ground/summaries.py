@@ -15,6 +15,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ...version import __version__
+from .kicks import outcome_text
 
 #: The series of a run's ``to_dict()``, in the order of ``GroundRunResult.series()`` (the last three
 #: only with the NES).
@@ -29,13 +30,18 @@ def ratio(a: float, b: float) -> float | None:
 def comparison_table(runs: Mapping[str, Mapping[str, Any]]) -> list[dict[str, Any]]:
     """One row per run (each ``GroundRunResult.summary()`` or ``to_dict()``, by configuration): time in
     shimmy, peaks, onset delay, speed range and, when ``original`` is among the runs, the change of the
-    time in shimmy (s) and the ratios of the peaks to those of ``original``."""
+    time in shimmy (s) and the ratios of the peaks to those of ``original``; with a kick, whether shimmy started
+    after it, its mode and the outcome in words."""
     base = runs.get("original")
     rows = []
     for name, r in runs.items():
         row = {"config": name, "time_in_shimmy_s": r["time_in_shimmy_s"], "peak_psi": r["peak_psi"]["value"],
                "peak_lateral": r["peak_lateral"]["value"], "onset_delay_s": r["onset_delay_s"],
                "speed_range": r["speed_range"], "success": r["success"]}
+        kick = r.get("kick")
+        if kick is not None:  # what the kick started, if anything
+            row.update(kick_shimmy_started=kick["shimmy_started"], kick_mode=kick["mode"],
+                       kick_outcome=outcome_text(kick))
         if base is not None:
             row["time_in_shimmy_change_s"] = r["time_in_shimmy_s"] - base["time_in_shimmy_s"]
             row["peak_psi_ratio"] = ratio(r["peak_psi"]["value"], base["peak_psi"]["value"])
@@ -66,6 +72,10 @@ def ground_run_summary(run: dict[str, Any], header: bool = True) -> str:
     lines.append(f"  {run['config']:<8} in shimmy {run['time_in_shimmy_s']:7.3f} s (V {speeds_text}); peak |psi| "
                  f"{psi['value']:.4g} rad at {psi['t']:.4g} s ({psi['V']:.4g} m/s); "
                  f"peak |l_g delta| {1e3 * lateral['value']:.4g} mm; onset delay {delay}")
+    if run.get("kick") is not None:
+        k = run["kick"]
+        where = f"t = {k['t']:.4g} s, V = {k['V']:.4g} m/s"
+        lines.append(f"      kick {k['kind']} {k['size']:+g} {k['unit']} at {where}: {outcome_text(k)}")
     for c in run["boundary_crossings"]:
         lines.append(f"      crosses the {c['curve']} curve at t = {c['t']:.4g} s, V = {c['V']:.5g} m/s, "
                      f"Fz = {c['Fz'] / 1e3:.5g} kN" + (f" ({c['direction']})" if "direction" in c else ""))

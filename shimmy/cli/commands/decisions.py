@@ -35,8 +35,10 @@ def _cmd_optimise(args) -> int:
 def _cmd_robustness(args) -> int:
     from ...analyses.decisions.summaries import robustness_summary
 
+    disturbance = {} if args.disturbance is None else numbers("robustness", args, "disturbance")
     canonical = request("robustness", {"config": args.config, "tolerances": args.tolerance or [],
                                        "samples": args.samples, **numbers("robustness", args, "Fz"), "seed": args.seed,
+                                       **disturbance, "disturbance_direction": args.disturbance_direction,
                                        "params": design(args)})
     with progress(args) as bar:
         spread = answer(args, "robustness", canonical, bar)
@@ -112,6 +114,10 @@ def add_parsers(commands) -> None:
                         "or half-width (uniform), e.g. k_lam=0.05")
     add_field(p, "robustness", "--samples", "quasi-Monte Carlo samples", type=int)
     add_field(p, "robustness", "--seed", "seed of the scrambled Sobol sequence", type=int)
+    add_field(p, "robustness", "--disturbance", "also P(shimmy) after a disturbance up to this size from straight "
+              "rolling, counting every attractor it reaches, and which mode (rad, as the yaw angle of the same energy; "
+              "about 5 s per sample and core)", limits=True)
+    add_field(p, "robustness", "--disturbance-direction", "the disturbed component, or energy (all four)")
     p.add_argument("--with-samples", action="store_true", help="include every sample's values in the JSON")
     add_common(p)
     add_progress(p)

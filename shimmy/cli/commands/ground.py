@@ -7,7 +7,7 @@ from typing import Any
 from ...errors import InvalidParameterError
 from ...model.configurations import CONFIGURATION_NAMES
 from ..answers import add_no_cache, answer, design, emit, numbers, request
-from ..common import EXIT_FAILED, add_command, add_common, add_config, add_field, parse_sets
+from ..common import EXIT_FAILED, add_command, add_common, add_config, add_field, limit, parse_sets
 
 
 def _read_profile_csv(path: str) -> tuple[list[list[Any]], list[int]]:
@@ -42,12 +42,16 @@ def _read_profile_csv(path: str) -> tuple[list[list[Any]], list[int]]:
 
 def _profile(args):
     from ...analyses.ground.ground_profiles import PRESETS, preset, profile_from_table
+    from ...analyses.ground.kicks import KICK_PRESETS
 
     settings = parse_sets(args.profile_set)
     if args.profile in PRESETS:
         return preset(args.profile, {k: v for k, v in settings.items()})
+    if args.profile in KICK_PRESETS:
+        return preset(KICK_PRESETS[args.profile]["preset"], {k: v for k, v in settings.items()})
     if settings:
-        raise InvalidParameterError("--profile-set", args.profile_set, f"only with a preset ({', '.join(PRESETS)})",
+        raise InvalidParameterError("--profile-set", args.profile_set,
+                                    f"only with a preset ({', '.join([*PRESETS, *KICK_PRESETS])})",
                                     "is given with a table")
     rows, lines = _read_profile_csv(args.profile)
     try:
@@ -60,15 +64,33 @@ def _profile(args):
         raise
 
 
+def _kick(args) -> dict[str, Any]:
+    """The kick's request fields from --kick, --kick-size, --kick-at-time, --kick-at-speed, each number checked as
+    typed against its range (the size against that of the kick's kind)."""
+    from ...analyses.ground.kicks import KINDS
+    from ...model.parameters import check_number
+
+    out: dict[str, Any] = {"kick": args.kick}
+    for name in ("kick_size", "kick_at_time", "kick_at_speed"):
+        value = getattr(args, name)
+        if value is not None and name == "kick_size" and args.kick in KINDS:
+            _, unit, largest, what = KINDS[args.kick]
+            check_number(name, value, -largest, largest, f"{unit} (a kick in {args.kick}, the {what})")
+        out[name] = None if value is None else limit("ground_run", name, value)
+    return out
+
+
 def _cmd_ground_run(args) -> int:
     from ...analyses.ground.ground_profiles import PRESETS
+    from ...analyses.ground.kicks import KICK_PRESETS
     from ...analyses.ground.summaries import (comparison_dict, comparison_summary, ground_run_summary,
                                               write_ground_run_csv)
 
     profile = _profile(args)
+    named = args.profile in PRESETS or args.profile in KICK_PRESETS
     body = {**numbers("ground_run", args, "psi_threshold", "lateral_threshold", "series_dt"),
-            "fold_torus": args.fold_torus, "exact_nes": args.exact_nes, "params": design(args),
-            **({"preset": args.profile, "preset_options": profile.settings} if args.profile in PRESETS
+            "fold_torus": args.fold_torus, "exact_nes": args.exact_nes, "params": design(args), **_kick(args),
+            **({"preset": args.profile, "preset_options": profile.settings} if named
                else {"profile": profile.rows()})}
     configs = list(CONFIGURATION_NAMES) if args.config == "all" else [args.config]
     requests = [request("ground_run", {**body, "config": config}) for config in configs]  # all checked first
@@ -90,10 +112,17 @@ def add_parsers(commands) -> None:
     p = add_command(commands, "ground-run", "take-off, landing roll or taxi: V(t), Fz(t) from a profile",
                     _cmd_ground_run)
     add_config(p, extra=["all"], help="configuration, or all four compared")
-    p.add_argument("--profile", required=True, metavar="takeoff|landing|taxi|FILE.csv",
-                   help="a preset, or a CSV table of t (s), V (m/s), Fz (N) rows (optional header t,V,Fz)")
+    p.add_argument("--profile", required=True, metavar="takeoff|landing|taxi|runway_joint|touchdown_yaw|FILE.csv",
+                   help="a preset, a scenario (runway_joint: the take-off with a yaw-rate kick of 1 rad/s at 60 m/s; "
+                        "touchdown_yaw: the landing roll from a yaw of 0.05 rad at t = 0; the --kick options given "
+                        "take the place of theirs), or a CSV table of t (s), V (m/s), Fz (N) rows (optional header "
+                        "t,V,Fz)")
     p.add_argument("--profile-set", action="append", metavar="NAME=VALUE",
                    help="adjust a preset's setting (repeatable), e.g. V_rotate=75")
+    add_field(p, "ground_run", "--kick", "a kick during the run: a jump of the yaw angle (psi) or the yaw rate (dpsi)")
+    add_field(p, "ground_run", "--kick-size", "the kick's size: rad for psi (-0.5 to 0.5), rad/s for dpsi (-50 to 50)")
+    add_field(p, "ground_run", "--kick-at-time", "when the kick comes (s, on the profile's clock, within the run)")
+    add_field(p, "ground_run", "--kick-at-speed", "or at which speed (m/s): the first time the run reaches it")
     add_field(p, "ground_run", "--psi-threshold", "torsional amplitude counted as shimmy (rad)")
     add_field(p, "ground_run", "--lateral-threshold", "lateral amplitude l_g delta counted as shimmy (m)")
     add_field(p, "ground_run", "--series-dt", "sampling interval of the series in the JSON and CSV (s)")

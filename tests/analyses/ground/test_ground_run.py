@@ -251,6 +251,16 @@ def test_command_line_json_csv_and_refusals(tmp_path):
     assert "line 4: profile[1].V=600.0 (row 2 of the table) is out of range" in out.stderr
     out = _cli("--config", "nes", "--profile", "takeoff", "--profile-set", "V_rotate=200")
     assert out.returncode == 2 and "V_rotate=200 is out of range; allowed: a number in [20, 150] m/s" in out.stderr
+    # a kick: a scenario, its size changed; a kick with a table
+    out = _cli("--config", "original", "--profile", "touchdown_yaw", "--kick-size", "0.1", "--json")
+    assert out.returncode == 0, out.stderr
+    kick = json.loads(out.stdout)["kick"]
+    assert (kick["kind"], kick["size"], kick["t"], kick["applied"]) == ("psi", 0.1, 0.0, True)
+    table.write_text("t,V,Fz\n0,5,150000\n20,40,120000\n")
+    out = _cli("--config", "all", "--profile", str(table), "--kick", "dpsi", "--kick-size", "3", "--kick-at-speed",
+               "22.5")
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.count("kick dpsi +3 rad/s at t = 10 s, V = 22.5 m/s: ") == 4
 
 
 @pytest.mark.slow
