@@ -52,7 +52,7 @@ def grid(parameter: str, params: Parameters, values: Sequence[float] = ()) -> li
 
 def max_psi_curve(config: str, parameter: str, rows: Sequence[dict[str, Any]],
                   v_range: tuple[float, float]) -> StudyCurve:
-    """The curve from one diagram's row per grid value (as :func:`~.studies._unit` makes them:
+    """The curve from one diagram's row per grid value (as the study's units of work make them:
     ``max_psi``, ``max_psi_V`` and the parameter's value), sorted by theta, with its switches."""
     ordered = sorted(rows, key=lambda r: r[parameter])
     p = [float(r[parameter]) for r in ordered]

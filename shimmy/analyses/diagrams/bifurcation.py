@@ -628,7 +628,7 @@ def _draw_located(branches: list[Branch], raw: PeriodicBranch, problem: Periodic
         return
 
 
-#: Stable cycles whose NES rotation :func:`_nes_rotation` samples at most (largest bound first).
+#: Stable cycles whose NES rotation is sampled at most, for the cubic-range warning (largest bound first).
 NES_ROTATION_SAMPLES = 12
 
 
