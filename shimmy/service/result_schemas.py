@@ -223,7 +223,25 @@ RESULTS: dict[str, Schema] = {
         "counters": mapping(INT, "integrator counters"), "elapsed_s": ELAPSED, "warnings": ref("Warnings"),
         "version": VERSION, "t": NUMBERS, "V": NUMBERS, "Fz": NUMBERS, "psi": NUMBERS, "lateral": NUMBERS,
         "envelope_psi": NUMBERS, "envelope_lateral": NUMBERS, "series_dt": num("s")},
-        {"hopf_curves": arr(obj({"V": NUMBERS, "Fz": NUMBERS})), "cycle_curves": {"type": "object"}}),
+        {"hopf_curves": arr(obj({"V": NUMBERS, "Fz": NUMBERS})), "cycle_curves": {"type": "object"},
+         "psis": arr(NUM, "NES rotation (rad), with an NES"), "dpsis": arr(NUM, "its rate (rad/s)"),
+         "nes_relative": arr(NUM, "NES relative rotation psi - psis (rad)"),
+         "kick": nullable({"type": "object", "description": "the yaw kick of the run and what it started: kind, size, "
+                                                           "unit, at_time or at_speed, t (s), applied, shimmy_started, "
+                                                           "mode, without_kick, extra_time_in_shimmy_s, method; "
+                                                           "null without a kick",
+                           "required": ["kind", "size", "unit", "t", "applied", "shimmy_started", "mode"],
+                           "properties": {
+                               "kind": {"type": "string", "enum": ["psi", "dpsi"]}, "size": NUM, "unit": STR,
+                               "at_time": nullable(num("s")), "at_speed": nullable(num("m/s")), "t": num("s"),
+                               "V": nullable(num("m/s")), "Fz": nullable(num("N")),
+                               "state_before": nullable(mapping(NUM, "the kicked components before the jump")),
+                               "state_after": nullable(mapping(NUM, "the kicked components after the jump")),
+                               "in_shimmy_before": nullable(BOOL), "applied": BOOL, "shimmy_started": nullable(BOOL),
+                               "mode": nullable(STR), "t_judged": nullable(num("s")), "V_judged": nullable(num("m/s")),
+                               "amplitude": nullable(mapping(NUM, "rad / m")), "peak": nullable({"type": "object"}),
+                               "without_kick": nullable({"type": "object"}), "method": STR,
+                               "extra_time_in_shimmy_s": nullable(num("s"))}})}),
     "sensitivity": obj({
         "config": CONFIG, "Fz": num("N"), "params": ref("Params"), "names": STRINGS,
         "hopf_points": arr({"type": "object"}), "min_shimmy_Fz": nullable({"type": "object"}),
@@ -252,6 +270,11 @@ RESULTS: dict[str, Schema] = {
         "samples": INT, "seed": INT, "hopf_points": arr({"type": "object"}),
         "min_shimmy_Fz": nullable({"type": "object"}),
         "p_shimmy": mapping(nullable(NUM), "share of samples with unstable straight rolling, per operating point"),
+        "p_shimmy_ci95": mapping(nullable(PAIR), "its 95 % Wilson interval, per operating point"),
+        "disturbance": nullable({"type": "object", "description": "the stated disturbance (size, unit, direction); "
+                                                                  "null without one"}),
+        "p_shimmy_disturbed": nullable(mapping({"type": "object"}, "per operating point: P(shimmy | disturbance) "
+                                                                   "with its interval and the share by mode")),
         "p_shimmy_linear": mapping(nullable(NUM), "the same from the linear propagation"),
         "operating_points": mapping(VP, "the operating points by name"), "refused_samples": INT,
         "elapsed_s": ELAPSED, "executor": EXECUTOR, "warnings": ref("Warnings"), "methods": METHODS,

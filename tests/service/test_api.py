@@ -376,6 +376,7 @@ RESULT_JOBS = [
     {"analysis": "study", "parameter": "e_p", "values": [0.0005, 0.005], "parameter2": "k_s",
      "values2": [1.2e6, 1.4e6], "configs": ["nes"]},
     {"analysis": "ground_run", "config": "original", "preset": "takeoff", "hopf_curves": True},
+    {"analysis": "ground_run", "config": "nes", "preset": "runway_joint"},  # a yaw-rate kick at 60 m/s
     {"analysis": "sensitivity", "config": "nes", "names": ["r2", "k_s"]},
     {"analysis": "optimise", "config": "nes", "parameters": ["e_p"], "starts": 2, "local_runs": 1,
      "constraints": ["max_psi<=0.5"], "params": {"k_s": 1.3e6}},
