@@ -9,7 +9,8 @@ the run of loads over which that name persists (:func:`labelled`): the same regi
 slice between which and the row the name does not vanish. The row's
 interval takes the types of that interval on the slices that have it, as fractions of the
 interval: the nearest slice below and above the row that have it, their breakpoints (mode
-changes) interpolated linearly in Fz where both show the same sequence of types, else the
+changes) interpolated linearly in Fz where both show the same sequence of types or one has a
+piece the other lacks (it narrows linearly to where it vanishes: no staircase), else the
 nearer one. A region that no slice crosses (pinched between curves between two slice loads) is
 what :func:`uncovered` reports, so that the map classifies a slice through it; one left over
 (thinner than a grid cell or smaller than the map's threshold) is read off the nearest slice at
@@ -106,6 +107,51 @@ def _interpolated(below, above, w: float):
     return [(p[0] + w * (q[0] - p[0]), p[1] + w * (q[1] - p[1]), p[2]) for p, q in zip(below, above, strict=True)]
 
 
+def _with_vanished(longer, shorter):
+    """``shorter`` with the one piece of ``longer`` it lacks put back at zero width, so that the two have
+    the same types and their breakpoints interpolate: a piece (a cycle's mode, such as Both) that one
+    slice has and the next has not then narrows linearly in Fz to where it vanishes, instead of the rows
+    switching from one slice's pieces to the other's halfway (a staircase edge). Where it sat: at the
+    region's end for an end piece, at the breakpoint of ``shorter`` between its neighbours for an
+    interior piece between two types, and at its centre on ``longer`` for one inside a single type
+    (the neighbours merged). None if the two differ otherwise."""
+    types_long, types_short = [p[2] for p in longer], [p[2] for p in shorter]
+    if len(types_long) not in (len(types_short) + 1, len(types_short) + 2):
+        return None
+    for j in range(len(longer)):
+        rest = types_long[:j] + types_long[j + 1:]
+        merged = 0 < j < len(longer) - 1 and types_long[j - 1] == types_long[j + 1]
+        if merged:
+            rest = rest[:j] + rest[j + 1:]  # its neighbours are one piece on the other slice
+        if rest != types_short:
+            continue
+        kind = types_long[j]
+        if j == 0:
+            return [(0.0, 0.0, kind)] + list(shorter)
+        if j == len(longer) - 1:
+            return list(shorter) + [(1.0, 1.0, kind)]
+        if not merged:  # between shorter's pieces j - 1 and j
+            at = shorter[j - 1][1]
+            return list(shorter[:j]) + [(at, at, kind)] + list(shorter[j:])
+        at = 0.5 * (longer[j][0] + longer[j][1])  # inside shorter's piece j - 1: split it there
+        a0, a1, t = shorter[j - 1]
+        at = min(max(at, a0), a1)
+        return list(shorter[:j - 1]) + [(a0, at, t), (at, at, kind), (at, a1, t)] + list(shorter[j:])
+    return None
+
+
+def _aligned(p0, p1):
+    """The pieces of two slices with one sequence of types (one piece that only one of them has put back
+    on the other at zero width, :func:`_with_vanished`), or None."""
+    if [p[2] for p in p0] == [p[2] for p in p1]:
+        return p0, p1
+    if len(p0) > len(p1):
+        q1 = _with_vanished(p0, p1)
+        return None if q1 is None else (p0, q1)
+    q0 = _with_vanished(p1, p0)
+    return None if q0 is None else (q0, p1)
+
+
 def labelled(curves: Sequence[Curve], loads: Sequence[float], v_range: tuple[float, float]):
     """{load: [(V_low, V_high, region)]} for the loads in ascending order, where a region is an
     interval name with the number of its run: a name that vanishes between two loads (the curves
@@ -162,9 +208,10 @@ def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequen
                 k1 = above[0] if above else None
                 p0 = known.pieces(k0, region) if k0 is not None else None
                 p1 = known.pieces(k1, region) if k1 is not None else None
-                if p0 is not None and p1 is not None and k0 != k1 and [p[2] for p in p0] == [p[2] for p in p1]:
+                pair = _aligned(p0, p1) if p0 is not None and p1 is not None and k0 != k1 else None
+                if pair is not None:
                     w = (Fz - known.loads[k0]) / (known.loads[k1] - known.loads[k0])
-                    parts = _interpolated(p0, p1, float(w))
+                    parts = _interpolated(*pair, float(w))
                 elif p0 is not None and (p1 is None or Fz - known.loads[k0] <= known.loads[k1] - Fz):
                     parts = p0
                 else:

@@ -522,3 +522,42 @@ def test_every_region_of_the_map_is_confirmed_by_simulation_from_three_starts(or
             assert "Both" in reached, (V, Fz, reached)
         checked.add(t)
     assert checked == set(SHIMMY_TYPES), checked
+
+
+@pytest.mark.parametrize("upper, inside", [
+    # Both inside Torsion on the lower slice only: it narrows to its centre at the upper slice
+    ([{"type": "Torsion", "V_start": 1.0, "V_end": 80.0}], True),
+    # Both between Torsion and Lateral on the lower slice only: it narrows to the upper slice's breakpoint
+    ([{"type": "Torsion", "V_start": 1.0, "V_end": 30.0}, {"type": "Lateral", "V_start": 30.0, "V_end": 80.0}],
+     False),
+])
+def test_a_mode_piece_one_slice_lacks_narrows_linearly_instead_of_a_staircase(upper, inside):
+    """A cycle's mode (here Both) that the lower slice shows inside an interval and the upper does not:
+    the rows between the slices narrow it linearly in Fz (its edges straight lines in (V, Fz)), not
+    the lower slice's pieces up to halfway and the upper's above (a staircase edge)."""
+    curve = ("b", np.array([[50.0, 0.0], [150.0, 1.0e6]]))  # the interval's end: V = 50 + Fz / 1e4
+    lower = [{"type": "Torsion", "V_start": 1.0, "V_end": 20.0}, {"type": "Both", "V_start": 20.0, "V_end": 40.0}]
+    lower += [{"type": "Torsion" if inside else "Lateral", "V_start": 40.0, "V_end": 60.0}]
+    slices = [_Slice(1e5, lower), _Slice(3e5, upper)]
+    loads = [1.5e5, 2e5, 2.5e5]
+    rows, fallbacks = map_shading.row_segments(slices, [curve], loads, (1.0, 200.0))
+    assert fallbacks == 0
+    widths = []
+    for Fz, row in zip(loads, rows, strict=True):
+        both = [(a, b) for a, b, t in row if t == "Both"]
+        assert len(both) == 1
+        widths.append(both[0][1] - both[0][0])
+        edge = 50.0 + Fz / 1e4
+        assert row[-2][1] == pytest.approx(edge) and row[-1][2] == "Stable"
+    # the Both piece's share of [1, edge] shrinks linearly: 3/4, 1/2, 1/4 of the lower slice's (20/59)
+    shares = [w / (50.0 + Fz / 1e4 - 1.0) for w, Fz in zip(widths, loads, strict=True)]
+    assert shares == pytest.approx([0.75 * 20 / 59, 0.5 * 20 / 59, 0.25 * 20 / 59], rel=1e-9)
+    # where it narrows to: its own centre (19 + 39) / 2 / 59 of the interval inside one type, the upper
+    # slice's breakpoint (29 / 79) between two
+    target = 29 / 59 if inside else 29 / 79
+    lower_mid = 29 / 59
+    for Fz, row in zip(loads, rows, strict=True):
+        w = (Fz - 1e5) / 2e5
+        (a, b), = [(a, b) for a, b, t in row if t == "Both"]
+        mid = (0.5 * (a + b) - 1.0) / (50.0 + Fz / 1e4 - 1.0)
+        assert mid == pytest.approx(lower_mid + w * (target - lower_mid), rel=1e-9)
