@@ -401,7 +401,7 @@ def plane(result):
     if crossings:
         fig.add_scatter(x=[c["V"] for c in crossings], y=[c["Fz"] / units.KN for c in crossings], mode="markers",
                         name="crossings of the Hopf curves (H)", customdata=[c["t"] for c in crossings],
-                        marker=markers.marker(PointKind.HOPF, "#D55E00"), meta={"kind": "H"},
+                        marker=markers.marker(PointKind.HOPF, "#D55E00"), meta={"kind": str(PointKind.HOPF)},
                         hovertemplate="crosses at t %{customdata:.4g} s<br>V %{x:.4g} m/s<br>Fz %{y:.4g} kN"
                                       "<extra></extra>")
     v_max = max(r[1] for r in rows)

@@ -248,13 +248,14 @@ def test_study_page_runs_a_study_and_tabulates_it(server, browser):
     first = rows[0].find_elements(By.TAG_NAME, "td")
     assert first[0].text == "0.0005" and first[1].text == "NES" and float(first[2].text) > 6
     # per configuration: three exact curves over the whole range (Hopf start, end, min shimmy load), the
-    # sampled values as markers on the two Hopf panels, the sampled amplitudes (lines and markers)
-    # (and each configuration's largest stable |psi| marked; special points and legend keys aside)
+    # largest stable |psi| on its grid of diagrams (lines and markers), the two sampled values as markers
+    # on the four panels but the third (and each configuration's largest stable |psi| marked; special
+    # points and legend keys aside)
     wait_for(lambda: trace_count(browser, "study-graph") >= 12, what="four panels x two configurations")
     modes = browser.execute_script("return document.querySelector('#study-graph .js-plotly-plot').data"
                                    ".filter(t => t.x[0] !== null && !(t.meta && (t.meta.kind || t.meta.mark)))"
-                                   ".map(t => t.mode + ':' + (t.x.length > 10 ? 'range' : 'samples'));")
-    assert sorted(modes) == sorted(["lines:range"] * 6 + ["markers:samples"] * 4 + ["lines+markers:samples"] * 2)
+                                   ".map(t => t.mode + ':' + (t.x.length > 2 ? 'range' : 'samples'));")
+    assert sorted(modes) == sorted(["lines:range"] * 6 + ["lines+markers:range"] * 2 + ["markers:samples"] * 6)
     marks = browser.execute_script("return document.querySelector('#study-graph .js-plotly-plot').data"
                                    ".filter(t => t.meta && t.meta.mark).map(t => t.meta.config);")
     assert sorted(marks) == ["nes", "nes_pd"]

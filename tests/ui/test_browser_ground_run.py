@@ -83,7 +83,9 @@ def test_ground_run_page_runs_the_presets_and_a_table(server, browser):
     # A bad row is refused, naming its row and column.
     _edit_cell(browser, 1, "V", "600")
     browser.find_element(By.ID, "gr-run").click()
-    message = wait_for(lambda: text_of(browser, "gr-error"), timeout=20, what="the refusal")
+    # (the error line may still carry the last run's warnings: wait for the refusal itself)
+    message = wait_for(lambda: "profile[1]" in text_of(browser, "gr-error") and text_of(browser, "gr-error"),
+                       timeout=20, what="the refusal")
     assert "profile[1].V=600" in message and "row 2 of the table" in message and "[1, 500] m/s" in message
 
     # The landing roll from the URL, at the smaller window.
@@ -140,5 +142,7 @@ def test_ground_run_page_runs_a_kick_and_refuses_it_in_its_unit(server, browser)
     box = browser.find_element(By.ID, "gr-kick-size")
     type_into(box, "0.8")
     browser.find_element(By.ID, "gr-run").click()
-    message = wait_for(lambda: text_of(browser, "gr-error"), timeout=20, what="the refusal")
+    # (the error line may still carry the last run's warnings: wait for the refusal itself)
+    message = wait_for(lambda: "profile[1]" in text_of(browser, "gr-error") and text_of(browser, "gr-error"),
+                       timeout=20, what="the refusal")
     assert "kick size (yaw angle psi) = 0.8 rad is outside [-0.5, 0.5] rad" in message

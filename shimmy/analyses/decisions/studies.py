@@ -128,8 +128,10 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
     sampled values (:func:`~shimmy.analyses.decisions.max_psi_curve.max_psi_curve`)."""
     if executor is None:  # one pool for the sampled rows and the curve's grid
         with open_executor() as own:
-            return study(parameter, values, configs=configs, Fz=Fz, params=params, v_range=v_range, options=options,
-                         executor=own, progress=progress)
+            result = study(parameter, values, configs=configs, Fz=Fz, params=params, v_range=v_range,
+                           options=options, executor=own, progress=progress)
+        result.executor = name_of(None)  # what this environment's executor is (a Dask cluster, a pool)
+        return result
     base = params if params is not None else Parameters()
     checked = _check_values(parameter, values, base)
     result = _run([parameter], [{parameter: v} for v in checked], configs, Fz, v_range, base, executor, progress,

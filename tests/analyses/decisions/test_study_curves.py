@@ -53,10 +53,15 @@ def test_curves_equal_the_sampled_study_at_its_values():
     values = [0.0006, 0.0031]
     result = study("e_p", values, configs=["nes", "nes_pd"], Fz=FZ).to_dict()
     assert {(c["config"], c["quantity"]) for c in result["curves"]} == {
-        (c, q) for c in ("nes", "nes_pd") for q in ("hopf_V_start", "hopf_V_end", "min_shimmy_Fz")}
+        (c, q) for c in ("nes", "nes_pd") for q in ("hopf_V_start", "hopf_V_end", "min_shimmy_Fz", "max_psi")}
     for c in result["curves"]:
         if c["quantity"] == "min_shimmy_Fz":  # tests/analyses/decisions/test_min_shimmy_curve.py
             assert c["unit"] == "N" and c["p"][0] == 0.0005 and c["p"][-1] == 0.005
+            continue
+        if c["quantity"] == "max_psi":  # the sampled rows themselves at their values (test_studies.py)
+            assert c["unit"] == "rad" and c["p"][0] == 0.0005 and c["p"][-1] == 0.005
+            for row in (r for r in result["rows"] if r["config"] == c["config"]):
+                assert c["values"][c["p"].index(row["e_p"])] == row["max_psi"]
             continue
         assert c["p"][0] == 0.0005 and c["p"][-1] == 0.005 and c["unit"] == "m/s"
         assert c["p"] == sorted(c["p"]) and len(c["p"]) == len(c["values"]) > 20

@@ -71,7 +71,12 @@ def test_diagram_structure_at_150_kN(diagrams, config):
     result = diagrams[config]
     scan = hopf_points(config, FZ, v_range=(1.0, 200.0))
     eq = result.branches[0]
-    assert eq.kind == "equilibrium" and not result.warnings
+    from shimmy.analyses.core.nes_range import WARNING_START
+
+    assert eq.kind == "equilibrium" and not [w for w in result.warnings if not w.startswith(WARNING_START)]
+    # the NES's stable cycles turn it 0.18 rad, beyond the cubic's 1 % range (0.094 rad): said; with the PD
+    # beside it they stay within it
+    assert [w.startswith(WARNING_START) for w in result.warnings] == ([True] if config == "nes" else [])
     assert [s["V"] for s in eq.special_points if s["kind"] == "H"] == [h.V for h in scan.hopf_points]
     # x = 0 is unstable exactly between the two Hopf points.
     low, high = (h.V for h in scan.hopf_points)
