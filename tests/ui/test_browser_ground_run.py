@@ -143,6 +143,6 @@ def test_ground_run_page_runs_a_kick_and_refuses_it_in_its_unit(server, browser)
     type_into(box, "0.8")
     browser.find_element(By.ID, "gr-run").click()
     # (the error line may still carry the last run's warnings: wait for the refusal itself)
-    message = wait_for(lambda: "profile[1]" in text_of(browser, "gr-error") and text_of(browser, "gr-error"),
+    message = wait_for(lambda: "kick size" in text_of(browser, "gr-error") and text_of(browser, "gr-error"),
                        timeout=20, what="the refusal")
     assert "kick size (yaw angle psi) = 0.8 rad is outside [-0.5, 0.5] rad" in message
