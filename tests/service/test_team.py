@@ -315,10 +315,10 @@ def test_hostile_campaign_with_auth_on_gives_no_5xx(team):
     credentials = [("good", alice)] * 6 + [("none", {}), ("wrong", bearer("shm_" + "C" * 43)),
                                            ("wrong", bearer(secret[::-1])), ("wrong", {"Authorization": "Basic eA=="}),
                                            ("read", team.auth["reader"])]
-    api = [(*api_case(rng), rng.choice(credentials)) for _ in range(1500)]
+    api = [(*api_case(rng), rng.choice(credentials)) for _ in range(7500)]  # with the callbacks: 10 000 in all
     status, _, deps = team.request("GET", "/_dash-dependencies", headers=alice)
     assert status == 200
-    callbacks = [(*callback_case(rng, deps), rng.choice(credentials)) for _ in range(500)]
+    callbacks = [(*callback_case(rng, deps), rng.choice(credentials)) for _ in range(2500)]
 
     def one(case):
         path, body, headers, (kind, credential) = case
