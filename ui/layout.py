@@ -188,7 +188,7 @@ dash.clientside_callback(
 # validates again.
 dash.clientside_callback(
     """
-    function(values, boxes, material, reset, ids, boxIds, errorIds, stores) {
+    function(values, boxes, material, reset, ids, boxIds, errorIds, stores, shown) {
         const C = window.dash_clientside, trig = C.callback_context.triggered_id;
         const SPEC = %(spec)s, PRESET = %(preset)s, BASE = %(base)s, DEFAULT = %(default)s, ADVANCED = %(advanced)s;
         const ID = %(ids)s;
@@ -212,8 +212,8 @@ dash.clientside_callback(
         } else if (trig && typeof trig === "object" && trig.type === ID.param) {
             const n = trig.name, s = SPEC[n];
             if (s.step && typeof cur[n] === "number" && isFinite(cur[n])) {  // moved: onto the step grid
-                cur[n] = Number((s.low + Math.round((cur[n] - s.low) / s.step) * s.step).toFixed(s.decimals));
-                outValues[names.indexOf(n)] = cur[n];
+                const onGrid = Number((s.low + Math.round((cur[n] - s.low) / s.step) * s.step).toFixed(s.decimals));
+                if (onGrid !== cur[n]) { cur[n] = onGrid; outValues[names.indexOf(n)] = onGrid; }  // else: as it is
             }
             if (boxNames.includes(n)) { outBoxes[boxNames.indexOf(n)] = cur[n]; }
         }
@@ -247,8 +247,11 @@ dash.clientside_callback(
         const summary = refused.length ? "Not applied: " + refused.join(", ") + " (see the field" +
                         (refused.length > 1 ? "s" : "") + ")" : "";
         const openAdvanced = refused.some(n => ADVANCED.includes(n)) ? true : C.no_update;
+        // only the fields whose message changes are redrawn (a slider step redraws none of them)
+        const errors = errorIds.map((i, k) => ((problems[i.name] || "") === (shown[k] || "") ? C.no_update
+                                                                                             : (problems[i.name] || "")));
         return [outValues, outBoxes, outMaterial, url, stores.map(() => ({material: material, params: params})),
-                summary, errorIds.map(i => problems[i.name] || ""), openAdvanced];
+                summary, errors, openAdvanced];
     }
     """ % {"spec": json.dumps({n: {"low": s.low, "high": s.high, "integer": s.integer, "allowed": s.allowed,
                                    "unit": s.unit, "range": f"[{s.low:g}, {s.high:g}] {s.unit}".rstrip(),
@@ -275,5 +278,6 @@ dash.clientside_callback(
     State(ids.param_box(ALL), "id"),
     State(ids.param_error(ALL), "id"),
     State(ids.design_store(ALL), "data"),
+    State(ids.param_error(ALL), "children"),
     prevent_initial_call=True,
 )
