@@ -134,10 +134,16 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
         return result
     base = params if params is not None else Parameters()
     checked = _check_values(parameter, values, base)
-    result = _run([parameter], [{parameter: v} for v in checked], configs, Fz, v_range, base, executor, progress,
-                  options)
+    report = progress or (lambda fraction, message: None)
+
+    def part(low: float, high: float):  # the progress of one stage, within the study's (never back)
+        return lambda fraction, message: report(low + (high - low) * fraction, message)
+
+    result = _run([parameter], [{parameter: v} for v in checked], configs, Fz, v_range, base, executor,
+                  part(0.0, 0.5), options)
     clock = time.perf_counter()
-    for config in result.configs:
+    for k, config in enumerate(result.configs):
+        report(0.5 + 0.3 * k / len(result.configs), f"curves of {config} in {parameter}")
         speeds = hopf_speed_curves(config, parameter, Fz=result.Fz, params=base, v_range=result.v_range)
         result.curves += [c.to_dict() for c in speeds.study_curves(values=checked)]
         result.warnings += [f"{config}, curves in {parameter}: {w}" for w in speeds.warnings]
@@ -151,7 +157,8 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
     extra = [theta for theta in max_psi_grid(parameter, base, checked) if theta not in checked]
     tasks = [(c, {parameter: theta}, result.Fz, *result.v_range, base, options or BifurcationOptions(mesh_check=False))
              for theta in extra for c in result.configs]
-    more = run_units(_unit, tasks, executor, None, lambda t: f"{t[0]} at {parameter} = {t[1][parameter]:g}")
+    report(0.8, f"largest amplitude over the range of {parameter}")
+    more = run_units(_unit, tasks, executor, part(0.8, 1.0), lambda t: f"{t[0]} at {parameter} = {t[1][parameter]:g}")
     for config in result.configs:
         rows = [r for r in result.rows + more if r["config"] == config]
         result.curves.append(max_psi_curve(config, parameter, rows, result.v_range).to_dict())

@@ -96,7 +96,8 @@ def test_a_study_on_the_dask_cluster_equals_the_local_one(dask_cluster, monkeypa
     remote = study(*args, **kwargs, progress=lambda f, m: seen.append(f))
     assert remote.executor == f"dask cluster at {dask_cluster}"
     assert remote.rows == local.rows
-    assert seen == [0.25, 0.5, 0.75, 1.0]
+    # the four sampled diagrams fill the first half, the curves (Hopf, min shimmy, the max_psi grid) the rest
+    assert seen[:4] == [0.125, 0.25, 0.375, 0.5] and seen == sorted(seen) and seen[-1] == 1.0
 
 
 def test_a_map_on_the_dask_cluster_equals_the_local_one(dask_cluster):
