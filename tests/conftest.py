@@ -131,22 +131,26 @@ def start_server(cache_dir: Path, env: dict[str, str] | None = None, workers: in
     proc = subprocess.Popen([sys.executable, "-m", "gunicorn", "app:server", "--bind", f"127.0.0.1:{port}",
                              "--workers", str(workers), "--timeout", "120", "--no-control-socket"],
                             cwd=ROOT, env=full_env, stdout=log, stderr=subprocess.STDOUT)
-    base = f"http://127.0.0.1:{port}"
+    server = Server(_healthy(f"http://127.0.0.1:{port}", proc, cache_dir, "gunicorn"), cache_dir, proc)
+    server.log = log
+    return server
+
+
+def _healthy(base: str, proc: subprocess.Popen, cache_dir: Path, what: str) -> str:
+    """``base`` once its health answers 200 (within 60 s); the process killed and its log quoted if it ends
+    or does not answer."""
     deadline = time.time() + 60
     while True:
         try:
             with urllib.request.urlopen(base + "/api/v1/health", timeout=2) as resp:
                 if resp.status == 200:
-                    break
+                    return base
         except OSError:
             pass
         if proc.poll() is not None or time.time() > deadline:
             proc.kill()
-            raise RuntimeError("gunicorn did not start: " + (cache_dir / "gunicorn.log").read_text()[-2000:])
+            raise RuntimeError(f"{what} did not start: " + (cache_dir / "gunicorn.log").read_text()[-2000:])
         time.sleep(0.3)
-    server = Server(base, cache_dir, proc)
-    server.log = log
-    return server
 
 
 def stop_server(server: Server, timeout: float = 15) -> None:
@@ -205,20 +209,7 @@ def start_proxied_server(cache_dir: Path, env: dict[str, str] | None = None, wor
                              str(workers), "--run-dir", str(run_dir), "--access-log",
                              access_log or str(run_dir / "access.log")],
                             cwd=ROOT, env=full_env, stdout=log, stderr=subprocess.STDOUT)
-    base = f"http://127.0.0.1:{port}"
-    deadline = time.time() + 60
-    while True:
-        try:
-            with urllib.request.urlopen(base + "/api/v1/health", timeout=2) as resp:
-                if resp.status == 200:
-                    break
-        except OSError:
-            pass
-        if proc.poll() is not None or time.time() > deadline:
-            proc.kill()
-            raise RuntimeError("shimmy serve did not start: " + (cache_dir / "gunicorn.log").read_text()[-2000:])
-        time.sleep(0.3)
-    server = Server(base, cache_dir, proc)
+    server = Server(_healthy(f"http://127.0.0.1:{port}", proc, cache_dir, "shimmy serve"), cache_dir, proc)
     server.log, server.run_dir = log, run_dir
     return server
 

@@ -109,6 +109,13 @@ def torque_cubic(a, k1: float, k3: float):
 CUBIC_TOLERANCE = 0.01
 
 
+def cubic_error(a, r1: float, r2: float, r3: float, k_s: float, e_p: float):
+    """Relative error |cubic - exact| / |exact| of the cubic torque at rotation(s) ``a`` (rad, 0 < |a| < pi/6)."""
+    a = np.asarray(a, dtype=float)
+    exact = torque_core(a, *geometry(r1, r2, r3), k_s, e_p)
+    return np.abs(torque_cubic(a, *cubic_coefficients(r1, r2, r3, k_s, e_p)) - exact) / np.abs(exact)
+
+
 def cubic_range(r1: float, r2: float, r3: float, k_s: float, e_p: float,
                 tolerance: float = CUBIC_TOLERANCE) -> float:
     """The largest relative rotation a0 (rad) with the cubic's torque within ``tolerance`` (relative)
@@ -116,12 +123,8 @@ def cubic_range(r1: float, r2: float, r3: float, k_s: float, e_p: float,
 
     The error is scanned on 2000 angles up to 0.98 pi/6 (it grows like a^4 from a = 0, the a^5 term
     the cubic drops) and its first crossing of ``tolerance`` refined by bisection to 1e-10 rad."""
-    A, rho, delta0 = geometry(r1, r2, r3)
-    k1, k3 = cubic_coefficients(r1, r2, r3, k_s, e_p)
-
     def error(a):
-        exact = torque_core(np.asarray(a, dtype=float), A, rho, delta0, k_s, e_p)
-        return np.abs(torque_cubic(a, k1, k3) - exact) / np.abs(exact)
+        return cubic_error(a, r1, r2, r3, k_s, e_p)
 
     grid = np.linspace(0.0, 0.98 * VALID_ANGLE, 2001)[1:]
     over = np.flatnonzero(error(grid) > tolerance)

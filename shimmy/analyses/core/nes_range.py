@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...model.configurations import Configuration
-from ...model.nes import CUBIC_TOLERANCE, VALID_ANGLE, cubic_coefficients, cubic_range, geometry, torque_core, \
-    torque_cubic
+from ...model import nes as nes_model
+from ...model.nes import CUBIC_TOLERANCE, VALID_ANGLE, cubic_range
 from ...model.parameters import Parameters
 
 #: The warning's first words: pages and tests find it by them.
@@ -28,10 +28,7 @@ def rotation_peak(states: np.ndarray) -> float:
 def cubic_error(params: Parameters, a: float) -> float:
     """Relative error of the cubic torque against the exact one at rotation ``a`` (rad, |a| < pi/6)."""
     n = params.nes
-    a = min(abs(a), 0.999 * VALID_ANGLE)
-    exact = torque_core(np.asarray(a), *geometry(n.r1, n.r2, n.r3), n.k_s, n.e_p)
-    k1, k3 = cubic_coefficients(n.r1, n.r2, n.r3, n.k_s, n.e_p)
-    return float(abs(torque_cubic(a, k1, k3) - exact) / abs(exact))
+    return float(nes_model.cubic_error(min(abs(a), 0.999 * VALID_ANGLE), n.r1, n.r2, n.r3, n.k_s, n.e_p))
 
 
 def warning(config: Configuration | str, params: Parameters, peak: float, exact_nes: bool,
