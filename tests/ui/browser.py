@@ -16,6 +16,7 @@ pytest.importorskip("selenium")
 from selenium import webdriver  # noqa: E402
 from selenium.webdriver.chrome.service import Service  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.common.exceptions import StaleElementReferenceException  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -84,10 +85,14 @@ def severe(driver) -> list[str]:
 
 def wait_for(predicate, timeout=60.0, interval=0.1, what="condition"):
     """``predicate()`` once it is true; ``what`` (text, or a function giving it when the wait fails:
-    the page's state then) names what was waited for."""
+    the page's state then) names what was waited for. An element the page replaced while the predicate
+    read it (Dash re-rendered it: StaleElementReferenceException) counts as not yet."""
     deadline = time.time() + timeout
     while time.time() < deadline:
-        value = predicate()
+        try:
+            value = predicate()
+        except StaleElementReferenceException:
+            value = None
         if value:
             return value
         time.sleep(interval)
@@ -112,6 +117,13 @@ def open_page(driver, server, path, size=(1440, 900), *, clear_log=False, wait_i
     wait_for(lambda: driver.find_elements(By.CSS_SELECTOR, ".page-header h1"), what="the page header")
     if wait_idle:
         idle(driver)
+
+
+def table_rows(driver, css) -> list[list[str]]:
+    """The text of each cell of each row matched by ``css`` (e.g. "#id tbody tr"), read in one script
+    so that a table Dash re-renders meanwhile is never half read (no stale elements)."""
+    return driver.execute_script("return [...document.querySelectorAll(arguments[0])]"
+                                 ".map(r => [...r.querySelectorAll('td')].map(c => c.innerText.trim()));", css)
 
 
 def by_id(driver, element_id):

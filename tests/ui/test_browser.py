@@ -17,7 +17,7 @@ from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
 from browser import (DOWNLOADS, PAGES, SHOTS, browser_fixture, idle, job_records, on_figure, severe,  # noqa: E402
-                     text_of, trace_count, wait_for)
+                     table_rows, text_of, trace_count, wait_for)
 
 browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)
 
@@ -192,8 +192,7 @@ def test_background_job_shows_progress_then_its_figure(server, browser):
     n_traces = wait_for(lambda: trace_count(browser, "bif-graph") > 4 and trace_count(browser, "bif-graph"),
                         what="the diagram's traces")
     assert n_traces > 4
-    rows = browser.find_elements(By.CSS_SELECTOR, "#bif-summary tbody tr")
-    assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["original", "NES"]
+    assert [r[0] for r in table_rows(browser, "#bif-summary tbody tr")] == ["original", "NES"]
     assert not browser.find_element(By.ID, "bif-run").get_attribute("disabled")
     browser.save_screenshot(str(SHOTS / "bifurcation-result.png"))
     assert severe(browser) == []
@@ -218,8 +217,7 @@ def test_map_click_opens_the_time_history_at_that_point(server, browser):
     computing = {t for t in figures if "Computing the map (original, nes, 4 Fz slices each)" in t}
     assert len(computing) >= 2 and all("so far" in t for t in computing)  # the seconds go on
     assert not any("Press Compute" in t for t in figures)
-    rows = browser.find_elements(By.CSS_SELECTOR, "#map-summary tbody tr")
-    assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["original", "NES"]
+    assert [r[0] for r in table_rows(browser, "#map-summary tbody tr")] == ["original", "NES"]
     wait_for(lambda: trace_count(browser, "map-graph") > 8, what="the map's traces")
     idle(browser)
     browser.save_screenshot(str(SHOTS / "stability-map-result.png"))
@@ -242,11 +240,11 @@ def test_study_page_runs_a_study_and_tabulates_it(server, browser):
     run = wait_for(lambda: browser.find_elements(By.ID, "study-run"), what="the Compute button")[0]
     idle(browser)
     run.click()
-    rows = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#study-summary tbody tr"), timeout=120,
+    rows = wait_for(lambda: table_rows(browser, "#study-summary tbody tr"), timeout=120,
                     what="the study table")
     assert len(rows) == 4
-    first = rows[0].find_elements(By.TAG_NAME, "td")
-    assert first[0].text == "0.0005" and first[1].text == "NES" and float(first[2].text) > 6
+    first = rows[0]
+    assert first[0] == "0.0005" and first[1] == "NES" and float(first[2]) > 6
     # per configuration: three exact curves over the whole range (Hopf start, end, min shimmy load), the
     # largest stable |psi| on its grid of diagrams (lines and markers), the two sampled values as markers
     # on the four panels but the third (and each configuration's largest stable |psi| marked; special

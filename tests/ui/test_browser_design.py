@@ -11,8 +11,8 @@ import pytest
 pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
 
-from browser import (SHOTS, browser_fixture, idle, on_figure, open_page, severe, text_of,  # noqa: E402
-                     trace_count, type_into, wait_for)
+from browser import (SHOTS, browser_fixture, idle, on_figure, open_page, severe, table_rows,  # noqa: E402
+                     text_of, trace_count, type_into, wait_for)
 
 browser = browser_fixture("chromium-profile-design", "1440,900")
 #: How these tests open the page: the console read from there on, the window as started, no wait for idle.
@@ -73,9 +73,9 @@ def test_a_small_robustness_run_shows_histograms_statistics_and_shimmy_probabili
     type_into(samples, "16")
     wait_for(lambda: text_of(browser, "rob-samples-error") == "", timeout=10, what="the refusal to clear")
     browser.find_element(By.ID, "rob-run").click()
-    rows = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#rob-stats tbody tr"), timeout=120,
+    rows = wait_for(lambda: table_rows(browser, "#rob-stats tbody tr"), timeout=120,
                     what="the statistics table")
-    assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == [
+    assert [r[0] for r in rows] == [
         "Hopf speed 1 at 150 kN (m/s)", "Hopf speed 2 at 150 kN (m/s)", "Minimum shimmy load (kN)"]
     for graph in ("rob-hist-V1", "rob-hist-V2", "rob-hist-Fzmin"):
         kinds = wait_for(lambda g=graph: on_figure(browser, g, "return g.data.map(t => t.type);"), timeout=20,

@@ -15,8 +15,8 @@ selenium = pytest.importorskip("selenium")
 from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 
-from browser import (SHOTS, browser_fixture, by_id, idle, on_figure, open_page, severe, text_of,  # noqa: E402
-                     trace_count, type_into, wait_for)
+from browser import (SHOTS, browser_fixture, by_id, idle, on_figure, open_page, severe, table_rows,  # noqa: E402
+                     text_of, trace_count, type_into, wait_for)
 
 browser = browser_fixture("chromium-margins", "1440,900")
 POINT = "/time-history?config=original&V=50&Fz=550&map_type=Bistable"
@@ -39,8 +39,7 @@ def _small(browser) -> None:
 
 
 def _rows(browser) -> list[list[str]]:
-    return [[td.text for td in tr.find_elements(By.TAG_NAME, "td")]
-            for tr in browser.find_elements(By.CSS_SELECTOR, "#thm-summary tbody tr")]
+    return table_rows(browser, "#thm-summary tbody tr")
 
 
 def test_margins_of_a_bistable_point_and_a_run_from_the_torsional_threshold(server, browser):
@@ -119,8 +118,7 @@ def test_margins_on_the_map_over_its_regions_and_a_click_runs_from_the_kick(serv
     # over the map: its regions (filled) and curves drawn under the margins
     assert on_figure(browser, "mapm-graph", "return g.data.filter(t => t.fill === 'toself').length;") > 0
     assert "compute the map above" not in on_figure(browser, "mapm-graph", TITLE)
-    rows = browser.find_elements(By.CSS_SELECTOR, "#mapm-summary tbody tr")
-    assert [r.find_elements(By.TAG_NAME, "td")[0].text for r in rows] == ["600", "800"]
+    assert [r[0] for r in table_rows(browser, "#mapm-summary tbody tr")] == ["600", "800"]
     assert not browser.find_element(By.ID, "mapm-csv").get_attribute("disabled")
     idle(browser)
     browser.execute_script("document.getElementById('mapm-graph').scrollIntoView()")
@@ -155,8 +153,7 @@ def test_a_bistable_map_point_runs_every_start_and_the_series_shows_the_last_cyc
     open_page(browser, server, POINT + "&run=1", clear_log=True)
     wait_for(lambda: len(browser.find_elements(By.CSS_SELECTOR, "#th-starts tbody tr")) == 3, timeout=300,
              what=lambda: "the three starts (" + text_of(browser, "th-status") + text_of(browser, "th-error") + ")")
-    rows = [[td.text for td in tr.find_elements(By.TAG_NAME, "td")]
-            for tr in browser.find_elements(By.CSS_SELECTOR, "#th-starts tbody tr")]
+    rows = table_rows(browser, "#th-starts tbody tr")
     assert rows[0][0].startswith("psi0 = 0.001 rad") and "lateral limit cycle" in rows[0][1]
     assert rows[1][0].startswith("psi0 = 0.2 rad") and "torsional limit cycle" in rows[1][1]
     assert float(rows[1][2]) == pytest.approx(0.187, rel=0.03)
