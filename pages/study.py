@@ -163,7 +163,7 @@ jobs.register(
     blank=lambda: (style.message_figure("Refused: see the message above", 560), None))
 
 
-HEIGHT, BOTTOM = 860, 130
+HEIGHT, BOTTOM = 1020, 130
 #: The vertical line at the current design's value of the parameter (drawn in the browser: it follows the panel).
 CURRENT_DESIGN_LINE = {"color": "#555", "dash": "dot", "width": 1.5}
 #: the panels: (key of a sampled row, quantity of an exact curve, axis title, scale of the values)
@@ -171,6 +171,10 @@ PANELS = (("hopf_start", "hopf_V_start", "first Hopf V (m/s)", 1.0),
           ("hopf_end", "hopf_V_end", "last Hopf V (m/s)", 1.0),
           (None, "min_shimmy_Fz", "lowest Hopf Fz (kN)", 1 / units.KN),
           ("max_psi", "max_psi", "max stable |psi| (rad)", 1.0))
+#: the last panel: the loads of the GH and double-Hopf points of the Hopf curves in (V, Fz), each point a
+#: line (its kind's marker on the line), the speed in the hover
+POINT_PANEL = "GH, HH load (kN)"
+POINT_KINDS = {"gh_Fz": ("gh_V", "GH", "dash"), "double_hopf_Fz": ("double_hopf_V", "HH", "dot")}
 
 
 def figure(result):
@@ -178,7 +182,7 @@ def figure(result):
     the picture changes as crosses) with the sampled diagrams' values as markers on them; the largest
     amplitude on its grid of diagrams over the whole range (small dots joined by lines)."""
     name = result["parameters"][0]
-    fig = make_subplots(rows=len(PANELS), cols=1, shared_xaxes=True, vertical_spacing=0.05)
+    fig = make_subplots(rows=len(PANELS) + 1, cols=1, shared_xaxes=True, vertical_spacing=0.04)
     curves = {(c["config"], c["quantity"]): c for c in result.get("curves") or []}
     kinds: set[str] = set()
     largest = False
@@ -231,6 +235,7 @@ def figure(result):
                                     meta={"mark": "largest stable |psi|", "config": config}, row=row, col=1,
                                     hovertemplate=f"<b>{label}: largest stable |psi|</b><br>{name} %{{x:.6g}}<br>"
                                                   f"{style.ANGLE_HOVER}<extra></extra>")
+    kinds |= _codim2_points(fig, result, name, len(PANELS) + 1)
     markers.legend(fig, kinds, "legend2")
     if largest:
         style.legend_key(fig, markers.LARGEST_PSI.name, "legend2", mode="markers",
@@ -243,10 +248,49 @@ def figure(result):
                       template=style.TEMPLATE, margin={**style.MARGIN, "l": 70, "b": BOTTOM},
                       meta={"study": {"parameter": name, "unit": PARAMETER_SPECS[name].unit}})
     style.legends(fig, ["configuration (colour)", "points, marks"], HEIGHT, BOTTOM)
-    fig.update_xaxes(title_text=f"{name}{_unit(name)}", row=len(PANELS), col=1)
+    fig.update_xaxes(title_text=f"{name}{_unit(name)}", row=len(PANELS) + 1, col=1)
     for row, (_, _, title, _) in enumerate(PANELS, start=1):
         fig.update_yaxes(title_text=title, row=row, col=1)
+    fig.update_yaxes(title_text=POINT_PANEL, row=len(PANELS) + 1, col=1)
     return fig
+
+
+def _codim2_points(fig, result, name: str, row: int) -> set[str]:
+    """The GH and double-Hopf points' loads against the parameter (a line per point through its exact
+    values, dashed for GH, dotted for double Hopf, the kind's marker at its first and last value; the
+    speed in the hover); the kinds drawn."""
+    speeds = {(c["config"], c["quantity"], c.get("point")): c for c in result.get("curves") or []}
+    drawn: set[str] = set()
+    for c in result.get("curves") or []:
+        if c["quantity"] not in POINT_KINDS:
+            continue
+        v_name, kind, dash = POINT_KINDS[c["quantity"]]
+        speed = speeds.get((c["config"], v_name, c.get("point")))
+        colour, label = style.CONFIG_COLOURS[c["config"]], style.CONFIG_LABELS[c["config"]]
+        m = markers.of(kind)
+        drawn.add(kind)
+        # the kind's marker at the first and last value, the exact values joined by the kind's dash
+        known = [i for i, v in enumerate(c["values"]) if v is not None]
+        ends_at = {known[0], known[-1]} if known else set()
+        fig.add_scatter(x=c["p"], y=[None if v is None else units.to_kn(v) for v in c["values"]], mode="lines+markers",
+                        line={"color": colour, "width": 1.5, "dash": dash}, legendgroup=c["config"], showlegend=False,
+                        marker={**markers.marker(kind, colour, size=9),
+                                "size": [9 if i in ends_at else 0 for i in range(len(c["p"]))]},
+                        name=f"{label}: {m.name} {c.get('point')}",
+                        customdata=None if speed is None else speed["values"], meta={"kind": m.label, "point": True},
+                        hovertemplate=f"{label}: {m.name} point {c.get('point')}<br>{name} %{{x:.6g}}<br>"
+                                      "Fz %{y:.6g} kN" + ("" if speed is None else ", V %{customdata:.5g} m/s")
+                                      + "<extra>exact curve</extra>", row=row, col=1)
+        ends = [q for q in c["special_points"] if q.get("kind") == "end" and q.get("value") is not None]
+        if ends:
+            drawn.add("EP")
+            fig.add_scatter(x=[q["p"] for q in ends], y=[units.to_kn(q["value"]) for q in ends], mode="markers",
+                            marker=markers.marker("EP", colour), legendgroup=c["config"], showlegend=False,
+                            meta={"kind": markers.of("EP").label}, row=row, col=1,
+                            customdata=[q.get("why", "") for q in ends],
+                            hovertemplate=f"{label}: {m.name} point {c.get('point')} ends<br>{name} %{{x:.8g}}<br>"
+                                          "Fz %{y:.6g} kN<br>%{customdata}<extra></extra>")
+    return drawn
 
 
 def summary(result):

@@ -20,29 +20,39 @@ from typing import Callable
 import numpy as np
 
 
-def hopf_eigenvectors(A: np.ndarray):
-    """q, p with A q = i w q, A^T p = -i w p, <q, q> = 1, <p, q> = 1 (<a, b> = a^H b)."""
+def hopf_eigenvectors(A: np.ndarray, omega_hint: float | None = None):
+    """q, p with A q = i w q, A^T p = -i w p, <q, q> = 1, <p, q> = 1 (<a, b> = a^H b): the pair
+    with Im > 0 nearest the imaginary axis, or with ``omega_hint`` the eigenvalue nearest
+    i omega_hint. Off a Hopf point (A's eigenvalue a + i w, a != 0) q and p are that eigenvalue's
+    (A q = (a + i w) q), and w its imaginary part."""
     ev, vecs = np.linalg.eig(A)
-    i = np.argmin(np.abs(ev.real) + np.where(ev.imag > 0, 0.0, np.inf))
+    if omega_hint is None:
+        i = np.argmin(np.abs(ev.real) + np.where(ev.imag > 0, 0.0, np.inf))
+    else:
+        i = np.argmin(np.abs(ev - 1j * abs(omega_hint)))
     omega = ev[i].imag
     q = vecs[:, i] / np.linalg.norm(vecs[:, i])
     evT, vecsT = np.linalg.eig(A.T)
-    j = np.argmin(np.abs(evT - (-1j * omega)))
+    j = np.argmin(np.abs(evT - np.conj(ev[i])))
     p = vecsT[:, j]
     p = p / np.conj(np.vdot(p, q))
     return omega, q, p
 
 
 def first_lyapunov_coefficient(jacobian: Callable[[np.ndarray], np.ndarray], n: int,
-                               h: float = 1e-20, eps: float = 1e-4) -> float:
+                               h: float = 1e-20, eps: float = 1e-4, omega_hint: float | None = None) -> float:
     """l1 at a Hopf point of the equilibrium x = 0 of x' = f(x) (Kuznetsov eq. 3.20).
 
     ``jacobian(x)`` must return df/dx and accept complex ``x`` (complex-analytic f).
-    Negative l1: supercritical (stable small cycles); positive: subcritical.
+    Negative l1: supercritical (stable small cycles); positive: subcritical. ``omega_hint``: the
+    pair nearest i omega_hint (default: the pair nearest the imaginary axis). Evaluated off a Hopf
+    point (the pair at a + i w) the same formula with that pair's vectors and w is a smooth function
+    of the parameters equal to l1 on the Hopf curve: a test function whose zero on it is a
+    generalised Hopf point.
     """
     zero = np.zeros(n)
     A = jacobian(zero).real
-    omega, q, p = hopf_eigenvectors(A)
+    omega, q, p = hopf_eigenvectors(A, omega_hint)
 
     def B_matrix(u, base=zero):
         # d/dt J(base + t u) at t = 0, by a complex step on the analytic Jacobian.

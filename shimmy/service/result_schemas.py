@@ -204,11 +204,14 @@ RESULTS: dict[str, Schema] = {
         "units": mapping(STR, "unit of each column"), "executor": EXECUTOR, "warnings": ref("Warnings"),
         "elapsed_s": ELAPSED, "version": VERSION,
         "curves": arr(obj({"config": CONFIG, "quantity": {"type": "string", "enum": [
-            "hopf_V_start", "hopf_V_end", "min_shimmy_Fz", "max_psi"]}, "param": STR,
+            "hopf_V_start", "hopf_V_end", "min_shimmy_Fz", "max_psi", "gh_Fz", "gh_V", "double_hopf_Fz",
+            "double_hopf_V"]}, "param": STR,
             "p": NUMBERS, "values": arr(nullable(NUM)),
-            "special_points": arr(obj({"kind": STR, "p": NUM}, {"value": nullable(NUM), "V": {}, "located": BOOL,
-                                                               "bracket": PAIR, "why": STR})),
-            "unit": STR}), "each figure continued in the parameter (one-parameter studies)")}),
+            "special_points": arr(obj({"kind": STR, "p": NUM}, {"value": nullable(NUM), "V": {}, "Fz": NUM,
+                                                               "located": BOOL, "bracket": PAIR, "why": STR})),
+            "unit": STR}, {"point": {"type": "integer", "minimum": 1, "description": "which GH or double-Hopf "
+                                     "point of the base design the curve follows (1, 2, ... by speed)"}}),
+            "each figure continued in the parameter (one-parameter studies)")}),
     "ground_run": obj({
         "config": CONFIG, "time_in_shimmy_s": num("s"),
         "shimmy_intervals": arr(obj({"t_start": NUM, "t_end": NUM, "V_start": NUM, "V_end": NUM,

@@ -264,11 +264,13 @@ def _criticality(model: Model, V: float, Fz: float, warnings: list[str]):
     return float(l1), Criticality.SUPERCRITICAL if l1 < 0 else Criticality.SUBCRITICAL
 
 
-def first_lyapunov_coefficient(model: Model, V: float, Fz: float, eps: float = 1e-4) -> float:
+def first_lyapunov_coefficient(model: Model, V: float, Fz: float, eps: float = 1e-4,
+                               omega_hint: float | None = None) -> float:
     """l1 of x = 0 at a Hopf point (V, Fz) of a smooth configuration; < 0 is supercritical (the
-    Jacobian evaluated as plain Python, a dozen evaluations: see :func:`~shimmy.model.equations.jacobian`)."""
+    Jacobian evaluated as plain Python, a dozen evaluations: see :func:`~shimmy.model.equations.jacobian`).
+    ``omega_hint``: the pair nearest i omega_hint (:func:`shimmy.continuation.first_lyapunov_coefficient`)."""
     return lyapunov.first_lyapunov_coefficient(lambda x: jacobian(model, x, V, Fz, plain=True), model.n_states,
-                                               eps=eps)
+                                               eps=eps, omega_hint=omega_hint)
 
 
 def growth_rates(Fz: float, *, params: Parameters | None = None, v_range: tuple[float, float] = V_RANGE,

@@ -54,15 +54,15 @@ def _minima(hopf) -> list[tuple[float, float]]:
 
 def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Parameters | None = None,
                      v_range: tuple[float, float] = DIAGRAM_V_RANGE, fz_range: tuple[float, float] = FZ_RANGE,
-                     values: Sequence[float] = (), n: int = N_GRID) -> tuple[StudyCurve, list[str]]:
+                     values: Sequence[float] = (), n: int = N_GRID, hopf=None) -> tuple[StudyCurve, list[str]]:
     """The curve ``min_shimmy_Fz`` (N) of ``config`` against ``parameter`` over its whole range, and
-    warnings (see the module)."""
+    warnings (see the module). ``hopf``: the base design's Hopf curves in this box, if computed already."""
     config = Configuration.parse(config)
     params = params if params is not None else Parameters()
     lo, hi = parameter_range(parameter, params)
     base = float(getattr(params, parameter))
     warnings: list[str] = []
-    starts = _minima(hopf_curves(config, params=params, v_range=v_range, fz_range=fz_range))
+    starts = _minima(hopf or hopf_curves(config, params=params, v_range=v_range, fz_range=fz_range))
     if not starts:
         raise ConvergenceError(f"{config.value}: the Hopf curves have no lowest point inside the box at "
                                f"{parameter} = {base:g}: no minimum shimmy load to follow")

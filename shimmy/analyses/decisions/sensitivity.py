@@ -130,7 +130,7 @@ class _Eigen:
         return complex(np.conj(self.w) @ dJ @ self.q)
 
 
-def _critical(J: np.ndarray, omega_hint: float | None = None) -> _Eigen:
+def critical_pair(J: np.ndarray, omega_hint: float | None = None) -> _Eigen:
     """The eigenvalue with Im > 0 nearest the imaginary axis (nearest to i omega_hint if given)."""
     ev, vl, vr = scipy.linalg.eig(J, left=True, right=True)
     if omega_hint is None:
@@ -280,7 +280,7 @@ def hopf_sensitivities(model: Model, Fz: float, hopf_V: Sequence[float], pairs: 
     lin = Linearisation(model, Fz)
     out = []
     for V in hopf_V:
-        eig = _critical(lin.at(V))
+        eig = critical_pair(lin.at(V))
         dlam_dV = eig.derivative(_dJ_dV(lin, V))
         if abs(dlam_dV.real) < 1e-14:
             raise ConvergenceError(f"the Hopf point at V = {V:.6g} m/s, Fz = {Fz:.6g} N is degenerate "
@@ -297,39 +297,56 @@ def hopf_sensitivities(model: Model, Fz: float, hopf_V: Sequence[float], pairs: 
     return out
 
 
+def newton_in_plane(g, z0, scale, tol: float, what: str, max_steps: int = 30) -> np.ndarray:
+    """A zero z = (V, Fz) of the two equations ``g(V, Fz)`` near ``z0``, by Newton's method with a
+    central-difference Jacobian (step 1e-6 of ``scale``): converged when a step is below ``tol`` of the
+    scales, or when steps stop shrinking below 1e-8 of them (the rounding level of the
+    finite-difference Jacobian); ConvergenceError naming ``what`` otherwise (or on a singular
+    Jacobian, or a value that is not finite)."""
+    z = np.array(z0, float)
+    scale = np.asarray(scale, float)
+    last = math.inf
+    for _ in range(max_steps):
+        r = np.asarray(g(*z), float)
+        if not np.all(np.isfinite(r)):
+            break
+        D = np.empty((2, 2))
+        for k in range(2):
+            e = np.zeros(2)
+            e[k] = 1e-6 * scale[k]
+            D[:, k] = (np.asarray(g(*(z + e)), float) - np.asarray(g(*(z - e)), float)) / (2 * e[k])
+        try:
+            dz = -np.linalg.solve(D, r)
+        except np.linalg.LinAlgError:
+            raise ConvergenceError(f"{what}: singular Newton matrix at V = {z[0]:.6g} m/s, Fz = {z[1]:.6g} N") from None
+        if not np.all(np.isfinite(dz)):
+            break
+        z = z + dz
+        size = float(np.max(np.abs(dz) / scale))
+        if size > 1.0 and size > 2.0 * last:  # diverging: no point in the remaining steps
+            break
+        if size < tol or (size < 1e-8 and size >= 0.5 * last):
+            g(*z)  # the caller's state (e.g. the followed frequency) at the solution
+            return z
+        last = size
+    raise ConvergenceError(f"{what} near V = {z0[0]:.6g} m/s, Fz = {z0[1]:.6g} N did not converge in "
+                           f"{max_steps} Newton steps")
+
+
 def polish_lowest_point(model: Model, V: float, Fz: float, tol: float = 1e-10) -> tuple[float, float, float]:
     """(V, Fz, omega) of the turning point Re lambda = d Re lambda/dV = 0 near (V, Fz), by Newton with
-    a finite-difference Jacobian (scales 10 m/s and 1e5 N): converged when a step is below ``tol`` of
-    the scales, or when steps stop shrinking below 1e-8 of them (the rounding level of the
-    finite-difference Jacobian)."""
+    a finite-difference Jacobian (scales 10 m/s and 1e5 N; :func:`newton_in_plane`)."""
     omega = None
 
     def g(v, f):
         nonlocal omega
         lin = Linearisation(model, f)
-        eig = _critical(lin.at(v), omega)
+        eig = critical_pair(lin.at(v), omega)
         omega = eig.lam.imag
         return np.array([eig.lam.real, V_SCALE * eig.derivative(_dJ_dV(lin, v)).real])
 
-    z = np.array([V, Fz], float)
-    scale = np.array([V_SCALE, 1e5])
-    last = math.inf
-    for _ in range(30):
-        r = g(*z)
-        D = np.empty((2, 2))
-        for k in range(2):
-            e = np.zeros(2)
-            e[k] = 1e-6 * scale[k]
-            D[:, k] = (g(*(z + e)) - g(*(z - e))) / (2 * e[k])
-        dz = -np.linalg.solve(D, r)
-        z = z + dz
-        size = float(np.max(np.abs(dz) / scale))
-        if size < tol or (size < 1e-8 and size >= 0.5 * last):
-            g(*z)
-            return float(z[0]), float(z[1]), float(omega)
-        last = size
-    raise ConvergenceError(f"the lowest point of the Hopf curve near V = {V:.6g} m/s, Fz = {Fz:.6g} N did not "
-                           "converge in 30 Newton steps")
+    z = newton_in_plane(g, (V, Fz), (V_SCALE, 1e5), tol, "the lowest point of the Hopf curve")
+    return float(z[0]), float(z[1]), float(omega)
 
 
 def min_shimmy_sensitivity(model: Model, pairs: dict[str, tuple], fz_box: tuple[float, float],
@@ -361,7 +378,7 @@ def min_shimmy_sensitivity(model: Model, pairs: dict[str, tuple], fz_box: tuple[
                 "reason": f"the lowest point is where a Hopf curve stopped inside the box ({reasons}): not a turning "
                           "point, no derivative"}
     lin = Linearisation(model, Fz)
-    eig = _critical(lin.at(V), omega)
+    eig = critical_pair(lin.at(V), omega)
     dlam_dFz = eig.derivative(_dJ_dFz(model, V, Fz))
     dJ = jacobian_derivatives(model, V, Fz, pairs)
     return {"Fz": Fz, "V": V, "frequency_hz": omega / (2 * math.pi),
@@ -371,12 +388,12 @@ def min_shimmy_sensitivity(model: Model, pairs: dict[str, tuple], fz_box: tuple[
 def _hopf_load_at(model: Model, V: float, Fz: float, omega: float, tol: float = 1e-10) -> tuple[float, float]:
     """(Fz, omega) with Re lambda(V, Fz) = 0 near Fz, by Newton with the exact d lambda/dFz."""
     for _ in range(30):
-        eig = _critical(Linearisation(model, Fz).at(V), omega)
+        eig = critical_pair(Linearisation(model, Fz).at(V), omega)
         omega = eig.lam.imag
         step = -eig.lam.real / eig.derivative(_dJ_dFz(model, V, Fz)).real
         Fz += step
         if abs(step) <= tol * Fz:
-            return Fz, _critical(Linearisation(model, Fz).at(V), omega).lam.imag
+            return Fz, critical_pair(Linearisation(model, Fz).at(V), omega).lam.imag
     raise ConvergenceError(f"the Hopf load at V = {V:.6g} m/s near Fz = {Fz:.6g} N did not converge in 30 Newton "
                            "steps")
 

@@ -18,11 +18,13 @@ from ..diagrams.bifurcation import BifurcationOptions, bifurcation
 from ...model.configurations import CONFIGURATION_NAMES, Configuration
 from ...errors import ConvergenceError, InvalidParameterError
 from ..core.executors import name_of, open_executor, run_units
+from ..diagrams.hopf_curves import hopf_curves
+from .codim2_curve import codim2_curves
 from .max_psi_curve import grid as max_psi_grid, max_psi_curve
 from .min_shimmy_curve import min_shimmy_curve
 from .study_curves import hopf_speed_curves
 from .summaries import STUDY_COLUMNS, study_summary, write_study_csv
-from ...model.parameters import (DEFAULT_FZ, DIAGRAM_V_RANGE, PARAMETER_SPECS, V_RANGE, Parameters,
+from ...model.parameters import (DEFAULT_FZ, DIAGRAM_V_RANGE, FZ_RANGE, PARAMETER_SPECS, V_RANGE, Parameters,
                                  check_operating_point, check_range)
 
 MAX_VALUES = 200  # per parameter
@@ -125,7 +127,9 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
     and min_shimmy_Fz (N), the lowest point of the Hopf curves in (V, Fz) over the plane V in the
     study's range, Fz 10-900 kN (:func:`~shimmy.analyses.decisions.min_shimmy_curve.min_shimmy_curve`), and
     max_psi (rad), the largest stable torsional amplitude at Fz, on a grid over the whole range with the
-    sampled values (:func:`~shimmy.analyses.decisions.max_psi_curve.max_psi_curve`)."""
+    sampled values (:func:`~shimmy.analyses.decisions.max_psi_curve.max_psi_curve`), and the GH and
+    double-Hopf points of the Hopf curves in that plane, their loads and speeds
+    (:func:`~shimmy.analyses.decisions.codim2_curve.codim2_curves`)."""
     if executor is None:  # one pool for the sampled rows and the curve's grid
         with open_executor() as own:
             result = study(parameter, values, configs=configs, Fz=Fz, params=params, v_range=v_range,
@@ -147,13 +151,18 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
         speeds = hopf_speed_curves(config, parameter, Fz=result.Fz, params=base, v_range=result.v_range)
         result.curves += [c.to_dict() for c in speeds.study_curves(values=checked)]
         result.warnings += [f"{config}, curves in {parameter}: {w}" for w in speeds.warnings]
+        hopf = hopf_curves(config, params=base, v_range=result.v_range, fz_range=FZ_RANGE)
         try:
-            lowest, notes = min_shimmy_curve(config, parameter, params=base, v_range=result.v_range, values=checked)
+            lowest, notes = min_shimmy_curve(config, parameter, params=base, v_range=result.v_range, values=checked,
+                                             hopf=hopf)
         except ConvergenceError as exc:
             result.warnings.append(f"{config}, min_shimmy_Fz in {parameter}: not followed: {exc}")
         else:
             result.curves.append(lowest.to_dict())
             result.warnings += [f"{config}, min_shimmy_Fz in {parameter}: {w}" for w in notes]
+        points, notes = codim2_curves(config, parameter, params=base, v_range=result.v_range, values=checked, hopf=hopf)
+        result.curves += [c.to_dict() for c in points]
+        result.warnings += [f"{config}, GH and double-Hopf points in {parameter}: {w}" for w in notes]
     extra = [theta for theta in max_psi_grid(parameter, base, checked) if theta not in checked]
     tasks = [(c, {parameter: theta}, result.Fz, *result.v_range, base, options or BifurcationOptions(mesh_check=False))
              for theta in extra for c in result.configs]

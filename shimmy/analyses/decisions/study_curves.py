@@ -55,7 +55,8 @@ from ..core.stability import Linearisation, hopf_points
 from .sensitivity import model_with
 
 #: The quantities a study curve can follow, with their units.
-CURVE_QUANTITIES = {"hopf_V_start": "m/s", "hopf_V_end": "m/s", "min_shimmy_Fz": "N", "max_psi": "rad"}
+CURVE_QUANTITIES = {"hopf_V_start": "m/s", "hopf_V_end": "m/s", "min_shimmy_Fz": "N", "max_psi": "rad",
+                    "gh_Fz": "N", "gh_V": "m/s", "double_hopf_Fz": "N", "double_hopf_V": "m/s"}
 #: Central-difference step of the field's derivative in theta, relative to theta's range.
 THETA_STEP = 1e-6
 #: Start values of theta over its range (plus the base design's value): evenly, and geometrically
@@ -139,6 +140,8 @@ class StudyCurve:
     p: list[float]
     values: list[float | None]
     special_points: list[dict[str, Any]]
+    #: which point of the base design a codimension-2 point's curves follow (1, 2, ... by speed); None otherwise
+    point: int | None = None
 
     def value_at(self, theta: float) -> float | None:
         """The value at a grid value of p (exact there); KeyError off the grid."""
@@ -150,7 +153,7 @@ class StudyCurve:
     def to_dict(self) -> dict[str, Any]:
         return {"config": self.config, "quantity": self.quantity, "param": self.param, "p": list(self.p),
                 "values": list(self.values), "special_points": list(self.special_points),
-                "unit": CURVE_QUANTITIES[self.quantity]}
+                "unit": CURVE_QUANTITIES[self.quantity], **({} if self.point is None else {"point": self.point})}
 
 
 def _critical(J: np.ndarray, omega: float):
@@ -310,7 +313,7 @@ class HopfSpeedCurves:
         return out
 
 
-def _grid(lo: float, hi: float, n: int) -> np.ndarray:
+def value_grid(lo: float, hi: float, n: int) -> np.ndarray:
     """n values evenly over [lo, hi], and n geometrically spaced too if lo > 0 and hi > 10 lo."""
     even = np.linspace(lo, hi, n)
     if lo > 0 and hi > 10 * lo:
@@ -365,12 +368,12 @@ def hopf_speed_curves(config: Configuration | str, parameter: str, *, Fz: float 
     options = ContinuationOptions(ds=0.05, ds_max=0.5, max_steps=2000, max_correction=1.0)
     box = ((v_lo, v_hi), (p_lo, p_hi))
     p_scale = np.array([V_SCALE, span / 10.0])
-    thetas = _grid(p_lo, p_hi, N_STARTS)
+    thetas = value_grid(p_lo, p_hi, N_STARTS)
     starts = [(None, float(t)) for t in thetas]
     nominal = float(getattr(params, parameter))
     if p_lo < nominal < p_hi:
         starts.append((None, nominal))
-    fine = _grid(p_lo, p_hi, N_EDGE_SCAN)
+    fine = value_grid(p_lo, p_hi, N_EDGE_SCAN)
     starts += [(V, t) for V in (v_lo, v_hi) for t in _edge_starts(config, params, parameter, Fz, V, fine)]
     curves: list[HopfCurve] = []
     warnings: list[str] = []

@@ -125,22 +125,25 @@ def study_summary(result: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def study_curves_lines(curves: list[dict[str, Any]], rows: int = 11) -> list[str]:
+def study_curves_lines(curves: list[dict[str, Any]], rows: int = 11, columns: int = 4) -> list[str]:
     """The study curves as text: per configuration, p against each quantity on ``rows`` grid values
-    (evenly picked, the ends included) and the special points."""
+    (evenly picked, the ends included), at most ``columns`` curves side by side, and the special points."""
     lines: list[str] = []
     by_config: dict[tuple, list[dict[str, Any]]] = {}
     for c in curves:  # a table per configuration and grid (the curves on the same values of p side by side)
-        by_config.setdefault((c["config"], tuple(c["p"])), []).append(c)
+        key = (c["config"], tuple(c["p"]))
+        while len(by_config.get(key, ())) == columns:
+            key += (None,)
+        by_config.setdefault(key, []).append(c)
 
     def num(x):
         return f"{'-':>14}" if x is None else f"{x:14.6g}"
 
-    for (config, _), group in by_config.items():
+    for (config, *_), group in by_config.items():
         p = group[0]["p"]
         lines.append(f"curves of {config} against {group[0]['param']} ({len(p)} exact points each, "
                      f"{p[0]:g}..{p[-1]:g}):")
-        lines.append(f"{group[0]['param']:>14}" + "".join(f"{c['quantity'] + ' (' + c['unit'] + ')':>24}"
+        lines.append(f"{group[0]['param']:>14}" + "".join(f"{_curve_name(c) + ' (' + c['unit'] + ')':>24}"
                                                            for c in group))
         picks = sorted({round(k * (len(p) - 1) / (rows - 1)) for k in range(rows)}) if len(p) > 1 else [0]
         for i in picks:
@@ -148,9 +151,15 @@ def study_curves_lines(curves: list[dict[str, Any]], rows: int = 11) -> list[str
         for c in group:
             for s in c["special_points"]:
                 value = s.get("value")
-                lines.append(f"  {c['quantity']}: {s['kind']} at {c['param']} = {s['p']:.8g}"
-                             + ("" if value is None else f", value {value:.8g} {c['unit']}"))
+                lines.append(f"  {_curve_name(c)}: {s['kind']} at {c['param']} = {s['p']:.8g}"
+                             + ("" if value is None else f", value {value:.8g} {c['unit']}")
+                             + (f" ({s['why']})" if s.get("why") else ""))
     return lines
+
+
+def _curve_name(curve: dict[str, Any]) -> str:
+    """A curve's quantity, with the number of the point it follows (GH and double-Hopf points)."""
+    return curve["quantity"] + ("" if curve.get("point") is None else f" #{curve['point']}")
 
 
 def write_study_csv(result: dict[str, Any], stream) -> None:

@@ -53,7 +53,8 @@ def test_curves_equal_the_sampled_study_at_its_values():
     values = [0.0006, 0.0031]
     result = study("e_p", values, configs=["nes", "nes_pd"], Fz=FZ).to_dict()
     assert {(c["config"], c["quantity"]) for c in result["curves"]} == {
-        (c, q) for c in ("nes", "nes_pd") for q in ("hopf_V_start", "hopf_V_end", "min_shimmy_Fz", "max_psi")}
+        (c, q) for c in ("nes", "nes_pd") for q in ("hopf_V_start", "hopf_V_end", "min_shimmy_Fz", "max_psi",
+                                                    "double_hopf_Fz", "double_hopf_V")} | {("nes", "gh_Fz"), ("nes", "gh_V")}
     for c in result["curves"]:
         if c["quantity"] == "min_shimmy_Fz":  # tests/analyses/decisions/test_min_shimmy_curve.py
             assert c["unit"] == "N" and c["p"][0] == 0.0005 and c["p"][-1] == 0.005
@@ -62,6 +63,9 @@ def test_curves_equal_the_sampled_study_at_its_values():
             assert c["unit"] == "rad" and c["p"][0] == 0.0005 and c["p"][-1] == 0.005
             for row in (r for r in result["rows"] if r["config"] == c["config"]):
                 assert c["values"][c["p"].index(row["e_p"])] == row["max_psi"]
+            continue
+        if c["quantity"].startswith(("gh_", "double_hopf_")):  # tests/analyses/decisions/test_codim2_curve.py
+            assert c["p"][0] == 0.0005 and c["p"][-1] == 0.005 and None not in c["values"] and c["point"] in (1, 2)
             continue
         assert c["p"][0] == 0.0005 and c["p"][-1] == 0.005 and c["unit"] == "m/s"
         assert c["p"] == sorted(c["p"]) and len(c["p"]) == len(c["values"]) > 20
