@@ -326,11 +326,22 @@ class Parameters:
         return canonical_digest(self.to_dict())
 
 
-def design_distance(a: Parameters, b: Parameters) -> float:
-    """The largest relative difference between two designs' parameters (0: the same design)."""
+def design_distance(a: Parameters, b: Parameters, config: Any = None) -> float:
+    """The largest relative difference between two designs' parameters (0: the same design); with
+    ``config``, of the parameters that enter that configuration's model only
+    (:func:`~shimmy.model.configurations.affects`: a device's parameters do not enter a gear without it)."""
     da, db = a.to_dict(), b.to_dict()
-    return max((abs(da[k] - db[k]) / max(abs(da[k]), abs(db[k]), 1e-300) for k in da if da[k] != db[k]),
+    names = da if config is None else affecting(da, config)
+    return max((abs(da[k] - db[k]) / max(abs(da[k]), abs(db[k]), 1e-300) for k in names if da[k] != db[k]),
                default=0.0)
+
+
+def affecting(params: dict[str, Any], config: Any) -> dict[str, Any]:
+    """The entries of a parameter dict that enter the model of ``config`` (names outside the
+    parameter table are kept: what is not known to be irrelevant counts)."""
+    from .configurations import affects
+
+    return {k: v for k, v in params.items() if k not in PARAMETER_SPECS or affects(k, config)}
 
 
 def canonical_json(obj: Any) -> str:

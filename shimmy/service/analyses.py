@@ -280,11 +280,11 @@ def run(analysis: str, body: Any, progress: Progress | None = None) -> tuple[dic
     none comes); a cached answer takes neither."""
     request = schemas.validate(analysis, body)
     k = cache.key(analysis, request)
-    found = cache.get_key(k)
+    found = cache.as_asked(cache.get_key(k), request)
     if found is not None:
         return found, True
     with admission.fast_slot(analysis, admission.requester()):
-        found = cache.get_key(k)  # computed by another request while this one waited for its slot
+        found = cache.as_asked(cache.get_key(k), request)  # computed by another request while this one waited
         if found is not None:
             return found, True
         value = RUNNERS[analysis](request, progress)

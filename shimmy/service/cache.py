@@ -27,7 +27,7 @@ from typing import Any, Callable, Iterator
 import diskcache
 
 from ..version import __version__
-from ..model.parameters import canonical_digest
+from ..model.parameters import affecting, canonical_digest
 from . import settings
 
 log = logging.getLogger(__name__)
@@ -109,13 +109,32 @@ def results() -> diskcache.Cache:
     return open_store(settings.cache_dir() / "results", settings.cache_size_limit())
 
 
+#: Analyses of one configuration whose result depends on the design only through that configuration's
+#: model: their key holds only the parameters that enter it (:func:`~shimmy.model.parameters.affecting`),
+#: so the map of ``original`` is one entry however the NES and damper sliders stand. (Analyses that
+#: report parameter values, sample or search them, or cover several configurations key them all.)
+MODEL_ONLY = frozenset({"map", "hopf", "bifurcation", "hopf_curves", "simulate", "ground_run", "margins",
+                        "margin_map"})
+
+
 def key(analysis: str, request: dict[str, Any]) -> str:
-    return canonical_digest({"analysis": analysis, "request": request, "schema": settings.SCHEMA_VERSION,
+    keyed = request
+    if analysis in MODEL_ONLY and isinstance(request.get("params"), dict) and isinstance(request.get("config"), str):
+        keyed = {**request, "params": affecting(request["params"], request["config"])}
+    return canonical_digest({"analysis": analysis, "request": keyed, "schema": settings.SCHEMA_VERSION,
                              "version": __version__})
 
 
+def as_asked(value: dict[str, Any] | None, request: dict[str, Any]) -> dict[str, Any] | None:
+    """A cached ``value`` as the answer to ``request``: the same numbers, its ``params`` the request's (a
+    MODEL_ONLY result may have been computed for a design that differs in parameters outside the model)."""
+    if isinstance(value, dict) and "params" in value and "params" in request and value["params"] != request["params"]:
+        return {**value, "params": request["params"]}
+    return value
+
+
 def get(analysis: str, request: dict[str, Any]) -> dict[str, Any] | None:
-    return get_key(key(analysis, request))
+    return as_asked(get_key(key(analysis, request)), request)
 
 
 def get_key(k: str) -> dict[str, Any] | None:
@@ -148,7 +167,7 @@ def get_or_compute(analysis: str, request: dict[str, Any],
                    compute: Callable[[], dict[str, Any]]) -> tuple[dict[str, Any], bool]:
     """(result, True if it came from the cache)."""
     k = key(analysis, request)
-    found = get_key(k)
+    found = as_asked(get_key(k), request)
     if found is not None:
         return found, True
     value = compute()

@@ -247,7 +247,7 @@ def _end(s: diskcache.Cache, job: dict[str, Any], message: str) -> None:
 
 
 def result(job: dict[str, Any]) -> dict[str, Any] | None:
-    return cache.get_key(job["result_key"]) if job["status"] == "done" else None
+    return cache.as_asked(cache.get_key(job["result_key"]), job["request"]) if job["status"] == "done" else None
 
 
 def public(job: dict[str, Any], with_result: bool = True) -> dict[str, Any]:

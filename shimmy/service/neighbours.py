@@ -62,8 +62,9 @@ def _ranked(analysis: str, request: dict[str, Any]) -> list[dict[str, Any]]:
         store = cache.results()
         listed = store.get(_question(analysis, request)) or []
         here = Parameters.from_dict(request["params"])
-        ranked = sorted((design_distance(here, Parameters.from_dict(e["params"])), k) for k, e in enumerate(listed)
-                        if e["params"] != request["params"])
+        config = request.get("config")  # a parameter outside its model is no distance
+        ranked = sorted((design_distance(here, Parameters.from_dict(e["params"]), config), k)
+                        for k, e in enumerate(listed) if e["params"] != request["params"])
         # a warm start the cache has evicted (large entries go first) is no neighbour
         return [listed[k] for distance, k in ranked if distance <= MAX_DISTANCE and listed[k]["key"] in store]
     except Exception as exc:  # noqa: BLE001 - an unreadable index or store: no neighbour, the map is cold

@@ -23,6 +23,40 @@ def test_equal_questions_have_equal_cache_keys():
     assert cache.key("hopf", a) != cache.key("stability", a)
 
 
+def test_a_parameter_outside_the_configurations_model_is_not_part_of_its_key():
+    """The NES's e_p does not enter the original gear (nor the damper's a_p the NES gear): their maps,
+    diagrams and Hopf points are one entry however those sliders stand; analyses that report or
+    sample parameter values (sensitivity, robustness, studies) key every parameter."""
+    def key(analysis, config, **params):
+        return cache.key(analysis, schemas.validate(analysis, {"config": config, "Fz": 150000, "params": params}))
+
+    assert key("hopf", "original", e_p=0.002) == key("hopf", "original", e_p=0.003) == key("hopf", "original")
+    assert key("hopf", "nes", e_p=0.002) != key("hopf", "nes", e_p=0.003)
+    assert key("hopf", "nes", a_p=0.8) == key("hopf", "nes", a_p=0.9) != key("hopf", "nes_pd", a_p=0.8)
+    assert key("hopf", "nes_pd", a_p=0.8) != key("hopf", "nes_pd", a_p=0.9)
+    assert key("hopf", "original", k_psi=4e5) != key("hopf", "original")
+    for analysis, extra in (("map", {}), ("bifurcation", {"Fz": 150000}), ("hopf_curves", {}), ("margin_map", {})):
+        a = schemas.validate(analysis, {"config": "pd", "params": {"r2": 0.075}, **extra})
+        b = schemas.validate(analysis, {"config": "pd", "params": {"r2": 0.085}, **extra})
+        assert cache.key(analysis, a) == cache.key(analysis, b), analysis
+    a = schemas.validate("sensitivity", {"config": "original", "Fz": 150000, "params": {"e_p": 0.002}})
+    b = schemas.validate("sensitivity", {"config": "original", "Fz": 150000, "params": {"e_p": 0.003}})
+    assert cache.key("sensitivity", a) != cache.key("sensitivity", b)
+
+
+def test_a_shared_entry_answers_with_the_askers_parameters(tmp_path, monkeypatch):
+    """Computed once for e_p = 2 mm, the original gear's Hopf points answer a request at e_p = 3 mm from
+    the cache: the same numbers, its params the request's."""
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+    from shimmy.service import analyses
+
+    first, cached = analyses.run("hopf", {"config": "original", "Fz": 150000, "params": {"e_p": 0.002}})
+    again, cached_again = analyses.run("hopf", {"config": "original", "Fz": 150000, "params": {"e_p": 0.003}})
+    assert not cached and cached_again
+    assert first["params"]["e_p"] == 0.002 and again["params"]["e_p"] == 0.003
+    assert {k: v for k, v in again.items() if k != "params"} == {k: v for k, v in first.items() if k != "params"}
+
+
 @pytest.mark.parametrize("body,field", [
     ({"config": "nes", "V": 30, "Fz": 150000, "params": {"r2": 0.2}}, "params.r2"),
     ({"config": "nes", "V": 30, "Fz": 150000, "params": {"n": 2.5}}, "params.n"),

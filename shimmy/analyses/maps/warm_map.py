@@ -24,7 +24,8 @@ little: the curves move, but where their arrangement stays the same the regions 
    their order being the polylines' rounding): each slice's intervals move with the curves (an end
    on a curve to that curve's new crossing, an end where a cycle's mode changes stays, held in its
    interval between the curves), its Hopf points are located again by the eigenvalue scan, its
-   fold and torus points are the new curves' located crossings of its load. Its diagram is not
+   fold and torus points are the new curves' located crossings of its load (each point moved with
+   its curve's drawn crossing, then matched to the located crossing there). Its diagram is not
    recomputed, so it reports no largest amplitude (``max_psi`` None, ``"carried": true``). A slice
    whose load the curves now cross otherwise, or with a Hopf point more or less, or with a point
    on no curve of the map (a period doubling), is computed again; and, as a cold map does, a slice
@@ -165,14 +166,36 @@ def _crossings_of(curves: list[GearCycleCurve], Fz: float) -> dict[str, list[flo
     return out
 
 
+def _on_curve(old_boundaries, new_boundaries, Fz: float, carry: _Carrier, tol: float) -> Callable[[float, str], float]:
+    """Where a slice's point of a fold or torus curve goes: by the move of that curve's drawn crossing of
+    the load (the crossing of the kind nearest the point, within its polyline's chord error: 1 % of V,
+    at least two half cells; its label found again at the new design); :class:`_Carrier` where no
+    crossing is that near. (Carried like an interval's end, a point on a curve that moved more than
+    half a cell stayed behind and the slice was computed again.)"""
+    old = map_shading.crossings(old_boundaries, Fz)
+    new = {label: V for V, label in map_shading.crossings(new_boundaries, Fz)}
+
+    def moved(V: float, kind: str) -> float:
+        reach = max(2.0 * tol, 0.01 * abs(V))
+        near = [(abs(x - V), x, label) for x, label in old
+                if label[0].startswith(kind) and label in new and abs(x - V) <= reach]
+        if not near:
+            return carry(V)
+        _, x, label = min(near)
+        return V + new[label] - x
+
+    return moved
+
+
 def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameters, v_range, n_v: int,
-                   carry: _Carrier, crossings: dict[str, list[float]], tol: float) -> SliceResult:
+                   carry: _Carrier, on_curve: Callable[[float, str], float], crossings: dict[str, list[float]],
+                   tol: float) -> SliceResult:
     """A slice of the old map at the new design (see the module's step 4); NotWarm where it cannot be
     carried (it is then computed again)."""
     clock = time.perf_counter()
     Fz = float(old["Fz"])
     computed_at = old.get("computed_at")
-    if computed_at is None or design_distance(params, Parameters.from_dict(computed_at)) > CARRY_DISTANCE:
+    if computed_at is None or design_distance(params, Parameters.from_dict(computed_at), config) > CARRY_DISTANCE:
         raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN was computed at a design more than "
                       f"{CARRY_DISTANCE:g} (relative) from this one")
     scan = hopf_points(config, Fz, params=params, v_range=v_range).hopf_points
@@ -181,18 +204,20 @@ def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameter
                       f"{len(old['hopf_points'])}")
     hopf = [{"V": h.V, "frequency_hz": h.frequency_hz, "criticality": h.criticality.value} for h in scan]
     special: list[dict[str, Any]] = []
-    taken: set[float] = set()
+    taken: dict[float, float] = {}  # a located crossing: the old point it was given to
     for q in old["special_points"]:
         if q["kind"] not in ON_CURVES:
             raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a {q['kind']} point, on no curve of the map")
-        V = carry(q["V"])
-        # the new curve's located crossing of this load where the point was carried, each used once
-        located = [x for x in crossings.get(str(q["kind"]), []) if abs(x - V) <= tol and x not in taken]
+        V = on_curve(q["V"], str(q["kind"]))
+        # the new curve's located crossing of this load where the point was carried, each used once (a
+        # point the slice lists twice, found on two of its branches, is one point)
+        located = [x for x in crossings.get(str(q["kind"]), []) if abs(x - V) <= tol
+                   and (x not in taken or abs(taken[x] - q["V"]) <= 1e-9 * max(abs(q["V"]), 1.0))]
         if not located:
             raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a {q['kind']} point at V = {q['V']:.5g} m/s that "
                           "no curve of the map crosses there now")
         V = min(located, key=lambda x: abs(x - V))
-        taken.add(V)
+        taken[V] = q["V"]
         special.append({"kind": q["kind"], "V": V, "mode": q["mode"]})
     # an interval's end at one of the slice's located points goes to that point at the new design
     exact = list(zip([h["V"] for h in old["hopf_points"]] + [q["V"] for q in old["special_points"]],
@@ -321,9 +346,10 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         try:
             if change:
                 raise NotWarm(f"the curves' arrangement changed on it: {change}")
-            slices.append(_carried_slice(old, config, params, v_range, n_v,
-                                         _Carrier(old_boundaries, boundaries, Fz, v_range), _crossings_of(curves, Fz),
-                                         tol))
+            carry = _Carrier(old_boundaries, boundaries, Fz, v_range)
+            slices.append(_carried_slice(old, config, params, v_range, n_v, carry,
+                                         _on_curve(old_boundaries, boundaries, Fz, carry, tol),
+                                         _crossings_of(curves, Fz), tol))
         except NotWarm as exc:
             again[Fz] = exc.reason
     # regions between the new curves that no slice crosses: slices through them, as a cold map adds
