@@ -29,6 +29,7 @@ only for workers on another host sharing the directory.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import reprlib
@@ -45,6 +46,7 @@ import diskcache
 import psutil
 
 from ..errors import InvalidParameterError
+from ..analyses.core import executors
 from . import admission, analyses, cache, schemas, settings
 
 ACTIVE = ("queued", "running")
@@ -606,6 +608,11 @@ class Cancelled(Exception):
     pass
 
 
+#: Analyses that run their units through a process pool: a worker slot that starts with one forks its
+#: pool once (:func:`shimmy.analyses.core.executors.shared_pool`) for all its jobs.
+POOLED = frozenset({"map", "margin_map", "margins", "study", "robustness", "optimise"})
+
+
 def run(job_id: str) -> None:
     """Run job ``job_id`` in this process (``python -m shimmy.service.worker``), then the next
     queued jobs in the same slot until the queue is empty."""
@@ -617,15 +624,18 @@ def run(job_id: str) -> None:
         while not stop.wait(1.0):
             update(current[0], heartbeat=_now())
 
-    threading.Thread(target=beat, daemon=True).start()
-    try:
-        while job_id is not None:
-            current[0] = job_id
-            if not _run_one(job_id):  # cancelled: the canceller's SIGTERM for this group is on its way
-                return
-            job_id = _next(job_id, me)
-    finally:
-        stop.set()
+    # the slot's process pool, forked before the heartbeat thread exists: warm for every job of the slot
+    first = store().get(("job", job_id)) or {}
+    with executors.shared_pool() if first.get("analysis") in POOLED else contextlib.nullcontext():
+        threading.Thread(target=beat, daemon=True).start()
+        try:
+            while job_id is not None:
+                current[0] = job_id
+                if not _run_one(job_id):  # cancelled: the canceller's SIGTERM for this group is on its way
+                    return
+                job_id = _next(job_id, me)
+        finally:
+            stop.set()
 
 
 def _run_one(job_id: str) -> bool:
@@ -639,6 +649,7 @@ def _run_one(job_id: str) -> bool:
     except Cancelled:
         return False
     except Exception as exc:  # noqa: BLE001 - every failure is reported on the job
+        executors.drop_shared_pool()  # units of the failed job may still run there
         update(job_id, status="failed", error=f"{type(exc).__name__}: {exc}", sketch=None)
         return True
     update(job_id, status="done", progress=1.0, message="done", sketch=None)

@@ -122,6 +122,10 @@ def open_executor(max_workers: int | None = None, scheduler: str | None = None) 
     if n == 1:
         yield InlineExecutor()
         return
+    shared = _SHARED[0]
+    if shared is not None and max_workers is None and not getattr(shared, "_broken", False):
+        yield shared  # the process's own pool (:func:`shared_pool`): open already, closed by its owner
+        return
     if threading.active_count() == 1:
         context = multiprocessing.get_context("fork")
     else:
@@ -129,6 +133,52 @@ def open_executor(max_workers: int | None = None, scheduler: str | None = None) 
         context.set_forkserver_preload(PRELOAD)
     with ProcessPoolExecutor(max_workers=n, mp_context=context) as pool:
         yield pool
+
+
+#: The pool :func:`shared_pool` made for this process, if one is open.
+_SHARED: list[ProcessPoolExecutor | None] = [None]
+
+
+def _ready() -> None:
+    """A unit that does nothing: submitted once, it makes a pool start its workers."""
+
+
+@contextlib.contextmanager
+def shared_pool() -> Iterator[None]:
+    """For as long as the block lasts, :func:`open_executor` (default workers, no Dask scheduler)
+    hands out one local process pool made here instead of a pool per call. Made while the caller is
+    still single-threaded (call it before starting threads): its workers are forked at once from
+    this process, with :data:`PRELOAD` imported, so they start warm and every computation in the
+    block (a job worker's jobs, one after another) uses them without starting processes. Where a
+    pool per call would not be a local pool (one worker, a Dask scheduler) nothing is made."""
+    if os.environ.get(DASK_ENV, "").strip() or worker_count() == 1 or _SHARED[0] is not None:
+        yield
+        return
+    import importlib
+
+    for module in PRELOAD:
+        importlib.import_module(module)
+    context = multiprocessing.get_context("fork" if threading.active_count() == 1 else "forkserver")
+    if context.get_start_method() == "forkserver":
+        context.set_forkserver_preload(PRELOAD)
+    pool = ProcessPoolExecutor(max_workers=worker_count(), mp_context=context)
+    pool.submit(_ready).result()  # a fork pool starts all its workers at its first unit: now, before any thread
+    _SHARED[0] = pool
+    try:
+        yield
+    finally:
+        _SHARED[0] = None
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def drop_shared_pool() -> None:
+    """End the shared pool now (its running units killed): after a failed computation whose units may
+    still be running there. Later calls open a pool each."""
+    pool, _SHARED[0] = _SHARED[0], None
+    if pool is not None:
+        for process in list(getattr(pool, "_processes", {}).values()):
+            process.kill()
+        pool.shutdown(wait=False, cancel_futures=True)
 
 
 def run_units(fn: Callable[[Any], Any], units: Sequence[Any], executor: Executor | None = None,

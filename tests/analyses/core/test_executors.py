@@ -12,12 +12,44 @@ import pytest
 
 from shimmy.errors import InvalidParameterError
 from shimmy.service.dask_cluster import loopback_cluster
-from shimmy.analyses.core.executors import (DASK_ENV, WORKERS_ENV, InlineExecutor, describe, open_executor, run_dynamic,
-                                       run_units, worker_count)
+from shimmy.analyses.core.executors import (DASK_ENV, PRELOAD, WORKERS_ENV, InlineExecutor, describe, drop_shared_pool,
+                                           open_executor, run_dynamic, run_units, shared_pool, worker_count)
 from shimmy.analyses.maps.stability_map import stability_map
 from shimmy.analyses.decisions.studies import study
 
 distributed = pytest.importorskip("distributed")
+
+
+def _worker_state(_):
+    import sys
+
+    return os.getpid(), all(m in sys.modules for m in PRELOAD)
+
+
+def test_a_shared_pool_is_handed_out_open_with_its_workers_started_warm(monkeypatch):
+    """Within shared_pool every open_executor() gets the one pool (not closed by the call), whose
+    workers were started when it was made, with the preloaded modules imported; after
+    drop_shared_pool calls open pools of their own again."""
+    monkeypatch.setenv(WORKERS_ENV, "2")
+    monkeypatch.delenv(DASK_ENV, raising=False)
+    with shared_pool():
+        with open_executor() as first:
+            pids = {p.pid for p in first._processes.values()}
+            assert len(pids) == 2  # started before any unit of a computation
+            states = run_units(_worker_state, [0, 1, 2, 3], first)
+        with open_executor() as second:
+            assert second is first and not first._shutdown_thread
+            assert {pid for pid, _ in run_units(_worker_state, [0, 1], second)} <= pids
+        assert all(warm for _, warm in states) and {pid for pid, _ in states} <= pids
+        with open_executor(max_workers=2) as own:  # a caller that asks for its own count gets its own pool
+            assert own is not first
+        drop_shared_pool()
+        with open_executor() as third:
+            assert third is not first and isinstance(third, ProcessPoolExecutor)
+    monkeypatch.setenv(WORKERS_ENV, "1")
+    with shared_pool():
+        with open_executor() as inline:
+            assert isinstance(inline, InlineExecutor)
 
 
 def test_run_units_keeps_the_order_and_reports_each_unit():
