@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import dash
-from dash import Input, Output, State, dcc, html, no_update
+from dash import Input, Output, Patch, State, dcc, html, no_update
 
 from shimmy.continuation.kinds import PointKind
 from shimmy.errors import InvalidParameterError
@@ -89,32 +89,67 @@ def layout_page(query, children):
     Output(ids.OV_GROUP.error, "children"), Output(ids.OV_GROUP.csv, "disabled"), Output(ids.OV_GROUP.json, "disabled"),
     Output(ids.URL_UPDATE, "data", allow_duplicate=True),
     Input(ids.design_store(ids.OV), "data"), Input(ids.OV_FZ, "value"), Input(ids.OV_VMAX, "value"),
+    State(ids.OV_DATA, "data"),
     prevent_initial_call="initial_duplicate",
 )
-def update(design, fz_kn, v_max):
+def update(design, fz_kn, v_max, drawn):
     try:
-        result, _ = analyses.run("stability", {"Fz": FZ.read(fz_kn), "v_max": V_MAX.read(v_max), "n_points": 120,
-                                              **design})
+        request = {"Fz": FZ.read(fz_kn), "v_max": V_MAX.read(v_max), "n_points": 120, **design}
+        result, _ = analyses.run("stability", request)
     except InvalidParameterError as exc:
         if dash.ctx.triggered_id is None:  # the first drawing: the layout already says what of the address failed
             return no_update, no_update, no_update, no_update, True, True, no_update
         return no_update, no_update, no_update, str(exc), True, True, no_update
     except admission.Busy as exc:  # the service is busy: say so, keep what is drawn
         return no_update, no_update, no_update, f"The service is busy: {exc}.", no_update, no_update, no_update
+    traces = growth_traces(result)
+    title = f"Growth rate of straight rolling at Fz = {fz_kn:g} kN"
+    if drawn:  # the figure is there: only what a design step changes (its traces' points, the title)
+        fig = Patch()
+        same_speeds = drawn.get("request", {}).get("v_max") == request["v_max"]  # the lines' V grid is drawn
+        for k, trace in enumerate(traces):
+            for key in ("x", "y", "hovertext"):
+                if key in trace and not (key == "x" and trace["mode"] == "lines" and same_speeds):
+                    fig["data"][k][key] = trace[key]
+        fig["layout"]["title"]["text"] = title
+    else:
+        lay = style.layout(title, "forward speed V (m/s)", "largest eigenvalue real part (1/s)", x_log=True)
+        lay["shapes"] = [{"type": "line", "xref": "paper", "x0": 0, "x1": 1, "y0": 0, "y1": 0,
+                          "line": {"color": "#888", "width": 1}}]
+        fig = {"data": traces, "layout": lay}
+    rows = hopf_rows(result)
+    table = ui.table(HOPF_COLUMNS, rows, ids.OV_HOPF_TABLE)
+    return (fig, table, {"columns": HOPF_COLUMNS, "rows": rows, "request": request}, "", False, False,
+            {"Fz": f"{float(fz_kn):g}", "vmax": f"{float(v_max):g}"})
+
+
+HOPF_COLUMNS = ["configuration", "unstable for V in (m/s)", "onset (m/s)", "end (m/s)", "onset vs original (m/s)",
+                "onset frequency (Hz)", "criticality"]
+
+
+def growth_traces(result) -> list[dict]:
+    """Per configuration, in order: its growth-rate line, then its Hopf points (a trace even when there
+    are none: the figure keeps its traces from one design to the next, so a step patches their points)."""
     traces = []
-    rows = []
-    base = result["configs"]["original"]["unstable_intervals"]
     for config in CONFIGS:
         data = result["configs"][config]
         traces.append({"type": "scatter", "x": result["V"], "y": data["max_real"], "mode": "lines",
                        "name": style.CONFIG_LABELS[config],
                        "line": {"color": style.CONFIG_COLOURS[config], "width": 2}})
         hv = [h["V"] for h in data["hopf_points"]]
-        if hv:
-            traces.append({"type": "scatter", "x": hv, "y": [0] * len(hv), "mode": "markers", "showlegend": False,
-                           "marker": markers.marker(PointKind.HOPF, style.CONFIG_COLOURS[config]),
-                           "meta": {"kind": markers.of(PointKind.HOPF).label}, "hoverinfo": "text",
-                           "hovertext": [f"{style.CONFIG_LABELS[config]} Hopf point (H) V = {v:.4g} m/s" for v in hv]})
+        traces.append({"type": "scatter", "x": hv, "y": [0] * len(hv), "mode": "markers", "showlegend": False,
+                       "marker": markers.marker(PointKind.HOPF, style.CONFIG_COLOURS[config]),
+                       "meta": {"kind": markers.of(PointKind.HOPF).label}, "hoverinfo": "text",
+                       "hovertext": [f"{style.CONFIG_LABELS[config]} Hopf point (H) V = {v:.4g} m/s" for v in hv]})
+    return traces
+
+
+def hopf_rows(result) -> list[list[str]]:
+    """The Hopf speed interval table's rows (HOPF_COLUMNS), one per configuration."""
+    rows = []
+    base = result["configs"]["original"]["unstable_intervals"]
+    for config in CONFIGS:
+        data = result["configs"][config]
         intervals = data["unstable_intervals"]
         onset = intervals[0][0] if intervals else None
         end = intervals[-1][1] if intervals else None
@@ -125,16 +160,7 @@ def update(design, fz_kn, v_max):
                      formats.significant(onset), formats.significant(end), formats.signed(d_onset),
                      formats.significant(freq),
                      ", ".join(h["criticality"] for h in data["hopf_points"]) or "–"])
-    lay = style.layout(f"Growth rate of straight rolling at Fz = {fz_kn:g} kN", "forward speed V (m/s)",
-                       "largest eigenvalue real part (1/s)", x_log=True)
-    lay["shapes"] = [{"type": "line", "xref": "paper", "x0": 0, "x1": 1, "y0": 0, "y1": 0,
-                      "line": {"color": "#888", "width": 1}}]
-    fig = {"data": traces, "layout": lay}
-    columns = ["configuration", "unstable for V in (m/s)", "onset (m/s)", "end (m/s)", "onset vs original (m/s)",
-               "onset frequency (Hz)", "criticality"]
-    table = ui.table(columns, rows, ids.OV_HOPF_TABLE)
-    return (fig, table, {"columns": columns, "rows": rows, "result": result}, "", False, False,
-            {"Fz": f"{float(fz_kn):g}", "vmax": f"{float(v_max):g}"})
+    return rows
 
 
 @dash.callback(Output(ids.OV_GROUP.download, "data"), Input(ids.OV_GROUP.csv, "n_clicks"), Input(ids.OV_GROUP.json,
@@ -145,7 +171,11 @@ def download(_csv, _json, data):
         return no_update
     if dash.ctx.triggered_id == ids.OV_GROUP.csv:
         return {"content": ui.csv_text(data["columns"], data["rows"]), "filename": "overview_hopf.csv"}
-    return {"content": ui.json_text(data["result"]), "filename": "overview_stability.json"}
+    try:  # the answer drawn: the service's cached one for the same request
+        result, _ = analyses.run("stability", data["request"])
+    except (InvalidParameterError, admission.Busy) as exc:
+        return {"content": str(exc), "filename": "overview_stability_refused.txt"}
+    return {"content": ui.json_text(result), "filename": "overview_stability.json"}
 
 
 @dash.callback(Output(ids.OV_CMP.designs, "children"), Output(ids.OV_CMP_GRAPH, "figure"),

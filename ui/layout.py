@@ -188,7 +188,7 @@ dash.clientside_callback(
 # validates again.
 dash.clientside_callback(
     """
-    function(values, boxes, material, reset, ids, boxIds, errorIds, stores, shown) {
+    function(values, boxes, material, reset, ids, boxIds, errorIds, stores, shown, shownSummary) {
         const C = window.dash_clientside, trig = C.callback_context.triggered_id;
         const SPEC = %(spec)s, PRESET = %(preset)s, BASE = %(base)s, DEFAULT = %(default)s, ADVANCED = %(advanced)s;
         const ID = %(ids)s;
@@ -251,7 +251,7 @@ dash.clientside_callback(
         const errors = errorIds.map((i, k) => ((problems[i.name] || "") === (shown[k] || "") ? C.no_update
                                                                                              : (problems[i.name] || "")));
         return [outValues, outBoxes, outMaterial, url, stores.map(() => ({material: material, params: params})),
-                summary, errors, openAdvanced];
+                summary === (shownSummary || "") ? C.no_update : summary, errors, openAdvanced];
     }
     """ % {"spec": json.dumps({n: {"low": s.low, "high": s.high, "integer": s.integer, "allowed": s.allowed,
                                    "unit": s.unit, "range": f"[{s.low:g}, {s.high:g}] {s.unit}".rstrip(),
@@ -279,5 +279,6 @@ dash.clientside_callback(
     State(ids.param_error(ALL), "id"),
     State(ids.design_store(ALL), "data"),
     State(ids.param_error(ALL), "children"),
+    State(ids.DESIGN_ERROR, "children"),
     prevent_initial_call=True,
 )

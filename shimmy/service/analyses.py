@@ -123,16 +123,25 @@ def stability_map(request: dict[str, Any], progress: Progress | None = None) -> 
     from the map of the nearest cached design within reach (:mod:`shimmy.service.neighbours`), if there is one;
     its own warm start is kept for the next. A job's progress with a ``sketch`` (a job worker's) is told
     the curves as they are known, for the map page to draw them before the shading."""
-    from ..analyses.maps.design_metrics import metrics
+    from ..analyses.core.executors import name_of, open_executor, run_work_unit
+    from ..analyses.maps.design_metrics import SpeedMetricsUnit, metrics
     from ..analyses.maps.stability_map import stability_map as run_map
+    from ..model.configurations import Configuration
 
-    smap = run_map(request["config"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
-                   fz_range=(request["fz_min"], request["fz_max"]), resolution=request["resolution"],
-                   n_v=request["n_v"], progress=progress, warm_from=neighbours.nearest("map", request),
-                   sketch=getattr(progress, "sketch", None))
+    params = _params(request)
+    v_range = (request["v_min"], request["v_max"])
+    with open_executor() as pool:  # the metrics' slice beside the map's units, not after them
+        at_fz = pool.submit(run_work_unit, SpeedMetricsUnit(Configuration.parse(request["config"]),
+                                                            request["metrics_Fz"], params, v_range))
+        smap = run_map(request["config"], params=params, v_range=v_range,
+                       fz_range=(request["fz_min"], request["fz_max"]), resolution=request["resolution"],
+                       n_v=request["n_v"], progress=progress, warm_from=neighbours.nearest("map", request),
+                       sketch=getattr(progress, "sketch", None), executor=pool)
+        smap.executor = name_of(None)  # this environment's executor, as a map opening its own says
+        at_fz = at_fz.result()
     neighbours.remember("map", request, smap.warm_start())
     out = smap.to_dict()
-    out["metrics"] = metrics(smap, Fz=request["metrics_Fz"])
+    out["metrics"] = metrics(smap, Fz=request["metrics_Fz"], at_fz=at_fz)
     return out
 
 

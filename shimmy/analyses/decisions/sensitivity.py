@@ -121,16 +121,19 @@ def _model(model: Model, coefficients: np.ndarray) -> Model:
 
 
 @dataclass(frozen=True)
-class _Eigen:
+class EigenPair:
+    """A simple eigenvalue of a Jacobian with its right (q) and left (w) eigenvectors."""
+
     lam: complex
     q: np.ndarray
     w: np.ndarray  # left eigenvector scaled so that w^H q = 1
 
     def derivative(self, dJ: np.ndarray) -> complex:
+        """d lambda for the change dJ of the Jacobian: w^H dJ q."""
         return complex(np.conj(self.w) @ dJ @ self.q)
 
 
-def critical_pair(J: np.ndarray, omega_hint: float | None = None) -> _Eigen:
+def critical_pair(J: np.ndarray, omega_hint: float | None = None) -> EigenPair:
     """The eigenvalue with Im > 0 nearest the imaginary axis (nearest to i omega_hint if given)."""
     ev, vl, vr = scipy.linalg.eig(J, left=True, right=True)
     if omega_hint is None:
@@ -140,7 +143,7 @@ def critical_pair(J: np.ndarray, omega_hint: float | None = None) -> _Eigen:
     i = int(np.argmin(score))
     q, w = vr[:, i], vl[:, i]
     w = w / np.conj(np.conj(w) @ q)
-    return _Eigen(complex(ev[i]), q, w)
+    return EigenPair(complex(ev[i]), q, w)
 
 
 def _dJ_dFz(model: Model, V: float, Fz: float) -> np.ndarray:

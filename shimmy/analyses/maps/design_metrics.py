@@ -18,6 +18,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -53,25 +54,53 @@ def torsion_area(smap: StabilityMap, fz_max: float = BAND_FZ_MAX) -> dict[str, A
             "band": {"V": list(smap.v_range), "Fz": [smap.fz_range[0], top], "rows": int(f.size)}}
 
 
+#: The grid of the speed metrics' slice (points over the speed range; the fine grid is ten times finer).
+SPEED_N_V = 200
+
+
+@dataclass(frozen=True, eq=False)
+class SpeedMetricsUnit:
+    """The slice the speed metrics at one load are read from: a unit of work, so that a map's service
+    runner computes it beside the map's own units instead of after them."""
+
+    config: Configuration
+    Fz: float
+    params: Parameters
+    v_range: tuple[float, float] = BAND_V
+    n_v: int = SPEED_N_V
+    options: BifurcationOptions | None = None
+
+    def run(self) -> dict[str, Any]:
+        s = map_slice(self.config, self.Fz, v_range=(self.v_range[0], self.v_range[1]), n_v=self.n_v,
+                      params=self.params, options=self.options)
+        hull = None if not s.intervals else [s.intervals[0]["V_start"], s.intervals[-1]["V_end"]]
+        return {"Fz": s.Fz, "shimmy_intervals": s.intervals, "shimmy_speed_range": hull,
+                "hopf_points": [h["V"] for h in s.hopf_points], "max_psi": s.max_psi, "max_psi_V": s.max_psi_V,
+                "grid_step": (self.v_range[1] - self.v_range[0]) / ((self.n_v - 1) * 10)}
+
+    def describe(self) -> str:
+        return f"speed metrics at Fz = {self.Fz / 1e3:.4g} kN"
+
+
 def speed_metrics(config: Configuration | str, Fz: float, *, params: Parameters | None = None,
-                  v_range: tuple[float, float] = BAND_V, n_v: int = 200,
+                  v_range: tuple[float, float] = BAND_V, n_v: int = SPEED_N_V,
                   options: BifurcationOptions | None = None) -> dict[str, Any]:
     """Shimmy speed intervals and the largest stable torsional amplitude at one load."""
-    params = params if params is not None else Parameters()
-    s = map_slice(config, Fz, v_range=(v_range[0], v_range[1]), n_v=n_v, params=params, options=options)
-    hull = None if not s.intervals else [s.intervals[0]["V_start"], s.intervals[-1]["V_end"]]
-    return {"Fz": s.Fz, "shimmy_intervals": s.intervals, "shimmy_speed_range": hull,
-            "hopf_points": [h["V"] for h in s.hopf_points], "max_psi": s.max_psi, "max_psi_V": s.max_psi_V,
-            "grid_step": (v_range[1] - v_range[0]) / ((n_v - 1) * 10)}
+    return SpeedMetricsUnit(Configuration.parse(config), Fz, params if params is not None else Parameters(),
+                            v_range, n_v, options).run()
 
 
-def metrics(smap: StabilityMap, *, Fz: float = DEFAULT_FZ, options: BifurcationOptions | None = None) -> dict[str, Any]:
-    """All figures of merit of one configuration from its map (plus one slice at ``Fz``)."""
+def metrics(smap: StabilityMap, *, Fz: float = DEFAULT_FZ, options: BifurcationOptions | None = None,
+            at_fz: dict[str, Any] | None = None) -> dict[str, Any]:
+    """All figures of merit of one configuration from its map (plus one slice at ``Fz``; ``at_fz``: that
+    slice's figures, :class:`SpeedMetricsUnit` of the map's configuration, design and speed range, if
+    computed already)."""
     lateral = smap.hopf.lateral_minimum
     out = {"config": smap.config.value, "min_shimmy_Fz": smap.min_shimmy_Fz, "min_shimmy": smap.min_shimmy,
            "lateral_min_Fz": None if lateral is None else lateral["Fz"], "lateral_min": lateral}
     out.update(torsion_area(smap))
-    out["at_Fz"] = speed_metrics(smap.config, Fz, params=smap.params, v_range=smap.v_range, options=options)
+    out["at_Fz"] = at_fz if at_fz is not None else speed_metrics(smap.config, Fz, params=smap.params,
+                                                                 v_range=smap.v_range, options=options)
     return out
 
 
