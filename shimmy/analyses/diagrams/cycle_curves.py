@@ -587,15 +587,26 @@ def _continue(config: Configuration, params: Parameters, start: Start, box, load
     return GearCycleCurve(start.kind, curve, start.origin), None
 
 
+#: Where a new curve is probed against a known one (fractions of its points): all must lie on it.
+SAME_CURVE_PROBES = (0.25, 0.5, 0.75)
+
+
 def same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:
-    """Whether a curve continued while another was under way is that curve again (its start, the
-    first point of its half traced first, lies on the other)."""
+    """Whether a curve continued while another was under way is that curve again: its points at a
+    quarter, half and three quarters of its length all lie on the other. (The middle alone took a
+    torus curve of nes_pd, traced from a slice's torus point at 120.6 m/s, 273.5 kN that no known
+    curve passed, for the low-speed torus curve it runs into, and dropped the part of the map's
+    boundary it carried.)"""
     if new.kind != old.kind:
         return False
     c = new.curve
-    i = len(c.p) // 2
-    probe = SpecialPoint(new.kind, float(c.p[i, 0]), 0, {"x_max": c.x_max[i].tolist(), "x_min": c.x_min[i].tolist()})
-    return _on_curve(old, Start(new.kind, probe, float(c.p[i, 1]), 0, ""), l_g)
+    for fraction in SAME_CURVE_PROBES:
+        i = min(int(fraction * len(c.p)), len(c.p) - 1)
+        probe = SpecialPoint(new.kind, float(c.p[i, 0]), 0,
+                             {"x_max": c.x_max[i].tolist(), "x_min": c.x_min[i].tolist()})
+        if not _on_curve(old, Start(new.kind, probe, float(c.p[i, 1]), 0, ""), l_g):
+            return False
+    return True
 
 
 def _starts_beside(config, model, params, point, kind, v_range, fz_range, origin) -> list[Start]:
