@@ -99,6 +99,9 @@ DESIGN_ERROR = "design-error"
 MATERIAL = "material"
 RESET_DESIGN = "reset-design"
 ADVANCED = "advanced"
+#: The advanced parameters' boxes: filled when their section is first opened (fewer components on a slider step).
+ADVANCED_GRID = "advanced-grid"
+ADVANCED_SUMMARY = "advanced-summary"
 PARAM_TYPE = "param"  # {"type", "name"}: a parameter's slider or number box
 PARAM_BOX_TYPE = "param-box"  # the number box beside a slider
 PARAM_ERROR_TYPE = "param-error"

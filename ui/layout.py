@@ -98,12 +98,35 @@ def design_panel(query: dict[str, str], page_id: str, shown: bool = True) -> htm
                   html.Div(at_field.get("material"), className="error field-error", role="alert")],
                  className="slider-row"),
         *[_slider(n, values[n], at_field.get(n)) for n in DESIGN],
-        html.Details([html.Summary("Advanced parameters"),
-                      html.Div([_number(n, values[n], at_field.get(n)) for n in ADVANCED], className="advanced-grid")],
+        # rendered when first opened (or open already, for a refusal at one of them): ~30 boxes fewer on
+        # the page while it is closed, and every slider step reaches its figure sooner (each of Dash's
+        # updates runs every component's selector)
+        html.Details([html.Summary("Advanced parameters", id=ids.ADVANCED_SUMMARY),
+                      html.Div(advanced_boxes(values, at_field) if advanced_problem else [], id=ids.ADVANCED_GRID,
+                               className="advanced-grid")],
                      id=ids.ADVANCED, open=advanced_problem),
         html.Button("Reset design", id=ids.RESET_DESIGN, className="secondary"),
         sessions.section(),
     ], className="design-panel", id=ids.DESIGN_PANEL, hidden=not shown)
+
+
+def advanced_boxes(values: dict[str, float], at_field: dict[str, str] | None = None) -> list[html.Div]:
+    """The advanced parameters' number boxes at ``values`` (complete), with refusals at their fields."""
+    return [_number(n, values[n], (at_field or {}).get(n)) for n in ADVANCED]
+
+
+@dash.callback(Output(ids.ADVANCED_GRID, "children"), Input(ids.ADVANCED_SUMMARY, "n_clicks"),
+               State(ids.design_store(ALL), "data"), State(ids.param(ALL), "id"), prevent_initial_call=True)
+def fill_advanced(clicks, stores, shown):
+    """The advanced boxes, when their section is first opened (a click on its summary: the Details'
+    ``open`` does not follow the user's toggle), at the design's values (its store)."""
+    if not clicks or any(i["name"] in ADVANCED for i in shown) or not stores:
+        return dash.no_update
+    design = stores[0] or {}
+    material = design.get("material", state.DEFAULT_MATERIAL)
+    values = {**state.material_params(material if material in MATERIALS else state.DEFAULT_MATERIAL),
+              **(design.get("params") or {})}
+    return advanced_boxes(values)
 
 
 def page(query: dict[str, str], page_id: str, *children, design: bool = True) -> html.Div:
@@ -194,6 +217,11 @@ dash.clientside_callback(
         const ID = %(ids)s;
         const names = ids.map(i => i.name), boxNames = boxIds.map(i => i.name);
         const previous = Object.assign({}, BASE[DEFAULT], ((stores || [])[0] || {}).params || {});
+        // the design as stored: the values of parameters whose fields are not on the page (the advanced
+        // section until it is first opened)
+        const storedMaterial = ((stores || [])[0] || {}).material;
+        const stored = Object.assign({}, BASE[BASE[storedMaterial] ? storedMaterial : DEFAULT],
+                                     ((stores || [])[0] || {}).params || {});
         let cur = {};
         names.forEach((n, i) => { cur[n] = values[i]; });
         const boxOf = {};
@@ -233,6 +261,11 @@ dash.clientside_callback(
             if (problems[n]) { full[n] = kept; } else {
                 full[n] = v;
                 if (n === typed) { outValues[names.indexOf(n)] = v; }
+            }
+        }
+        for (const n in SPEC) {  // no field on the page: as stored, a reset's or a preset's value aside
+            if (!names.includes(n) && trig !== ID.reset) {
+                full[n] = trig === ID.material && n in PRESET[material] ? PRESET[material][n] : stored[n];
             }
         }
         const params = {}, url = {};

@@ -71,10 +71,32 @@ def test_slider_steps_are_engineering_steps_without_float_noise(server, browser,
     assert severe(browser) == []
 
 
+def test_advanced_values_are_kept_while_their_section_is_closed(server, browser):
+    """The advanced boxes are rendered when their section is first opened: until then the design keeps
+    their values from the address (a slider step does not drop them), and opened they show them."""
+    open_page(browser, server, "/?k_psi=400000")
+    assert by_id(browser, pattern("k_psi", "param")) is None
+    slider = by_id(browser, pattern("r2", "param")).find_element(By.CSS_SELECTOR, "[role='slider']")
+    slider.click()
+    slider.send_keys(Keys.ARROW_RIGHT)
+    wait_for(lambda: "r2=" in browser.current_url, timeout=10, what="the step in the address")
+    assert "k_psi=400000" in browser.current_url
+    browser.find_element(By.CSS_SELECTOR, "#advanced summary").click()
+    box = wait_for(lambda: by_id(browser, pattern("k_psi", "param")), timeout=10, what="the advanced boxes")
+    assert box.get_attribute("value") == "400000"
+    type_into(box, "410000")
+    wait_for(lambda: "k_psi=410000" in browser.current_url, timeout=10, what="the typed value in the address")
+    assert "r2=" in browser.current_url
+    assert severe(browser) == []
+
+
 def test_refusals_are_at_the_field_in_its_unit_quoting_what_was_typed(server, browser):
     open_page(browser, server, "/")
+    assert by_id(browser, pattern("k_psi", "param")) is None  # filled when the section is first opened
     browser.find_element(By.CSS_SELECTOR, "#advanced summary").click()
-    type_into(by_id(browser, pattern("k_psi", "param")), "-5")
+    k_psi = wait_for(lambda: by_id(browser, pattern("k_psi", "param")), timeout=10, what="the advanced boxes")
+    assert k_psi.get_attribute("value") == "380000"  # the design's value
+    type_into(k_psi, "-5")
     wait_for(lambda: text_of(browser, pattern("k_psi", "param-error")), timeout=10, what="the error at k_psi")
     assert text_of(browser, pattern("k_psi", "param-error")).startswith(
         "k_psi = -5 N m/rad is outside [10000, 1e+07] N m/rad (kept 380000")
