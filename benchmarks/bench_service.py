@@ -83,22 +83,30 @@ def throughput(port: int, bodies, seconds: float, threads: int = 8) -> float:
     return sum(count) / seconds
 
 
-def slider_latency(base: str, repeats: int) -> list[float]:
+def overview_slider(driver, base: str):
+    """The Overview opened at ``base`` with its figure drawn, and its first (r2) slider's handle, focused."""
     from selenium.webdriver.common.by import By
+    from test_browser import _nes_onset
+
+    driver.get(base + "/")
+    deadline = time.time() + 60
+    while not (_nes_onset(driver) and driver.find_elements(By.CSS_SELECTOR, "[role='slider']")) \
+            and time.time() < deadline:
+        time.sleep(0.05)
+    handle = driver.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]
+    handle.click()
+    time.sleep(1.0)
+    return handle
+
+
+def slider_latency(base: str, repeats: int) -> list[float]:
     from selenium.webdriver.common.keys import Keys
     from browser import chromium  # the tests' own Chromium (its profile, flags and console log)
-    from test_browser import NES_TRACE, _nes_onset
+    from test_browser import NES_TRACE
 
     driver = chromium("chromium-bench-service", "1500,1100")
     try:
-        driver.get(base + "/")
-        deadline = time.time() + 60
-        while not (_nes_onset(driver) and driver.find_elements(By.CSS_SELECTOR, "[role='slider']")) \
-                and time.time() < deadline:
-            time.sleep(0.05)
-        handle = driver.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]
-        handle.click()
-        time.sleep(1.0)
+        handle = overview_slider(driver, base)
         # In-page clock: keydown -> the last DOM change of the figure (Plotly's redraw done).
         driver.execute_script(
             "window.__marks = []; new MutationObserver(() => window.__marks.push(performance.now()))"

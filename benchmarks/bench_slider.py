@@ -48,25 +48,17 @@ def main() -> None:
     parser.add_argument("--port", type=int, default=8771)
     parser.add_argument("--show", type=int, default=2, help="the last steps whose whole log is printed")
     args = parser.parse_args()
-    from bench_service import start_server
+    from bench_service import overview_slider, start_server
     from browser import chromium
-    from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
-    from test_browser import NES_TRACE, _nes_onset
+    from test_browser import NES_TRACE
 
     cache_dir = tempfile.mkdtemp(prefix="shimmy-bench-slider-")
     os.chmod(cache_dir, 0o700)
     server = start_server(cache_dir, args.port)
     driver = chromium("chromium-bench-slider", "1500,1100")
     try:
-        driver.get(f"http://127.0.0.1:{args.port}/")
-        deadline = time.time() + 60
-        while not (_nes_onset(driver) and driver.find_elements(By.CSS_SELECTOR, "[role='slider']")) \
-                and time.time() < deadline:
-            time.sleep(0.05)
-        handle = driver.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]
-        handle.click()
-        time.sleep(1.0)
+        handle = overview_slider(driver, f"http://127.0.0.1:{args.port}")
         driver.execute_script(INSTRUMENT)
         to_request, to_figure = [], []
         for k in range(args.repeats):
