@@ -84,12 +84,10 @@ def canonical(analysis: str, wanted: Any) -> list[dict[str, Any]]:
     MAX_PAGE_REQUESTS."""
     if not isinstance(wanted, list) or not wanted:
         raise InvalidParameterError("requests", type(wanted).__name__, "a non-empty list of requests")
-    out, keys = [], set()
-    for body in wanted:
+    out = []
+    for body in wanted:  # the same request twice is one (two designs may still share a cached result)
         request = schemas.validate(analysis, body)
-        k = cache.key(analysis, request)
-        if k not in keys:
-            keys.add(k)
+        if request not in out:
             out.append(request)
     if len(out) > settings.MAX_PAGE_REQUESTS:
         raise InvalidParameterError("configs", len(out), f"at most {settings.MAX_PAGE_REQUESTS} analyses at once",

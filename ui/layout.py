@@ -216,9 +216,8 @@ dash.clientside_callback(
         const SPEC = %(spec)s, PRESET = %(preset)s, BASE = %(base)s, DEFAULT = %(default)s, ADVANCED = %(advanced)s;
         const ID = %(ids)s;
         const names = ids.map(i => i.name), boxNames = boxIds.map(i => i.name);
-        const previous = Object.assign({}, BASE[DEFAULT], ((stores || [])[0] || {}).params || {});
-        // the design as stored: the values of parameters whose fields are not on the page (the advanced
-        // section until it is first opened)
+        // the design as stored: what a refused value keeps, and the values of parameters whose fields are
+        // not on the page (the advanced section until it is first opened)
         const storedMaterial = ((stores || [])[0] || {}).material;
         const stored = Object.assign({}, BASE[BASE[storedMaterial] ? storedMaterial : DEFAULT],
                                      ((stores || [])[0] || {}).params || {});
@@ -249,7 +248,7 @@ dash.clientside_callback(
         for (const n of names) {
             const v = cur[n], s = SPEC[n];
             const unit = s.unit ? " " + s.unit : "";
-            const kept = previous[n] !== undefined ? previous[n] : base[n];
+            const kept = stored[n] !== undefined ? stored[n] : base[n];
             if (v === null || v === undefined || v === "" || typeof v !== "number" || !isFinite(v)) {
                 problems[n] = n + " is empty or not a number; enter " + s.allowed + " (kept " + kept + unit + ")";
             } else if (v < s.low || v > s.high) {

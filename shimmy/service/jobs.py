@@ -5,7 +5,7 @@ diskcache store next to the results: id, analysis, canonical request, status (qu
 running | done | failed | cancelled), progress 0-1, message, error, timestamps. Besides the
 records the store holds the queue (ids waiting, in order, at most ``MAX_QUEUED_JOBS``), the
 running map (id -> the process that holds one of ``MAX_RUNNING_JOBS`` slots) and an index
-result key -> active job, so that an identical request already queued or running is that job.
+request -> active job, so that an identical request already queued or running is that job.
 
 Who waits for a job: a workbench page submits on behalf of one view of it (a ``watcher`` token the
 page chose) and :func:`release` says when that view waits no more (the page was left, its question
@@ -46,6 +46,7 @@ import diskcache
 import psutil
 
 from ..errors import InvalidParameterError
+from ..model.parameters import canonical_digest
 from ..analyses.core import executors
 from . import admission, analyses, cache, schemas, settings
 
@@ -93,8 +94,8 @@ def update(job_id: str, **changes) -> dict[str, Any] | None:
         if job["status"] not in ACTIVE and "status" in changes:
             return job  # done/failed/cancelled are final
         job.update(changes)
-        if job["status"] not in ACTIVE and s.get(("active", job["result_key"])) == job_id:
-            s.delete(("active", job["result_key"]))
+        if job["status"] not in ACTIVE and s.get(_active(job)) == job_id:
+            s.delete(_active(job))
         return _put(s, job)
 
 
@@ -118,7 +119,8 @@ def submit_canonical(analysis: str, request: dict[str, Any], watcher: str | None
     if watcher is not None:
         _check_watcher(watcher)
     key = cache.key(analysis, request)
-    job = {"id": uuid.uuid4().hex, "analysis": analysis, "request": request, "status": "queued",
+    asked = _asked_key(analysis, request)
+    job = {"id": uuid.uuid4().hex, "analysis": analysis, "request": request, "status": "queued", "asked_key": asked,
            "progress": 0.0, "message": "queued", "error": None, "created": _now(), "heartbeat": _now(),
            "result_key": key, "watchers": [] if watcher is None else [watcher], "pinned": watcher is None,
            "user": user, "users": [] if user is None else [user], "restarts": 0}
@@ -130,7 +132,7 @@ def submit_canonical(analysis: str, request: dict[str, Any], watcher: str | None
         return job
     _reap(s)
     with s.transact():
-        same = s.get(("active", key))
+        same = s.get(("active", asked))
         existing = s.get(("job", same)) if same else None
         if existing is not None and existing["status"] in ACTIVE:
             return _put(s, _asked_by(_watched_by(existing, watcher), user))
@@ -142,7 +144,7 @@ def submit_canonical(analysis: str, request: dict[str, Any], watcher: str | None
             _check_share(s, user, queue, running)
         _put(s, job)
         s.set("queue", [*queue, job["id"]])
-        s.set(("active", key), job["id"])
+        s.set(("active", asked), job["id"])
     _bound(s)
     pump()
     return store().get(("job", job["id"])) or job
@@ -239,12 +241,24 @@ def release(job_id: str, watcher: str) -> dict[str, Any] | None:
     return job
 
 
+def _asked_key(analysis: str, request: dict[str, Any]) -> str:
+    """What an identical request is: the whole canonical request (every parameter), not the result's
+    key (which may leave out parameters outside the configuration's model: two such requests share a
+    result, but each job reports its own request)."""
+    return canonical_digest({"analysis": analysis, "request": request})
+
+
+def _active(job: dict[str, Any]) -> tuple[str, str]:
+    """The active index's entry of a job (a record from before the index took whole requests: its result key)."""
+    return ("active", job.get("asked_key", job["result_key"]))
+
+
 def _end(s: diskcache.Cache, job: dict[str, Any], message: str) -> None:
     """Mark an active job cancelled and take it off the queue and the active index (in a transaction)."""
     job.update(status="cancelled", message=message)
     s.set("queue", [j for j in s.get("queue", []) if j != job["id"]])
-    if s.get(("active", job["result_key"])) == job["id"]:
-        s.delete(("active", job["result_key"]))
+    if s.get(_active(job)) == job["id"]:
+        s.delete(_active(job))
     _put(s, job)
 
 
@@ -426,8 +440,8 @@ def server_started() -> dict[str, list[str]]:
                 job.update(status="failed", error=f"the process running this job ended without a result when the "
                            f"server stopped, {job.get('restarts', 0) + 1} times; submit it again")
                 _put(s, job)
-                if s.get(("active", job["result_key"])) == job_id:
-                    s.delete(("active", job["result_key"]))
+                if s.get(_active(job)) == job_id:
+                    s.delete(_active(job))
                 failed.append(job_id)
     return {"requeued": requeued, "failed": failed}
 
@@ -624,8 +638,9 @@ def run(job_id: str) -> None:
         while not stop.wait(1.0):
             update(current[0], heartbeat=_now())
 
-    # the slot's process pool, forked before the heartbeat thread exists: warm for every job of the slot
-    first = store().get(("job", job_id)) or {}
+    # running from now (the slot is this process's); then the slot's process pool, forked before the
+    # heartbeat thread exists: warm for every job of the slot
+    first = update(job_id, status="running", message="running", heartbeat=_now()) or {}
     with executors.shared_pool() if first.get("analysis") in POOLED else contextlib.nullcontext():
         threading.Thread(target=beat, daemon=True).start()
         try:

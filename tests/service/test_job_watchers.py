@@ -117,3 +117,15 @@ def _until(predicate, timeout=60.0, what="condition"):
             return value
         time.sleep(0.1)
     raise AssertionError(f"timed out waiting for {what}")
+
+
+def test_requests_that_share_a_result_but_not_a_design_are_jobs_of_their_own(held):
+    """Two maps of original at two e_p (the NES's: not in its model) share one cache key, so the second is
+    answered from the first's result once it is in; but while the first is queued, the second is its own
+    job with its own request (a shared job would report the first asker's design)."""
+    a = jobs.submit_canonical("map", _map(params={"e_p": 0.002}))
+    b = jobs.submit_canonical("map", _map(params={"e_p": 0.003}))
+    same = jobs.submit_canonical("map", _map(params={"e_p": 0.003}))
+    assert a["id"] != b["id"] and same["id"] == b["id"] and a["result_key"] == b["result_key"]
+    assert jobs.public(b)["request"]["params"]["e_p"] == 0.003 and jobs.public(a)["request"]["params"]["e_p"] == 0.002
+    assert _queue() == [a["id"], b["id"]]

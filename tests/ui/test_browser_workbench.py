@@ -90,6 +90,14 @@ def test_advanced_values_are_kept_while_their_section_is_closed(server, browser)
     assert severe(browser) == []
 
 
+def test_a_refused_value_keeps_the_materials_value_not_the_default_materials(server, browser):
+    open_page(browser, server, "/?material=tungsten")
+    type_into(by_id(browser, pattern("rho_p", "param-box")), "1")
+    wait_for(lambda: text_of(browser, pattern("rho_p", "param-error")), timeout=10, what="the error at rho_p")
+    assert "(kept 16500 kg/m^3)" in text_of(browser, pattern("rho_p", "param-error"))
+    assert severe(browser) == []
+
+
 def test_refusals_are_at_the_field_in_its_unit_quoting_what_was_typed(server, browser):
     open_page(browser, server, "/")
     assert by_id(browser, pattern("k_psi", "param")) is None  # filled when the section is first opened

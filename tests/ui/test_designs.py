@@ -321,3 +321,15 @@ def test_the_page_figures_name_each_design_in_its_colour():
     keys = [t["name"] for t in fig["data"] if t.get("showlegend") and t.get("legend", "legend") == "legend"]
     assert keys == names
     assert fig["layout"]["xaxis4"]["title"]["text"] == "forward speed V (m/s)"
+
+
+def test_compared_designs_that_share_a_cached_result_are_each_asked_for():
+    """Two NES designs compared on the original gear's map ask one cached answer (e_p does not enter it)
+    but are two requests of the page: each keeps its label, its design and its place."""
+    import app  # noqa: F401 - registers the pages
+    from ui import jobs
+
+    asked = jobs.canonical("map", [{"config": "original", "params": {"e_p": 0.002}},
+                                   {"config": "original", "params": {"e_p": 0.003}},
+                                   {"config": "original", "params": {"e_p": 0.003}}])
+    assert [r["params"]["e_p"] for r in asked] == [0.002, 0.003]

@@ -151,7 +151,11 @@ def shared_pool() -> Iterator[None]:
     this process, with :data:`PRELOAD` imported, so they start warm and every computation in the
     block (a job worker's jobs, one after another) uses them without starting processes. Where a
     pool per call would not be a local pool (one worker, a Dask scheduler) nothing is made."""
-    if os.environ.get(DASK_ENV, "").strip() or worker_count() == 1 or _SHARED[0] is not None:
+    try:
+        own = not (os.environ.get(DASK_ENV, "").strip() or worker_count() == 1 or _SHARED[0] is not None)
+    except InvalidParameterError:  # a bad SHIMMY_WORKERS: each computation says so where it opens its executor
+        own = False
+    if not own:
         yield
         return
     import importlib

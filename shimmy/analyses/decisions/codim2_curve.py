@@ -56,6 +56,9 @@ TOL = 1e-10
 SCALES = (10.0, 1e5)
 #: Newton steps allowed per point (from the secant it converges in 3-6; a failed step is halved)
 MAX_NEWTON = 12
+#: A point whose frequency moved more than this fraction from the last point's is refused (the step is
+#: halved): Newton followed another pair of eigenvalues.
+FREQUENCY_JUMP = 0.05
 #: A point's end (where Newton stops converging, or it leaves the box) is bracketed to this fraction of
 #: theta's range.
 END_TOL = 1e-6
@@ -113,9 +116,15 @@ def polish(kind: str, model: Model, V: float, Fz: float, frequencies: Sequence[f
         g = double_hopf_equations(model, *frequencies)
         what = "the double-Hopf point"
     with np.errstate(all="ignore"):  # a value that is not finite is refused by Newton's method
-        z = newton_in_plane(g, (V, Fz), SCALES, TOL, what, max_steps=MAX_NEWTON)
+        z = newton_in_plane(g, (V, Fz), SCALES, TOL, what, max_steps=MAX_NEWTON, stop_diverging=True)
     omega = g.state["omega"]  # type: ignore[attr-defined]
-    return float(z[0]), float(z[1]), list(omega) if isinstance(omega, list) else [omega]
+    found = list(omega) if isinstance(omega, list) else [omega]
+    # the same pair(s) as at the start: a frequency that jumped is another pair's point
+    for before, after in zip(frequencies, found, strict=True):
+        if abs(after - before) > FREQUENCY_JUMP * abs(before):
+            raise ConvergenceError(f"{what} near V = {V:.6g} m/s, Fz = {Fz:.6g} N converged on another pair "
+                                   f"(frequency {before / (2 * np.pi):.4g} -> {after / (2 * np.pi):.4g} Hz)")
+    return float(z[0]), float(z[1]), found
 
 
 def _follow(solve: Callable[[float, tuple[float, float], list[float]], tuple[float, float, list[float]]],

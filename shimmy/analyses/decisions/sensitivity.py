@@ -300,18 +300,22 @@ def hopf_sensitivities(model: Model, Fz: float, hopf_V: Sequence[float], pairs: 
     return out
 
 
-def newton_in_plane(g, z0, scale, tol: float, what: str, max_steps: int = 30) -> np.ndarray:
+def newton_in_plane(g, z0, scale, tol: float, what: str, max_steps: int = 30,
+                    stop_diverging: bool = False) -> np.ndarray:
     """A zero z = (V, Fz) of the two equations ``g(V, Fz)`` near ``z0``, by Newton's method with a
     central-difference Jacobian (step 1e-6 of ``scale``): converged when a step is below ``tol`` of the
     scales, or when steps stop shrinking below 1e-8 of them (the rounding level of the
     finite-difference Jacobian); ConvergenceError naming ``what`` otherwise (or on a singular
-    Jacobian, or a value that is not finite)."""
+    Jacobian, or a value that is not finite). ``stop_diverging``: give up as soon as a step longer
+    than the scales doubles (a caller that halves its continuation step instead)."""
     z = np.array(z0, float)
     scale = np.asarray(scale, float)
     last = math.inf
+    why = f"did not converge in {max_steps} Newton steps"
     for _ in range(max_steps):
         r = np.asarray(g(*z), float)
         if not np.all(np.isfinite(r)):
+            why = f"gave a value that is not finite at V = {z[0]:.6g} m/s, Fz = {z[1]:.6g} N"
             break
         D = np.empty((2, 2))
         for k in range(2):
@@ -323,17 +327,18 @@ def newton_in_plane(g, z0, scale, tol: float, what: str, max_steps: int = 30) ->
         except np.linalg.LinAlgError:
             raise ConvergenceError(f"{what}: singular Newton matrix at V = {z[0]:.6g} m/s, Fz = {z[1]:.6g} N") from None
         if not np.all(np.isfinite(dz)):
+            why = "took a step that is not finite"
             break
         z = z + dz
         size = float(np.max(np.abs(dz) / scale))
-        if size > 1.0 and size > 2.0 * last:  # diverging: no point in the remaining steps
+        if stop_diverging and size > 1.0 and size > 2.0 * last:  # diverging: no point in the remaining steps
+            why = f"diverged (steps of {last:.2g} then {size:.2g} of the scales)"
             break
         if size < tol or (size < 1e-8 and size >= 0.5 * last):
             g(*z)  # the caller's state (e.g. the followed frequency) at the solution
             return z
         last = size
-    raise ConvergenceError(f"{what} near V = {z0[0]:.6g} m/s, Fz = {z0[1]:.6g} N did not converge in "
-                           f"{max_steps} Newton steps")
+    raise ConvergenceError(f"{what} near V = {z0[0]:.6g} m/s, Fz = {z0[1]:.6g} N {why}")
 
 
 def polish_lowest_point(model: Model, V: float, Fz: float, tol: float = 1e-10) -> tuple[float, float, float]:

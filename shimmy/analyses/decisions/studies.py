@@ -151,7 +151,12 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
         speeds = hopf_speed_curves(config, parameter, Fz=result.Fz, params=base, v_range=result.v_range)
         result.curves += [c.to_dict() for c in speeds.study_curves(values=checked)]
         result.warnings += [f"{config}, curves in {parameter}: {w}" for w in speeds.warnings]
-        hopf = hopf_curves(config, params=base, v_range=result.v_range, fz_range=FZ_RANGE)
+        try:  # the base design's Hopf curves in (V, Fz): where the lowest point and the GH/HH points start
+            hopf = hopf_curves(config, params=base, v_range=result.v_range, fz_range=FZ_RANGE)
+        except ConvergenceError as exc:
+            result.warnings.append(f"{config}, min_shimmy_Fz and GH/HH points in {parameter}: not followed: the base "
+                                   f"design's Hopf curves: {exc}")
+            continue
         try:
             lowest, notes = min_shimmy_curve(config, parameter, params=base, v_range=result.v_range, values=checked,
                                              hopf=hopf)
@@ -160,9 +165,14 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
         else:
             result.curves.append(lowest.to_dict())
             result.warnings += [f"{config}, min_shimmy_Fz in {parameter}: {w}" for w in notes]
-        points, notes = codim2_curves(config, parameter, params=base, v_range=result.v_range, values=checked, hopf=hopf)
-        result.curves += [c.to_dict() for c in points]
-        result.warnings += [f"{config}, GH and double-Hopf points in {parameter}: {w}" for w in notes]
+        try:
+            points, notes = codim2_curves(config, parameter, params=base, v_range=result.v_range, values=checked,
+                                          hopf=hopf)
+        except ConvergenceError as exc:
+            result.warnings.append(f"{config}, GH and double-Hopf points in {parameter}: not followed: {exc}")
+        else:
+            result.curves += [c.to_dict() for c in points]
+            result.warnings += [f"{config}, GH and double-Hopf points in {parameter}: {w}" for w in notes]
     extra = [theta for theta in max_psi_grid(parameter, base, checked) if theta not in checked]
     tasks = [(c, {parameter: theta}, result.Fz, *result.v_range, base, options or BifurcationOptions(mesh_check=False))
              for theta in extra for c in result.configs]

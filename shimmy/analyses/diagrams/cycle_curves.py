@@ -592,8 +592,8 @@ SAME_CURVE_PROBES = (0.25, 0.5, 0.75)
 
 
 def same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:
-    """Whether a curve continued while another was under way is that curve again: its points at a
-    quarter, half and three quarters of its length all lie on the other. (The middle alone took a
+    """Whether a curve continued while another was under way is that curve again: its points a quarter,
+    half and three quarters along its list of points all lie on the other. (The middle alone took a
     torus curve of nes_pd, traced from a slice's torus point at 120.6 m/s, 273.5 kN that no known
     curve passed, for the low-speed torus curve it runs into, and dropped the part of the map's
     boundary it carried.)"""
