@@ -144,11 +144,14 @@ def download(ask, stores):
 
 @dash.callback(Output(ids.DESIGNS_LIST, "children"), Output(ids.DESIGN_COMPARE, "options"),
                Output(ids.DESIGN_NAME, "value"),
-               Input(ids.SAVED, "data"), Input(ids.design_store(ALL), "data"), State(ids.DESIGN_NAME, "value"))
-def show(saved, stores, name):
+               Input(ids.SAVED, "data"), Input(ids.design_store(ALL), "data"), State(ids.DESIGN_NAME, "value"),
+               State(ids.DESIGNS_LIST, "children"))
+def show(saved, stores, name, shown):
     """The saved designs (the current one marked, one that can no longer be used says why) and the
     compare choices; an empty name box takes the name of the saved design shown."""
     entries = designs.saved_list(saved)
+    if not entries and shown and dash.ctx.triggered_id != ids.SAVED:  # a design step, nothing saved: as shown
+        return no_update, no_update, no_update
     try:
         match = designs.matching(saved, designs.current_design(_current(stores)))
     except designs.DesignError:

@@ -79,13 +79,13 @@ def test_advanced_values_are_kept_while_their_section_is_closed(server, browser)
     slider = by_id(browser, pattern("r2", "param")).find_element(By.CSS_SELECTOR, "[role='slider']")
     slider.click()
     slider.send_keys(Keys.ARROW_RIGHT)
-    wait_for(lambda: "r2=" in browser.current_url, timeout=10, what="the step in the address")
+    wait_for(lambda: "r2=" in browser.current_url, timeout=30, what="the step in the address")
     assert "k_psi=400000" in browser.current_url
     browser.find_element(By.CSS_SELECTOR, "#advanced summary").click()
-    box = wait_for(lambda: by_id(browser, pattern("k_psi", "param")), timeout=10, what="the advanced boxes")
+    box = wait_for(lambda: by_id(browser, pattern("k_psi", "param")), timeout=30, what="the advanced boxes")
     assert box.get_attribute("value") == "400000"
     type_into(box, "410000")
-    wait_for(lambda: "k_psi=410000" in browser.current_url, timeout=10, what="the typed value in the address")
+    wait_for(lambda: "k_psi=410000" in browser.current_url, timeout=30, what="the typed value in the address")
     assert "r2=" in browser.current_url
     assert severe(browser) == []
 
@@ -93,7 +93,7 @@ def test_advanced_values_are_kept_while_their_section_is_closed(server, browser)
 def test_a_refused_value_keeps_the_materials_value_not_the_default_materials(server, browser):
     open_page(browser, server, "/?material=tungsten")
     type_into(by_id(browser, pattern("rho_p", "param-box")), "1")
-    wait_for(lambda: text_of(browser, pattern("rho_p", "param-error")), timeout=10, what="the error at rho_p")
+    wait_for(lambda: text_of(browser, pattern("rho_p", "param-error")), timeout=30, what="the error at rho_p")
     assert "(kept 16500 kg/m^3)" in text_of(browser, pattern("rho_p", "param-error"))
     assert severe(browser) == []
 
@@ -102,7 +102,7 @@ def test_refusals_are_at_the_field_in_its_unit_quoting_what_was_typed(server, br
     open_page(browser, server, "/")
     assert by_id(browser, pattern("k_psi", "param")) is None  # filled when the section is first opened
     browser.find_element(By.CSS_SELECTOR, "#advanced summary").click()
-    k_psi = wait_for(lambda: by_id(browser, pattern("k_psi", "param")), timeout=10, what="the advanced boxes")
+    k_psi = wait_for(lambda: by_id(browser, pattern("k_psi", "param")), timeout=30, what="the advanced boxes")
     assert k_psi.get_attribute("value") == "380000"  # the design's value
     type_into(k_psi, "-5")
     wait_for(lambda: text_of(browser, pattern("k_psi", "param-error")), timeout=10, what="the error at k_psi")
