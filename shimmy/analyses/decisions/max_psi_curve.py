@@ -2,19 +2,30 @@
 
 ``max_psi`` of a study is the largest |psi| over the stable limit cycles of the one-parameter
 bifurcation diagram in V at the study's load (:func:`shimmy.analyses.diagrams.bifurcation.bifurcation`:
-the cycles continued by collocation, the maximum refined along its branch). Here it is computed on a
-grid of the design parameter theta over its whole range (:data:`N_GRID` values evenly, the ends
-included, with the sampled study's values and the base design's), each value a full diagram with the
-sampled study's own options: at the sampled values the curve's value *is* the sampled row's, and at
-every grid value it is exact to the diagram's tolerances (the maximum located to 1e-8 of the
-branch's arclength). Between grid values the curve is not continued: its polyline joins exact
-points.
+the cycles continued by collocation, the maximum refined along its branch). The curve is made in two
+passes:
 
-Where the picture changes between two grid values (special points, ``"kind": "switch"``, not
-located: ``"located": false`` with the ``bracket`` of theta): the speed of the maximum jumps by more
-than :data:`SWITCH_JUMP` of the study's speed range (the maximum moves to another branch or another
-hump of its branch), or stable cycles appear or vanish (max_psi 0 on one side). A maximum that lives
-only between two grid values is missed; the grid can be refined by asking for values.
+1. **Grid**: a full diagram at :data:`N_GRID` values of theta evenly over its whole range (the ends
+   included), the sampled study's values and the base design's, with the sampled study's own
+   options: at the sampled values the curve's value *is* the sampled row's.
+2. **Followed between grid values** (:func:`follow_maximum`): where a grid diagram's maximum lies
+   inside a stable stretch of its branch (d max|psi| / ds = 0 there), that cycle is followed towards
+   the next grid value in :data:`SUBSTEPS` steps of theta: at each step the cycle is corrected by
+   Newton at the new design on the same collocation mesh at fixed V, and the maximum of max|psi| along
+   the branch is located again by a bounded search in arclength (to 1e-5 of the search span, each
+   orbit's maximum on its collocation polynomial, as the diagram does). Every followed point is thus a
+   located maximum of a stable cycle, exact to the diagram's tolerances (it equals a full diagram of
+   that design to ~1e-10 relative where the diagram's maximum is the same one). The follow arriving at
+   the next grid value must reproduce that diagram's value to :data:`AGREE`; where it does not (the
+   largest amplitude has moved to another branch or hump), the next grid value's maximum is followed
+   back, and at each step the larger of the two stable values is the curve's.
+
+Where the picture changes (special points, ``"kind": "switch"``, not located: ``"located": false``
+with the ``bracket`` of theta, as narrow as the points on either side): the speed of the maximum jumps
+by more than :data:`SWITCH_JUMP` of the study's speed range between two neighbouring points (the
+maximum moves to another branch or another hump of its branch), or stable cycles appear or vanish
+(max_psi 0 on one side). A followed maximum is a local one: a third branch whose stable cycles rise
+above it only between two grid values and fall below it again at both is not seen.
 """
 
 from __future__ import annotations
@@ -23,14 +34,26 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ...model.configurations import Configuration
 from ...model.parameters import Parameters
 from .study_curves import SNAP, StudyCurve, parameter_range
 
 #: Grid values of theta over its whole range, the ends included (plus the sampled and base values).
 N_GRID = 9
 #: A jump of the maximum's speed by more than this fraction of the study's speed range between two
-#: grid values marks a switch of the maximum (to another branch or hump).
+#: neighbouring points marks a switch of the maximum (to another branch or hump).
 SWITCH_JUMP = 0.1
+#: Steps of theta from one grid value to the next when a maximum is followed (the last one lands on
+#: the next grid value, where the follow is checked against that value's diagram).
+SUBSTEPS = 6
+#: A followed maximum arriving at a grid value is the diagram's maximum there if it agrees to this
+#: (relative); followed and diagram values agree to ~1e-10 where the maximum is the same one.
+AGREE = 1e-6
+#: Arclength half-width (the diagram's metric) of the search for the maximum along the branch at each
+#: followed value; re-centred (at most :data:`RECENTRES` times) while the maximum is at its edge.
+SEARCH_SPAN = 0.1
+#: How many times the search for the maximum is re-centred before a follow stops.
+RECENTRES = 6
 
 
 def grid(parameter: str, params: Parameters, values: Sequence[float] = ()) -> list[float]:
@@ -50,14 +73,117 @@ def grid(parameter: str, params: Parameters, values: Sequence[float] = ()) -> li
     return out
 
 
+def substeps(a: float, b: float) -> list[float]:
+    """The values of theta a follow from grid value a towards b visits, b last (exactly)."""
+    return [*(a + (b - a) * k / SUBSTEPS for k in range(1, SUBSTEPS)), b]
+
+
+def orbit_of(result) -> tuple[np.ndarray, int, np.ndarray] | None:
+    """What a follow starts from: the diagram's maximum's cycle (mesh points, ncol, unknowns) when
+    that maximum lies inside a stable stretch of its branch, else None."""
+    orbit = result.max_psi_orbit
+    if orbit is None or not orbit.interior:
+        return None
+    return orbit.mesh, orbit.ncol, orbit.u
+
+
+def follow_maximum(task: tuple) -> dict[str, Any]:
+    """One unit of work: the maximum's cycle of one grid diagram followed through ``thetas``.
+
+    ``task`` = (config, Fz, parameter, base params, orbit (mesh points, ncol, u), thetas, options).
+    Returns ``{"config", "points": [{"p", "value", "V"}], "stopped": None or why}``: the points up to
+    where the follow stopped (the cycle no longer converges at the next value, the maximum is no
+    longer found in the search, or the cycle of the maximum is no longer stable)."""
+    from ...continuation import ContinuationOptions, CurvePoint, step, weighted_norm
+    from ...continuation.collocation import Mesh, PeriodicProblem
+    from ...continuation.scalar import minimum_in
+    from ...model.equations import build_model
+    from ..diagrams.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
+
+    config, Fz, parameter, params, (mesh_points, ncol, u), thetas, options = task
+    copts = ContinuationOptions(ds=options.ds, ds_max=options.ds_max)
+    points: list[dict[str, float]] = []
+    for theta in thetas:
+        model = build_model(Configuration.parse(config), params.with_overrides({parameter: theta}),
+                            exact_nes=options.exact_nes)
+        problem = PeriodicProblem(gear_field(model, Fz), Mesh(mesh_points, ncol), STATE_SCALE[:model.n_states],
+                                  T_SCALE, V_SCALE)
+        problem.accept(u)
+        along_v = np.zeros_like(u)
+        along_v[-1] = 1.0
+        centre = step(problem, CurvePoint(u, along_v / weighted_norm(along_v, problem.weights)), 0.0, copts)
+        if centre is None:
+            return {"config": config, "points": points, "stopped": f"the cycle does not converge at {theta:.6g}"}
+        problem.accept(centre.u)
+        found = None
+        for _ in range(RECENTRES):
+            tried: dict[float, tuple[float, Any]] = {}
+
+            def minus_amplitude(h):
+                point = step(problem, centre, h, copts, with_tangent=False) if h != 0 else centre
+                tried[h] = (0.0, None) if point is None else (problem.peak(point.u, 0)[2], point)
+                return -tried[h][0]
+
+            h, _ = minimum_in(minus_amplitude, -SEARCH_SPAN, SEARCH_SPAN, xatol=1e-5 * SEARCH_SPAN)
+            amplitude, point = tried[h]
+            if point is None:
+                break
+            if abs(h) < 0.9 * SEARCH_SPAN:
+                found = (amplitude, point)
+                break
+            centre = step(problem, centre, h, copts)  # the maximum lies beyond the span: search from there
+            if centre is None:
+                break
+        if found is None:
+            return {"config": config, "points": points, "stopped": f"no maximum along the branch at {theta:.6g}"}
+        amplitude, point = found
+        multipliers = problem.multipliers(point.u)
+        if not np.all(np.abs(multipliers[1:]) < 1.0):
+            return {"config": config, "points": points,
+                    "stopped": f"the cycle of the maximum is unstable at {theta:.6g}"}
+        u = point.u.copy()
+        points.append({"p": float(theta), "value": float(amplitude), "V": float(u[-1])})
+    return {"config": config, "points": points, "stopped": None}
+
+
+def arrives(follow: dict[str, Any] | None, theta: float, value: float | None) -> bool:
+    """Whether a follow reached grid value theta with the diagram's value there (to :data:`AGREE`)."""
+    if follow is None or not follow["points"] or value is None:
+        return False
+    end = follow["points"][-1]
+    return end["p"] == theta and abs(end["value"] - value) <= AGREE * max(abs(value), 1e-12)
+
+
 def max_psi_curve(config: str, parameter: str, rows: Sequence[dict[str, Any]],
-                  v_range: tuple[float, float]) -> StudyCurve:
+                  v_range: tuple[float, float],
+                  follows: dict[tuple[float, float], dict[str, Any]] | None = None) -> StudyCurve:
     """The curve from one diagram's row per grid value (as the study's units of work make them:
-    ``max_psi``, ``max_psi_V`` and the parameter's value), sorted by theta, with its switches."""
+    ``max_psi``, ``max_psi_V`` and the parameter's value), sorted by theta, with the followed points
+    between them (``follows[(a, b)]``: the follow from grid value a towards b, as
+    :func:`follow_maximum` returns it) and its switches."""
     ordered = sorted(rows, key=lambda r: r[parameter])
-    p = [float(r[parameter]) for r in ordered]
-    values = [None if r["max_psi"] is None else float(r["max_psi"]) for r in ordered]
-    speeds = [r.get("max_psi_V") for r in ordered]
+    follows = follows or {}
+    p: list[float] = []
+    values: list[float | None] = []
+    speeds: list[float | None] = []
+    for k, row in enumerate(ordered):
+        p.append(float(row[parameter]))
+        values.append(None if row["max_psi"] is None else float(row["max_psi"]))
+        speeds.append(row.get("max_psi_V"))
+        if k + 1 == len(ordered):
+            break
+        a, b = p[-1], float(ordered[k + 1][parameter])
+        ahead = follows.get((a, b))
+        back = follows.get((b, a))
+        between = {}
+        for follow in (ahead, back):
+            for q in (follow or {"points": []})["points"]:
+                if q["p"] not in (a, b) and (q["p"] not in between or q["value"] > between[q["p"]]["value"]):
+                    between[q["p"]] = q
+        for theta in sorted(between):
+            p.append(theta)
+            values.append(between[theta]["value"])
+            speeds.append(between[theta]["V"])
     jump = SWITCH_JUMP * (v_range[1] - v_range[0])
     special = []
     for k in range(len(p) - 1):

@@ -15,12 +15,12 @@ from typing import Any, Callable, Sequence
 
 from ...version import __version__
 from ..diagrams.bifurcation import BifurcationOptions, bifurcation
-from ...model.configurations import CONFIGURATION_NAMES, Configuration
+from ...model.configurations import CONFIGURATION_NAMES, Configuration, affects
 from ...errors import ConvergenceError, InvalidParameterError
 from ..core.executors import name_of, open_executor, run_units
 from ..diagrams.hopf_curves import hopf_curves
 from .codim2_curve import codim2_curves
-from .max_psi_curve import grid as max_psi_grid, max_psi_curve
+from .max_psi_curve import arrives, follow_maximum, grid as max_psi_grid, max_psi_curve, orbit_of, substeps
 from .min_shimmy_curve import min_shimmy_curve
 from .study_curves import hopf_speed_curves
 from .summaries import STUDY_COLUMNS, study_summary, write_study_csv
@@ -45,6 +45,9 @@ class StudyResult:
     warnings: list[str] = field(default_factory=list)
     #: Exact curves of the Hopf speeds against the parameter (:mod:`.study_curves`); a one-parameter study's.
     curves: list[dict[str, Any]] = field(default_factory=list)
+    #: each row's maximum's cycle where a follow can start from it (:func:`.max_psi_curve.orbit_of`), by
+    #: (config, the row's parameter values); not part of the JSON
+    orbits: dict[tuple, Any] = field(default_factory=dict, repr=False)
 
     COLUMNS = STUDY_COLUMNS
 
@@ -92,7 +95,12 @@ def _unit(task: tuple) -> dict[str, Any]:
     return {**overrides, "config": config, "hopf_start": speeds[0] if speeds else None,
             "hopf_end": speeds[-1] if speeds else None, "max_psi": result.max_psi, "max_psi_V": result.max_psi_V,
             "hopf_points": speeds, "unstable_intervals": [list(iv) for iv in result.hopf.unstable_intervals],
-            "warnings": list(result.warnings)}
+            "warnings": list(result.warnings), "orbit": orbit_of(result)}
+
+
+def _orbits(rows: list[dict[str, Any]], parameters: Sequence[str]) -> dict[tuple, Any]:
+    """Take the cycles out of the rows (rows are JSON), by (config, the row's parameter values)."""
+    return {(r["config"], tuple(r[p] for p in parameters)): r.pop("orbit") for r in rows}
 
 
 def _run(parameters: list[str], designs: list[dict[str, float]], configs, Fz, v_range, params, executor,
@@ -109,12 +117,13 @@ def _run(parameters: list[str], designs: list[dict[str, float]], configs, Fz, v_
     tasks = [(c, d, Fz, v_min, v_max, params, options) for d in designs for c in configs]
     rows = run_units(_unit, tasks, executor, progress,
                      lambda t: f"{t[0]} at " + ", ".join(f"{k} = {v:g}" for k, v in t[1].items()))
+    orbits = _orbits(rows, parameters)
     warnings = [f"{r['config']} at " + ", ".join(f"{p} = {r[p]:g}" for p in parameters) + f": {w}"
                 for r in rows for w in r["warnings"]]
     values = [sorted({d[p] for d in designs}, key=[d[p] for d in designs].index) for p in parameters]
     return StudyResult(parameters, values, configs, Fz, (v_min, v_max), rows,
                        name_of(executor), time.perf_counter() - clock,
-                       warnings)
+                       warnings, orbits=orbits)
 
 
 def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = DEFAULT_CONFIGS,
@@ -174,17 +183,45 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
             result.curves += [c.to_dict() for c in points]
             result.warnings += [f"{config}, GH and double-Hopf points in {parameter}: {w}" for w in notes]
     extra = [theta for theta in max_psi_grid(parameter, base, checked) if theta not in checked]
-    tasks = [(c, {parameter: theta}, result.Fz, *result.v_range, base, options or BifurcationOptions(mesh_check=False))
-             for theta in extra for c in result.configs]
+    options = options or BifurcationOptions(mesh_check=False)
+    tasks = [(c, {parameter: theta}, result.Fz, *result.v_range, base, options) for theta in extra for c in result.configs]
     report(0.8, f"largest amplitude over the range of {parameter}")
-    more = run_units(_unit, tasks, executor, part(0.8, 1.0), lambda t: f"{t[0]} at {parameter} = {t[1][parameter]:g}")
+    more = run_units(_unit, tasks, executor, part(0.8, 0.93), lambda t: f"{t[0]} at {parameter} = {t[1][parameter]:g}")
+    orbits = {**result.orbits, **_orbits(more, [parameter])}
+    rows = {c: sorted((r for r in result.rows + more if r["config"] == c), key=lambda r: r[parameter])
+            for c in result.configs}
+    follows = _follow_maxima(parameter, rows, orbits, result.Fz, base, options, executor, part(0.93, 0.98),
+                             part(0.98, 1.0))
     for config in result.configs:
-        rows = [r for r in result.rows + more if r["config"] == config]
-        result.curves.append(max_psi_curve(config, parameter, rows, result.v_range).to_dict())
+        result.curves.append(max_psi_curve(config, parameter, rows[config], result.v_range,
+                                           follows[config]).to_dict())
+    result.orbits.clear()  # what the follows started from; the result is its JSON
     result.warnings += [f"{r['config']} at {parameter} = {r[parameter]:g} (max_psi curve): {w}"
                         for r in more for w in r["warnings"]]
     result.elapsed_s += time.perf_counter() - clock
     return result
+
+
+def _follow_maxima(parameter: str, rows: dict[str, list[dict[str, Any]]], orbits: dict[tuple, Any], Fz: float,
+                   base: Parameters, options: BifurcationOptions, executor, ahead, back) -> dict[str, dict]:
+    """Each grid diagram's maximum followed to the next grid value; where it does not arrive at that
+    value's maximum, that one followed back (:func:`.max_psi_curve.follow_maximum`). By config, then
+    by (from, towards) grid value. A configuration whose model the parameter does not enter has the
+    same diagram at every grid value: nothing to follow. ``ahead``, ``back``: the two passes' progress."""
+    follows: dict[str, dict] = {c: {} for c in rows}
+
+    def run(pairs, report):
+        pairs = [(c, a, b) for c, a, b in pairs if orbits.get((c, (a,))) is not None and affects(parameter, c)]
+        tasks = [(c, Fz, parameter, base, orbits[c, (a,)], substeps(a, b), options) for c, a, b in pairs]
+        done = run_units(follow_maximum, tasks, executor, report,
+                         lambda t: f"{t[0]}: largest amplitude followed to {parameter} = {t[5][-1]:g}")
+        for (c, a, b), follow in zip(pairs, done, strict=True):
+            follows[c][a, b] = follow
+
+    steps = [(c, r[parameter], s[parameter], s["max_psi"]) for c in rows for r, s in zip(rows[c], rows[c][1:])]
+    run([(c, a, b) for c, a, b, _ in steps], ahead)
+    run([(c, b, a) for c, a, b, value in steps if not arrives(follows[c].get((a, b)), b, value)], back)
+    return follows
 
 
 def study_grid(parameters: tuple[str, str], values: tuple[Sequence[float], Sequence[float]],

@@ -122,6 +122,19 @@ class Branch:
                 "points": points, "special_points": self.special_points}
 
 
+@dataclass(frozen=True)
+class MaximumOrbit:
+    """The stable cycle of the largest torsional amplitude, as the collocation left it: its mesh
+    (``mesh`` points, ``ncol``) and unknowns ``u`` (X, T, V). ``interior``: the maximum was located
+    inside a stable stretch of its branch (d max|psi| / ds = 0 there); otherwise it is the last
+    computed stable point before the branch loses stability or ends, not located."""
+
+    mesh: np.ndarray
+    ncol: int
+    u: np.ndarray
+    interior: bool
+
+
 @dataclass
 class BifurcationResult:
     config: Configuration
@@ -138,6 +151,9 @@ class BifurcationResult:
     options: BifurcationOptions
     elapsed_s: float
     warnings: list[str] = field(default_factory=list)
+    #: the cycle of ``max_psi`` (None if no stable cycle), for following it in a design parameter
+    #: (:mod:`shimmy.analyses.decisions.max_psi_curve`); not part of the JSON
+    max_psi_orbit: MaximumOrbit | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {"config": self.config.value, "Fz": self.Fz, "v_min": self.v_min, "v_max": self.v_max,
@@ -249,7 +265,8 @@ def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | 
                 branches.append(seeded)
 
     report(0.97, "maximum torsional amplitude")
-    max_psi, max_v, max_any, mesh_check = _maximum(system, branches, options, scale, warnings, params.gear.l_g)
+    max_psi, max_v, max_any, mesh_check, orbit = _maximum(system, branches, options, scale, warnings,
+                                                         params.gear.l_g)
     if config.has_nes and not options.exact_nes:
         n = params.nes
         peak, is_bound = _nes_rotation(system, branches, scale, cubic_range(n.r1, n.r2, n.r3, n.k_s, n.e_p))
@@ -259,7 +276,7 @@ def bifurcation(config: Configuration | str, Fz: float, *, params: Parameters | 
             warnings.append(beyond)
     report(1.0, "done")
     return BifurcationResult(config, Fz, v_min, v_max, params, hopf, branches, max_psi, max_v, max_any,
-                             mesh_check, options, time.perf_counter() - clock, warnings)
+                             mesh_check, options, time.perf_counter() - clock, warnings, orbit)
 
 
 def _seed_speeds(hopf: HopfResult) -> list[float]:
@@ -657,7 +674,8 @@ def _nes_rotation(system, branches: list[Branch], scale, limit: float) -> tuple[
 
 
 def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale, warnings, l_g: float):
-    """Largest torsional amplitude of stable cycles, refined along the branch, and a mesh check."""
+    """Largest torsional amplitude of stable cycles, refined along the branch, a mesh check, and the
+    cycle of the maximum (:class:`MaximumOrbit`)."""
     best = (0.0, None, None, None)  # amplitude, V, branch, index into its raw points
     max_any = 0.0
     for b in branches:
@@ -672,7 +690,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
             best = (float(stable_amp[i]), float(raw.p[i]), raw, i)
     amp, V, raw, i = best
     if raw is None:
-        return 0.0, None, max_any, None
+        return 0.0, None, max_any, None, None
     copts = ContinuationOptions(ds=options.ds, ds_max=options.ds_max)
     lo = max(i - 1, 0)
     if 0 < i < raw.p.size - 1 and raw.stable[lo] and raw.stable[i + 1]:
@@ -698,6 +716,10 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
             i_point = None
     else:
         i_point = None
+    if i_point is not None:  # the refined point lives on point lo's mesh
+        orbit = MaximumOrbit(raw.solutions[lo][0], raw.ncol, i_point.u.copy(), True)
+    else:
+        orbit = MaximumOrbit(raw.solutions[i][0], raw.ncol, raw.solutions[i][1].copy(), False)
     mesh_check = None
     if options.mesh_check:
         problem, start, _ = _restore(system, raw, i, scale)
@@ -716,4 +738,4 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
             a_c = problem.peak(point.u, 0)[2]
             mesh_check = {"V": float(point.u[-1]), "ntst": problem.mesh.ntst, "ntst_fine": fine.mesh.ntst,
                           "max_psi": a_c, "max_psi_fine": a_f, "change": abs(a_f - a_c)}
-    return amp, V, max(max_any, amp), mesh_check
+    return amp, V, max(max_any, amp), mesh_check, orbit

@@ -46,7 +46,7 @@ def test_the_nes_pre_stretch_changes_nes_rows_only(e_p_study):
 
 
 def test_the_max_psi_curve_passes_through_the_sampled_rows_and_is_a_diagram_at_each_grid_value(e_p_study):
-    from shimmy.analyses.decisions.max_psi_curve import N_GRID
+    from shimmy.analyses.decisions.max_psi_curve import N_GRID, SUBSTEPS, grid
 
     for config in ("original", "nes"):
         curve = next(c for c in e_p_study.curves if c["config"] == config and c["quantity"] == "max_psi")
@@ -55,13 +55,17 @@ def test_the_max_psi_curve_passes_through_the_sampled_rows_and_is_a_diagram_at_e
         for row in (r for r in e_p_study.rows if r["config"] == config):
             assert curve["values"][curve["p"].index(row["e_p"])] == row["max_psi"]  # the sampled row itself
     nes = next(c for c in e_p_study.curves if c["config"] == "nes" and c["quantity"] == "max_psi")
-    k = len(nes["p"]) // 2
-    direct = bifurcation("nes", 150e3, v_range=(1.0, 200.0), params=Parameters().with_overrides({"e_p": nes["p"][k]}),
-                         options=BifurcationOptions(mesh_check=False))
-    assert nes["values"][k] == pytest.approx(direct.max_psi, rel=1e-9)  # an exact value between the samples
+    on_grid = grid("e_p", Parameters(), [0.0005, 0.005])
+    assert len(nes["p"]) == len(on_grid) + (len(on_grid) - 1) * (SUBSTEPS - 1)  # followed between all of them
+    k = nes["p"].index(on_grid[len(on_grid) // 2])
+    for theta in (nes["p"][k], nes["p"][k + 1], nes["p"][k + SUBSTEPS // 2]):  # a grid value, two followed ones
+        direct = bifurcation("nes", 150e3, v_range=(1.0, 200.0), params=Parameters().with_overrides({"e_p": theta}),
+                             options=BifurcationOptions(mesh_check=False))
+        assert nes["values"][nes["p"].index(theta)] == pytest.approx(direct.max_psi, rel=1e-8), theta
     assert np.all(np.diff(nes["values"]) < 0)  # more pre-stretch, a stiffer NES: a smaller amplitude throughout
     original = next(c for c in e_p_study.curves if c["config"] == "original" and c["quantity"] == "max_psi")
     assert len(set(original["values"])) == 1 and original["special_points"] == []  # e_p is not in original
+    assert original["p"] == on_grid  # nothing to follow where the parameter does not enter
 
 
 def test_max_psi_switches_are_marked_where_the_maximum_jumps_or_cycles_vanish():
@@ -72,6 +76,34 @@ def test_max_psi_switches_are_marked_where_the_maximum_jumps_or_cycles_vanish():
     curve = max_psi_curve("nes", "x", rows[::-1], (1.0, 200.0))
     assert curve.p == [0.0, 1.0, 2.0, 3.0] and curve.values == [0.1, 0.12, 0.15, 0.0]
     assert [(s["bracket"], s["located"]) for s in curve.special_points] == [([1.0, 2.0], False), ([2.0, 3.0], False)]
+
+
+def test_followed_maxima_take_the_larger_stable_value_and_narrow_a_switch_to_their_step():
+    from shimmy.analyses.decisions.max_psi_curve import max_psi_curve
+
+    rows = [{"x": 1.0, "max_psi": 0.12, "max_psi_V": 12.0}, {"x": 2.0, "max_psi": 0.15, "max_psi_V": 60.0}]
+    ahead = {"points": [{"p": 1.25, "value": 0.125, "V": 12.5}, {"p": 1.5, "value": 0.13, "V": 13.0},
+                        {"p": 1.75, "value": 0.135, "V": 13.5}, {"p": 2.0, "value": 0.14, "V": 14.0}], "stopped": None}
+    back = {"points": [{"p": 1.75, "value": 0.145, "V": 59.0}, {"p": 1.5, "value": 0.128, "V": 58.0}],
+            "stopped": "the cycle of the maximum is unstable at 1.25"}
+    curve = max_psi_curve("nes", "x", rows, (1.0, 200.0), {(1.0, 2.0): ahead, (2.0, 1.0): back})
+    assert curve.p == [1.0, 1.25, 1.5, 1.75, 2.0]
+    assert curve.values == [0.12, 0.125, 0.13, 0.145, 0.15]  # the larger of the two where both exist
+    assert [s["bracket"] for s in curve.special_points] == [[1.5, 1.75]]  # not [1, 2]: between followed points
+
+
+def test_a_followed_maximum_is_the_diagrams_maximum_of_each_design_it_passes():
+    from shimmy.analyses.decisions.max_psi_curve import follow_maximum, orbit_of, substeps
+
+    options = BifurcationOptions(mesh_check=False)
+    start = bifurcation("nes", 150e3, params=Parameters().with_overrides({"k_s": 1.0e6}), options=options)
+    follow = follow_maximum(("nes", 150e3, "k_s", Parameters(), orbit_of(start), substeps(1.0e6, 1.2e6), options))
+    assert follow["stopped"] is None and [q["p"] for q in follow["points"]] == substeps(1.0e6, 1.2e6)
+    assert np.all(np.diff([q["value"] for q in follow["points"]]) < 0)
+    for q in (follow["points"][1], follow["points"][-1]):
+        direct = bifurcation("nes", 150e3, params=Parameters().with_overrides({"k_s": q["p"]}), options=options)
+        assert q["value"] == pytest.approx(direct.max_psi, rel=1e-8)
+        assert q["V"] == pytest.approx(direct.max_psi_V, rel=1e-5)  # a flat maximum: its speed to ~sqrt(tol)
 
 
 def test_two_parameter_grid_has_a_row_per_pair_and_configuration():
