@@ -196,6 +196,7 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
         result.curves.append(max_psi_curve(config, parameter, rows[config], result.v_range,
                                            follows[config]).to_dict())
     result.orbits.clear()  # what the follows started from; the result is its JSON
+    report(1.0, f"largest amplitude over the range of {parameter} done")
     result.warnings += [f"{r['config']} at {parameter} = {r[parameter]:g} (max_psi curve): {w}"
                         for r in more for w in r["warnings"]]
     result.elapsed_s += time.perf_counter() - clock

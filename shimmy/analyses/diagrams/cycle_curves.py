@@ -57,6 +57,10 @@ PLAIN = {PointKind.FOLD_OF_CYCLES: "fold-of-cycles", PointKind.TORUS: "torus",
 FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 kN
 CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400,
                                                                    max_angle=0.3))
+#: A torus start whose multiplier pair lies within this angle (rad per period) of +1 or -1 is a strong
+#: resonance, not a torus: nes_pd's diagram at 278.5 kN reports a torus point at its fold of cycles at
+#: 130.25 m/s with the pair at 6.6e-6 rad (two multipliers at +1), where no torus curve passes.
+RESONANCE_ANGLE = 1e-4
 BESIDE = 0.015  # relative offset in Fz from a GH / double-Hopf point to the Hopf point a start branch leaves
 START_STEPS = 80  # step budget of a start branch
 SCAN_FRACTIONS = (0.3, 0.6, 0.9)  # loads of the one-parameter diagrams, as fractions of the box in Fz
@@ -297,7 +301,7 @@ class CurveSearch:
         if warning:
             self.warnings.append(warning)
         elif curve is not None and not any(same_curve(curve, c, self.params.gear.l_g) for c in self.curves):
-            self.curves.append(curve)
+            self.curves = with_curve(self.curves, curve, self.params.gear.l_g)
 
     def idle(self) -> bool:
         """Nothing under way, waiting or expected: the curves stand as they are."""
@@ -385,7 +389,7 @@ class ContinueUnit:
     loads: tuple[float, ...]
 
     def run(self) -> tuple[GearCycleCurve | None, str | None]:
-        return _continue(self.config, self.params, self.start, self.box, self.loads)
+        return continue_start(self.config, self.params, self.start, self.box, self.loads)
 
     def describe(self) -> str:
         return (f"{PLAIN[self.start.kind]} curve from V = {self.start.point.p:.4g} m/s, "
@@ -420,6 +424,12 @@ class CurveSeed:
     Fz: float
     ncol: int
     kappa: float | None
+    #: the smallest amplitude (state scales) at the curve's zero-amplitude ends, None without one: a
+    #: trace from the seed ends only below half of it (where a trace ends near a GH or double-Hopf
+    #: point depends on the largest amplitude it met, so on where it began: traced from its large
+    #: cycles, a torus curve of nes_pd stopped at 116.8 m/s; from a slice's small cycle at 120.6 m/s it
+    #: ran on to 123.2 m/s, and the warm map missed the slices' torus points in between)
+    end_amplitude: float | None = None
 
     @classmethod
     def of(cls, curve: GearCycleCurve, n: int) -> CurveSeed:
@@ -443,18 +453,20 @@ class CurveSeed:
         ntst = len(mesh) - 1
         ncol = int(round(((len(u) - 2) / n - 1) / ntst))
         kappa = float(c.kappa[i]) if np.isfinite(c.kappa[i]) else None
+        ends = [float(q.data["amplitude"]) for q in c.special_points if q.kind == PointKind.ZERO_AMPLITUDE]
         return cls(curve.kind, curve.origin, np.asarray(mesh, float), np.asarray(u, float), float(c.p[i, 1]), ncol,
-                   kappa)
+                   kappa, min(ends) if ends else None)
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind.value, "origin": self.origin, "mesh": self.mesh.tolist(), "u": self.u.tolist(),
-                "Fz": self.Fz, "ncol": self.ncol, "kappa": self.kappa}
+                "Fz": self.Fz, "ncol": self.ncol, "kappa": self.kappa, "end_amplitude": self.end_amplitude}
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> CurveSeed:
         return cls(PointKind(data["kind"]), str(data["origin"]), np.asarray(data["mesh"], float),
                    np.asarray(data["u"], float), float(data["Fz"]), int(data["ncol"]),
-                   None if data["kappa"] is None else float(data["kappa"]))
+                   None if data["kappa"] is None else float(data["kappa"]),
+                   None if data.get("end_amplitude") is None else float(data["end_amplitude"]))
 
 
 @dataclass(frozen=True, eq=False)
@@ -480,8 +492,10 @@ class WarmUnit:
             data["torus_angle"] = math.acos(s.kappa)
         point = SpecialPoint(s.kind, float(s.u[-1]), 0, data, solution=(s.mesh, s.u))
         start = Start(s.kind, point, s.Fz, s.ncol, s.origin)
-        return _continue(self.config, self.params, start, self.box, self.loads,
-                         (self.direction,) if self.direction else (1, -1))
+        options = CURVE_OPTIONS if s.end_amplitude is None else \
+            dataclasses.replace(CURVE_OPTIONS, amplitude_end_below=0.5 * s.end_amplitude)
+        return continue_start(self.config, self.params, start, self.box, self.loads,
+                              (self.direction,) if self.direction else (1, -1), options)
 
     def describe(self) -> str:
         half = {1: ", towards higher Fz", -1: ", towards lower Fz"}.get(self.direction, "")
@@ -567,28 +581,45 @@ def starts_of_diagram(diagram, Fz: float) -> list[Start]:
             for s in b.raw.special_points if s.kind in KINDS]
 
 
-def _continue(config: Configuration, params: Parameters, start: Start, box, loads: tuple[float, ...],
-              directions: tuple[int, ...] = (1, -1)) -> tuple[GearCycleCurve | None, str | None]:
+def continue_start(config: Configuration, params: Parameters, start: Start, box, loads: tuple[float, ...],
+                   directions: tuple[int, ...] = (1, -1), options: CycleCurveOptions | None = None
+                   ) -> tuple[GearCycleCurve | None, str | None]:
     """One curve continued from one start (a unit of :func:`cycle_curves`); with one of
     ``directions``, the half traced that way (whatever its length: the other half may hold the rest)."""
     system = gear_two_parameter_field(config, params)
-    kappa = math.cos(start.point.data["torus_angle"]) if start.kind == PointKind.TORUS else None
-    if kappa is not None and not -1.0 < kappa < 1.0:
-        return None, None
+    angle = start.point.data["torus_angle"] if start.kind == PointKind.TORUS else None
+    if angle is not None and not RESONANCE_ANGLE < angle < math.pi - RESONANCE_ANGLE:
+        return None, None  # a pair at +1 or -1 (a strong resonance, e.g. born at a fold), not a torus
+    kappa = None if angle is None else math.cos(angle)
     about = f"{start.kind} point at V = {start.point.p:.6g} m/s, Fz = {kn(start.Fz)} ({start.origin})"
     try:
-        curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box=box, options=CURVE_OPTIONS,
+        curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box=box,
+                            options=options or CURVE_OPTIONS,
                             scale=STATE_SCALE[:system.n], p_scale=(V_SCALE, FZ_SCALE), kappa=kappa, ncol=start.ncol,
                             p2_marks=loads, directions=directions)
     except ContinuationError as exc:
         return None, f"{about} not continued: {exc}"
-    if len(curve.p) < 2 and len(directions) == 2:  # stopped at its start both ways (at a strong resonance)
+    extent = np.ptp(curve.p / np.array([V_SCALE, FZ_SCALE]), axis=0).max() if len(curve.p) else 0.0
+    if (len(curve.p) < 2 or extent <= 1e-6) and len(directions) == 2:  # stopped at its start both ways
         return None, f"{about} gives no curve: {'; '.join(curve.stop_reasons)}"
     return GearCycleCurve(start.kind, curve, start.origin), None
 
 
 #: Where a new curve is probed against a known one (fractions of its points): all must lie on it.
 SAME_CURVE_PROBES = (0.25, 0.5, 0.75)
+
+
+def with_curve(curves: list[GearCycleCurve], new: GearCycleCurve, l_g: float) -> list[GearCycleCurve]:
+    """``curves`` with a new curve that is none of them (:func:`same_curve`): a curve it contains (a
+    shorter trace of the same curve, its points all on the new one) gives way to it, in its place;
+    else the new curve is added last. (A torus curve of nes_pd traced from a slice's torus point ran
+    on to the double-Hopf point at 123.5 m/s, 275 kN, past the end of the one traced from beside that
+    point, 116.7 m/s: both were kept, the map had the same boundary twice, and every warm map of it
+    fell back to a cold one, finding the two one curve.)"""
+    inside = [k for k, c in enumerate(curves) if same_curve(c, new, l_g)]
+    if not inside:
+        return [*curves, new]
+    return [new if k == inside[0] else c for k, c in enumerate(curves) if k == inside[0] or k not in inside]
 
 
 def same_curve(new: GearCycleCurve, old: GearCycleCurve, l_g: float) -> bool:

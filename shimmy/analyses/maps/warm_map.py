@@ -29,7 +29,9 @@ little: the curves move, but where their arrangement stays the same the regions 
    recomputed, so it reports no largest amplitude (``max_psi`` None, ``"carried": true``). A slice
    whose load the curves now cross otherwise, or with a Hopf point more or less, or with a point
    on no curve of the map (a period doubling), is computed again; and, as a cold map does, a slice
-   is added through each region between the new curves that no slice crosses.
+   is added through each region between the new curves that no slice crosses. A fold or torus point
+   of a slice computed again that lies on no curve is continued as a cold map continues it: a curve
+   the map lacks makes the map cold; none (no such point converges there) is the cold map's warning.
 
 The result's ``methods.warmed_from`` names the design warmed from, the parameters changed and the
 slices carried, computed again and added. What the checks cannot see: a curve born away from a GH
@@ -52,9 +54,8 @@ from ...model.parameters import FZ_RANGE, V_RANGE, Parameters, check_range, desi
 from ..core.executors import describe_work_unit, name_of, open_executor, run_dynamic, run_work_unit
 from ..core.stability import hopf_points
 from ..diagrams.bifurcation import V_SCALE, BifurcationOptions
-from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, GearCycleCurve, WarmUnit, joined_halves,
-                                     reversed_curve,
-                                     same_curve)
+from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, GearCycleCurve, WarmUnit,
+                                     continue_start, joined_halves, reversed_curve, same_curve)
 from ..diagrams.hopf_curves import HopfCurvesResult
 from . import map_shading
 from .map_slices import FINE, SliceResult, speed_grids, type_lengths
@@ -242,6 +243,26 @@ def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameter
                        time.perf_counter() - clock, carried=True, computed_at=computed_at)
 
 
+def _off_curve(q: dict[str, Any], s: SliceResult, config: Configuration, params: Parameters, box, marks,
+               curves: list[GearCycleCurve]) -> list[str]:
+    """A fold or torus point of a slice computed again that lies on no curve of the map: continued as
+    a cold map continues it (:func:`~shimmy.analyses.diagrams.cycle_curves.continue_start` from the
+    slice's located point). A curve that is none of the map's means the arrangement changed
+    (:class:`NotWarm`); no curve (no such point converges near it, as at a fold of cycles where a
+    complex pair of multipliers is born: nes_pd at 278.5 kN, 130.25 m/s) is what the cold map finds
+    too, and its warning is the cold map's."""
+    where = f"the slice computed at Fz = {s.Fz / 1e3:.4g} kN has a {q['kind']} point at V = {q['V']:.5g} m/s"
+    start = min((t for t in s.starts if t.kind == q["kind"]), key=lambda t: abs(t.point.p - q["V"]), default=None)
+    if start is None or abs(start.point.p - q["V"]) > 1e-6 * max(abs(q["V"]), 1.0):
+        raise NotWarm(f"{where} on no curve of the map, without its located point")
+    curve, warning = continue_start(config, params, start, box, marks)
+    if curve is None:
+        return [warning] if warning else []
+    if any(same_curve(curve, c, params.gear.l_g) or same_curve(c, curve, params.gear.l_g) for c in curves):
+        return []
+    raise NotWarm(f"{where} on no curve of the map: it continues to a curve the nearby design's map lacks")
+
+
 def compatible(start: dict[str, Any], config: Configuration | str, *, v_range, fz_range, resolution: int, n_v: int,
                options: BifurcationOptions) -> str | None:
     """None if a map of ``config`` on this plane, grid and options can be warmed from ``start``,
@@ -309,6 +330,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     run_dynamic(run_work_unit, units, executor, done, lambda f, m: report(0.8 * f, m), describe_work_unit)
     hopf: HopfCurvesResult = results[0]
     curves: list[GearCycleCurve] = []
+    traced_from: list[CurveSeed] = []
     l_g = params.gear.l_g
     for j, seed in enumerate(seeds):
         curve, warning = curve_of(j)
@@ -317,6 +339,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         if any(same_curve(curve, c, l_g) for c in curves):
             raise NotWarm(f"two {seed.kind} curves of the nearby design are one curve at this design")
         curves.append(curve)
+        traced_from.append(seed)
     old_boundaries = [(name, np.array(p, float).reshape(-1, 2)) for name, p in start["boundaries"]]
     old_curves = old_boundaries[len(start["arrangement"]["hopf_curves"]):]
     scale = np.array([V_SCALE, FZ_SCALE])
@@ -325,6 +348,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         if len(before) and np.linalg.norm((curve.curve.p[-1] - before[0]) / scale) \
                 < np.linalg.norm((curve.curve.p[0] - before[0]) / scale):
             curves[k] = reversed_curve(curve)
+    ends = {id(c): seed.end_amplitude for c, seed in zip(curves, traced_from, strict=True)}
     curves.sort(key=lambda c: KINDS.index(c.kind))  # stable: each kind's in the old order, as a cold map's
     search = CurveSearch(config, params, box, (PointKind.FOLD_OF_CYCLES, PointKind.TORUS), loads)
     search.start_units(hopf)  # its GH and double-Hopf points (the units beside them are not run)
@@ -363,21 +387,21 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         loads_now += extra
         added += extra
     fresh = sorted(again) + added
+    warnings_off: list[str] = []  # off-curve points continued as a cold map does, that gave no curve
     if fresh:
         report(0.8, f"{len(again)} slice(s) computed again, {len(added)} added through regions no slice crosses")
         units = [(2, SliceUnit(config, Fz, v_range, n_v, params, options)) for Fz in fresh]
         computed: list[SliceResult] = []
         run_dynamic(run_work_unit, units, executor, lambda unit, result: computed.append(result) or [],
                     lambda f, m: report(0.8 + 0.15 * f, m), describe_work_unit)
-        for s in computed:  # a fold or torus point on no curve of the map: a curve the warm map lacks
+        for s in computed:  # a fold or torus point on no curve of the map: a curve the warm map may lack
             # just above and below the load too: a curve ending on a box edge at this load crosses it there
             near = [x for f in (s.Fz, s.Fz * (1 + 1e-7), s.Fz * (1 - 1e-7))
                     for x in map_shading.crossings(boundaries, f)]
             on_curves = {str(k): [V for V, (name, _) in near if name.startswith(k)] for k in ON_CURVES}
             for q in s.special_points:
                 if q["kind"] in ON_CURVES and not any(abs(V - q["V"]) <= 2 * tol for V in on_curves[str(q["kind"])]):
-                    raise NotWarm(f"the slice computed at Fz = {s.Fz / 1e3:.4g} kN has a {q['kind']} point at "
-                                  f"V = {q['V']:.5g} m/s on no curve of the map: a curve a cold map would continue")
+                    warnings_off += _off_curve(q, s, config, params, box, marks, curves)
             s.computed_at = params.to_dict()
         slices += computed
     slices.sort(key=lambda s: s.Fz)
@@ -386,7 +410,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         c.curve.special_points = [q for q in c.curve.special_points if q.kind != PointKind.P2_MARK
                                   or not any(abs(q.data["p2"] - f) <= 1e-9 * f for f in marks[len(loads):])]
     cycles = search.result(0.0).to_dict()
-    warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
+    warnings = list(hopf.warnings) + list(cycles.pop("warnings")) + warnings_off
     for s in slices:
         warnings += [f"Fz = {kn(s.Fz)}: {w}" for w in s.warnings]
     segments, fallbacks = map_shading.row_segments(slices, boundaries, rows, v_range)
@@ -398,7 +422,10 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
                         [map_shading.measures(r) for r in segments], fallbacks, map_shading.polygons(segments, rows),
                         lowest_shimmy(hopf, cycles, slices), type(executor).__name__, elapsed, warnings,
                         resolution=resolution, n_v=n_v, options=options,
-                        seeds=[CurveSeed.of(c, config.n_states) for c in curves],
+                        # the end amplitudes of the cold map's traces, not of these (each warm map would
+                        # reach half as far again towards the codimension-2 points)
+                        seeds=[dataclasses.replace(CurveSeed.of(c, config.n_states), end_amplitude=ends[id(c)])
+                               for c in curves],
                         warmed_from={"params": start["params"], "changed": _changed(old_params, params),
                                      "slices": {"carried": len(start["slices"]) - len(again),
                                                 "computed_again": [{"Fz": Fz, "why": why} for Fz, why in

@@ -38,6 +38,10 @@ class CycleCurveOptions:
     adapt_every: int = 10
     period_max: float = math.inf
     amplitude_min: float = 0.02  # end: amplitude below this fraction of the curve's largest
+    #: ... and below this (in the problem's state scales): a trace that must reach at least as far
+    #: towards an end as another trace of the same curve did (whose largest amplitude, and so whose
+    #: end, depended on where it began) goes on to half that trace's end amplitude
+    amplitude_end_below: float = math.inf
     #: the drawn polyline in (p1, p2): each step's chord strays from the curve (the midpoint of
     #: the cubic through both points with their tangents) by at most this fraction of each
     #: parameter (at least a tenth of its scale)
@@ -53,6 +57,8 @@ class CycleCurveOptions:
             raise InvalidInputError("chord_tol", self.chord_tol, "a number in (0, 1]")
         if not 0.0 < self.amplitude_min < 1.0:
             raise InvalidInputError("amplitude_min", self.amplitude_min, "a number in (0, 1)")
+        if not self.amplitude_end_below > 0.0:
+            raise InvalidInputError("amplitude_end_below", self.amplitude_end_below, "a number > 0")
 
 
 @dataclass
@@ -121,6 +127,10 @@ def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[n
         t = first.tangent if first.tangent[problem.n_x + 2] * direction >= 0 else -first.tangent
         rows, special, stop, steps = _trace(half_problem, CurvePoint(first.u.copy(), t), box, options,
                                                       tuple(p2_marks), progress)
+        if direction > 0 and any(abs(p2 - m) <= 1e-9 * problem.p_scale[1] for m in p2_marks):
+            # a start on a marked value (a slice's point, traced from its diagram) crosses it there;
+            # the steps see only the crossings between points (told once: by the half along +p2)
+            special.insert(0, half_problem.special_point(PointKind.P2_MARK, first.u, 0))
         halves.append((rows, special))
         stops.append(stop)
         steps_total += steps
@@ -250,7 +260,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
             break
         amp = _amplitude(problem, rows["xmax"][-1], rows["xmin"][-1])
         amp_peak = max(amp_peak, amp)
-        if amp < options.amplitude_min * amp_peak and amp < amp_last:
+        if amp < options.amplitude_min * amp_peak and amp < options.amplitude_end_below and amp < amp_last:
             stop = Stop(StopReason.ZERO_AMPLITUDE, f"amplitude shrank to zero near p = ({p_new[0]:.6g}, "
                         f"{p_new[1]:.6g}): the curve ends at a codimension-2 point of the equilibrium")
             special.append(SpecialPoint(PointKind.ZERO_AMPLITUDE, float(p_new[0]), len(rows["p"]) - 1,

@@ -154,3 +154,43 @@ def test_a_fold_start_next_to_a_hopf_point_converges():
     assert warning is None and curve is not None, warning
     V = curve.curve.p[:, 0]
     assert V.min() == pytest.approx(1.0) and V.max() == pytest.approx(200.0)
+
+
+def test_a_longer_trace_of_a_known_curve_takes_its_place(original):
+    """A curve traced from another start may run on past a known curve's end (towards a GH or
+    double-Hopf point, where a trace's end depends on the amplitudes it met): the longer trace
+    replaces the shorter in its place, never both kept (the same boundary twice)."""
+    import dataclasses
+
+    from shimmy.analyses.diagrams.cycle_curves import GearCycleCurve, same_curve, with_curve
+
+    l_g = 2.5
+    full = max(original.curves, key=lambda c: len(c.curve.p))
+    cut = len(full.curve.p) * 3 // 5
+    c = full.curve
+    short = GearCycleCurve(full.kind, dataclasses.replace(c, p=c.p[:cut], period=c.period[:cut], x_max=c.x_max[:cut],
+                                                          x_min=c.x_min[:cut], kappa=c.kappa[:cut],
+                                                          multipliers=c.multipliers[:cut],
+                                                          solutions=c.solutions[:cut]), full.origin)
+    others = [k for k in original.curves if k is not full]
+    assert same_curve(short, full, l_g) and not same_curve(full, short, l_g)
+    assert with_curve([others[0], short, *others[1:]], full, l_g) == [others[0], full, *others[1:]]
+    assert with_curve(others, full, l_g) == [*others, full]
+
+
+def test_a_torus_point_at_a_fold_with_a_pair_at_plus_one_starts_no_curve():
+    """`nes_pd` at 278.5 kN: the diagram's fold of cycles at 130.25 m/s is also reported as a torus
+    point, its complex pair 6.6e-6 rad from +1 (two multipliers at +1, a strong resonance, not a
+    torus). It starts no curve (the fold point at the same speed starts the fold curve)."""
+    from shimmy.analyses.diagrams.cycle_curves import RESONANCE_ANGLE, continue_start, starts_of_diagram
+    from shimmy.model.configurations import Configuration
+    from shimmy.model.parameters import Parameters
+
+    Fz = 278491.6201117318  # a slice of the nes_pd map
+    diagram = bifurcation("nes_pd", Fz, v_range=(1.0, 200.0), options=BifurcationOptions(mesh_check=False))
+    at_fold = [s for s in starts_of_diagram(diagram, Fz) if abs(s.point.p - 130.247) < 1e-2]
+    assert sorted(s.kind for s in at_fold) == ["LPC", "NS"]
+    torus = next(s for s in at_fold if s.kind == "NS")
+    assert torus.point.data["torus_angle"] < RESONANCE_ANGLE
+    assert continue_start(Configuration.parse("nes_pd"), Parameters(), torus, ((1.0, 200.0), (1e4, 9e5)), ()) \
+        == (None, None)

@@ -40,6 +40,40 @@ def maps():
     return near, cold, warm, start
 
 
+@pytest.fixture(scope="module")
+def nes_pd_maps():
+    """nes_pd on its default plane, the same step: its torus curves run into a double-Hopf point, where
+    a trace's end depended on where it began, and a slice has a torus point at its fold of cycles
+    (a pair at +1) on no curve; every warm map of it fell back to a cold one."""
+    near = stability_map("nes_pd")
+    params = Parameters().with_overrides(STEP)
+    cold = stability_map("nes_pd", params=params)
+    warm = stability_map("nes_pd", params=params, warm_from=json.loads(json.dumps(near.warm_start())))
+    return near, cold, warm, None
+
+
+BOTH = pytest.mark.parametrize("pair", ["maps", "nes_pd_maps"])
+#: A carried slice's fold and torus points are its curves' located crossings, a computed slice's its
+#: diagram's (40 mesh intervals): they differ by the diagrams' mesh error, below 1e-5 for the smooth
+#: nes; for nes_pd (the damper's |dpsi|^(1/2) dpsi) the torus point at 248.7 kN, e_p 1.1 mm moves
+#: 75.82565 -> 75.82677 -> 75.82728 m/s with 40, 80, 160 intervals (the curve's crossing: 75.82807)
+SLICE_REL = {"maps": 1e-5, "nes_pd_maps": 5e-5}
+#: Located points of the curves: the issue's 1e-6 for nes. nes_pd's curves carry the mesh error of
+#: its nonsmooth torque, which differs between traces from different starts on their own adapted
+#: meshes: the turning point in Fz at 229.76 kN is at 33.20547 m/s traced from the cold map's start,
+#: 33.20538 m/s from the warm seed (Fz equal to 3e-8)
+CURVE_REL = {"maps": REL, "nes_pd_maps": 1e-5}
+#: A turning point's Fz is well conditioned; its V is not (the curve runs along V there: a change dFz
+#: of the turn moves its V by ~sqrt(dFz / curvature)): nes_pd's turn at 232.03 kN is at 32.71736 and
+#: 32.71523 m/s, its Fz equal to 6e-7
+TURN_V_REL = {"maps": REL, "nes_pd_maps": 1e-3}
+#: Maps whose codimension-2 points on the cycle curves depend on the trace, not only the curve (a
+#: known defect, not the warm map's: two cold traces differ the same way): nes_pd's second torus curve
+#: at e_p 1.1 mm has a fold-torus point at 106.35 m/s traced from a slice's torus point, one at
+#: 14.76 m/s (not located) and none at 106.35 traced from the warm seed. Their R3 and R4 points agree.
+CODIM2_BY_TRACE = {"nes_pd_maps"}
+
+
 #: codimension-2 points on the cycle curves found where a multiplier crosses a value are located to
 #: the multipliers' accuracy (continuation.cycle_curves.codim2.MULTIPLIER_TOL = 1e-5): a cold map
 #: traced from another start finds them as far apart
@@ -50,14 +84,14 @@ def _close(a: float, b: float, scale: float, rel: float = REL) -> bool:
     return abs(a - b) <= rel * max(abs(a), abs(b), scale)
 
 
-def _same_points(cold: list[dict], warm: list[dict], rel: float = REL) -> None:
+def _same_points(cold: list[dict], warm: list[dict], rel: float = REL, v_rel: float | None = None) -> None:
     assert len(cold) == len(warm), (cold, warm)
     for p, q in zip(sorted(cold, key=lambda e: (e["Fz"], e["V"])), sorted(warm, key=lambda e: (e["Fz"], e["V"])),
                     strict=True):
         assert p["kind"] == q["kind"] if "kind" in p else True
         if p.get("located") is False or q.get("located") is False:
             continue  # the search did not reach its tolerance (the nearest point it got): nothing to compare
-        assert _close(p["V"], q["V"], 1.0, rel) and _close(p["Fz"], q["Fz"], 1e3, rel), (p, q)
+        assert _close(p["V"], q["V"], 1.0, v_rel or rel) and _close(p["Fz"], q["Fz"], 1e3, rel), (p, q)
 
 
 def test_the_warm_map_says_what_it_was_warmed_from(maps):
@@ -75,20 +109,24 @@ def test_the_warm_map_says_what_it_was_warmed_from(maps):
     assert all(a["why"] for a in info["computed_again"])
 
 
-def test_warm_curves_are_the_cold_curves(maps):
-    _, cold, warm, _ = maps
+@BOTH
+def test_warm_curves_are_the_cold_curves(pair, request):
+    _, cold, warm, _ = request.getfixturevalue(pair)
+    assert warm.warmed_from is not None, warm.warm_refused
     c, w = cold.to_dict(), warm.to_dict()
     assert c["gh_points"] == w["gh_points"] and c["double_hopf_points"] == w["double_hopf_points"]
     assert c["hopf_curves"] == w["hopf_curves"]  # computed afresh, the same computation
     assert [d["kind"] for d in c["cycle_curves"]] == [d["kind"] for d in w["cycle_curves"]]
     for dc, dw in zip(c["cycle_curves"], w["cycle_curves"], strict=True):
         assert dc["closed"] == dw["closed"]
-        for key in ("crossings", "turning_points"):
-            _same_points(dc[key], dw[key])
-        _same_points(dc["codim2_points"], dw["codim2_points"], CODIM2_REL)
+        _same_points(dc["crossings"], dw["crossings"], CURVE_REL[pair])
+        _same_points(dc["turning_points"], dw["turning_points"], CURVE_REL[pair], TURN_V_REL[pair])
+        if pair not in CODIM2_BY_TRACE:
+            _same_points(dc["codim2_points"], dw["codim2_points"], max(CODIM2_REL, CURVE_REL[pair]))
         # an end on the box is located; a zero-amplitude end is where the tracing stopped, beside the
         # GH or double-Hopf point the curve ends at (which the Hopf curves locate, equal above)
-        _same_points([e for e in dc["ends"] if e["kind"] == "END"], [e for e in dw["ends"] if e["kind"] == "END"])
+        _same_points([e for e in dc["ends"] if e["kind"] == "END"], [e for e in dw["ends"] if e["kind"] == "END"],
+                     CURVE_REL[pair])
         assert [e["kind"] for e in dc["ends"]] == [e["kind"] for e in dw["ends"]]
     # the map's list (located points only, each once): the same, but for a point one of the two
     # did not locate on its curve (listed there with "located": false, and not in this list)
@@ -100,24 +138,26 @@ def test_warm_curves_are_the_cold_curves(maps):
                    and _close(p["Fz"], q["Fz"], 1e3, CODIM2_REL) for q in among)
 
     for a, b in ((c["codim2_points"], w["codim2_points"]), (w["codim2_points"], c["codim2_points"])):
-        assert all(matched(p, b) or p["kind"] in unlocated for p in a), (a, b)
-    assert _close(c["min_shimmy_Fz"], w["min_shimmy_Fz"], 1e3)
+        assert all(matched(p, b) or p["kind"] in unlocated or pair in CODIM2_BY_TRACE for p in a), (a, b)
+    assert _close(c["min_shimmy_Fz"], w["min_shimmy_Fz"], 1e3, CURVE_REL[pair])
     assert c["min_shimmy"]["source"] == w["min_shimmy"]["source"]
 
 
-def test_warm_slices_are_the_cold_slices_at_their_curves(maps):
-    _, cold, warm, _ = maps
+@BOTH
+def test_warm_slices_are_the_cold_slices_at_their_curves(pair, request):
+    _, cold, warm, _ = request.getfixturevalue(pair)
     assert [s.Fz for s in cold.slices] == [s.Fz for s in warm.slices]
     for c, w in zip(cold.slices, warm.slices, strict=True):
         assert [h["V"] for h in c.hopf_points] == [h["V"] for h in w.hopf_points]  # the same scan
         assert [p["kind"] for p in c.special_points] == [p["kind"] for p in w.special_points]
-        for p, q in zip(c.special_points, w.special_points, strict=True):
-            assert abs(p["V"] - q["V"]) <= 1e-5 * max(p["V"], 1.0), (c.Fz, p, q)  # the curves' located crossings
+        for p, q in zip(c.special_points, w.special_points, strict=True):  # the curves' located crossings
+            assert abs(p["V"] - q["V"]) <= SLICE_REL[pair] * max(p["V"], 1.0), (c.Fz, p, q)
         assert [iv["type"] for iv in c.intervals] == [iv["type"] for iv in w.intervals]
 
 
-def test_warm_shading_equals_the_cold_shading(maps):
-    _, cold, warm, _ = maps
+@BOTH
+def test_warm_shading_equals_the_cold_shading(pair, request):
+    _, cold, warm, _ = request.getfixturevalue(pair)
     a, b = np.array(cold.shading), np.array(warm.shading)
     assert a.shape == b.shape
     differ = np.argwhere(a != b)
