@@ -50,8 +50,8 @@ def main() -> None:
     grid_s = time.perf_counter() - clock
     orbits = studies._orbits(rows, [args.param])
     clock = time.perf_counter()
-    follows = studies._follow_maxima(args.param, {args.config: rows}, orbits, DEFAULT_FZ, base, options,
-                                     InlineExecutor(), None, None)[args.config]
+    follows = studies._follow_maxima(args.param, {args.config: rows}, orbits, DEFAULT_FZ, DIAGRAM_V_RANGE, base,
+                                     options, InlineExecutor(), None, None)[args.config]
     follow_s = time.perf_counter() - clock
     points = sum(len(f["points"]) for f in follows.values())
     print(f"max_psi curve {args.config} in {args.param}: {len(rows)} grid diagrams {grid_s:.2f} s, "

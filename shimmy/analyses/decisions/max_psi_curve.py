@@ -15,7 +15,7 @@ passes:
    the branch is located again by a bounded search in arclength (to 1e-5 of the search span, each
    orbit's maximum on its collocation polynomial, as the diagram does). Every followed point is thus a
    located maximum of a stable cycle, exact to the diagram's tolerances (it equals a full diagram of
-   that design to ~1e-10 relative where the diagram's maximum is the same one). The follow arriving at
+   that design to 2e-12-2e-9 relative where the diagram's maximum is the same one). The follow arriving at
    the next grid value must reproduce that diagram's value to :data:`AGREE`; where it does not (the
    largest amplitude has moved to another branch or hump), the next grid value's maximum is followed
    back, and at each step the larger of the two stable values is the curve's.
@@ -34,6 +34,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ...continuation.errors import ContinuationError as EngineError
+from ...errors import ShimmyError
 from ...model.configurations import Configuration
 from ...model.parameters import Parameters
 from .study_curves import SNAP, StudyCurve, parameter_range
@@ -47,7 +49,7 @@ SWITCH_JUMP = 0.1
 #: the next grid value, where the follow is checked against that value's diagram).
 SUBSTEPS = 6
 #: A followed maximum arriving at a grid value is the diagram's maximum there if it agrees to this
-#: (relative); followed and diagram values agree to ~1e-10 where the maximum is the same one.
+#: (relative); followed and diagram values agree to 2e-12-2e-9 where the maximum is the same one.
 AGREE = 1e-6
 #: Arclength half-width (the diagram's metric) of the search for the maximum along the branch at each
 #: followed value; re-centred (at most :data:`RECENTRES` times) while the maximum is at its edge.
@@ -74,8 +76,12 @@ def grid(parameter: str, params: Parameters, values: Sequence[float] = ()) -> li
 
 
 def substeps(a: float, b: float) -> list[float]:
-    """The values of theta a follow from grid value a towards b visits, b last (exactly)."""
-    return [*(a + (b - a) * k / SUBSTEPS for k in range(1, SUBSTEPS)), b]
+    """The values of theta a follow from grid value a towards b visits, b last (exactly): the same
+    numbers either way (interpolated from the lower end), so that followed points from both ends of an
+    interval meet at equal theta."""
+    lo, hi = min(a, b), max(a, b)
+    inner = [lo + (hi - lo) * k / SUBSTEPS for k in range(1, SUBSTEPS)]
+    return [*(inner if a < b else inner[::-1]), b]
 
 
 def orbit_of(result) -> tuple[np.ndarray, int, np.ndarray] | None:
@@ -90,60 +96,83 @@ def orbit_of(result) -> tuple[np.ndarray, int, np.ndarray] | None:
 def follow_maximum(task: tuple) -> dict[str, Any]:
     """One unit of work: the maximum's cycle of one grid diagram followed through ``thetas``.
 
-    ``task`` = (config, Fz, parameter, base params, orbit (mesh points, ncol, u), thetas, options).
-    Returns ``{"config", "points": [{"p", "value", "V"}], "stopped": None or why}``: the points up to
-    where the follow stopped (the cycle no longer converges at the next value, the maximum is no
-    longer found in the search, or the cycle of the maximum is no longer stable)."""
-    from ...continuation import ContinuationOptions, CurvePoint, step, weighted_norm
+    ``task`` = (config, Fz, parameter, base params, orbit (mesh points, ncol, u), thetas, options,
+    (v_min, v_max)). Returns ``{"config", "points": [{"p", "value", "V"}], "stopped": None or why}``:
+    the points up to where the follow stopped (the cycle no longer converges at the next value, the
+    maximum is no longer found in the search or not a maximum of its neighbours, the cycle of the
+    maximum is no longer stable, or the maximum leaves the speed range, where a diagram would no
+    longer see it)."""
+    from ...continuation import ContinuationOptions
+
+    config, Fz, parameter, params, (mesh_points, ncol, u), thetas, options, (v_min, v_max) = task
+    copts = ContinuationOptions(ds=options.ds, ds_max=options.ds_max)
+    points: list[dict[str, float]] = []
+    for theta in thetas:
+        try:
+            found = _maximum_at(config, Fz, parameter, params, theta, mesh_points, ncol, u, options, copts)
+        except (np.linalg.LinAlgError, ShimmyError, EngineError) as exc:  # the follow stops; the grid stands
+            return {"config": config, "points": points, "stopped": f"at {theta:.6g}: {exc}"}
+        if isinstance(found, str):
+            return {"config": config, "points": points, "stopped": f"{found} at {theta:.6g}"}
+        amplitude, u = found
+        if not v_min <= u[-1] <= v_max:
+            return {"config": config, "points": points,
+                    "stopped": f"the maximum leaves the speed range at {theta:.6g} (V = {u[-1]:.6g} m/s)"}
+        points.append({"p": float(theta), "value": float(amplitude), "V": float(u[-1])})
+    return {"config": config, "points": points, "stopped": None}
+
+
+def _maximum_at(config, Fz, parameter, params, theta, mesh_points, ncol, u, options, copts):
+    """(amplitude, cycle unknowns) of the maximum of max|psi| along the branch through the cycle u
+    corrected at design theta, or why there is none (a string)."""
+    from ...continuation import CurvePoint, step, weighted_norm
     from ...continuation.collocation import Mesh, PeriodicProblem
     from ...continuation.scalar import minimum_in
     from ...model.equations import build_model
     from ..diagrams.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
 
-    config, Fz, parameter, params, (mesh_points, ncol, u), thetas, options = task
-    copts = ContinuationOptions(ds=options.ds, ds_max=options.ds_max)
-    points: list[dict[str, float]] = []
-    for theta in thetas:
-        model = build_model(Configuration.parse(config), params.with_overrides({parameter: theta}),
-                            exact_nes=options.exact_nes)
-        problem = PeriodicProblem(gear_field(model, Fz), Mesh(mesh_points, ncol), STATE_SCALE[:model.n_states],
-                                  T_SCALE, V_SCALE)
-        problem.accept(u)
-        along_v = np.zeros_like(u)
-        along_v[-1] = 1.0
-        centre = step(problem, CurvePoint(u, along_v / weighted_norm(along_v, problem.weights)), 0.0, copts)
+    model = build_model(Configuration.parse(config), params.with_overrides({parameter: theta}),
+                        exact_nes=options.exact_nes)
+    problem = PeriodicProblem(gear_field(model, Fz), Mesh(mesh_points, ncol), STATE_SCALE[:model.n_states],
+                              T_SCALE, V_SCALE)
+    problem.accept(u)
+    along_v = np.zeros_like(u)
+    along_v[-1] = 1.0
+    centre = step(problem, CurvePoint(u, along_v / weighted_norm(along_v, problem.weights)), 0.0, copts)
+    if centre is None:
+        return "the cycle does not converge"
+    problem.accept(centre.u)
+    found = None
+    for _ in range(RECENTRES):
+        tried: dict[float, tuple[float, Any]] = {}
+
+        def minus_amplitude(h):
+            point = step(problem, centre, h, copts, with_tangent=False) if h != 0 else centre
+            tried[h] = (0.0, None) if point is None else (problem.peak(point.u, 0)[2], point)
+            return -tried[h][0]
+
+        h, _ = minimum_in(minus_amplitude, -SEARCH_SPAN, SEARCH_SPAN, xatol=1e-5 * SEARCH_SPAN)
+        amplitude, point = tried[h]
+        if point is None:
+            break
+        if abs(h) < 0.9 * SEARCH_SPAN:
+            found = (amplitude, point, h)
+            break
+        centre = step(problem, centre, h, copts)  # the maximum lies beyond the span: search from there
         if centre is None:
-            return {"config": config, "points": points, "stopped": f"the cycle does not converge at {theta:.6g}"}
+            break
         problem.accept(centre.u)
-        found = None
-        for _ in range(RECENTRES):
-            tried: dict[float, tuple[float, Any]] = {}
-
-            def minus_amplitude(h):
-                point = step(problem, centre, h, copts, with_tangent=False) if h != 0 else centre
-                tried[h] = (0.0, None) if point is None else (problem.peak(point.u, 0)[2], point)
-                return -tried[h][0]
-
-            h, _ = minimum_in(minus_amplitude, -SEARCH_SPAN, SEARCH_SPAN, xatol=1e-5 * SEARCH_SPAN)
-            amplitude, point = tried[h]
-            if point is None:
-                break
-            if abs(h) < 0.9 * SEARCH_SPAN:
-                found = (amplitude, point)
-                break
-            centre = step(problem, centre, h, copts)  # the maximum lies beyond the span: search from there
-            if centre is None:
-                break
-        if found is None:
-            return {"config": config, "points": points, "stopped": f"no maximum along the branch at {theta:.6g}"}
-        amplitude, point = found
-        multipliers = problem.multipliers(point.u)
-        if not np.all(np.abs(multipliers[1:]) < 1.0):
-            return {"config": config, "points": points,
-                    "stopped": f"the cycle of the maximum is unstable at {theta:.6g}"}
-        u = point.u.copy()
-        points.append({"p": float(theta), "value": float(amplitude), "V": float(u[-1])})
-    return {"config": config, "points": points, "stopped": None}
+    if found is None:
+        return "no maximum along the branch"
+    amplitude, point, h = found
+    for side in (-1.0, 1.0):  # a maximum of its neighbours, not the edge of where steps fail
+        near = step(problem, centre, h + side * 1e-3 * SEARCH_SPAN, copts, with_tangent=False)
+        if near is None or problem.peak(near.u, 0)[2] > amplitude * (1.0 + 1e-12):
+            return "no maximum along the branch (not a maximum of its neighbours)"
+    multipliers = problem.multipliers(point.u)
+    if not np.all(np.abs(multipliers[1:]) < 1.0):
+        return "the cycle of the maximum is unstable"
+    return amplitude, point.u.copy()
 
 
 def arrives(follow: dict[str, Any] | None, theta: float, value: float | None) -> bool:

@@ -31,6 +31,7 @@ from ...continuation import PointKind
 from ...errors import ConvergenceError
 from ...model.configurations import Configuration
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, Parameters
+from ...model.units import kn
 from ..diagrams.hopf_curves import hopf_curves
 from .sensitivity import model_with, polish_lowest_point
 from .study_curves import StudyCurve, parameter_range
@@ -114,8 +115,8 @@ def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Par
         there = hopf_curves(config, params=params.with_overrides({parameter: grid[k]}), v_range=v_range,
                             fz_range=fz_range).fz_minimum
         if there is not None and curve_values[k] is not None and there["Fz"] < curve_values[k] * (1 - 1e-6):
-            warnings.append(f"at {parameter} = {grid[k]:g} the Hopf curves reach down to Fz = {there['Fz']:.6g} N "
-                            f"(V = {there['V']:.5g} m/s), below the followed minimum {curve_values[k]:.6g} N: a "
+            warnings.append(f"at {parameter} = {grid[k]:g} the Hopf curves reach down to Fz = {kn(there['Fz'])} "
+                            f"(V = {there['V']:.5g} m/s), below the followed minimum {kn(curve_values[k])}: a "
                             "lower point not followed from the base design")
     curve = StudyCurve(config.value, "min_shimmy_Fz", parameter, grid, curve_values,
                        sorted(special, key=lambda s: s["p"]))

@@ -65,6 +65,7 @@ from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import Configuration, affects
 from ...model.equations import Model, build_model, jacobian, model_coefficients
 from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
+from ...model.units import kn
 from ..diagrams.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, BifurcationOptions, bifurcation, gear_field
 from .design_space import DESIGN_PARAMETERS
 from .summaries import sensitivity_summary
@@ -315,7 +316,7 @@ def newton_in_plane(g, z0, scale, tol: float, what: str, max_steps: int = 30,
     for _ in range(max_steps):
         r = np.asarray(g(*z), float)
         if not np.all(np.isfinite(r)):
-            why = f"gave a value that is not finite at V = {z[0]:.6g} m/s, Fz = {z[1]:.6g} N"
+            why = f"gave a value that is not finite at V = {z[0]:.6g} m/s, Fz = {kn(z[1])}"
             break
         D = np.empty((2, 2))
         for k in range(2):
@@ -373,7 +374,7 @@ def min_shimmy_sensitivity(model: Model, pairs: dict[str, tuple], fz_box: tuple[
         source = "lowest point of the Hopf curves"
     elif abs(low["Fz"] - hopf.fz_range[0]) <= 1e-9 * low["Fz"]:
         return {"Fz": low["Fz"], "V": low["V"], "dFz_dp": None, "source": "load edge",
-                "reason": f"the Hopf curves reach the lowest load of the box ({hopf.fz_range[0]:g} N): the minimum "
+                "reason": f"the Hopf curves reach the lowest load of the box ({kn(hopf.fz_range[0])}): the minimum "
                           "shimmy load is that edge, not a point that moves with the parameters"}
     elif min(abs(low["V"] - edge) for edge in hopf.v_range) <= 1e-9 * max(hopf.v_range):
         # an end of a curve on a speed edge: the corner moves along the edge

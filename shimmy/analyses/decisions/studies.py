@@ -47,7 +47,7 @@ class StudyResult:
     curves: list[dict[str, Any]] = field(default_factory=list)
     #: each row's maximum's cycle where a follow can start from it (:func:`.max_psi_curve.orbit_of`), by
     #: (config, the row's parameter values); not part of the JSON
-    orbits: dict[tuple, Any] = field(default_factory=dict, repr=False)
+    orbits: dict[tuple, Any] = field(default_factory=dict, repr=False, compare=False)
 
     COLUMNS = STUDY_COLUMNS
 
@@ -135,8 +135,9 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
     (:func:`~shimmy.analyses.decisions.study_curves.hopf_speed_curves`), through the sampled values,
     and min_shimmy_Fz (N), the lowest point of the Hopf curves in (V, Fz) over the plane V in the
     study's range, Fz 10-900 kN (:func:`~shimmy.analyses.decisions.min_shimmy_curve.min_shimmy_curve`), and
-    max_psi (rad), the largest stable torsional amplitude at Fz, on a grid over the whole range with the
-    sampled values (:func:`~shimmy.analyses.decisions.max_psi_curve.max_psi_curve`), and the GH and
+    max_psi (rad), the largest stable torsional amplitude at Fz, from diagrams on a grid over the whole
+    range with the sampled values, the maximum followed between them
+    (:func:`~shimmy.analyses.decisions.max_psi_curve.max_psi_curve`), and the GH and
     double-Hopf points of the Hopf curves in that plane, their loads and speeds
     (:func:`~shimmy.analyses.decisions.codim2_curve.codim2_curves`)."""
     if executor is None:  # one pool for the sampled rows and the curve's grid
@@ -184,14 +185,15 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
             result.warnings += [f"{config}, GH and double-Hopf points in {parameter}: {w}" for w in notes]
     extra = [theta for theta in max_psi_grid(parameter, base, checked) if theta not in checked]
     options = options or BifurcationOptions(mesh_check=False)
-    tasks = [(c, {parameter: theta}, result.Fz, *result.v_range, base, options) for theta in extra for c in result.configs]
+    tasks = [(c, {parameter: theta}, result.Fz, *result.v_range, base, options)
+             for theta in extra for c in result.configs]
     report(0.8, f"largest amplitude over the range of {parameter}")
     more = run_units(_unit, tasks, executor, part(0.8, 0.93), lambda t: f"{t[0]} at {parameter} = {t[1][parameter]:g}")
     orbits = {**result.orbits, **_orbits(more, [parameter])}
     rows = {c: sorted((r for r in result.rows + more if r["config"] == c), key=lambda r: r[parameter])
             for c in result.configs}
-    follows = _follow_maxima(parameter, rows, orbits, result.Fz, base, options, executor, part(0.93, 0.98),
-                             part(0.98, 1.0))
+    follows = _follow_maxima(parameter, rows, orbits, result.Fz, result.v_range, base, options, executor,
+                             part(0.93, 0.98), part(0.98, 1.0))
     for config in result.configs:
         result.curves.append(max_psi_curve(config, parameter, rows[config], result.v_range,
                                            follows[config]).to_dict())
@@ -204,7 +206,8 @@ def study(parameter: str, values: Sequence[float], *, configs: Sequence[str] = D
 
 
 def _follow_maxima(parameter: str, rows: dict[str, list[dict[str, Any]]], orbits: dict[tuple, Any], Fz: float,
-                   base: Parameters, options: BifurcationOptions, executor, ahead, back) -> dict[str, dict]:
+                   v_range: tuple[float, float], base: Parameters, options: BifurcationOptions, executor, ahead,
+                   back) -> dict[str, dict]:
     """Each grid diagram's maximum followed to the next grid value; where it does not arrive at that
     value's maximum, that one followed back (:func:`.max_psi_curve.follow_maximum`). By config, then
     by (from, towards) grid value. A configuration whose model the parameter does not enter has the
@@ -213,7 +216,7 @@ def _follow_maxima(parameter: str, rows: dict[str, list[dict[str, Any]]], orbits
 
     def run(pairs, report):
         pairs = [(c, a, b) for c, a, b in pairs if orbits.get((c, (a,))) is not None and affects(parameter, c)]
-        tasks = [(c, Fz, parameter, base, orbits[c, (a,)], substeps(a, b), options) for c, a, b in pairs]
+        tasks = [(c, Fz, parameter, base, orbits[c, (a,)], substeps(a, b), options, v_range) for c, a, b in pairs]
         done = run_units(follow_maximum, tasks, executor, report,
                          lambda t: f"{t[0]}: largest amplitude followed to {parameter} = {t[5][-1]:g}")
         for (c, a, b), follow in zip(pairs, done, strict=True):
@@ -237,4 +240,6 @@ def study_grid(parameters: tuple[str, str], values: tuple[Sequence[float], Seque
     first = _check_values(parameters[0], values[0], base)
     second = _check_values(parameters[1], values[1], base)
     designs = [{parameters[0]: a, parameters[1]: b} for a in first for b in second]
-    return _run(list(parameters), designs, configs, Fz, v_range, base, executor, progress, options)
+    result = _run(list(parameters), designs, configs, Fz, v_range, base, executor, progress, options)
+    result.orbits.clear()  # nothing is followed in a two-parameter study
+    return result

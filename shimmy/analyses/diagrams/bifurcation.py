@@ -122,12 +122,13 @@ class Branch:
                 "points": points, "special_points": self.special_points}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MaximumOrbit:
     """The stable cycle of the largest torsional amplitude, as the collocation left it: its mesh
     (``mesh`` points, ``ncol``) and unknowns ``u`` (X, T, V). ``interior``: the maximum was located
-    inside a stable stretch of its branch (d max|psi| / ds = 0 there); otherwise it is the last
-    computed stable point before the branch loses stability or ends, not located."""
+    inside a stable stretch of its branch (d max|psi| / ds = 0 there); otherwise it is the largest
+    computed stable point, not located (at the end of a stable stretch, where the branch loses
+    stability or ends, or where the refinement did not improve on it)."""
 
     mesh: np.ndarray
     ncol: int
@@ -153,7 +154,7 @@ class BifurcationResult:
     warnings: list[str] = field(default_factory=list)
     #: the cycle of ``max_psi`` (None if no stable cycle), for following it in a design parameter
     #: (:mod:`shimmy.analyses.decisions.max_psi_curve`); not part of the JSON
-    max_psi_orbit: MaximumOrbit | None = None
+    max_psi_orbit: MaximumOrbit | None = field(default=None, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
         return {"config": self.config.value, "Fz": self.Fz, "v_min": self.v_min, "v_max": self.v_max,

@@ -427,8 +427,9 @@ class CurveSeed:
     #: the smallest amplitude (state scales) at the curve's zero-amplitude ends, None without one: a
     #: trace from the seed ends only below half of it (where a trace ends near a GH or double-Hopf
     #: point depends on the largest amplitude it met, so on where it began: traced from its large
-    #: cycles, a torus curve of nes_pd stopped at 116.8 m/s; from a slice's small cycle at 120.6 m/s it
-    #: ran on to 123.2 m/s, and the warm map missed the slices' torus points in between)
+    #: cycles, a torus curve of nes_pd stopped at 116.7 m/s; from a slice's small cycle at 120.6 m/s it
+    #: ran on to 123.2 m/s, next to the double-Hopf point at 123.5 m/s, and the warm map missed the
+    #: slices' torus points in between)
     end_amplitude: float | None = None
 
     @classmethod
@@ -611,11 +612,14 @@ SAME_CURVE_PROBES = (0.25, 0.5, 0.75)
 
 def with_curve(curves: list[GearCycleCurve], new: GearCycleCurve, l_g: float) -> list[GearCycleCurve]:
     """``curves`` with a new curve that is none of them (:func:`same_curve`): a curve it contains (a
-    shorter trace of the same curve, its points all on the new one) gives way to it, in its place;
-    else the new curve is added last. (A torus curve of nes_pd traced from a slice's torus point ran
-    on to the double-Hopf point at 123.5 m/s, 275 kN, past the end of the one traced from beside that
-    point, 116.7 m/s: both were kept, the map had the same boundary twice, and every warm map of it
-    fell back to a cold one, finding the two one curve.)"""
+    shorter trace of the same curve: its points probed all on the new one) gives way to it, in its
+    place; else the new curve is added last. (A torus curve of nes_pd traced from a slice's torus
+    point ran on to 123.2 m/s, 275 kN, next to the double-Hopf point at 123.5 m/s, past the end of the
+    one traced from beside that point at 116.7 m/s: both were kept, the map had the same boundary
+    twice, and every warm map of it fell back to a cold one, finding the two one curve.) Where each
+    trace ran further at a different end (where a trace ends near a GH or double-Hopf point depends on
+    the largest amplitude it met), the tail the replaced one had beyond the new one's end, among
+    cycles below 2 % of its largest, next to that point, is given up with it."""
     inside = [k for k, c in enumerate(curves) if same_curve(c, new, l_g)]
     if not inside:
         return [*curves, new]

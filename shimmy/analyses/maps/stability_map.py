@@ -284,7 +284,7 @@ class _MapBuild:
         self.pending = 0  # units submitted or queued and not finished
         self.finished_at = 0.0  # s after the start when its last unit finished
         self.sketch: Sketch | None = None
-        self._sketched = -1  # curves known at the last sketch
+        self._sketched: list[int] | None = None  # the curves (ids) known at the last sketch
 
     def _slice_unit(self, Fz: float) -> SliceUnit:
         return SliceUnit(self.config, float(Fz), self.v_range, self.n_v, self.params, self.options)
@@ -328,8 +328,9 @@ class _MapBuild:
             more += self._coverage()
         if not more and self.pending == 0:
             self.finished_at = elapsed
-        if self.sketch is not None and self.hopf is not None and len(self.search.curves) != self._sketched:
-            self._sketched = len(self.search.curves)
+        if self.sketch is not None and self.hopf is not None \
+                and [id(c) for c in self.search.curves] != self._sketched:  # a curve added or replaced
+            self._sketched = [id(c) for c in self.search.curves]
             self.sketch(sketch_of(self.config, self.v_range, self.fz_range, self.hopf, self.search.curves))
         return self._counted(more)
 

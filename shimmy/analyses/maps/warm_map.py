@@ -258,9 +258,9 @@ def _off_curve(q: dict[str, Any], s: SliceResult, config: Configuration, params:
     curve, warning = continue_start(config, params, start, box, marks)
     if curve is None:
         return [warning] if warning else []
-    if any(same_curve(curve, c, params.gear.l_g) or same_curve(c, curve, params.gear.l_g) for c in curves):
-        return []
-    raise NotWarm(f"{where} on no curve of the map: it continues to a curve the nearby design's map lacks")
+    if any(same_curve(curve, c, params.gear.l_g) for c in curves):
+        return []  # a curve of the map after all (the point lay beside its polyline)
+    raise NotWarm(f"{where} on no curve of the map: it continues to a curve, or a part of one, the map lacks")
 
 
 def compatible(start: dict[str, Any], config: Configuration | str, *, v_range, fz_range, resolution: int, n_v: int,
@@ -348,7 +348,9 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         if len(before) and np.linalg.norm((curve.curve.p[-1] - before[0]) / scale) \
                 < np.linalg.norm((curve.curve.p[0] - before[0]) / scale):
             curves[k] = reversed_curve(curve)
-    ends = {id(c): seed.end_amplitude for c, seed in zip(curves, traced_from, strict=True)}
+    # the cold trace's end amplitude; a seed from an older cache has none: this trace's own then
+    ends = {id(c): CurveSeed.of(c, config.n_states).end_amplitude if seed.end_amplitude is None
+            else seed.end_amplitude for c, seed in zip(curves, traced_from, strict=True)}
     curves.sort(key=lambda c: KINDS.index(c.kind))  # stable: each kind's in the old order, as a cold map's
     search = CurveSearch(config, params, box, (PointKind.FOLD_OF_CYCLES, PointKind.TORUS), loads)
     search.start_units(hopf)  # its GH and double-Hopf points (the units beside them are not run)

@@ -127,9 +127,15 @@ def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[n
         t = first.tangent if first.tangent[problem.n_x + 2] * direction >= 0 else -first.tangent
         rows, special, stop, steps = _trace(half_problem, CurvePoint(first.u.copy(), t), box, options,
                                                       tuple(p2_marks), progress)
-        if direction > 0 and any(abs(p2 - m) <= 1e-9 * problem.p_scale[1] for m in p2_marks):
+        on_mark = [m for m in p2_marks if abs(p2 - m) <= 1e-9 * problem.p_scale[1]]
+        if direction > 0 and on_mark:
             # a start on a marked value (a slice's point, traced from its diagram) crosses it there;
-            # the steps see only the crossings between points (told once: by the half along +p2)
+            # the steps see only the crossings between points (told once: by the half along +p2; a
+            # closed curve's last step, back onto its start, does not tell it again)
+            last = len(rows["p"]) - 1
+            if stop.reason is StopReason.CLOSED:
+                special = [q for q in special if not (q.kind == PointKind.P2_MARK and q.index == last
+                                                      and abs(q.data["p2"] - on_mark[0]) <= 1e-6 * problem.p_scale[1])]
             special.insert(0, half_problem.special_point(PointKind.P2_MARK, first.u, 0))
         halves.append((rows, special))
         stops.append(stop)
@@ -323,7 +329,7 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
         a, b = prev.u[i2] - mark, new.u[i2] - mark
         if abs(b) <= 1e-9 * problem.p_scale[1]:  # the step ends on the mark (a box edge)
             found.append(problem.special_point(PointKind.P2_MARK, new.u, len(rows["p"]) - 1))
-        elif a * b < 0:
+        elif a * b < 0 and abs(a) > 1e-9 * problem.p_scale[1]:  # (a step from the mark: told there)
             at = point_at(problem, prev, new, i2, mark, copts)  # p2 held at the mark: one Newton solve
             if at is None:
                 hit = locate_between(problem, prev, new, lambda q, m=mark: q.u[i2] - m, a, b, copts,

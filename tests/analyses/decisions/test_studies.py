@@ -97,13 +97,29 @@ def test_a_followed_maximum_is_the_diagrams_maximum_of_each_design_it_passes():
 
     options = BifurcationOptions(mesh_check=False)
     start = bifurcation("nes", 150e3, params=Parameters().with_overrides({"k_s": 1.0e6}), options=options)
-    follow = follow_maximum(("nes", 150e3, "k_s", Parameters(), orbit_of(start), substeps(1.0e6, 1.2e6), options))
+    follow = follow_maximum(("nes", 150e3, "k_s", Parameters(), orbit_of(start), substeps(1.0e6, 1.2e6), options,
+                             (1.0, 200.0)))
     assert follow["stopped"] is None and [q["p"] for q in follow["points"]] == substeps(1.0e6, 1.2e6)
     assert np.all(np.diff([q["value"] for q in follow["points"]]) < 0)
     for q in (follow["points"][1], follow["points"][-1]):
         direct = bifurcation("nes", 150e3, params=Parameters().with_overrides({"k_s": q["p"]}), options=options)
         assert q["value"] == pytest.approx(direct.max_psi, rel=1e-8)
         assert q["V"] == pytest.approx(direct.max_psi_V, rel=1e-5)  # a flat maximum: its speed to ~sqrt(tol)
+    # a maximum beyond the study's speed range is no diagram's maximum: the follow stops there
+    V = follow["points"][0]["V"]
+    short = follow_maximum(("nes", 150e3, "k_s", Parameters(), orbit_of(start), substeps(1.0e6, 1.2e6), options,
+                            (1.0, V - 0.01)))
+    assert short["points"] == [] and "leaves the speed range" in short["stopped"]
+
+
+def test_follows_from_both_ends_of_an_interval_visit_the_same_values():
+    from shimmy.analyses.decisions.max_psi_curve import SUBSTEPS, grid, substeps
+
+    values = grid("e_p", Parameters(), [0.0005, 0.005])
+    for a, b in zip(values, values[1:]):
+        ahead, back = substeps(a, b), substeps(b, a)
+        assert len(ahead) == SUBSTEPS and ahead[-1] == b and back[-1] == a
+        assert ahead[:-1] == back[:-1][::-1]  # equal floats: the larger of two values taken at each
 
 
 def test_two_parameter_grid_has_a_row_per_pair_and_configuration():
