@@ -424,13 +424,15 @@ class CurveSeed:
     Fz: float
     ncol: int
     kappa: float | None
-    #: the smallest amplitude (state scales) at the curve's zero-amplitude ends, None without one: a
-    #: trace from the seed ends only below half of it (where a trace ends near a GH or double-Hopf
-    #: point depends on the largest amplitude it met, so on where it began: traced from its large
-    #: cycles, a torus curve of nes_pd stopped at 116.7 m/s; from a slice's small cycle at 120.6 m/s it
-    #: ran on to 123.2 m/s, next to the double-Hopf point at 123.5 m/s, and the warm map missed the
-    #: slices' torus points in between)
-    end_amplitude: float | None = None
+    #: the amplitudes (state scales) at the curve's zero-amplitude ends, its first and its last point
+    #: (None at an end that is not one): a trace from the seed towards such an end stops only below
+    #: it. Where a trace ends near a GH or double-Hopf point depends on the largest amplitude it met,
+    #: so on where it began: traced from its large cycles, a torus curve of nes_pd stopped at 116.7 m/s;
+    #: from a slice's small cycle at 120.6 m/s it ran on to 123.2 m/s, next to the double-Hopf point
+    #: at 123.5 m/s, and the warm map missed the slices' torus points in between
+    end_amplitudes: tuple[float | None, float | None] = (None, None)
+    #: whether the trace towards higher Fz from the seed runs towards the curve's last point
+    plus_to_last: bool = True
 
     @classmethod
     def of(cls, curve: GearCycleCurve, n: int) -> CurveSeed:
@@ -454,20 +456,26 @@ class CurveSeed:
         ntst = len(mesh) - 1
         ncol = int(round(((len(u) - 2) / n - 1) / ntst))
         kappa = float(c.kappa[i]) if np.isfinite(c.kappa[i]) else None
-        ends = [float(q.data["amplitude"]) for q in c.special_points if q.kind == PointKind.ZERO_AMPLITUDE]
+        ends: list[float | None] = [None, None]
+        for q in c.special_points:
+            if q.kind == PointKind.ZERO_AMPLITUDE:
+                ends[0 if q.index <= (count - 1) / 2 else 1] = float(q.data["amplitude"])
+        rising = c.p[min(i + 1, count - 1), 1] - c.p[max(i - 1, 0), 1] >= 0
         return cls(curve.kind, curve.origin, np.asarray(mesh, float), np.asarray(u, float), float(c.p[i, 1]), ncol,
-                   kappa, min(ends) if ends else None)
+                   kappa, (ends[0], ends[1]), bool(rising))
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind.value, "origin": self.origin, "mesh": self.mesh.tolist(), "u": self.u.tolist(),
-                "Fz": self.Fz, "ncol": self.ncol, "kappa": self.kappa, "end_amplitude": self.end_amplitude}
+                "Fz": self.Fz, "ncol": self.ncol, "kappa": self.kappa, "end_amplitudes": list(self.end_amplitudes),
+                "plus_to_last": self.plus_to_last}
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> CurveSeed:
         return cls(PointKind(data["kind"]), str(data["origin"]), np.asarray(data["mesh"], float),
                    np.asarray(data["u"], float), float(data["Fz"]), int(data["ncol"]),
                    None if data["kappa"] is None else float(data["kappa"]),
-                   None if data.get("end_amplitude") is None else float(data["end_amplitude"]))
+                   tuple(None if a is None else float(a) for a in data.get("end_amplitudes", (None, None))),
+                   bool(data.get("plus_to_last", True)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -493,8 +501,10 @@ class WarmUnit:
             data["torus_angle"] = math.acos(s.kappa)
         point = SpecialPoint(s.kind, float(s.u[-1]), 0, data, solution=(s.mesh, s.u))
         start = Start(s.kind, point, s.Fz, s.ncol, s.origin)
-        options = CURVE_OPTIONS if s.end_amplitude is None else \
-            dataclasses.replace(CURVE_OPTIONS, amplitude_end_below=0.5 * s.end_amplitude)
+        first, last = s.end_amplitudes
+        towards = {1: last if s.plus_to_last else first, -1: first if s.plus_to_last else last}
+        end = towards.get(self.direction, min((a for a in (first, last) if a is not None), default=None))
+        options = CURVE_OPTIONS if end is None else dataclasses.replace(CURVE_OPTIONS, amplitude_end_below=end)
         return continue_start(self.config, self.params, start, self.box, self.loads,
                               (self.direction,) if self.direction else (1, -1), options)
 

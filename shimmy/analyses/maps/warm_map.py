@@ -348,9 +348,10 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         if len(before) and np.linalg.norm((curve.curve.p[-1] - before[0]) / scale) \
                 < np.linalg.norm((curve.curve.p[0] - before[0]) / scale):
             curves[k] = reversed_curve(curve)
-    # the cold trace's end amplitude; a seed from an older cache has none: this trace's own then
-    ends = {id(c): CurveSeed.of(c, config.n_states).end_amplitude if seed.end_amplitude is None
-            else seed.end_amplitude for c, seed in zip(curves, traced_from, strict=True)}
+    # the cold traces' end amplitudes (in the curve's order, kept above); a seed from an older cache
+    # has none: this trace's own then
+    ends = {id(c): CurveSeed.of(c, config.n_states).end_amplitudes if seed.end_amplitudes == (None, None)
+            else seed.end_amplitudes for c, seed in zip(curves, traced_from, strict=True)}
     curves.sort(key=lambda c: KINDS.index(c.kind))  # stable: each kind's in the old order, as a cold map's
     search = CurveSearch(config, params, box, (PointKind.FOLD_OF_CYCLES, PointKind.TORUS), loads)
     search.start_units(hopf)  # its GH and double-Hopf points (the units beside them are not run)
@@ -426,7 +427,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
                         resolution=resolution, n_v=n_v, options=options,
                         # the end amplitudes of the cold map's traces, not of these (each warm map would
                         # reach half as far again towards the codimension-2 points)
-                        seeds=[dataclasses.replace(CurveSeed.of(c, config.n_states), end_amplitude=ends[id(c)])
+                        seeds=[dataclasses.replace(CurveSeed.of(c, config.n_states), end_amplitudes=ends[id(c)])
                                for c in curves],
                         warmed_from={"params": start["params"], "changed": _changed(old_params, params),
                                      "slices": {"carried": len(start["slices"]) - len(again),

@@ -54,10 +54,11 @@ def nes_pd_maps():
 
 BOTH = pytest.mark.parametrize("pair", ["maps", "nes_pd_maps"])
 #: A carried slice's fold and torus points are its curves' located crossings, a computed slice's its
-#: diagram's (40 mesh intervals): they differ by the diagrams' mesh error, below 1e-5 for the smooth
-#: nes; for nes_pd (the damper's |dpsi|^(1/2) dpsi) the torus point at 248.7 kN, e_p 1.1 mm moves
-#: 75.82565 -> 75.82677 -> 75.82728 m/s with 40, 80, 160 intervals (the curve's crossing: 75.82807)
-SLICE_REL = {"maps": 1e-5, "nes_pd_maps": 5e-5}
+#: diagram's (40 mesh intervals): they differ by the mesh errors of both, below 1e-5 for the smooth
+#: nes; for nes_pd (the damper's |dpsi|^(1/2) dpsi) at e_p 1.1 mm the torus point at 248.7 kN moves
+#: 75.82565 -> 75.82677 -> 75.82728 m/s with 40, 80, 160 intervals (the curve's crossing: 75.82807),
+#: the one at 273.5 kN 6.72236 -> 6.72230 -> 6.72224 m/s (the curve's crossing: 6.72159, 1.1e-4 off)
+SLICE_REL = {"maps": 1e-5, "nes_pd_maps": 2e-4}
 #: Located points of the curves: the issue's 1e-6 for nes. nes_pd's curves carry the mesh error of
 #: its nonsmooth torque, which differs between traces from different starts on their own adapted
 #: meshes: the turning point in Fz at 229.76 kN is at 33.20547 m/s traced from the cold map's start,
