@@ -12,7 +12,16 @@ from typing import Any
 from urllib.parse import urlencode
 
 from ...model.parameters import PARAMETER_SPECS
-from ...model.units import kn
+from ...model.units import KN, kn
+
+#: Units the text shows in place of the JSON's SI unit: loads in kN, as everywhere else a person reads.
+SHOWN = {"N": ("kN", 1.0 / KN)}
+
+
+def shown(value: float | None, unit: str) -> tuple[float | None, str]:
+    """(value, unit) as the text shows them: a load in N as kN; anything else as it is."""
+    text_unit, factor = SHOWN.get(unit, (unit, 1.0))
+    return (None if value is None else value * factor), text_unit
 
 #: The columns of a study's rows after its parameters (``StudyResult.COLUMNS``).
 STUDY_COLUMNS = ("config", "hopf_start", "hopf_end", "max_psi", "max_psi_V")
@@ -24,13 +33,13 @@ def sensitivity_summary(result: dict[str, Any], top: int = 8) -> str:
     lines = [f"{result['config']} at Fz = {result['Fz'] / 1e3:g} kN: change of each quantity per +1 % of the "
              f"parameter (per half of its range in brackets); largest effects first, then the device parameters"]
     for q in result["quantities"]:
-        lines.append(f"\n{q['label']} = {q['value']:.6g} {q['unit']}")
+        value, unit = shown(q["value"], q["unit"])
+        lines.append(f"\n{q['label']} = {value:.6g} {unit}")
         active = [r for r in q["rows"] if r["reason"] is None]
-        shown = active[:top] + [r for r in active[top:] if r["device"]]
-        for r in shown:
-            percent = "(value 0)" if r["per_percent"] is None else f"{r['per_percent']:+.4g}"
-            lines.append(f"  {r['name']:<12}{percent:>12} {q['unit']:<4}"
-                         f"({r['per_half_range']:+.4g} {q['unit']} per half range)")
+        for r in active[:top] + [r for r in active[top:] if r["device"]]:
+            per_percent, per_half = shown(r["per_percent"], q["unit"])[0], shown(r["per_half_range"], q["unit"])[0]
+            percent = "(value 0)" if per_percent is None else f"{per_percent:+.4g}"
+            lines.append(f"  {r['name']:<12}{percent:>12} {unit:<4}({per_half:+.4g} {unit} per half range)")
         silent = [r["name"] for r in q["rows"] if r["reason"] is not None]
         if silent:
             lines.append(f"  no effect: {', '.join(silent)}")
@@ -60,8 +69,8 @@ def optimise_summary(result: dict[str, Any]) -> str:
     at = f" at {f['Fz'] / 1e3:g} kN" if f["Fz"] is not None else ""
     lines = [f"{result['config']}: {f['sense']} {f['label']}{at} over {', '.join(result['parameters'])} "
              f"({result['method']}, {result['evaluations']} evaluations, {result['elapsed_s']:.1f} s)",
-             f"  optimum {result['objective']:.6g} {f['unit']} (nominal "
-             + ("not evaluated" if nominal is None else f"{nominal:.6g} {f['unit']}") + ")",
+             "  optimum {:.6g} {} (nominal ".format(*shown(result["objective"], f["unit"]))
+             + ("not evaluated" if nominal is None else "{:.6g} {}".format(*shown(nominal, f["unit"]))) + ")",
              "  design: " + ", ".join(f"{n} = {v:.6g} {PARAMETER_SPECS[n].unit}".rstrip()
                                       for n, v in result["design"].items())]
     lines += [f"  constraint {constraint_text(c)}" for c in result["constraints"]]
@@ -143,16 +152,16 @@ def study_curves_lines(curves: list[dict[str, Any]], rows: int = 11, columns: in
         p = group[0]["p"]
         lines.append(f"curves of {config} against {group[0]['param']} ({len(p)} exact points each, "
                      f"{p[0]:g}..{p[-1]:g}):")
-        lines.append(f"{group[0]['param']:>14}" + "".join(f"{_curve_name(c) + ' (' + c['unit'] + ')':>24}"
-                                                           for c in group))
+        lines.append(f"{group[0]['param']:>14}"
+                     + "".join(f"{_curve_name(c) + ' (' + shown(0.0, c['unit'])[1] + ')':>24}" for c in group))
         picks = sorted({round(k * (len(p) - 1) / (rows - 1)) for k in range(rows)}) if len(p) > 1 else [0]
         for i in picks:
-            lines.append(f"{p[i]:14.6g}" + "".join(f"{num(c['values'][i]):>24}" for c in group))
+            lines.append(f"{p[i]:14.6g}" + "".join(f"{num(shown(c['values'][i], c['unit'])[0]):>24}" for c in group))
         for c in group:
             for s in c["special_points"]:
-                value = s.get("value")
+                value, unit = shown(s.get("value"), c["unit"])
                 lines.append(f"  {_curve_name(c)}: {s['kind']} at {c['param']} = {s['p']:.8g}"
-                             + ("" if value is None else f", value {value:.8g} {c['unit']}")
+                             + ("" if value is None else f", value {value:.8g} {unit}")
                              + (f" ({s['why']})" if s.get("why") else ""))
     return lines
 

@@ -26,7 +26,7 @@ from ...version import __version__
 from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
 from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from ..diagrams.cycle_curves import starts_of_diagram
-from ...model.units import kn
+from ...model.units import kn, mm
 
 SHIMMY_TYPES = tuple(ShimmyType)
 DEFAULT_V_RANGE = DIAGRAM_V_RANGE
@@ -285,5 +285,5 @@ def classification_summary(result: dict[str, Any]) -> str:
             lines.append("  stable: straight rolling x = 0")
         else:
             lines.append(f"  stable: {a['kind']} ({a['mode']}), max |psi| {a['max_psi']:.5g} rad, "
-                         f"max |l_g delta| {a['max_lateral']:.5g} m")
+                         f"max |l_g delta| {mm(a['max_lateral'], 5)}")
     return "\n".join(lines)

@@ -41,6 +41,7 @@ import numpy as np
 from ...model import integrator
 from ...model.configurations import Configuration
 from ...model.equations import build_model
+from ...model.units import mm
 from ...model.nes import cubic_coefficients
 from ...model.parameters import Parameters
 from ..core.basins import FAILED, UNSETTLED
@@ -303,7 +304,7 @@ def point_attractors(config: Configuration, V: float, Fz: float, *, params: Para
                                    "source": f"simulation from the {name}", "standard_start": False})
                 label = len(attractors) - 1
                 warnings.append(f"the run from the {name} settles on a motion the diagram does not have at "
-                                f"V = {V:g} m/s (psi {psi:.4g} rad, l_g delta {l_g * delta:.4g} m): added as an "
+                                f"V = {V:g} m/s (psi {psi:.4g} rad, l_g delta {mm(l_g * delta, 4)}): added as an "
                                 "attractor")
         elif label < 0:
             warnings.append(f"the run from the {name} settles on none of the attractors within {t_max:g} s")
