@@ -13,6 +13,7 @@ from urllib.parse import urlencode
 
 from ...model.parameters import PARAMETER_SPECS
 from ...model.units import KN, kn
+from .design_space import FIGURES
 
 #: Units the text shows in place of the JSON's SI unit: loads in kN, as everywhere else a person reads.
 SHOWN = {"N": ("kN", 1.0 / KN)}
@@ -74,9 +75,14 @@ def optimise_summary(result: dict[str, Any]) -> str:
              "  design: " + ", ".join(f"{n} = {v:.6g} {PARAMETER_SPECS[n].unit}".rstrip()
                                       for n, v in result["design"].items())]
     lines += [f"  constraint {constraint_text(c)}" for c in result["constraints"]]
+    def figure(key: str, value: Any) -> str:  # "max_psi@150000 = 0.16 rad": the figure's unit, a load in kN
+        spec = FIGURES.get(key.split("@")[0])
+        if not isinstance(value, float) or spec is None:
+            return f"{key}: {value}" if not isinstance(value, float) else f"{key} = {value:.6g}"
+        return "{} = {:.6g} {}".format(key, *shown(value, spec.unit))
+
     for label, table in result["figures"].items():
-        lines.append(f"  {label:<9}" + ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k}: {v}"
-                                                 for k, v in table.items()))
+        lines.append(f"  {label:<9}" + ", ".join(figure(k, v) for k, v in table.items()))
     lines.append(f"  {result['message']}")
     lines.append("  open in the workbench: /?" + urlencode(result["link_query"]))
     lines += [f"  warning: {w}" for w in result["warnings"]]
