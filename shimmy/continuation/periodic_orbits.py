@@ -37,6 +37,11 @@ from .kinds import PointKind, Stop, StopReason
 from .results import ContinuationResult, SpecialPoint
 
 COMPLEX_TOL = 1e-7  # |Im mu| below this (relative) counts as a real multiplier
+#: At a fold of cycles the multiplier passing +1 meets the trivial one at +1; the two can come out of
+#: the eigenvalue solver as a complex pair a hair off the real axis, which would count as a torus
+#: crossing: a "torus" point whose pair is within this angle (rad) of +1 is no torus (nes_pd at
+#: 278.5 kN: its fold at 130.25 m/s was also reported as a torus point, its pair at 6.6e-6 rad)
+FOLD_PAIR_ANGLE = 1e-4
 
 
 @dataclass(frozen=True)
@@ -487,5 +492,8 @@ def _events(problem: PeriodicProblem, rows, a: CurvePoint, b: CurvePoint, mu_a: 
                 hit = locate(problem, a, h, lambda q: g_mu(problem.multipliers(q.u)), ga, gb, copts)
                 if hit is not None:
                     at = hit[0]
-            found.append((offset + weighted_norm(at.u - a.u, problem.weights), _special(problem, kind, at, rows)))
+            point = _special(problem, kind, at, rows)
+            if kind is PointKind.TORUS and point.data.get("torus_angle", math.pi) < FOLD_PAIR_ANGLE:
+                return found  # a pair at +1 (a fold's multiplier beside the trivial one): not a torus
+            found.append((offset + weighted_norm(at.u - a.u, problem.weights), point))
     return found

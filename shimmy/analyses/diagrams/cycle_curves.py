@@ -58,8 +58,9 @@ FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 k
 CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400,
                                                                    max_angle=0.3))
 #: A torus start whose multiplier pair lies within this angle (rad per period) of +1 or -1 is a strong
-#: resonance, not a torus: nes_pd's diagram at 278.5 kN reports a torus point at its fold of cycles at
-#: 130.25 m/s with the pair at 6.6e-6 rad (two multipliers at +1), where no torus curve passes.
+#: resonance, not a torus: nes_pd's diagram at 278.5 kN reported a torus point at its fold of cycles at
+#: 130.25 m/s with the pair at 6.6e-6 rad (two multipliers at +1), where no torus curve passes (the
+#: diagrams no longer report such points: ``continuation.periodic_orbits.FOLD_PAIR_ANGLE``).
 RESONANCE_ANGLE = 1e-4
 BESIDE = 0.015  # relative offset in Fz from a GH / double-Hopf point to the Hopf point a start branch leaves
 START_STEPS = 80  # step budget of a start branch

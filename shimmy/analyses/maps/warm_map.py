@@ -248,9 +248,8 @@ def _off_curve(q: dict[str, Any], s: SliceResult, config: Configuration, params:
     """A fold or torus point of a slice computed again that lies on no curve of the map: continued as
     a cold map continues it (:func:`~shimmy.analyses.diagrams.cycle_curves.continue_start` from the
     slice's located point). A curve that is none of the map's means the arrangement changed
-    (:class:`NotWarm`); no curve (no such point converges near it, as at a fold of cycles where a
-    complex pair of multipliers is born: nes_pd at 278.5 kN, 130.25 m/s) is what the cold map finds
-    too, and its warning is the cold map's."""
+    (:class:`NotWarm`); no curve (no such point converges near it) is what the cold map finds too,
+    and its warning is the cold map's."""
     where = f"the slice computed at Fz = {s.Fz / 1e3:.4g} kN has a {q['kind']} point at V = {q['V']:.5g} m/s"
     start = min((t for t in s.starts if t.kind == q["kind"]), key=lambda t: abs(t.point.p - q["V"]), default=None)
     if start is None or abs(start.point.p - q["V"]) > 1e-6 * max(abs(q["V"]), 1.0):

@@ -178,19 +178,23 @@ def test_a_longer_trace_of_a_known_curve_takes_its_place(original):
     assert with_curve(others, full, l_g) == [*others, full]
 
 
-def test_a_torus_point_at_a_fold_with_a_pair_at_plus_one_starts_no_curve():
-    """`nes_pd` at 278.5 kN: the diagram's fold of cycles at 130.25 m/s is also reported as a torus
-    point, its complex pair 6.6e-6 rad from +1 (two multipliers at +1, a strong resonance, not a
-    torus). It starts no curve (the fold point at the same speed starts the fold curve)."""
-    from shimmy.analyses.diagrams.cycle_curves import RESONANCE_ANGLE, continue_start, starts_of_diagram
+def test_a_fold_whose_multiplier_meets_the_trivial_one_is_no_torus_point():
+    """`nes_pd` at 278.5 kN: at the fold of cycles at 130.25 m/s the multiplier through +1 and the
+    trivial one came out of the eigenvalue solver as a complex pair 6.6e-6 rad off +1, and the diagram
+    reported a torus point there too, where no torus curve passes. The diagram reports the fold only,
+    and such a pair starts no torus curve."""
+    from shimmy.analyses.diagrams.cycle_curves import RESONANCE_ANGLE, Start, continue_start, starts_of_diagram
+    from shimmy.continuation import SpecialPoint
     from shimmy.model.configurations import Configuration
     from shimmy.model.parameters import Parameters
 
     Fz = 278491.6201117318  # a slice of the nes_pd map
     diagram = bifurcation("nes_pd", Fz, v_range=(1.0, 200.0), options=BifurcationOptions(mesh_check=False))
     at_fold = [s for s in starts_of_diagram(diagram, Fz) if abs(s.point.p - 130.247) < 1e-2]
-    assert sorted(s.kind for s in at_fold) == ["LPC", "NS"]
-    torus = next(s for s in at_fold if s.kind == "NS")
-    assert torus.point.data["torus_angle"] < RESONANCE_ANGLE
+    assert [s.kind for s in at_fold] == ["LPC"]
+    fold = at_fold[0]
+    torus = Start("NS", SpecialPoint("NS", fold.point.p, 0, {"torus_angle": 6.6e-6}, solution=fold.point.solution),
+                  Fz, fold.ncol, "the fold's pair at +1")
+    assert 6.6e-6 < RESONANCE_ANGLE
     assert continue_start(Configuration.parse("nes_pd"), Parameters(), torus, ((1.0, 200.0), (1e4, 9e5)), ()) \
         == (None, None)
