@@ -26,6 +26,12 @@ class InvalidInputError(ContinuationError, ValueError):
         head = reason or "is out of range"
         super().__init__(message or f"{field}={value!r} {head}; allowed: {allowed}")
 
+    def __reduce__(self):
+        # rebuilt from its fields and message: a refusal raised in a process pool's worker reaches the
+        # caller as itself (Exception's default pickling passes only the message to __init__, whose
+        # unpickling failed and broke the pool: BrokenProcessPool instead of the field's error)
+        return self.__class__, (self.field, self.value, self.allowed, None, str(self))
+
     def to_dict(self) -> dict:
         return {"error": str(self), "field": self.field, "allowed": self.allowed}
 

@@ -37,7 +37,7 @@ import numpy as np
 from ...continuation.errors import ContinuationError as EngineError
 from ...errors import ShimmyError
 from ...model.configurations import Configuration
-from ...model.parameters import Parameters
+from ...model.parameters import PARAMETER_SPECS, Parameters
 from .study_curves import SNAP, StudyCurve, parameter_range
 
 #: Grid values of theta over its whole range, the ends included (plus the sampled and base values).
@@ -63,8 +63,10 @@ def grid(parameter: str, params: Parameters, values: Sequence[float] = ()) -> li
     ``values``; values closer than :data:`~.study_curves.SNAP` of the range are one."""
     lo, hi = parameter_range(parameter, params)
     base = float(getattr(params, parameter))
-    wanted = sorted(set(np.linspace(lo, hi, N_GRID).tolist()) | {float(v) for v in values}
-                    | ({base} if lo <= base <= hi else set()))
+    even = np.linspace(lo, hi, N_GRID)
+    if _integer(parameter):  # a count takes whole values only
+        even = np.unique(np.round(even))
+    wanted = sorted(set(even.tolist()) | {float(v) for v in values} | ({base} if lo <= base <= hi else set()))
     out: list[float] = []
     for theta in wanted:
         if out and abs(theta - out[-1]) <= SNAP * (hi - lo):
@@ -75,13 +77,20 @@ def grid(parameter: str, params: Parameters, values: Sequence[float] = ()) -> li
     return out
 
 
-def substeps(a: float, b: float) -> list[float]:
+def substeps(a: float, b: float, parameter: str | None = None) -> list[float]:
     """The values of theta a follow from grid value a towards b visits, b last (exactly): the same
     numbers either way (interpolated from the lower end), so that followed points from both ends of an
-    interval meet at equal theta."""
+    interval meet at equal theta; for an integer ``parameter`` (a count) the whole values among them."""
     lo, hi = min(a, b), max(a, b)
     inner = [lo + (hi - lo) * k / SUBSTEPS for k in range(1, SUBSTEPS)]
+    if parameter is not None and _integer(parameter):  # the whole values between, at most as many
+        inner = sorted({float(round(x)) for x in inner} - {lo, hi})
     return [*(inner if a < b else inner[::-1]), b]
+
+
+def _integer(parameter: str) -> bool:
+    spec = PARAMETER_SPECS.get(parameter)
+    return bool(spec is not None and spec.integer)
 
 
 def orbit_of(result) -> tuple[np.ndarray, int, np.ndarray] | None:

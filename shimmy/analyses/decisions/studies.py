@@ -216,7 +216,8 @@ def _follow_maxima(parameter: str, rows: dict[str, list[dict[str, Any]]], orbits
 
     def run(pairs, report):
         pairs = [(c, a, b) for c, a, b in pairs if orbits.get((c, (a,))) is not None and affects(parameter, c)]
-        tasks = [(c, Fz, parameter, base, orbits[c, (a,)], substeps(a, b), options, v_range) for c, a, b in pairs]
+        tasks = [(c, Fz, parameter, base, orbits[c, (a,)], substeps(a, b, parameter), options, v_range)
+                 for c, a, b in pairs]
         done = run_units(follow_maximum, tasks, executor, report,
                          lambda t: f"{t[0]}: largest amplitude followed to {parameter} = {t[5][-1]:g}")
         for (c, a, b), follow in zip(pairs, done, strict=True):

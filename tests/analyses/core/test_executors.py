@@ -11,6 +11,7 @@ from concurrent.futures import ProcessPoolExecutor
 import pytest
 
 from shimmy.errors import InvalidParameterError
+from shimmy.model.parameters import Parameters
 from shimmy.service.dask_cluster import loopback_cluster
 from shimmy.analyses.core.executors import (DASK_ENV, PRELOAD, WORKERS_ENV, InlineExecutor, describe, drop_shared_pool,
                                            open_executor, run_dynamic, run_units, shared_pool, worker_count)
@@ -86,6 +87,20 @@ def test_run_dynamic_runs_the_most_urgent_unit_first_including_units_added_on_th
 def test_a_failing_unit_fails_the_call():
     with pytest.raises(ValueError, match="math domain error"):
         run_units(math.sqrt, [1.0, -1.0, 4.0], InlineExecutor())
+
+
+def _refuse(value):
+    return Parameters().with_overrides({"n": value})  # n is a count: 50.5 is refused
+
+
+def test_a_refusal_in_a_process_pool_worker_reaches_the_caller_as_itself():
+    """A field's refusal raised in a worker used to break the pool (BrokenProcessPool): the error
+    could not be rebuilt from its pickle. It arrives as the same error, field and value."""
+    with ProcessPoolExecutor(max_workers=1) as pool:
+        with pytest.raises(InvalidParameterError) as err:
+            run_units(_refuse, [24.0, 50.5], pool)
+        assert err.value.field == "n" and err.value.value == 50.5 and "is not an integer" in str(err.value)
+        assert pool.submit(_refuse, 20.0).result().pd.n == 20.0  # the pool still works
 
 
 def test_worker_count_comes_from_the_argument_the_environment_or_the_cores(monkeypatch):

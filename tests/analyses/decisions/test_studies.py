@@ -112,6 +112,18 @@ def test_a_followed_maximum_is_the_diagrams_maximum_of_each_design_it_passes():
     assert short["points"] == [] and "leaves the speed range" in short["stopped"]
 
 
+def test_a_count_is_studied_at_whole_values_only():
+    from shimmy.analyses.decisions.max_psi_curve import grid, substeps
+
+    values = grid("n", Parameters(), [20, 24])
+    assert values[0] == 1.0 and values[-1] == 100.0 and {20.0, 24.0} <= set(values)
+    assert all(v == round(v) for v in values)
+    for a, b in zip(values, values[1:]):
+        inner = substeps(a, b, "n")[:-1]
+        assert all(v == round(v) and min(a, b) < v < max(a, b) for v in inner)
+        assert inner == substeps(b, a, "n")[:-1][::-1]
+
+
 def test_follows_from_both_ends_of_an_interval_visit_the_same_values():
     from shimmy.analyses.decisions.max_psi_curve import SUBSTEPS, grid, substeps
 
