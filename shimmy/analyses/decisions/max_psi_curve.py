@@ -134,34 +134,25 @@ def follow_maximum(task: tuple) -> dict[str, Any]:
 def _maximum_at(config, Fz, parameter, params, theta, mesh_points, ncol, u, options, copts):
     """(amplitude, cycle unknowns) of the maximum of max|psi| along the branch through the cycle u
     corrected at design theta, or why there is none (a string)."""
-    from ...continuation import CurvePoint, step, weighted_norm
+    from ...continuation import step
     from ...continuation.collocation import Mesh, PeriodicProblem
-    from ...continuation.scalar import minimum_in
     from ...model.equations import build_model
-    from ..diagrams.bifurcation import STATE_SCALE, T_SCALE, V_SCALE, gear_field
+    from ..diagrams.bifurcation import (STATE_SCALE, T_SCALE, V_SCALE, at_fixed_speed, gear_field,
+                                        largest_peak_along)
 
     model = build_model(Configuration.parse(config), params.with_overrides({parameter: theta}),
                         exact_nes=options.exact_nes)
     problem = PeriodicProblem(gear_field(model, Fz), Mesh(mesh_points, ncol), STATE_SCALE[:model.n_states],
                               T_SCALE, V_SCALE)
     problem.accept(u)
-    along_v = np.zeros_like(u)
-    along_v[-1] = 1.0
-    centre = step(problem, CurvePoint(u, along_v / weighted_norm(along_v, problem.weights)), 0.0, copts)
+    centre = at_fixed_speed(problem, u, copts)
     if centre is None:
         return "the cycle does not converge"
     problem.accept(centre.u)
     found = None
     for _ in range(RECENTRES):
-        tried: dict[float, tuple[float, Any]] = {}
-
-        def minus_amplitude(h):
-            point = step(problem, centre, h, copts, with_tangent=False) if h != 0 else centre
-            tried[h] = (0.0, None) if point is None else (problem.peak(point.u, 0)[2], point)
-            return -tried[h][0]
-
-        h, _ = minimum_in(minus_amplitude, -SEARCH_SPAN, SEARCH_SPAN, xatol=1e-5 * SEARCH_SPAN)
-        amplitude, point = tried[h]
+        h, amplitude, point = largest_peak_along(problem, centre, -SEARCH_SPAN, SEARCH_SPAN, copts,
+                                                 xatol=1e-5 * SEARCH_SPAN)
         if point is None:
             break
         if abs(h) < 0.9 * SEARCH_SPAN:

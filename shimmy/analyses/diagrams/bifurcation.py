@@ -674,6 +674,31 @@ def _nes_rotation(system, branches: list[Branch], scale, limit: float) -> tuple[
     return candidates[NES_ROTATION_SAMPLES][0], True
 
 
+def at_fixed_speed(problem: PeriodicProblem, u: np.ndarray, copts: ContinuationOptions) -> CurvePoint | None:
+    """The cycle ``u`` corrected by Newton with its speed V held (a step of length 0 along V), with
+    its tangent; None if Newton does not converge."""
+    along_v = np.zeros_like(u)
+    along_v[-1] = 1.0
+    return step(problem, CurvePoint(u, along_v / weighted_norm(along_v, problem.weights)), 0.0, copts)
+
+
+def largest_peak_along(problem: PeriodicProblem, start: CurvePoint, lo: float, hi: float,
+                       copts: ContinuationOptions, xatol: float) -> tuple[float, float, CurvePoint | None]:
+    """(h, A, point): the largest torsional amplitude A along the branch from ``start``, over the
+    arclength h in (lo, hi), by a bounded search to ``xatol`` (each orbit's peak on its collocation
+    polynomial, :meth:`PeriodicProblem.peak`); a trial step that does not converge counts as A = 0
+    (point None)."""
+    tried: dict[float, tuple[float, CurvePoint | None]] = {}
+
+    def minus_amplitude(h):
+        point = step(problem, start, h, copts, with_tangent=False) if h != 0 else start
+        tried[h] = (0.0, None) if point is None else (problem.peak(point.u, 0)[2], point)
+        return -tried[h][0]
+
+    h, _ = minimum_in(minus_amplitude, lo, hi, xatol=xatol)
+    return h, *tried.get(h, (0.0, None))
+
+
 def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale, warnings, l_g: float):
     """Largest torsional amplitude of stable cycles, refined along the branch, a mesh check, and the
     cycle of the maximum (:class:`MaximumOrbit`)."""
@@ -696,19 +721,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
     lo = max(i - 1, 0)
     if 0 < i < raw.p.size - 1 and raw.stable[lo] and raw.stable[i + 1]:
         problem, start, span = _restore(system, raw, lo, scale, to=i + 1)
-        cache: dict[float, tuple[float, CurvePoint | None]] = {}
-
-        def minus_amp(h):
-            point = step(problem, start, h, copts, with_tangent=False) if h > 0 else start
-            if point is None:
-                cache[h] = (0.0, None)
-                return 0.0
-            a = problem.peak(point.u, 0)[2]  # on the collocation polynomial, not the nearest sample
-            cache[h] = (a, point)
-            return -a
-
-        h_opt, _ = minimum_in(minus_amp, 0.0, span, xatol=1e-5 * span)
-        a_opt, point = cache.get(h_opt, (0.0, None))
+        _, a_opt, point = largest_peak_along(problem, start, 0.0, span, copts, xatol=1e-5 * span)
         if point is not None and a_opt >= amp:
             amp, V = a_opt, float(point.u[-1])
             i_point = point
@@ -729,9 +742,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
                                V_SCALE)
         u_f = problem.transfer(fine, point.u)
         fine.accept(u_f)
-        t_f = np.zeros_like(u_f)
-        t_f[-1] = 1.0
-        fixed = step(fine, CurvePoint(u_f, t_f / weighted_norm(t_f, fine.weights)), 0.0, copts)
+        fixed = at_fixed_speed(fine, u_f, copts)
         if fixed is None:
             warnings.append("mesh check: no convergence on the doubled mesh")
         else:

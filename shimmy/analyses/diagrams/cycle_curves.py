@@ -34,6 +34,7 @@ from ...version import __version__
 from ...continuation import (CYCLE_BIFURCATIONS, ContinuationOptions, CycleCurve, CycleCurveOptions, PointKind,
                              SpecialPoint, cycle_curve, join_halves, start_beside)
 from ...continuation.errors import ContinuationError
+from ...continuation.periodic_orbits import FOLD_PAIR_ANGLE
 from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.equations import build_model
@@ -60,8 +61,8 @@ CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_m
 #: A torus start whose multiplier pair lies within this angle (rad per period) of +1 or -1 is a strong
 #: resonance, not a torus: nes_pd's diagram at 278.5 kN reported a torus point at its fold of cycles at
 #: 130.25 m/s with the pair at 6.6e-6 rad (two multipliers at +1), where no torus curve passes (the
-#: diagrams no longer report such points: ``continuation.periodic_orbits.FOLD_PAIR_ANGLE``).
-RESONANCE_ANGLE = 1e-4
+#: diagrams no longer report such points: the engine's threshold, the same angle).
+RESONANCE_ANGLE = FOLD_PAIR_ANGLE
 BESIDE = 0.015  # relative offset in Fz from a GH / double-Hopf point to the Hopf point a start branch leaves
 START_STEPS = 80  # step budget of a start branch
 SCAN_FRACTIONS = (0.3, 0.6, 0.9)  # loads of the one-parameter diagrams, as fractions of the box in Fz
