@@ -225,7 +225,7 @@ def margins(request: dict[str, Any], progress: Progress | None = None) -> dict[s
     """The attractors at a point and the smallest disturbance to each; runs through the executor of this environment."""
     from ..analyses.maps.margins import margins as run_margins
 
-    settings = ("direction", "max_size", "min_size", "scan_points", "rtol", "t_max")
+    settings = ("direction", "mix", "origin", "phases", "max_size", "min_size", "scan_points", "rtol", "t_max")
     return run_margins(request["config"], request["V"], request["Fz"], params=_params(request), progress=progress,
                        **{name: request[name] for name in settings}).to_dict()
 

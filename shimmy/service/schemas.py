@@ -323,14 +323,18 @@ def _check_robustness(out: dict[str, Any]) -> None:
 
 
 def _check_margins(out: dict[str, Any]) -> None:
-    """The settings together, as the analysis checks them (min_size below max_size)."""
-    margin_options.MarginOptions(**{name: out[name] for name in margin_options.MarginOptions.__dataclass_fields__})
+    """The settings together, as the analysis checks them (min_size below max_size; a mix with direction mix
+    only), the mix in its canonical text (equal mixes, one cache key)."""
+    options = margin_options.MarginOptions(**{name: out[name]
+                                              for name in margin_options.MarginOptions.__dataclass_fields__})
+    out["mix"] = options.mix
 
 
 _CHECKS = {"sensitivity": _check_sensitivity, "optimise": _check_optimise, "robustness": _check_robustness,
            "margins": _check_margins}
 _RULES = {
-    "margins": "Margins: min_size below max_size.",
+    "margins": "Margins: min_size below max_size; mix given with direction mix and only then, as "
+               f"'{margin_options.MIX_EXAMPLE}' (components of " + ", ".join(margin_options.COMPONENTS) + ").",
     "simulate": f"Simulate: with include_series, at most {settings.MAX_SERIES_POINTS} samples per series "
                 "(t_end / series_dt + 1; series_dt is refused, naming the smallest it may be for this t_end).",
     "optimise": "Optimise: the search parameters are parameters of the configuration (default: those of r2, e_p, "
@@ -559,8 +563,16 @@ SCHEMAS: dict[str, RequestSchema] = {
     "margins": RequestSchema("margins", "disturbance margins at one operating point: its attractors and the smallest "
                              "disturbance from straight rolling that ends on each, each checked by two runs", (
         _config(), V, FZ,
-        Field("direction", "string", "the disturbed component (psi, dpsi, delta, ddelta; the rest at rest), or all "
-              "four in the energy norm (energy)", default=_MARGIN.direction, choices=margin_options.DIRECTIONS),
+        Field("direction", "string", "the disturbed component (psi, dpsi, delta, ddelta; the rest at rest), a given "
+              "mix of them (mix, with mix), or all four in the energy norm (energy)", default=_MARGIN.direction,
+              choices=margin_options.DIRECTIONS),
+        Field("mix", "string", "with direction mix: the mix's components in their units (rad, rad/s), such as "
+              f"'{margin_options.MIX_EXAMPLE}'; only its direction counts, the size is searched", default=None),
+        Field("origin", "string", "what the disturbance is added to: straight rolling, or the attractor the "
+              "standard start (psi = 0.001 rad) reaches, at phases points of its orbit", default=_MARGIN.origin,
+              choices=margin_options.ORIGINS),
+        _setting("phases", "phases of the orbit kicked with origin standard_attractor (each threshold the "
+                 "smallest over them)", _MARGIN),
         _setting("max_size", "largest disturbance scanned, as the yaw angle of the same energy", _MARGIN),
         _setting("min_size", "smallest disturbance scanned, as the yaw angle of the same energy", _MARGIN),
         _setting("scan_points", "sizes of the bracketing scan (geometric steps)", _MARGIN),

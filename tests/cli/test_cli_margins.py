@@ -78,3 +78,30 @@ def test_margin_map_json_gives_each_cell_its_margin_and_the_cache_answers_again(
 def test_bad_input_exits_2_naming_the_field(args, needle):
     out = run(*args)
     assert out.returncode == 2 and needle in out.stderr, out.stderr
+
+
+def test_margins_from_the_standard_starts_cycle_along_a_mix_and_equal_mixes_share_one_cache_entry(tmp_path):
+    """``--origin standard_attractor --direction mix --mix``: the kick added to the lateral cycle, along the mix;
+    the same mix written otherwise (order, spaces, 0.10 for 0.1) is the same request, answered from the cache."""
+    env = {**os.environ, "SHIMMY_CACHE_DIR": str(tmp_path)}
+    args = ("margins", *POINT, "--origin", "standard_attractor", "--phases", "2", "--direction", "mix", "--json",
+            "--progress", "none")
+    out = run(*args, "--mix", "psi=0.01,dpsi=0.1", env=env)
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["cache"] == "miss" and data["origin"]["kind"] == "standard_attractor"
+    assert data["origin"]["mode"] == "lateral" and data["options"]["mix"] == "psi=0.01,dpsi=0.1"
+    torsional = next(a for a in data["attractors"] if a["mode"] == "torsional")["min_disturbance"]
+    assert torsional["unit"] == "J" and torsional["mix"] == "psi=0.01,dpsi=0.1" and torsional["check"]["confirmed"]
+    assert torsional["disturbance"]["dpsi"] == pytest.approx(10 * torsional["disturbance"]["psi"], rel=1e-12)
+    assert 0.0 <= torsional["phase"] < 1.0 and len(torsional["origin_state"]) == 5
+    again = run(*args, "--mix", " dpsi = 0.10 , psi=0.01", env=env)
+    assert again.returncode == 0 and json.loads(again.stdout)["cache"] == "hit"
+
+
+@pytest.mark.parametrize("extra, field", [(("--direction", "mix"), "mix"), (("--mix", "psi=1"), "mix"),
+                                          (("--direction", "mix", "--mix", "psi=1,yaw=2"), "mix"),
+                                          (("--phases", "0"), "phases")])
+def test_bad_mix_origin_settings_exit_2_naming_the_field(extra, field):
+    out = run("margins", *POINT, *extra, "--no-cache")
+    assert out.returncode == 2 and f"{field}=" in out.stderr, out.stderr

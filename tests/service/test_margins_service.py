@@ -99,7 +99,12 @@ def test_margins_and_basins_jobs_over_http(server):
     assert status == 422 and answer["field"] == "direction"
     _, _, doc = server.request("GET", "/api/v1/openapi.json")
     props = doc["components"]["schemas"]["job_margins"]["properties"]
-    assert props["direction"]["enum"][:5] == ["psi", "dpsi", "delta", "ddelta", "energy"]
+    assert props["direction"]["enum"][:6] == ["psi", "dpsi", "delta", "ddelta", "mix", "energy"]
+    assert props["origin"]["enum"][:2] == ["straight_rolling", "standard_attractor"] and "mix" in props
+    for body, field in (({"direction": "mix", "mix": "psi=0.01,yaw=1"}, "mix"), ({"direction": "mix"}, "mix"),
+                        ({"mix": "psi=1"}, "mix"), ({"origin": "cycle"}, "origin"), ({"phases": 0}, "phases")):
+        status, _, answer = server.request("POST", "/api/v1/jobs", {"analysis": "margins", **POINT, **body})
+        assert status == 422 and answer["field"] == field, (body, answer)
     assert "job_basins" in doc["components"]["schemas"]
     props = doc["components"]["schemas"]["job_margin_map"]["properties"]
     assert (props["n_v"]["maximum"], props["n_fz"]["maximum"]) == (60, 40)

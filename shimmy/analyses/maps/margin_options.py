@@ -4,6 +4,7 @@ loading the integrator."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -12,13 +13,52 @@ from ...model.parameters import check_number, unknown_name_error
 
 #: The disturbed components of the state, their index and unit; the rest of the state starts at rest.
 COMPONENTS = {"psi": (0, "rad"), "dpsi": (1, "rad/s"), "delta": (2, "rad"), "ddelta": (3, "rad/s")}
-#: The directions a margin is asked along: one component, or all four in the energy norm ("energy").
-DIRECTIONS = (*COMPONENTS, "energy")
+#: The directions a margin is asked along: one component, a given mix of them ("mix", with ``mix``), or all four in
+#: the energy norm ("energy").
+DIRECTIONS = (*COMPONENTS, "mix", "energy")
+#: Where the disturbance is added: to straight rolling, or to the attractor the standard start reaches (at
+#: ``phases`` points of its cycle).
+ORIGINS = ("straight_rolling", "standard_attractor")
 #: (low, high, unit, integer) of every numeric setting.
 LIMITS = {"max_size": (0.002, 1.0, "rad", False), "min_size": (1e-5, 0.1, "rad", False),
           "scan_points": (4, 40, "", True), "rtol": (1e-4, 0.1, "", False), "t_max": (10.0, 600.0, "s", False),
           "radius": (1e-3, 1.0, "rad", False), "samples": (10, 5000, "", True), "seed": (0, 2 ** 31 - 1, "", True),
-          "n_v": (2, 60, "", True), "n_fz": (2, 40, "", True)}
+          "n_v": (2, 60, "", True), "n_fz": (2, 40, "", True), "phases": (1, 32, "", True)}
+MIX_EXAMPLE = "psi=0.01,dpsi=0.2"
+
+
+def parse_mix(value: Any) -> str:
+    """The canonical text of a mix of components (``"psi=0.01,dpsi=0.2"``: each the component's value in its
+    unit, rad or rad/s; only the direction counts, the size is searched): the named components in state order,
+    zeros left out. Refused with the field ``mix`` named: not text, an unknown component, a value that is not a
+    finite number, a component twice, all zero."""
+    allowed = f"components and values such as '{MIX_EXAMPLE}' (of {', '.join(COMPONENTS)}; rad, rad/s)"
+    if not isinstance(value, str) or not value.strip():
+        raise InvalidParameterError("mix", value, allowed, "is not a list of component=value")
+    values: dict[str, float] = {}
+    for part in value.split(","):
+        name, sep, number = (piece.strip() for piece in part.partition("="))
+        if not sep:
+            raise InvalidParameterError("mix", value, allowed, f"has '{part.strip()}' without '='")
+        if name not in COMPONENTS:
+            raise InvalidParameterError("mix", value, allowed, f"names an unknown component '{name}'")
+        if name in values:
+            raise InvalidParameterError("mix", value, allowed, f"names {name} twice")
+        try:
+            values[name] = float(number)
+        except ValueError:
+            raise InvalidParameterError("mix", value, allowed, f"gives {name} the value '{number}', not a number") \
+                from None
+        if not math.isfinite(values[name]):
+            raise InvalidParameterError("mix", value, allowed, f"gives {name} the value {number}, not finite")
+    if not any(values.values()):
+        raise InvalidParameterError("mix", value, allowed, "is zero in every component: no direction")
+    return ",".join(f"{name}={values[name]!r}" for name in COMPONENTS if values.get(name))
+
+
+def mix_vector(mix: str) -> "dict[str, float]":
+    """The components of a canonical mix (:func:`parse_mix`), in their units."""
+    return {name: float(number) for name, number in (part.split("=") for part in mix.split(","))}
 
 
 def _check(name: str, value: Any) -> float:
@@ -29,9 +69,11 @@ def _check(name: str, value: Any) -> float:
 
 @dataclass(frozen=True)
 class MarginOptions:
-    """How a margin is searched: ``direction`` (psi, dpsi, delta, ddelta or energy); the scan's sizes from
-    ``min_size`` to ``max_size`` (rad, as the yaw angle of the same energy) in ``scan_points`` geometric
-    steps; bisection to ``rtol`` of the threshold; runs of at most ``t_max`` (s)."""
+    """How a margin is searched: ``direction`` (psi, dpsi, delta, ddelta, mix with ``mix`` (:func:`parse_mix`),
+    or energy); the scan's sizes from ``min_size`` to ``max_size`` (rad, as the yaw angle of the same energy) in
+    ``scan_points`` geometric steps; bisection to ``rtol`` of the threshold; runs of at most ``t_max`` (s);
+    the disturbance added to straight rolling or to the attractor the standard start reaches (``origin``), there at
+    ``phases`` points of its cycle."""
 
     direction: str = "psi"
     max_size: float = 0.4
@@ -39,10 +81,24 @@ class MarginOptions:
     scan_points: int = 12
     rtol: float = 0.005
     t_max: float = 80.0
+    mix: str | None = None
+    origin: str = "straight_rolling"
+    phases: int = 8
 
     def __post_init__(self):
         if self.direction not in DIRECTIONS:
             raise unknown_name_error(str(self.direction), DIRECTIONS, "direction")
+        if self.direction == "mix":
+            if self.mix is None:
+                raise InvalidParameterError("mix", None, f"components and values such as '{MIX_EXAMPLE}'",
+                                            "is needed with direction mix")
+            object.__setattr__(self, "mix", parse_mix(self.mix))
+        elif self.mix is not None:
+            raise InvalidParameterError("mix", self.mix, "none unless direction is mix",
+                                        f"is given with direction {self.direction}, which does not read it")
+        if self.origin not in ORIGINS:
+            raise unknown_name_error(str(self.origin), ORIGINS, "origin")
+        object.__setattr__(self, "phases", _check("phases", self.phases))
         object.__setattr__(self, "max_size", _check("max_size", self.max_size))
         object.__setattr__(self, "min_size", _check("min_size", self.min_size))
         if not self.min_size < self.max_size:

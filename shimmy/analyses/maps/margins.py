@@ -6,8 +6,14 @@ the gear reaches depends on the size and the kind of the disturbance. At a point
 * :func:`margins`: the attractors (:func:`~shimmy.analyses.maps.point_attractors.point_attractors`:
   the stable equilibrium and cycles of the one-parameter diagram at V, the saddle cycles between
   them, runs from the standard and two large starts; the standard start's marked), and for each the
-  smallest disturbance from straight rolling that ends on it, the rest of the state at rest:
-  along one component (``direction`` psi, dpsi, delta or ddelta): a bracketing scan on a geometric
+  smallest disturbance that ends on it, added to straight rolling (``origin="straight_rolling"``, the
+  rest of the state at rest) or to the attractor the standard start reaches
+  (``origin="standard_attractor"``: at ``phases`` equally spaced phases of its orbit, phase 0 at a yaw
+  maximum, each threshold the smallest over the phases; kicks of both signs are covered, a kick -u
+  at one phase being the kick u half a period later on the gear's symmetric cycles):
+  along one component (``direction`` psi, dpsi, delta or ddelta) or a given mix of them
+  (``direction="mix"``, ``mix="psi=0.01,dpsi=0.2"``: the direction of that vector in the energy
+  norm; the threshold also as a multiple of the mix, ``factor``): a bracketing scan on a geometric
   grid of sizes, then bisection to ``rtol`` (:mod:`shimmy.analyses.core.basins`); over all
   directions of the four (``direction="energy"``): the smallest energy, from a sweep of 16
   directions with the bisection along each and a pattern search on the unit sphere from the best.
@@ -34,19 +40,23 @@ from typing import Any, Callable
 import numpy as np
 
 from ...version import __version__
-from ...errors import InvalidParameterError
+from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.parameters import DIAGRAM_V_RANGE, Parameters, check_operating_point
 from ...model.units import kn
 from ..core.basins import (FAILED, UNSETTLED, Ray, Threshold, geometric_sizes, refine, sample_ball, scan,
                            smallest_over_directions, sweep_directions, wilson)
 from ..core.executors import describe_work_unit, executor_width, name_of, open_executor, run_units, run_work_unit
-from .margin_options import COMPONENTS, BasinOptions, MarginOptions
-from .point_attractors import MATCH_TOL, WINDOW, PointAttractors, RunUnit, point_attractors
+from .margin_options import COMPONENTS, BasinOptions, MarginOptions, mix_vector
+from .point_attractors import (DISCOVERY_STARTS, MATCH_TOL, ORBIT_SETTLED, WINDOW, OrbitUnit, PointAttractors, RunUnit,
+                               point_attractors)
 from .summaries import basins_summary, margins_summary
 
 ENERGY_COMPONENTS = tuple(COMPONENTS)
 MIN_ANGLE_DEG = 1.0
+#: Rows of the orbit between two sampled phases: the phase of a smallest threshold is located to 1 / (phases *
+#: PHASE_STEPS) of the period (three halvings between the sampled phases).
+PHASE_STEPS = 8
 #: Sizes probed per round of the bisection (:func:`~shimmy.analyses.core.basins.refine`'s ``width``): two
 #: interior sizes of a bracket while it is the only one open (trisection: two runs side by side), one per bracket
 #: when several are. Fixed, not the executor's worker count, so that a margin is the same on every executor.
@@ -79,6 +89,7 @@ class MarginsResult:
     elapsed_s: float
     executor: str
     warnings: list[str] = field(default_factory=list)
+    origin: dict[str, Any] = field(default_factory=lambda: {"kind": "straight_rolling", "attractor": None})
 
     @property
     def attractors(self) -> list[dict[str, Any]]:
@@ -87,7 +98,8 @@ class MarginsResult:
     def to_dict(self) -> dict[str, Any]:
         return {**_header(self.config, self.V, self.Fz, self.params, self.found, self.options, self.runs,
                           self.elapsed_s, self.executor, self.warnings),
-                "direction": self.options.direction, "attractors": self.attractors, "unsettled_runs": self.unsettled}
+                "direction": self.options.direction, "origin": self.origin, "attractors": self.attractors,
+                "unsettled_runs": self.unsettled}
 
     def summary_text(self) -> str:
         """The lines ``python -m shimmy margins`` prints (:func:`~shimmy.analyses.maps.summaries.margins_summary`)."""
@@ -147,8 +159,13 @@ class _Runs:
                  report: Callable[[float, str], None], expected: int):
         self.config, self.V, self.Fz, self.params, self.executor, self.t_max = config, V, Fz, params, executor, t_max
         self.width = max(1, min(64, executor_width(executor)))
-        self.report, self.expected, self.count, self.unsettled = report, max(1, expected), 0, 0
+        self.expected, self.count, self.unsettled, self.shown = max(1, expected), 0, 0, 0.0
         self.found: PointAttractors | None = None
+
+        def forward(fraction: float, message: str) -> None:  # a bar that never goes back
+            self.shown = max(self.shown, fraction)
+            report(self.shown, message)
+        self.report = forward
 
     def units(self, units: list[RunUnit]) -> list[list[tuple]]:
         return run_units(run_work_unit, units, self.executor, describe_unit=describe_work_unit)
@@ -168,10 +185,11 @@ class _Runs:
         return out
 
 
-def _state(n: int, names: tuple[str, ...], scales: np.ndarray, z: np.ndarray) -> np.ndarray:
-    x = np.zeros(n)
+def _state(base: np.ndarray, names: tuple[str, ...], scales: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """``base`` (the state kicked) plus the disturbance ``z`` (sizes along ``names``, scaled to state units)."""
+    x = base.copy()
     for name, s, value in zip(names, scales, z, strict=True):
-        x[COMPONENTS[name][0]] = s * value
+        x[COMPONENTS[name][0]] += s * value
     return x
 
 
@@ -188,6 +206,98 @@ def _prepare(config, V, Fz, params, diagram, executor, t_max, report, expected) 
     return runs
 
 
+@dataclass(frozen=True)
+class Direction:
+    """What a margin is searched along: ``kind`` "component" (one of psi, dpsi, delta, ddelta), "mix" (a given mix of
+    them) or "energy" (all four); the components ``names`` and their ``scales`` (state change per unit of size);
+    for a component or a mix the unit vector ``u`` in size coordinates, and ``length``: the size of the mix as
+    given (a threshold of size a is a / length times the mix)."""
+
+    kind: str
+    names: tuple[str, ...]
+    scales: np.ndarray
+    u: np.ndarray | None
+    length: float = 1.0
+
+    @classmethod
+    def of(cls, options: MarginOptions, norm) -> "Direction":
+        if options.direction == "energy":
+            return cls("energy", ENERGY_COMPONENTS, norm.scales(ENERGY_COMPONENTS), None)
+        if options.direction == "mix":
+            given = mix_vector(options.mix)
+            names = tuple(given)
+            scales = norm.scales(names)
+            z = np.array([given[name] for name in names]) / scales
+            length = float(np.linalg.norm(z))
+            return cls("mix", names, scales, z / length, length)
+        names = (options.direction,)
+        return cls("component", names, norm.scales(names), np.array([1.0]))
+
+    @property
+    def in_energy(self) -> bool:
+        """Sizes reported as energies (J): several components at once."""
+        return self.kind != "component"
+
+
+@dataclass(frozen=True)
+class Origin:
+    """The states a disturbance may be added to (``states``: one row per phase, ``PHASE_STEPS`` rows between two
+    sampled phases; straight rolling: one row of zeros), the rows sampled first (``sampled``), the phases as
+    fractions of the period after a yaw maximum (None for straight rolling), and what it is (``info``, the
+    result's ``origin``)."""
+
+    states: np.ndarray
+    sampled: tuple[int, ...]
+    phases: np.ndarray | None
+    info: dict[str, Any]
+
+    @property
+    def refined(self) -> bool:
+        """Whether the phase of each smallest threshold is located between the sampled phases."""
+        return len(self.sampled) > 1
+
+
+def _straight(n: int, why: str) -> Origin:
+    return Origin(np.zeros((1, n)), (0,), None, {"kind": "straight_rolling", "attractor": None, "note": why})
+
+
+def _origin(runs: _Runs, options: MarginOptions, n: int) -> Origin:
+    """Straight rolling, or the attractor the standard start reaches (``options.origin``), sampled at
+    ``options.phases`` phases of its orbit (:func:`~shimmy.analyses.maps.point_attractors.orbit_states`)."""
+    found = runs.found
+    if options.origin == "straight_rolling":
+        return _straight(n, "straight rolling, the rest of the state at rest")
+    label = found.standard
+    if label is None:
+        raise ConvergenceError(f"the standard start (psi = {DISCOVERY_STARTS[0][2]:g} rad) settles on no attractor "
+                               f"within {options.t_max:g} s at V = {runs.V:g} m/s, Fz = {kn(runs.Fz)}: there is no "
+                               "attractor to disturb (origin standard_attractor)")
+    attractor = found.attractors[label]
+    if attractor["kind"] == "equilibrium":
+        return _straight(n, "the standard start ends on straight rolling: the disturbance is added to it")
+    x0 = np.zeros(n)
+    x0[0] = DISCOVERY_STARTS[0][2]
+    steps = PHASE_STEPS if options.phases > 1 else 1
+    rows = options.phases * steps
+    unit = OrbitUnit(runs.config, runs.V, runs.Fz, runs.params, tuple(map(float, x0)), found.classifier, label,
+                     options.t_max, rows)
+    orbit = runs.units([unit])[0]
+    if orbit["states"] is None:
+        raise ConvergenceError(f"the orbit of the standard start's {attractor['mode']} attractor at V = {runs.V:g} "
+                               f"m/s, Fz = {kn(runs.Fz)} was not reached: {orbit['status']}")
+    info = {"kind": "standard_attractor", "attractor": label, "mode": attractor["mode"],
+            "period_s": orbit["period"], "phases": options.phases, "settled_at_s": orbit["t_s"],
+            "note": f"the {attractor['mode']} {attractor['kind']} the standard start reaches, kicked at "
+                    + (f"{options.phases} phases of its yaw period ({orbit['period']:.4g} s; phase 0 at a yaw "
+                       f"maximum, to 1 ms), each threshold the smallest over them, its phase located to 1/{rows} of "
+                       "the period between the sampled ones" if options.phases > 1 else
+                       f"a yaw maximum (to 1 ms) of its period ({orbit['period']:.4g} s)")}
+    if not orbit["settled"]:
+        info["warning"] = (f"its amplitude still changed by more than {100 * ORBIT_SETTLED:g} % per {WINDOW:g} s at "
+                           f"{options.t_max:g} s")
+    return Origin(orbit["states"][:, :n], tuple(range(0, rows, steps)), np.arange(rows) / rows, info)
+
+
 def _outcome(found: PointAttractors, end: tuple, size: float, unit: str, l_g: float) -> dict[str, Any]:
     """A check run's end: the size it started from (in ``unit``), the attractor it ends on (None: none), its mode."""
     label, psi, delta, t, _ = end
@@ -198,67 +308,152 @@ def _outcome(found: PointAttractors, end: tuple, size: float, unit: str, l_g: fl
             "t_s": t}
 
 
-def _method(options: MarginOptions, names: tuple[str, ...], swept: int) -> str:
-    unit = "rad (the yaw angle of the same energy)" if len(names) > 1 else COMPONENTS[names[0]][1]
+def _method(options: MarginOptions, d: Direction, swept: int, origin: Origin) -> str:
+    unit = "rad (the yaw angle of the same energy)" if d.in_energy else COMPONENTS[d.names[0]][1]
     runs = (f"each run classified by its amplitudes within {100 * MATCH_TOL:g} % of the attractor's (energy-weighted) "
             f"and nearer to it than to any saddle cycle over two {WINDOW:g} s windows (at most {options.t_max:g} s)")
-    if len(names) == 1:
-        return (f"bracketing scan of {options.scan_points} sizes in geometric steps from {options.min_size:g} to "
-                f"{options.max_size:g} {unit} (in {names[0]}: the sizes of the same energy), then bisection to "
+    start = f"from {origin.info['note']}; "
+    if d.kind == "component":
+        return (f"{start}bracketing scan of {options.scan_points} sizes in geometric steps from {options.min_size:g} "
+                f"to {options.max_size:g} {unit} (in {d.names[0]}: the sizes of the same energy), then bisection to "
                 f"{options.rtol:g} of the threshold; {runs}")
-    return (f"sweep of {swept} directions in ({', '.join(names)}) (the axes and the diagonals of every pair, in the "
-            f"energy norm), along each a bracketing scan of {options.scan_points} sizes from {options.min_size:g} to "
-            f"{options.max_size:g} {unit} and bisection to {options.rtol:g}; then a pattern search on the unit sphere "
-            f"from the best direction, down to {MIN_ANGLE_DEG:g} degree; {runs}")
+    if d.kind == "mix":
+        return (f"{start}along the mix {options.mix} (its direction in the energy norm): bracketing scan of "
+                f"{options.scan_points} sizes in geometric steps from {options.min_size:g} to {options.max_size:g} "
+                f"{unit}, then bisection to {options.rtol:g} of the threshold; {runs}")
+    return (f"{start}sweep of {swept} directions in ({', '.join(d.names)}) (the axes and the diagonals of every pair, "
+            f"in the energy norm), along each a bracketing scan of {options.scan_points} sizes from "
+            f"{options.min_size:g} to {options.max_size:g} {unit} and bisection to {options.rtol:g}; then a pattern "
+            f"search on the unit sphere from the best direction, down to {MIN_ANGLE_DEG:g} degree; {runs}")
 
 
-def _unreached(options: MarginOptions, names: tuple[str, ...], norm, swept: int) -> dict[str, Any]:
-    energy = len(names) > 1
-    limit = norm.energy(options.max_size) if energy else options.max_size * norm.scales(names)[0]
-    unit = "J" if energy else COMPONENTS[names[0]][1]
-    return {"value": None, "unit": unit, "direction": "energy" if energy else names[0],
-            "method": _method(options, names, swept), "tolerance": None, "reached": False,
-            "note": f"no disturbance up to {limit:.4g} {unit} {'along any direction swept ' if energy else ''}"
-                    "ends on it", "check": None}
+def _unreached(options: MarginOptions, d: Direction, norm, swept: int, origin: Origin) -> dict[str, Any]:
+    limit = norm.energy(options.max_size) if d.in_energy else options.max_size * d.scales[0]
+    unit = "J" if d.in_energy else COMPONENTS[d.names[0]][1]
+    return {"value": None, "unit": unit, "direction": options.direction, "method": _method(options, d, swept, origin),
+            "tolerance": None, "reached": False,
+            "note": f"no disturbance up to {limit:.4g} {unit} {'along any direction swept ' if d.kind == 'energy' else ''}"
+                    "ends on it" + (f" at any of the {len(origin.sampled)} phases" if origin.refined else ""),
+            "check": None}
 
 
-def _minimum(found: PointAttractors, options: MarginOptions, names: tuple[str, ...], scales: np.ndarray, norm,
-             t: Threshold, u: np.ndarray, check: dict[str, Any], label: int, swept: int, l_g: float) -> dict[str, Any]:
-    """``min_disturbance`` of one attractor from its threshold ``t`` (sizes) along ``u``."""
-    energy = len(names) > 1
-    if energy:
+@dataclass(frozen=True)
+class Found:
+    """The smallest threshold of one attractor: its bracket ``t`` along the unit vector ``u`` (size coordinates),
+    from origin row ``row``, and the threshold's value at every row searched ({row: size or None})."""
+
+    t: Threshold
+    u: np.ndarray
+    row: int
+    by_row: dict[int, float | None]
+
+
+def _minimum(found: PointAttractors, options: MarginOptions, d: Direction, norm, hit: Found, check: dict[str, Any],
+             label: int, swept: int, l_g: float, origin: Origin) -> dict[str, Any]:
+    """``min_disturbance`` of one attractor from its smallest threshold ``hit``."""
+    t = hit.t
+    if d.in_energy:
         unit = "J"
         convert = norm.energy
         value = 0.0 if t.lower == 0.0 else norm.energy(t.value)
         tolerance = norm.energy(t.upper) if t.lower == 0.0 else 0.5 * (norm.energy(t.upper) - norm.energy(t.lower))
     else:
-        unit = COMPONENTS[names[0]][1]
+        unit = COMPONENTS[d.names[0]][1]
 
         def convert(size: float) -> float:
-            return float(size * scales[0])
+            return float(size * d.scales[0])
         value, tolerance = convert(t.value), convert(t.tolerance)
     sides = {side: None if check[side] is None else _outcome(found, check[side][1], convert(check[side][0]), unit, l_g)
              for side in ("below", "above")}
     below_ok = sides["below"] is None or sides["below"]["ends_on"] != label
     confirmed = bool(below_ok and sides["above"] is not None and sides["above"]["ends_on"] == label)
-    out = {"value": value, "unit": unit, "direction": options.direction, "method": _method(options, names, swept),
-           "tolerance": tolerance, "rtol": options.rtol, "reached": True, "lower": convert(t.lower),
-           "upper": convert(t.upper), "energy_J": norm.energy(t.value), "equivalent_psi": t.value,
-           "disturbance": {name: float(s * c * t.value) for name, s, c in zip(names, scales, u, strict=True)},
+    out = {"value": value, "unit": unit, "direction": options.direction,
+           "method": _method(options, d, swept, origin), "tolerance": tolerance, "rtol": options.rtol, "reached": True,
+           "lower": convert(t.lower), "upper": convert(t.upper), "energy_J": norm.energy(t.value),
+           "equivalent_psi": t.value,
+           "disturbance": {name: float(s * c * t.value) for name, s, c in zip(d.names, d.scales, hit.u, strict=True)},
            "check": {**sides, "confirmed": confirmed}}
+    if d.kind == "mix":
+        out["mix"] = options.mix
+        out["factor"] = t.value / d.length
+    if origin.phases is not None:
+        out["phase"] = float(origin.phases[hit.row])
+        out["origin_state"] = [float(x) for x in origin.states[hit.row]]
+        out["by_phase"] = [{"phase": float(origin.phases[row]),
+                            "value": None if v is None else norm.energy(v) if d.in_energy else convert(v)}
+                           for row, v in sorted(hit.by_row.items())]
     if t.lower == 0.0:
         out["note"] = (f"reached from the smallest size scanned ({convert(t.upper):.4g} {unit}): the threshold is "
                        "below it")
     return out
 
 
+def _search(probe, d: Direction, options: MarginOptions) -> tuple[dict[int, tuple[Threshold, np.ndarray]], int]:
+    """The smallest threshold of every attractor reached from one state, along the direction or over all."""
+    sizes = geometric_sizes(options.min_size, options.max_size, options.scan_points)
+    if d.kind == "energy":
+        rays, best = smallest_over_directions(probe, len(d.names), sizes, options.rtol, width=ROUND_WIDTH,
+                                              min_angle=math.radians(MIN_ANGLE_DEG))
+        return {label: (s.threshold, s.direction) for label, s in best.items()}, len(rays)
+    ray = Ray(d.u)
+    scan([ray], sizes, probe)
+    refine([ray], probe, options.rtol, ROUND_WIDTH)
+    return {label: (ray.threshold(label), ray.direction) for label in ray.reached()}, 1
+
+
+def _best_row(per_row: dict[int, dict[int, tuple[Threshold, np.ndarray]]], label: int) -> int:
+    """The row (phase) of the smallest threshold of ``label`` among the rows searched."""
+    rows = [(k, found[label][0]) for k, found in per_row.items() if label in found]
+    return min(rows, key=lambda row: (row[1].value, row[1].upper, row[0]))[0]
+
+
+def _smallest(per_row: dict[int, dict[int, tuple[Threshold, np.ndarray]]]) -> dict[int, Found]:
+    """Each attractor's smallest threshold over the origin's rows searched (phases)."""
+    out: dict[int, Found] = {}
+    for label in dict.fromkeys(label for found in per_row.values() for label in found):
+        k = _best_row(per_row, label)
+        t, u = per_row[k][label]
+        by_row = {row: found[label][0].value if label in found else None for row, found in per_row.items()}
+        out[label] = Found(t, u, k, by_row)
+    return out
+
+
+def _search_phases(origin: Origin, search: Callable[[int], dict[int, tuple[Threshold, np.ndarray]]],
+                   report: Callable[[str], None]) -> dict[int, dict[int, tuple[Threshold, np.ndarray]]]:
+    """The thresholds from every sampled row of ``origin``; then, for each attractor reached, its smallest
+    threshold's phase located between the sampled ones: the rows half way to the best row's neighbours, then
+    half of that, down to one row (``PHASE_STEPS`` between two sampled phases: three halvings). A local search:
+    the threshold need not be smooth in the phase, and a narrow dip between two sampled phases can be missed."""
+    per_row: dict[int, dict[int, tuple[Threshold, np.ndarray]]] = {}
+    rows = len(origin.states)
+
+    def at(row: int) -> None:
+        if row not in per_row:
+            report(f"phase {row / rows:.4g} of the period" if origin.refined else "")
+            per_row[row] = search(row)
+    for row in origin.sampled:
+        at(row)
+    if not origin.refined:
+        return per_row
+    for label in list(dict.fromkeys(label for found in per_row.values() for label in found)):
+        if per_row[_best_row(per_row, label)][label][0].lower == 0.0:
+            continue  # reached from the smallest size already at a sampled phase: nothing to locate
+        step = PHASE_STEPS // 2
+        while step >= 1:
+            best = _best_row(per_row, label)
+            for row in ((best - step) % rows, (best + step) % rows):
+                at(row)
+            step //= 2
+    return per_row
+
+
 def margins(config: Configuration | str, V: float, Fz: float, *, params: Parameters | None = None,
             options: MarginOptions | None = None, diagram=None, executor=None,
             progress: Callable[[float, str], None] | None = None, **option_overrides) -> MarginsResult:
-    """The attractors at (V, Fz) (m/s, N) and the smallest disturbance from straight rolling that ends on each,
-    along ``options.direction`` (module docstring). ``diagram``: the one-parameter diagram in V at Fz, if
-    already computed (default: computed, and kept for the process). Options as a :class:`MarginOptions` or as
-    keyword overrides (``direction="energy"``)."""
+    """The attractors at (V, Fz) (m/s, N) and the smallest disturbance that ends on each, from straight rolling
+    or from the attractor the standard start reaches (``options.origin``), along ``options.direction`` (module
+    docstring). ``diagram``: the one-parameter diagram in V at Fz, if already computed (default: computed, and
+    kept for the process). Options as a :class:`MarginOptions` or as keyword overrides (``direction="energy"``)."""
     clock = time.perf_counter()
     config = Configuration.parse(config)
     V, Fz = check_operating_point(V, Fz)
@@ -272,58 +467,55 @@ def margins(config: Configuration | str, V: float, Fz: float, *, params: Paramet
                              progress=progress)
         return MarginsResult(**{**result.__dict__, "executor": name_of(None)})
     report = progress or (lambda fraction, message: None)
-    energy = options.direction == "energy"
-    names = ENERGY_COMPONENTS if energy else (options.direction,)
     per_ray = options.scan_points + 10
-    expected = 3 + (len(sweep_directions(len(names))) * per_ray + 80 if energy else per_ray) + 6
-    runs = _prepare(config, V, Fz, params, diagram, executor, options.t_max, report, expected)
+    rows = options.phases + (6 if options.phases > 1 else 0) if options.origin == "standard_attractor" else 1
+    per_row = len(sweep_directions(4)) * per_ray + 80 if options.direction == "energy" else per_ray
+    runs = _prepare(config, V, Fz, params, diagram, executor, options.t_max, report, 3 + rows * per_row + 6)
+    report = runs.report
     found = runs.found
     norm = found.norm
-    scales = norm.scales(names)
-    n = config.n_states
-
-    def probe(points: np.ndarray) -> list[int]:
-        return [end[0] for end in runs.run([_state(n, names, scales, z) for z in points])]
-
-    sizes = geometric_sizes(options.min_size, options.max_size, options.scan_points)
+    d = Direction.of(options, norm)
+    origin = _origin(runs, options, config.n_states)
     report(0.1, "bracketing scan")
-    if energy:
-        rays, best = smallest_over_directions(probe, len(names), sizes, options.rtol, width=ROUND_WIDTH,
-                                              min_angle=math.radians(MIN_ANGLE_DEG))
-        found_at = {label: (s.threshold, s.direction) for label, s in best.items()}
-        swept = len(rays)
-    else:
-        ray = Ray(np.array([1.0]))
-        scan([ray], sizes, probe)
-        refine([ray], probe, options.rtol, ROUND_WIDTH)
-        found_at = {label: (ray.threshold(label), ray.direction) for label in ray.reached()}
-        swept = 1
+    swept = 1
+
+    def search(row: int) -> dict[int, tuple[Threshold, np.ndarray]]:
+        nonlocal swept
+        base = origin.states[row]
+
+        def probe(points: np.ndarray) -> list[int]:
+            return [end[0] for end in runs.run([_state(base, d.names, d.scales, z) for z in points])]
+        thresholds, swept = _search(probe, d, options)
+        return thresholds
+
+    per_row = _search_phases(origin, search, lambda message: message and report(
+        min(0.9, 0.1 + 0.85 * runs.count / runs.expected), message))
+    found_at = _smallest(per_row)
     report(0.95, "checking every threshold by two runs")
     checks: list[tuple[int, str, float]] = []
     starts = []
-    for label, (t, u) in found_at.items():
-        for side, size in (("below", t.lower), ("above", t.upper)):
+    for label, hit in found_at.items():
+        for side, size in (("below", hit.t.lower), ("above", hit.t.upper)):
             if size > 0.0:
                 checks.append((label, side, size))
-                starts.append(_state(n, names, scales, size * u))
+                starts.append(_state(origin.states[hit.row], d.names, d.scales, size * hit.u))
     ends = runs.run(starts, full=True)
     checked: dict[int, dict[str, Any]] = {}
     for (label, side, size), end in zip(checks, ends, strict=True):
         checked.setdefault(label, {"below": None, "above": None})[side] = (size, end)
-    warnings: list[str] = []
+    warnings: list[str] = [f"the orbit kicked: {origin.info['warning']}"] if "warning" in origin.info else []
     minima = []
     for label, attractor in enumerate(found.attractors):
         if label not in found_at:
-            minima.append(_unreached(options, names, norm, swept))
+            minima.append(_unreached(options, d, norm, swept, origin))
             continue
-        t, u = found_at[label]
-        minima.append(_minimum(found, options, names, scales, norm, t, u, checked.get(label, {"below": None,
-                               "above": None}), label, swept, params.gear.l_g))
+        minima.append(_minimum(found, options, d, norm, found_at[label], checked.get(label, {"below": None,
+                               "above": None}), label, swept, params.gear.l_g, origin))
         if not minima[-1]["check"]["confirmed"]:
             warnings.append(f"the threshold of the {attractor['mode']} attractor is not confirmed by its check runs")
     report(1.0, "done")
     return MarginsResult(config, V, Fz, params, options, found, minima, runs.count + found.runs, runs.unsettled,
-                         time.perf_counter() - clock, type(executor).__name__, warnings)
+                         time.perf_counter() - clock, type(executor).__name__, warnings, origin.info)
 
 
 def basins(config: Configuration | str, V: float, Fz: float, *, params: Parameters | None = None,
@@ -350,7 +542,7 @@ def basins(config: Configuration | str, V: float, Fz: float, *, params: Paramete
     names = ENERGY_COMPONENTS
     scales = found.norm.scales(names)
     points = sample_ball(len(names), options.radius, options.samples, options.seed)
-    labels = [end[0] for end in runs.run([_state(config.n_states, names, scales, z) for z in points])]
+    labels = [end[0] for end in runs.run([_state(np.zeros(config.n_states), names, scales, z) for z in points])]
     counts = [labels.count(k) for k in range(len(found.attractors))]
     report(1.0, "done")
     return BasinsResult(config, V, Fz, params, options, found, counts, labels.count(UNSETTLED), labels.count(FAILED),

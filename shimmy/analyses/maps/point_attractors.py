@@ -204,6 +204,87 @@ def run_to_attractor(model, x0: np.ndarray, V: float, Fz: float, attractors: Att
     return label, float(last[0]), float(last[1]), windows * WINDOW, bool(settled or label >= 0)
 
 
+#: The orbit a disturbance is added to is settled when its energy amplitude changes by less than this between
+#: two windows.
+ORBIT_SETTLED = 1e-3
+
+
+@dataclass(frozen=True)
+class OrbitUnit:
+    """The states at ``count`` phases of the attractor ``label`` that the run from ``start`` settles on (a small
+    frozen unit for the executor): :func:`orbit_states`."""
+
+    config: Configuration
+    V: float
+    Fz: float
+    params: Parameters
+    start: tuple[float, ...]
+    attractors: AttractorSet
+    label: int
+    t_max: float
+    count: int
+
+    def run(self) -> dict[str, Any]:
+        return orbit_states(build_model(self.config, self.params), np.array(self.start), self.V, self.Fz,
+                            self.attractors, self.label, self.t_max, self.count)
+
+    def describe(self) -> str:
+        return f"the orbit the standard start reaches at V = {self.V:g} m/s"
+
+
+def _maxima(psi: np.ndarray) -> np.ndarray:
+    """The samples where psi has a positive local maximum."""
+    inner = (psi[1:-1] > psi[:-2]) & (psi[1:-1] >= psi[2:]) & (psi[1:-1] > 0.0)
+    return np.flatnonzero(inner) + 1
+
+
+def orbit_states(model, x0: np.ndarray, V: float, Fz: float, attractors: AttractorSet, label: int, t_max: float,
+                 count: int) -> dict[str, Any]:
+    """The run from ``x0``, in windows of ``WINDOW``, until it is matched to attractor ``label`` in two windows in
+    a row and its energy amplitude changed by less than ``ORBIT_SETTLED`` between them (at most ``t_max``); then,
+    from the state at the last maximum of the yaw angle psi in that window (phase 0, to the 1 ms of the
+    samples), the states at ``count`` equal steps over one yaw period (the mean spacing of the window's psi
+    maxima; the window's length if it has fewer than two). Returns {"states": count x N_FULL rows or None,
+    "period" (s), "t_s": the time settled, "settled", "status": why there are no states}."""
+    start = np.zeros(integrator.N_FULL)
+    start[:x0.size] = x0
+    samples = int(round(WINDOW / DT_OUT)) + 1
+    out = np.empty((samples, integrator.N_FULL))
+    windows = int(math.ceil(t_max / WINDOW - 1e-9))
+    previous_size, streak, settled = None, 0, False
+    written = 0
+    for w in range(windows):
+        status, _, _, _, written = integrator.integrate(start, WINDOW, DT_OUT, V, Fz, model.coefficients, *model.flags,
+                                                        1e-7, 1e-10, 10_000_000, out)
+        if status != integrator.SUCCESS:
+            return {"states": None, "period": None, "t_s": w * WINDOW, "settled": False,
+                    "status": "the integration failed"}
+        start = out[written - 1].copy()
+        psi, delta = peak_amplitude(out[:written, 0]), peak_amplitude(out[:written, 2])
+        size = float(np.linalg.norm(attractors.vector(psi, delta)))
+        here = attractors.label(psi, delta, previous_size is not None and size < previous_size)
+        streak = streak + 1 if here == label else 0
+        change = math.inf if not previous_size else abs(size / previous_size - 1.0)
+        previous_size = size
+        if streak >= 2 and change < ORBIT_SETTLED:
+            settled = True
+            break
+    if streak < 2:
+        return {"states": None, "period": None, "t_s": windows * WINDOW, "settled": False,
+                "status": f"the run is not on attractor {label} at {windows * WINDOW:g} s"}
+    t_settled = (w + 1) * WINDOW
+    peaks = _maxima(out[:written, 0])
+    period = float(np.mean(np.diff(peaks))) * DT_OUT if peaks.size >= 2 else WINDOW
+    phase0 = out[peaks[-1]].copy() if peaks.size else out[written - 1].copy()
+    rows = np.empty((count + 1, integrator.N_FULL))
+    status, _, _, _, got = integrator.integrate(phase0, period, period / count, V, Fz, model.coefficients,
+                                                *model.flags, 1e-7, 1e-10, 10_000_000, rows)
+    if status != integrator.SUCCESS or got < count:
+        return {"states": None, "period": period, "t_s": t_settled, "settled": settled,
+                "status": "the integration over one period failed"}
+    return {"states": rows[:count].copy(), "period": period, "t_s": t_settled, "settled": settled, "status": "ok"}
+
+
 def cycles_at(diagram, V: float) -> list[dict[str, Any]]:
     """Every cycle of the diagram's periodic branches at speed V, stable or not (linear between the drawn
     points, as :func:`~shimmy.analyses.maps.map_slices.attractors_on` reads them), except the

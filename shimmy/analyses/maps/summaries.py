@@ -73,10 +73,17 @@ def margins_summary(result: dict[str, Any]) -> str:
     """The lines ``python -m shimmy margins`` prints, from ``MarginsResult.to_dict()``: each attractor with the
     smallest disturbance that ends on it and its two check runs, the saddle cycles, the runs, the warnings."""
     direction = result["direction"]
+    mix = result["options"].get("mix")
+    along = {"energy": "over all directions (energy)", "mix": f"along the mix {mix}"}.get(direction,
+                                                                                        f"along {direction}")
+    origin = result.get("origin") or {"kind": "straight_rolling"}
     lines = [f"{result['config']} at V = {result['V']:g} m/s, Fz = {kn(result['Fz'])}: straight rolling "
              f"{'stable' if result['straight_rolling_stable'] else 'unstable'}, {len(result['attractors'])} "
-             f"attractor{'s' if len(result['attractors']) != 1 else ''}; smallest disturbance "
-             + ("over all directions (energy)" if direction == "energy" else f"along {direction}")]
+             f"attractor{'s' if len(result['attractors']) != 1 else ''}; smallest disturbance {along}"]
+    if origin["kind"] == "standard_attractor":
+        lines.append(f"  from {origin['note']}")
+    elif origin.get("note", "").startswith("the standard start"):
+        lines.append(f"  from straight rolling: {origin['note']}")
     for a in result["attractors"]:
         lines.append(_attractor_line(a))
         m = a["min_disturbance"]
@@ -87,10 +94,13 @@ def margins_summary(result: dict[str, Any]) -> str:
             text = f"0 (reached from the smallest size scanned, {m['upper']:.4g} {m['unit']})"
         else:
             text = f"{m['value']:.5g} {m['unit']} +- {m['tolerance']:.2g}"
-        if direction == "energy" and m["value"] > 0.0:
+        if direction in ("energy", "mix") and m["value"] > 0.0:
             parts = ", ".join(f"{k} {v:.4g}" for k, v in m["disturbance"].items())
-            text += f" (yaw angle of the same energy {m['equivalent_psi']:.4g} rad: {parts})"
-        lines.append(f"      smallest {direction}: {text}{_check_text(m['check'])}")
+            times = f"{m['factor']:.4g} times the mix, " if direction == "mix" else ""
+            text += f" ({times}yaw angle of the same energy {m['equivalent_psi']:.4g} rad: {parts})"
+        if "phase" in m and m["value"] > 0.0:
+            text += f", at phase {m['phase']:.3g} of the period"
+        lines.append(f"      smallest {'kick' if direction == 'mix' else direction}: {text}{_check_text(m['check'])}")
     for s in result["saddles"]:
         lines.append(f"  saddle cycle ({s['mode']}): psi {s['amplitude']['psi']:.4g} rad, "
                      f"l_g delta {mm(s['amplitude']['lateral'], 4)}")

@@ -4,6 +4,7 @@ coexists with another attractor, the smallest yaw kick that starts it)."""
 
 from __future__ import annotations
 
+from ...analyses.maps.margin_options import MIX_EXAMPLE
 from ..answers import add_no_cache, answer, design, emit, numbers, request
 from ..common import (add_command, add_common, add_config, add_field, add_operating_point, add_plane, add_progress,
                       progress)
@@ -19,8 +20,8 @@ def _ask(args, analysis: str, settings: tuple[str, ...], extra: dict | None = No
 def _cmd_margins(args) -> int:
     from ...analyses.maps.summaries import margins_summary
 
-    result = _ask(args, "margins", ("max_size", "min_size", "scan_points", "rtol", "t_max"),
-                  {"direction": args.direction})
+    result = _ask(args, "margins", ("max_size", "min_size", "scan_points", "rtol", "t_max", "phases"),
+                  {"direction": args.direction, "mix": args.mix, "origin": args.origin})
     emit(result.result, [result], args.json, margins_summary(result.result))
     return 0
 
@@ -47,10 +48,16 @@ def _cmd_margin_map(args) -> int:
 
 def add_parsers(commands) -> None:
     p = add_command(commands, "margins", "disturbance margins at one operating point: its attractors and the "
-                    "smallest kick from straight rolling that ends on each, each checked by two runs", _cmd_margins)
+                    "smallest kick (from straight rolling, or from the attractor the standard start reaches) that ends on each, "
+                    "each checked by two runs", _cmd_margins)
     add_operating_point(p)
-    add_field(p, "margins", "--direction", "the kicked component (the rest at rest), or energy: all four, the "
-              "smallest energy")
+    add_field(p, "margins", "--direction", "the kicked component (the rest at rest), mix: the mix of --mix, or "
+              "energy: all four, the smallest energy")
+    add_field(p, "margins", "--mix", "with --direction mix: the components in their units, such as "
+              f"'{MIX_EXAMPLE}' (only the direction counts)")
+    add_field(p, "margins", "--origin", "kick straight rolling, or the attractor the standard start reaches (at "
+              "--phases points of its orbit)")
+    add_field(p, "margins", "--phases", "phases of the orbit kicked with --origin standard_attractor", limits=True)
     add_field(p, "margins", "--max-size", "largest kick scanned, as the yaw angle of the same energy",
               limits=True)
     add_field(p, "margins", "--min-size", "smallest kick scanned, as the yaw angle of the same energy",

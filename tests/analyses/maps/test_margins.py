@@ -126,6 +126,10 @@ def test_a_bistable_point_where_no_yaw_kick_reaches_the_lateral_cycle(pool):
 @pytest.mark.parametrize("overrides, field", [
     ({"direction": "yaw"}, "direction"), ({"rtol": 0}, "rtol"), ({"max_size": 2}, "max_size"),
     ({"min_size": 0.05, "max_size": 0.01}, "min_size"), ({"scan_points": 2.5}, "scan_points"), ({"t_max": 5}, "t_max"),
+    ({"direction": "mix"}, "mix"), ({"direction": "mix", "mix": "psi=0, dpsi=0"}, "mix"),
+    ({"direction": "mix", "mix": "psi=1,psi=2"}, "mix"), ({"direction": "mix", "mix": "psi=x"}, "mix"),
+    ({"direction": "mix", "mix": "psi=nan"}, "mix"), ({"direction": "mix", "mix": "yaw=1"}, "mix"),
+    ({"mix": "psi=1"}, "mix"), ({"origin": "cycle"}, "origin"), ({"phases": 33}, "phases"),
 ])
 def test_bad_settings_are_refused_naming_the_field(overrides, field):
     with pytest.raises(InvalidParameterError) as info:
@@ -164,3 +168,92 @@ def test_a_run_is_on_an_attractor_only_within_ten_percent_and_nearer_to_it_than_
     assert cycles.decaying() == UNSETTLED
     alone = AttractorSet(((0.0, 0.0),), (True,), (), 4.0, 1.0)
     assert alone.decaying() == 0 and alone.label(0.0004, 0.0, True) == 0 and alone.label(0.0006, 0.0, True) == UNSETTLED
+
+
+@pytest.fixture(scope="module")
+def from_cycle(pool):
+    return margins(*POINT, direction="psi", origin="standard_attractor", phases=4, executor=pool)
+
+
+def test_kicks_from_the_standard_starts_cycle_find_the_torsional_threshold_over_its_phases(from_cycle):
+    """Kicked on the lateral cycle the standard start reaches, at four phases of its period, the smallest yaw kick to
+    the torsional cycle is the smallest over the phases, and two independent 60 s time histories from that phase's
+    state, kicked 2 % below and above it, end on the lateral and on the torsional cycle."""
+    result = from_cycle.to_dict()
+    origin = result["origin"]
+    assert origin["kind"] == "standard_attractor" and origin["mode"] == "lateral" and origin["phases"] == 4
+    assert origin["period_s"] == pytest.approx(0.0624, rel=0.02)
+    modes = [a["mode"] for a in result["attractors"]]
+    lateral, torsional = (result["attractors"][modes.index(m)] for m in ("lateral", "torsional"))
+    assert lateral["min_disturbance"]["value"] == 0.0  # the origin's own attractor: the smallest kick stays there
+    m = torsional["min_disturbance"]
+    by_phase = {row["phase"]: row["value"] for row in m["by_phase"]}
+    assert {0.0, 0.25, 0.5, 0.75} <= set(by_phase) and m["check"]["confirmed"]
+    assert m["value"] == min(v for v in by_phase.values() if v is not None) == by_phase[m["phase"]]
+    sampled = min(v for p, v in by_phase.items() if p in (0.0, 0.25, 0.5, 0.75) and v is not None)
+    assert m["value"] <= sampled  # located between the sampled phases: no larger than the best of them
+    step = 1 / 32
+    neighbours = [by_phase.get(round((m["phase"] + s) % 1.0, 12)) for s in (-step, step)]
+    assert all(v is not None and v >= m["value"] for v in neighbours)  # a local minimum to 1/32 of the period
+    assert m["value"] > 0.05  # far above the 0.0165 rad from straight rolling: the lateral cycle holds
+    base = np.array(m["origin_state"])
+    assert abs(base[0]) <= 0.0293 * 1.02 and abs(base[2]) > 0.0  # a state on the lateral cycle
+    for factor, expected in ((0.98, ResponseType.LATERAL), (1.02, ResponseType.TORSION)):
+        x0 = base.copy()
+        x0[0] += factor * m["value"]
+        run = simulate("original", 50.0, 550e3, x0=list(x0), t_end=60.0)
+        assert run.response_type is expected and run.steady, factor
+    assert "from the lateral limit cycle the standard start reaches" in from_cycle.summary_text()
+
+
+def test_the_orbit_kicked_is_a_cycle_of_the_attractor(from_cycle):
+    """The states the kicks are added to lie on the lateral cycle: one period from each returns to it (within 2 % of
+    the amplitude; the period is the mean spacing of the yaw maxima on the 1 ms samples), and their yaw angles
+    reach the cycle's amplitude of the diagram."""
+    from shimmy.analyses.maps.point_attractors import OrbitUnit
+    from shimmy.model import integrator
+    from shimmy.model.equations import build_model
+
+    found = from_cycle.found
+    unit = OrbitUnit(Configuration.ORIGINAL, 50.0, 550e3, Parameters(), (0.001, 0, 0, 0, 0), found.classifier,
+                     found.standard, 80.0, 16)
+    orbit = unit.run()
+    states, period = orbit["states"], orbit["period"]
+    assert orbit["settled"] and states.shape == (16, integrator.N_FULL)
+    model = build_model(Configuration.ORIGINAL, Parameters())
+    out = np.empty((2, integrator.N_FULL))
+    scale = np.abs(states).max(axis=0)[:4]
+    for x in states[::4]:
+        integrator.integrate(x.copy(), period, period, 50.0, 550e3, model.coefficients, *model.flags, 1e-9, 1e-12,
+                             10_000_000, out)
+        assert np.all(np.abs(out[1, :4] - x[:4]) <= 0.02 * scale)
+    assert states[0, 0] == pytest.approx(found.attractors[found.standard]["amplitude"]["psi"], rel=0.02)
+
+
+def test_a_mix_along_one_component_is_that_component(yaw, pool):
+    """A mix of one component is that component's direction: the same threshold, in J of the same energy, and as a
+    multiple of the mix; a mix of two keeps its proportions at the threshold, confirmed by its check runs."""
+    torsional = next(a for a in yaw.to_dict()["attractors"] if a["mode"] == "torsional")["min_disturbance"]
+    mix = margins(*POINT, direction="mix", mix="psi=0.002", executor=pool).to_dict()
+    m = next(a for a in mix["attractors"] if a["mode"] == "torsional")["min_disturbance"]
+    assert m["unit"] == "J" and m["mix"] == "psi=0.002"
+    assert m["equivalent_psi"] == pytest.approx(torsional["value"], rel=1e-12)
+    assert m["factor"] == pytest.approx(torsional["value"] / 0.002, rel=1e-12)
+    two = margins(*POINT, direction="mix", mix="dpsi=0.1, psi=0.01", executor=pool).to_dict()
+    m = next(a for a in two["attractors"] if a["mode"] == "torsional")["min_disturbance"]
+    assert two["options"]["mix"] == "psi=0.01,dpsi=0.1" and m["check"]["confirmed"]
+    assert m["disturbance"]["dpsi"] == pytest.approx(10.0 * m["disturbance"]["psi"], rel=1e-12)
+    assert m["disturbance"]["psi"] == pytest.approx(0.01 * m["factor"], rel=1e-12)
+
+
+def test_where_the_standard_start_ends_on_straight_rolling_the_kicks_start_there(pool):
+    """At a point where straight rolling is the standard start's attractor, origin standard_attractor is straight
+    rolling, and says so: the same thresholds as from straight rolling."""
+    point = ("original", 5.0, 150e3)  # below the first Hopf speed (6.7 m/s at 150 kN)
+    plain = margins(*point, executor=pool).to_dict()
+    assert next(a for a in plain["attractors"] if a["standard_start"])["mode"] == "equilibrium"
+    kicked = margins(*point, origin="standard_attractor", executor=pool).to_dict()
+    assert kicked["origin"]["kind"] == "straight_rolling" and "standard start ends on straight" in \
+        kicked["origin"]["note"]
+    assert [a["min_disturbance"]["value"] for a in kicked["attractors"]] == \
+        [a["min_disturbance"]["value"] for a in plain["attractors"]]
