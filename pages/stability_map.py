@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+import math
 from urllib.parse import urlencode
 
 import dash
@@ -40,6 +42,13 @@ MARGIN_WAITING = ("Press Compute margins: the smallest yaw kick to torsional shi
 HEIGHT, BOTTOM = 740, 176
 FAINT, FAINT_REGIONS = 0.35, 0.16  # a previous design's curves and regions under the map being made
 MARGIN_REGIONS = 0.4  # the map's regions under the margins
+#: The iso-margin lines and their labels (rad): dark, the lines over a white halo and the labels on white, to read
+#: on the Viridis markers and on every region's colour.
+MARGIN_LINES = {"color": "#1a1a1a", "width": 1.3}
+MARGIN_STEPS = (5.0, 2.5, 2.0, 1.0)  # the step between two iso-margin lines: one of these x 10^k rad
+MARGIN_LEVELS = 4  # at least so many iso-margin lines (the largest step giving as many: 4 to 8)
+PLOT_PX = (490, 480)  # the plot's width and height (px) in a 1024 px window: where the lines' labels must not overlap
+LABEL_PX = (6.5, 16)  # a label's width per character and its height (px)
 
 
 def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | None = None,
@@ -93,7 +102,9 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
                "attractor (the Bistable cells, and any where straight rolling is stable beside a cycle): the "
                "smallest yaw kick from straight rolling that ends on the torsional cycle, for the shaded "
                "configuration and this design, each checked by two runs. 0: the standard start (psi = 0.001 rad) "
-               "already ends there. Click a cell to run its time history from just above its kick.", className="hint"),
+               "already ends there. Each cell is a coloured square (its margin on hover) under labelled contour "
+               "lines of equal kick (rad); click a cell to run its time history from just above its kick.",
+               className="hint"),
         html.Div([CELLS_V.field(f"Cells in V ({CELLS_V.low:g}-{CELLS_V.high:g})", ids.MAPM_NV, cells["margin_nv"]),
                   CELLS_FZ.field(f"Cells in Fz ({CELLS_FZ.low:g}-{CELLS_FZ.high:g})", ids.MAPM_NFZ,
                                  cells["margin_nfz"]),
@@ -437,10 +448,134 @@ def _kick_text(point, max_size):
             + ("" if point["confirmed"] else "; not confirmed by its check runs"))
 
 
+def margin_grid(result):
+    """The margins of a margin map on the regular grid of its cells' centres: (V in m/s, Fz in kN, z) with z[j][i]
+    the margin (rad) of the cell at (V[i], Fz[j]), NaN where there is none (a cell not computed: one attractor or
+    no torsional cycle there; or no kick up to the largest reaching torsional shimmy)."""
+    V, Fz = result["V"], result["Fz"]
+    z = [[math.nan] * len(V) for _ in Fz]
+    for p in result["points"]:
+        if p["margin"] is not None:
+            i = min(range(len(V)), key=lambda k: abs(V[k] - p["V"]))
+            j = min(range(len(Fz)), key=lambda k: abs(Fz[k] - p["Fz"]))
+            z[j][i] = p["margin"]
+    return list(V), [f / units.KN for f in Fz], z
+
+
+def margin_levels(low, high):
+    """The iso-margin levels (rad) strictly between the margins ``low`` and ``high``, evenly spaced by the largest
+    round step (MARGIN_STEPS) that gives at least MARGIN_LEVELS of them (so 4 to 8); none if ``high`` is not above
+    ``low``."""
+    if not high > low:
+        return []
+    for k in range(math.floor(math.log10(high - low)), -16, -1):
+        for step in MARGIN_STEPS:
+            size = step * 10.0 ** k
+            first, last = math.floor(low / size) + 1, math.ceil(high / size) - 1
+            if last - first + 1 >= MARGIN_LEVELS:
+                return [float(f"{n * size:.12g}") for n in range(first, last + 1)]
+    return []
+
+
+def _cropped(V, Fz, z):
+    """The grid cut to the rows and columns that hold a margin (Plotly fills the empty cells to draw, then hides
+    them: less of a line is drawn where it cannot be seen)."""
+    rows = [j for j, row in enumerate(z) if any(not math.isnan(m) for m in row)]
+    columns = [i for i in range(len(V)) if any(not math.isnan(row[i]) for row in z)]
+    if not rows:
+        return [], [], []
+    rows, columns = range(rows[0], rows[-1] + 1), range(columns[0], columns[-1] + 1)
+    return [V[i] for i in columns], [Fz[j] for j in rows], [[z[j][i] for i in columns] for j in rows]
+
+
+def _square(z):
+    """Whether some square of four neighbouring cells holds three or more margins (Plotly draws a contour only
+    there: it clips its lines to the cells that have a value)."""
+    return any(sum(not math.isnan(z[j + a][i + b]) for a in (0, 1) for b in (0, 1)) >= 3
+               for j in range(len(z) - 1) for i in range(len(z[0]) - 1))
+
+
+def _crossings(z, level, levels):
+    """Where the line of ``level`` crosses the edge between two neighbouring cells with margins (so where it is
+    drawn): (row, column) as fractional indices of z, the levels crossing that edge, the cells with margins at
+    its ends and beside it (row, column)."""
+    def has(j, i):
+        return 0 <= j < len(z) and 0 <= i < len(z[0]) and not math.isnan(z[j][i])
+
+    for j, i, (dj, di) in itertools.product(range(len(z)), range(len(z[0])), ((0, 1), (1, 0))):
+        if has(j, i) and has(j + dj, i + di) and (z[j][i] - level) * (z[j + dj][i + di] - level) < 0:
+            a, b = z[j][i], z[j + dj][i + di]
+            t = (level - a) / (b - a)
+            near = [(j + dj * e + di * s, i + di * e + dj * s) for e in (0, 1) for s in (-1, 0, 1)]
+            yield (j + t * dj, i + t * di), sum((a - m) * (b - m) < 0 for m in levels), [c for c in near if has(*c)]
+
+
+def _gap(a, b, cell):
+    """How far apart two boxes ((row, column), (width, height) px) are, on cells of ``cell`` (width, height) px:
+    as a multiple of the distance at which they would touch (below 1: they overlap)."""
+    ((ya, xa), (wa, ha)), ((yb, xb), (wb, hb)) = a, b
+    return max(abs(xa - xb) * cell[0] / ((wa + wb) / 2), abs(ya - yb) * cell[1] / ((ha + hb) / 2))
+
+
+def _label_places(z, levels, cell, marker):
+    """Where to write each level on its line, as (level, (row, column)) in fractional indices of z: on an edge
+    that line crosses between two cells with margins, over no label placed before (a level without such a place
+    goes unlabelled), best over none of the markers (``marker`` px on cells of ``cell`` px), inside the cells with
+    margins, crossed by no other line and away from the other labels. (Plotly's own labels, ``showlabels``, are
+    placed along the whole line, the part it hides over the empty cells too: some came out cut or unseen.)"""
+    placed = []
+    for level in levels:
+        box = (LABEL_PX[0] * len(f"{level:g}") + 4, LABEL_PX[1])
+        best, most = None, -math.inf
+        for at, lines, near in _crossings(z, level, levels):
+            apart = min((_gap((at, box), other, cell) for _, other in placed), default=3.0)
+            covered = sum(_gap((at, box), (c, (marker, marker)), cell) < 1 for c in near)
+            score = len(near) - 2 * covered - (lines - 1) + min(apart, 3.0)
+            if apart >= 1 and score > most:
+                best, most = at, score
+        if best is not None:
+            placed.append((level, (best, box)))
+    return [(level, at) for level, (at, _) in placed]
+
+
+def _at(axis, k):
+    """The value at the fractional index ``k`` of an evenly spaced ``axis``."""
+    return axis[0] + k * (axis[1] - axis[0]) if len(axis) > 1 else axis[0]
+
+
+def _margin_lines(fig, result):
+    """Iso-margin lines over the cells with margins, each labelled in rad, over a white halo (no hover: the
+    markers keep theirs; no colour bar: the markers' says rad). None where nothing is to contour: no square of
+    neighbouring cells with margins, or all margins equal."""
+    V, Fz, z = _cropped(*margin_grid(result))
+    reached = [m for row in z for m in row if not math.isnan(m)]
+    levels = margin_levels(min(reached, default=0.0), max(reached, default=0.0))
+    if not levels or not _square(z):
+        return
+    contours = {"coloring": "lines", "start": levels[0], "end": levels[-1],
+                "size": float(f"{levels[1] - levels[0]:.12g}"), "showlabels": False}
+    for name, line in (("iso-margin halo", style.halo(MARGIN_LINES["width"])), ("iso-margin lines", MARGIN_LINES)):
+        fig.add_contour(x=V, y=Fz, z=z, connectgaps=False, showscale=False, hoverinfo="skip", zorder=1, name=name,
+                        colorscale=[[0, line["color"]], [1, line["color"]]], line={"width": line["width"]},
+                        contours=contours)
+    cell = (PLOT_PX[0] / result["grid"]["n_v"], PLOT_PX[1] / result["grid"]["n_fz"])
+    for level, (y, x) in _label_places(z, levels, cell, _marker_size(result)):
+        fig.add_annotation(x=_at(V, x), y=_at(Fz, y), text=f"{level:g}", showarrow=False, name="iso-margin label",
+                           font={"size": 11, "color": MARGIN_LINES["color"]}, bgcolor="rgba(255,255,255,0.85)",
+                           borderpad=1)
+
+
+def _marker_size(result):
+    """A margin's marker (px): as large as the cells allow (the plot is some 500 px high and 500-900 px wide)."""
+    return max(6.0, min(18.0, 360.0 / result["grid"]["n_v"], 240.0 / result["grid"]["n_fz"]))
+
+
 def margin_figure(result, smap=None, why=""):
     """The margins of a margin map as coloured markers at the cells' centres (a colour bar in rad: dark, a small
-    kick) over the map's regions and curves (``smap``: the shown map of the same configuration, design and plane,
-    if any, else ``why`` not in the title); crosses where no kick up to the largest reaches torsional shimmy."""
+    kick; their margins on hover) under labelled iso-margin contour lines (a round step between them, drawn over
+    the cells with margins only) over the map's regions and curves (``smap``: the shown map of the same
+    configuration, design and plane, if any, else ``why`` not in the title); crosses where no kick up to the
+    largest reaches torsional shimmy."""
     label, colour = style.CONFIG_LABELS[result["config"]], style.CONFIG_COLOURS[result["config"]]
     series = [(label, colour)]
     max_size = result["options"]["max_size"]
@@ -453,8 +588,7 @@ def margin_figure(result, smap=None, why=""):
     if smap is not None:
         _regions(fig, smap, MARGIN_REGIONS)
         _curves(fig, [smap], series, "configuration")
-    # a marker per cell, as large as the cells allow (the plot is some 500 px high and 600-900 px wide)
-    size = max(6.0, min(18.0, 360.0 / result["grid"]["n_v"], 240.0 / result["grid"]["n_fz"]))
+    size = _marker_size(result)
     fig.add_scatter(x=[p["V"] for p in reached], y=[p["Fz"] / units.KN for p in reached], mode="markers",
                     name="min yaw kick", showlegend=False, customdata=[_kick_text(p, max_size) for p in reached],
                     marker={"size": size, "symbol": "square", "color": [p["margin"] for p in reached],
@@ -465,6 +599,7 @@ def margin_figure(result, smap=None, why=""):
                                          "len": 0.6, "y": 0.62}},
                     hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history"
                                   "</extra>")
+    _margin_lines(fig, result)
     if crossed:
         fig.add_scatter(x=[p["V"] for p in crossed], y=[p["Fz"] / units.KN for p in crossed], mode="markers",
                         marker={"symbol": "x-thin", "size": size * 0.8, "line": {"width": 2, "color": "#333"}},

@@ -13,8 +13,9 @@ from shimmy.errors import InvalidParameterError
 import shimmy.model.units as units
 from shimmy.model.configurations import STATE_NAMES, STATE_UNITS
 from shimmy.service import analyses, settings
+from shimmy.service.schemas import MIX_EXAMPLE
 from ui import components as ui
-from ui import fields, ids, jobs
+from ui import fields, formats, ids, jobs
 from ui import style
 from ui.series import DETAIL_SAMPLES, band, detail, last_cycles
 from ui.fields import Quantity
@@ -35,6 +36,12 @@ STARTS = {"standard": ("standard: psi = 0.001 rad", 0.001, 0.0),
           "typed": ("values typed below", None, None)}
 WAITING = "Choose an operating point and press Run (a result already in the cache is shown at once)"
 MARGINS_STALE = "Press Compute margins for this operating point (any margins shown are of the previous one)."
+#: The margins' kicks offered: a component (the rest as it was), a mix, or any direction (the smallest energy).
+KICKS = {"psi": "yaw angle psi", "dpsi": "yaw rate dpsi", "delta": "lateral bending delta",
+         "ddelta": "lateral bending rate ddelta", "mix": "a mix (typed beside)", "energy": "any (smallest energy)"}
+#: The kick's direction in the table's note.
+KICK_NOTE = {**KICKS, "mix": "the mix", "energy": "any direction (the smallest energy)"}
+ORIGIN_WORDS = {"straight_rolling": "straight rolling", "standard_attractor": "the standard start's attractor"}
 ATTRACTOR_WORDS = {"equilibrium": "straight rolling", "torsional": "torsional limit cycle",
                    "lateral": "lateral limit cycle", "both": "limit cycle, torsion and lateral bending both large"}
 
@@ -97,11 +104,23 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
         html.H2("Disturbance margins"),
         html.P("The attractors at this operating point (the stable equilibrium and limit cycles of the bifurcation "
                "diagram at its load, and any motion the runs from the standard and two large starts settle on), "
-               "and for each the smallest yaw kick psi0 from straight rolling that ends on it, found by a scan of "
-               "kicks and bisection, each checked by two runs just below and just above it. A row's Run button "
-               "runs the time history above from just above its kick: the gear ends on that attractor.",
+               "and for each the smallest kick that ends on it, found by a scan of kicks and bisection, each "
+               "checked by two runs just below and just above it. The kick is added to straight rolling, or to "
+               "the attractor the standard start reaches (at eight phases of its period, the best one then located "
+               "between them); along one component, a mix you type (each component in its unit, such as "
+               "psi=0.01,dpsi=0.2; the size is searched), or any direction (the smallest energy). A row's Run "
+               "button runs the time history above from just above its kick: the gear ends on that attractor.",
                className="hint"),
-        html.Div(jobs.controls(ids.THM, "Compute margins"), className="controls"),
+        html.Div([ui.field("Kick along", dcc.Dropdown(id=ids.THM_DIRECTION, value="psi", clearable=False,
+                                                      style={"width": "220px"},
+                                                      options=[{"label": v, "value": k} for k, v in KICKS.items()])),
+                  ui.field("Mix", dcc.Input(id=ids.THM_MIX, type="text", placeholder=MIX_EXAMPLE, debounce=True,
+                                            disabled=True, style={"width": "190px"})),
+                  ui.field("Kick added to", dcc.Dropdown(id=ids.THM_ORIGIN, value="straight_rolling", clearable=False,
+                                                         style={"width": "290px"}, options=[
+                                                             {"label": v, "value": k}
+                                                             for k, v in ORIGIN_WORDS.items()])),
+                  *jobs.controls(ids.THM, "Compute margins")], className="controls"),
         html.Div(id=ids.THM.error, className="error", role="alert"),
         html.Div(id=ids.THM_TABLE, className="table-wrap"),
         ui.downloads(ids.THM),
@@ -155,6 +174,10 @@ def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, torque, 
     series_dt = max(0.002, math.ceil(1000 * t / (settings.MAX_SERIES_POINTS - 1)) / 1000)
     common = {"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "t_end": t, "include_series": True,
               "series_dt": series_dt, **ui.exact_nes(config, torque), **design}
+    kick = _kick if isinstance(_kick, dict) else {}
+    if kick.get("x0") and kick.get("point") == [config, common["V"], common["Fz"]] and \
+            (psi0, lateral0) == (kick.get("psi0"), kick.get("lateral0")):
+        return [{**common, "x0": kick["x0"]}]  # a margin's kick, the boxes untouched since it was set
     starts = [(PSI0.read(psi0), LATERAL0.read(lateral0))]
     if bistable:
         large = [(PSI0.read(p), LATERAL0.read(q)) for key in ("torsional", "lateral") for _, p, q in [STARTS[key]]]
@@ -226,17 +249,43 @@ jobs.register(
     download=jobs.Download(ids.TH_GROUP, "time_history", _csv_rows, single=True, filename=_file_stem))
 
 
-def _margin_requests(config, V, fz_kn, design):
-    return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "direction": "psi", **design}]
+def _margin_requests(config, V, fz_kn, direction, mix, origin, design):
+    return [{"config": config, "V": SPEED.read(V), "Fz": FZ.read(fz_kn), "direction": direction,
+             "mix": (mix or "") if direction == "mix" else None, "origin": origin, **design}]
+
+
+@dash.callback(Output(ids.THM_MIX, "disabled"), Input(ids.THM_DIRECTION, "value"))
+def mix_box(direction):
+    """The mix is typed only for a kick along a mix."""
+    return direction != "mix"
 
 
 def _kick(m, max_size):
-    """An attractor's smallest yaw kick in words."""
+    """An attractor's smallest kick in words: its size and unit, with a mix the multiple of it, from an orbit the
+    phase."""
     if not m["reached"]:
-        return f"none up to {max_size:g} rad"
+        return m.get("note") or f"none up to {max_size:g} rad"
     if m["value"] == 0.0:
-        return f"0 (already from {m['upper']:g})"
-    return f"{m['value']:.4g} ± {m['tolerance']:.1g}"
+        return f"0 (already from {m['upper']:.4g} {m['unit']})"
+    text = (f"{formats.significant_or_whole(m['value'])} ± {formats.significant_or_whole(m['tolerance'], 2)} "
+            f"{m['unit']}")
+    if "factor" in m:
+        text += f" ({m['factor']:.4g} × the mix)"
+    if "phase" in m:
+        text += f" at {m['phase']:.3g} of the period"
+    return text
+
+
+def _run_start(m):
+    """The whole start of a row's run: that of its check run just above the smallest kick (None where no kick
+    reaches the attractor)."""
+    above = (m.get("check") or {}).get("above") if m["reached"] else None
+    return None if above is None or "x0" not in above else above["x0"]
+
+
+def _yaw_only(x0) -> bool:
+    """A start the psi0 box says whole: a yaw angle, the rest at rest."""
+    return all(x == 0.0 for x in x0[1:])
 
 
 def _check(m):
@@ -255,21 +304,28 @@ def margins_table(result):
         what = ATTRACTOR_WORDS.get(a["mode"], a["mode"]) + (" (simulated)" if a["kind"] == "simulation" else "")
         if a["standard_start"]:
             what += " (the standard start ends here)"
-        start = None if not m["reached"] else (STARTS["standard"][1] if m["value"] == 0.0 else m["upper"])
-        button = "–" if start is None else html.Button(f"Run from psi0 = {start:.5g} rad", id=ids.thm_run(k),
-                                                        className="secondary")
+        x0 = _run_start(m)
+        label = None if x0 is None else (f"Run from psi0 = {x0[0]:.5g} rad" if _yaw_only(x0) else
+                                          "Run from this kick")
+        button = "–" if x0 is None else html.Button(label, id=ids.thm_run(k), className="secondary")
         equilibrium = a["mode"] == "equilibrium"
         rows.append([what, "0" if equilibrium else f"{a['amplitude']['psi']:.4g}",
                      "0" if equilibrium else f"{units.to_mm(a['amplitude']['lateral']):.4g}",
                      _kick(m, result["options"]["max_size"]), _check(m), button])
     saddles = "; ".join(f"{s['mode']}, psi {s['amplitude']['psi']:.4g} rad" for s in result["saddles"])
+    origin = result.get("origin") or {}
+    kicked = (f"kicks along {KICK_NOTE.get(result['direction'], result['direction'])}"
+              + (f" {result['options']['mix']}" if result["direction"] == "mix" else "")
+              + (f" added to {origin['note']}" if origin.get("kind") == "standard_attractor" else
+                 " from straight rolling" + (f" ({origin['note']})" if "standard start" in origin.get("note", "")
+                                             else "")))
     note = (f"{style.CONFIG_LABELS[result['config']]} at V = {result['V']:g} m/s, Fz = {units.kn(result['Fz'])}: "
-            f"straight rolling {'stable' if result['straight_rolling_stable'] else 'unstable'}"
+            f"{kicked}; straight rolling {'stable' if result['straight_rolling_stable'] else 'unstable'}"
             + (f"; saddle cycles between the basins: {saddles}" if saddles else "")
             + f". {result['runs']} runs in {result['elapsed_s']:.1f} s.")
     warnings = [html.P(f"Warning: {w}", className="hint") for w in result["warnings"]]
     return [html.P(note, className="hint"), ui.table(
-        ["attractor", "max |psi| (rad)", "max |l_g delta| (mm)", "min yaw kick psi0 (rad)", "checked (psi0 → end)",
+        ["attractor", "max |psi| (rad)", "max |l_g delta| (mm)", "smallest kick", "checked (kick → end)",
          "time history"], rows, ids.THM_SUMMARY), *warnings]
 
 
@@ -279,18 +335,19 @@ def _margin_csv(results):
              a["min_disturbance"]["value"], a["min_disturbance"]["tolerance"], a["min_disturbance"].get("lower"),
              a["min_disturbance"].get("upper"), (a["min_disturbance"]["check"] or {}).get("confirmed")]
             for a in r["attractors"]]
-    return ["mode", "kind", "psi_amplitude_rad", "lateral_amplitude_mm", "standard_start", "min_yaw_kick_rad",
-            "tolerance_rad", "lower_rad", "upper_rad", "confirmed"], rows
+    return ["mode", "kind", "psi_amplitude_rad", "lateral_amplitude_mm", "standard_start", "min_kick", "tolerance",
+            "lower", "upper", "confirmed"], rows
 
 
 jobs.register(
     ids.THM, "margins", requests=_margin_requests, render=lambda results: (margins_table(results[0]),),
     outputs=[Output(ids.THM_TABLE, "children")],
-    follow=[Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value")],
+    follow=[Input(ids.TH_CONFIG, "value"), Input(ids.TH_V, "value"), Input(ids.TH_FZ, "value"),
+            Input(ids.THM_DIRECTION, "value"), Input(ids.THM_MIX, "value"), Input(ids.THM_ORIGIN, "value")],
     states=[State(ids.design_store(ids.TH), "data")], stale=MARGINS_STALE,
     download=jobs.Download(ids.THM, "disturbance_margins", _margin_csv, single=True,
                            filename=lambda results: f"margins_{results[0]['config']}_V{results[0]['V']:g}_Fz"
-                                                    f"{results[0]['Fz'] / units.KN:g}kN"),
+                                                    f"{results[0]['Fz'] / units.KN:g}kN_{results[0]['direction']}"),
     blank=lambda: (None,))
 
 
@@ -314,15 +371,21 @@ def run_from_kick(clicks, requests, t_end, config, V, fz_kn):
     k = trigger["index"]
     if result is None or not isinstance(k, int) or not 0 <= k < len(result["attractors"]):
         return nothing
-    m = result["attractors"][k]["min_disturbance"]
-    if not m["reached"]:
+    x0 = _run_start(result["attractors"][k]["min_disturbance"])
+    if x0 is None:
         return nothing
-    psi0 = STARTS["standard"][1] if m["value"] == 0.0 else float(f"{m['upper']:.5g}")
     longest = result["options"]["t_max"]
     t = t_end if isinstance(t_end, (int, float)) and t_end >= longest else longest
     point = (result["config"], result["V"], result["Fz"] / units.KN)
     moved = [new if new != old else no_update for new, old in zip(point, (config, V, fz_kn), strict=True)]
-    return psi0, 0.0, t, *moved, {"attractor": k, "psi0": psi0, "clicks": sum(c or 0 for c in clicks)}
+    kick = {"attractor": k, "clicks": sum(c or 0 for c in clicks)}
+    if _yaw_only(x0):  # the boxes say the whole start
+        psi0 = float(f"{x0[0]:.5g}")
+        return psi0, 0.0, t, *moved, {**kick, "psi0": psi0}
+    # a start the boxes cannot say: run from x0 while the boxes hold the values set here (its psi and l_g delta)
+    psi0, lateral0 = float(f"{x0[0]:.6g}"), float(f"{result['params']['l_g'] * x0[2] / units.MM:.6g}")
+    return psi0, lateral0, t, *moved, {**kick, "x0": x0, "psi0": psi0, "lateral0": lateral0,
+                                       "point": [result["config"], result["V"], result["Fz"]]}
 
 
 # A run asked from the margins' table is drawn at the top of the page: it scrolls up there (the start in the boxes,
@@ -498,6 +561,9 @@ def settled(result):
     start = result.get("start") or {}
     psi0, lat0 = start.get("psi0"), start.get("lateral0")
     where = "" if psi0 is None else f"From psi0 = {psi0:g} rad, l_g delta0 = {units.mm(lat0)} the run "
+    if "x0" in start:
+        state = ", ".join(f"{name} {x:.4g} {unit}" for name, unit, x in zip(STATE_NAMES, STATE_UNITS, start["x0"]))
+        where = f"From the margins' kick ({state}) the run "
     verb = "settled on" if result["steady"] else "was still approaching (not yet steady at t_end)"
     f = result["frequency_hz"]
     amp = result["amplitude"]

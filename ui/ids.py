@@ -210,6 +210,9 @@ THM = Group("thm")  # the point's disturbance margins
 THM_TABLE = "thm-table"
 THM_SUMMARY = "thm-summary"
 THM_RUN_TYPE = "thm-run"  # {"type", "index"}: the run button of an attractor's row
+THM_DIRECTION = "thm-direction"  # the kick's direction: a component, a mix or all (energy)
+THM_MIX = "thm-mix"  # the mix's components, "psi=0.01,dpsi=0.2"
+THM_ORIGIN = "thm-origin"  # what the kick is added to: straight rolling, or the standard start's attractor
 
 
 def th_op(name: Any) -> dict[str, Any]:

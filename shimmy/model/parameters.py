@@ -366,6 +366,8 @@ FZ_RANGE = (1.0e4, 9.0e5)
 DIAGRAM_V_RANGE = (V_RANGE[0], 200.0)
 #: The load (N) of the one-load questions (the study's Figs. 3-10): every such default reads it.
 DEFAULT_FZ = 150e3
+#: The standard start of a time history (rad of torsion, the rest of the state at rest), as the study's.
+DEFAULT_PSI0 = 0.001
 #: Classified Fz slices of a stability map by default (its boundaries are continued curves; the
 #: slices tell the regions' types, and more are added through regions they miss).
 DEFAULT_MAP_SLICES = 10

@@ -59,11 +59,16 @@ def simulate(request: dict[str, Any], progress: Progress | None = None) -> dict[
                                         f"{request['t_end']:g} s (at most {MAX_SERIES_POINTS} samples per series)",
                                         "gives too many samples")
     params = _params(request)
-    x0 = kicked_state(request["config"], params, request["psi0"], request["lateral0"])
+    if request["x0"] is None:
+        x0 = kicked_state(request["config"], params, request["psi0"], request["lateral0"])
+        start = {"psi0": request["psi0"], "lateral0": request["lateral0"]}
+    else:
+        x0 = request["x0"]  # checked with the request (schemas.check_whole_state)
+        start = {"psi0": x0[0], "lateral0": params.gear.l_g * x0[2], "x0": x0}
     result = run_simulation(request["config"], request["V"], request["Fz"], params=params, t_end=request["t_end"],
                             exact_nes=request["exact_nes"], x0=x0)
     out = result.to_dict()
-    out["start"] = {"psi0": request["psi0"], "lateral0": request["lateral0"]}
+    out["start"] = start
     if request["include_series"]:
         out["series"] = {k: v[::stride] for k, v in result.series().items()}
         out["series_dt"] = stride * result.options.dt_out

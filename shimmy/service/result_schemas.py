@@ -126,7 +126,7 @@ RESULTS: dict[str, Schema] = {
         "steady": BOOL, "success": BOOL, "message": STR,
         "counters": mapping(INT, "integrator counters"), "options": mapping({}, "the integrator's settings"),
         "params": ref("Params"), "version": VERSION,
-        "start": obj({"psi0": num("rad"), "lateral0": num("m")})},
+        "start": obj({"psi0": num("rad"), "lateral0": num("m")}, {"x0": NUMBERS})},
         {"series": mapping(NUMBERS, "time series sampled every series_dt (t in s, angles in rad, lateral in m)"),
          "series_dt": num("s"),
          "spectrum": obj({"frequency_hz": NUMBERS, "psi": NUMBERS, "lateral": NUMBERS},
@@ -282,7 +282,12 @@ RESULTS: dict[str, Schema] = {
         "operating_points": mapping(VP, "the operating points by name"), "refused_samples": INT,
         "elapsed_s": ELAPSED, "executor": EXECUTOR, "warnings": ref("Warnings"), "methods": METHODS,
         "version": VERSION}),
-    "margins": obj({**_MARGIN_COMMON, "direction": STR, "unsettled_runs": INT}),
+    "margins": obj({**_MARGIN_COMMON, "direction": STR, "unsettled_runs": INT,
+                    "origin": obj({"kind": STR, "attractor": nullable(INT)},
+                                  {"note": STR, "mode": STR, "period_s": num("s"), "phases": INT,
+                                   "settled_at_s": num("s"), "warning": STR},
+                                  "what the kicks were added to: straight rolling, or the attractor the standard "
+                                  "start reaches (its period and the phases kicked)")}),
     "basins": obj({**_MARGIN_COMMON, "unsettled": INT, "failed": INT, "energy_J": num("J"), "method": STR}),
     "margin_map": obj({
         "config": CONFIG, "params": ref("Params"), "v_range": PAIR, "fz_range": PAIR,

@@ -20,10 +20,12 @@ from ..analyses.decisions import design_space
 from ..analyses.ground.ground_profiles import MAX_PROFILE_POINTS, PRESETS
 from ..analyses.ground import kicks
 from ..analyses.maps import margin_options
-from ..model.parameters import (DEFAULT_FZ, DEFAULT_MAP_SLICES, DIAGRAM_V_RANGE, FZ_RANGE, MATERIALS,
+from ..model.parameters import (DEFAULT_FZ, DEFAULT_MAP_SLICES, DEFAULT_PSI0, DIAGRAM_V_RANGE, FZ_RANGE, MATERIALS,
                                 PARAMETER_SPECS, V_RANGE, Parameters, check_number, unknown_name_error)
 
 CONFIGS = tuple(c.value for c in Configuration)
+#: A margin's mix as typed (the workbench's placeholder).
+MIX_EXAMPLE = margin_options.MIX_EXAMPLE
 
 
 @dataclass(frozen=True)
@@ -322,6 +324,28 @@ def _check_robustness(out: dict[str, Any]) -> None:
                                     "points each)")
 
 
+def _check_simulate(out: dict[str, Any]) -> None:
+    """``x0``: one number per state of the configuration, psi and l_g delta within the ranges of psi0 and lateral0,
+    and not together with a psi0 or lateral0 of its own."""
+    if out.get("x0") is None:
+        return
+    x0, config = out["x0"], out["config"]
+    n = Configuration.parse(config).n_states
+    if len(x0) != n:
+        raise InvalidParameterError("x0", x0, f"{n} numbers for {config} (psi, dpsi, delta, ddelta, lambda"
+                                    + (", the NES rotation and rate)" if n == 7 else ")"), "has the wrong length")
+    l_g = Parameters.from_dict(out["params"]).gear.l_g
+    if abs(x0[0]) > 0.5:
+        raise InvalidParameterError("x0[0]", x0[0], "a number in [-0.5, 0.5] rad (psi)", "is out of range")
+    if abs(l_g * x0[2]) > 0.5:
+        raise InvalidParameterError("x0[2]", x0[2], f"delta in [{-0.5 / l_g:.4g}, {0.5 / l_g:.4g}] rad (l_g delta "
+                                    "within [-0.5, 0.5] m)", "is out of range")
+    for name, default in (("psi0", DEFAULT_PSI0), ("lateral0", 0.0)):
+        if out[name] != default:
+            raise InvalidParameterError(name, out[name], f"its default ({default:g}) when x0 is given",
+                                        "is given together with x0")
+
+
 def _check_margins(out: dict[str, Any]) -> None:
     """The settings together, as the analysis checks them (min_size below max_size; a mix with direction mix
     only), the mix in its canonical text (equal mixes, one cache key)."""
@@ -331,7 +355,7 @@ def _check_margins(out: dict[str, Any]) -> None:
 
 
 _CHECKS = {"sensitivity": _check_sensitivity, "optimise": _check_optimise, "robustness": _check_robustness,
-           "margins": _check_margins}
+           "margins": _check_margins, "simulate": _check_simulate}
 _RULES = {
     "margins": "Margins: min_size below max_size; mix given with direction mix and only then, as "
                f"'{margin_options.MIX_EXAMPLE}' (components of " + ", ".join(margin_options.COMPONENTS) + ").",
@@ -423,9 +447,13 @@ SCHEMAS: dict[str, RequestSchema] = {
               default=0.002, low=0.001, high=0.1, unit="s"),
         Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
         Field("psi0", "number", "initial torsion psi (the standard start: 0.001 rad; the rest of the state zero "
-              "unless lateral0 is given)", default=0.001, low=-0.5, high=0.5, unit="rad"),
+              "unless lateral0 is given)", default=DEFAULT_PSI0, low=-0.5, high=0.5, unit="rad"),
         Field("lateral0", "number", "initial lateral bending displacement l_g delta", default=0.0, low=-0.5,
               high=0.5, unit="m"),
+        Field("x0", "numbers", "the whole initial state instead of psi0 and lateral0, one number per state of the "
+              "configuration: psi (rad), dpsi (rad/s), delta (rad), ddelta (rad/s), lambda, and with the NES its "
+              "rotation and rate (a margin's start, origin_state plus the kick); psi and l_g delta within "
+              "[-0.5, 0.5] as psi0 and lateral0", high=7),
         PARAMS, MATERIAL)),
     "hopf": RequestSchema("hopf", "Hopf points of straight rolling in V at one load", (
         _config(), FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),

@@ -46,6 +46,11 @@ def test_canonical_requests_fill_the_defaults_of_the_analysis():
     ("margin_map", {"fz_min": 5e5, "fz_max": 4e5}, "fz_max", "must exceed fz_min"),
     ("margin_map", {"max_size": 0.001}, "max_size", r"allowed: a number in \[0.002, 1\] rad"),
     ("margin_map", {"V": 50}, "V", "unknown field"),
+    ("simulate", {"x0": [0.1, 0, 0]}, "x0", "5 numbers for original"),
+    ("simulate", {"x0": [0.6, 0, 0, 0, 0]}, "x0[0]", r"allowed: a number in \[-0.5, 0.5\] rad"),
+    ("simulate", {"x0": [0.1, 0, 0.3, 0, 0]}, "x0[2]", r"l_g delta within \[-0.5, 0.5\] m"),
+    ("simulate", {"x0": [0.1, 0, 0, 0, 0], "lateral0": 0.1}, "lateral0", "is given together with x0"),
+    ("simulate", {"x0": [0.1, None, 0, 0, 0]}, "x0[1]", "is not a number"),
 ])
 def test_refusals_name_the_field(analysis, body, field, message):
     base = PLANE if analysis == "margin_map" else POINT
@@ -121,3 +126,17 @@ def test_a_margin_map_job_over_http(server):
     assert [p["V"] for p in job["result"]["points"]] == [60.0, 100.0, 60.0]
     status, _, answer = server.request("POST", "/api/v1/jobs", {"analysis": "margin_map", **PLANE, "n_v": 100})
     assert status == 422 and answer["field"] == "n_v"
+
+
+def test_a_simulation_from_a_margins_check_state_ends_where_the_check_run_ended(tmp_path, monkeypatch):
+    """A margin's check run starts from a whole state (``check.above.x0``: the orbit's state plus the kick); the
+    time history from that ``x0`` (the workbench's Run from this kick) ends on the attractor the check ended on."""
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("SHIMMY_WORKERS", "1")
+    result, _ = analyses.run("margins", {**POINT, "origin": "standard_attractor", "phases": 2})
+    torsional = next(a for a in result["attractors"] if a["mode"] == "torsional")["min_disturbance"]
+    above = torsional["check"]["above"]
+    assert above["mode"] == "torsional" and len(above["x0"]) == 5 and any(above["x0"][1:])
+    run, _ = analyses.run("simulate", {**POINT, "x0": above["x0"], "t_end": 80})
+    assert run["response_type"] == "Torsion" and run["start"]["x0"] == above["x0"]
+    assert run["start"]["psi0"] == above["x0"][0] and run["start"]["lateral0"] == pytest.approx(2.5 * above["x0"][2])

@@ -1,8 +1,8 @@
 """Disturbance margins in the workbench, in real Chromium against gunicorn (tests/ui/browser.py): on the Time
 history page at original (50 m/s, 550 kN), opened as from a Bistable map point, the margins' table names the
 torsional cycle with its smallest yaw kick (~0.0165 rad) and its Run button runs the time history from just above
-it, which ends torsional; on the map page the margins of a small plane are drawn over the map. Bounded: one
-point, a 2 x 2 plane; waits, no timing assertions."""
+it, which ends torsional; on the map page the margins of a small plane are drawn over the map, as markers under
+labelled contour lines. Bounded: one point, a 2 x 2 plane; waits, no timing assertions."""
 
 from __future__ import annotations
 
@@ -115,6 +115,23 @@ def test_margins_on_the_map_over_its_regions_and_a_click_runs_from_the_kick(serv
     assert all(0 < v < 0.4 for v in kicks[2])
     hover = on_figure(browser, "mapm-graph", "return g.data.filter(t => t.name === 'min yaw kick')[0].customdata[0];")
     assert hover.startswith("min yaw kick to torsional shimmy: ") and hover.endswith(")")
+    # over the markers, contour lines of the cells' margins on their grid (none at (100, 800): not multistable),
+    # drawn as line paths clipped to the three cells, each level labelled
+    x, y, z, contours = on_figure(browser, "mapm-graph", "const t = g.data.filter(t => t.name === 'iso-margin "
+                                                         "lines')[0]; return [t.x, t.y, t.z, t.contours];")
+    margin = dict(zip(zip(kicks[0], kicks[1], strict=True), kicks[2], strict=True))
+    assert (x, y) == ([60, 100], [600, 800]) and contours["coloring"] == "lines"
+    assert z == [[margin[60, 600], margin[100, 600]], [margin[60, 800], None]]
+    levels = round((contours["end"] - contours["start"]) / contours["size"]) + 1
+    assert 4 <= levels <= 8 and min(kicks[2]) < contours["start"] < contours["end"] < max(kicks[2])
+    drawn = browser.execute_script("return [...document.querySelectorAll('#mapm-graph g.contourlevel path')]"
+                                   ".filter(p => (p.getAttribute('d') || '').length > 10).length;")
+    assert drawn >= levels  # the line of each level, over its halo
+    assert browser.execute_script("return document.querySelectorAll('#mapm-graph clipPath.contourclip').length;") > 0
+    labels = browser.execute_script("return [...document.querySelectorAll('#mapm-graph .annotation-text')]"
+                                    ".map(e => e.textContent);")
+    assert [float(t) for t in labels if re.fullmatch(r"0\.\d+", t)] == pytest.approx(
+        [contours["start"] + k * contours["size"] for k in range(levels)])
     # over the map: its regions (filled) and curves drawn under the margins
     assert on_figure(browser, "mapm-graph", "return g.data.filter(t => t.fill === 'toself').length;") > 0
     assert "compute the map above" not in on_figure(browser, "mapm-graph", TITLE)

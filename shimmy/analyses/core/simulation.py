@@ -19,7 +19,7 @@ from ...model import integrator
 from ...model.configurations import STATE_NAMES, Configuration
 from ...model.equations import build_model
 from ...errors import InvalidParameterError
-from ...model.parameters import Parameters, check_number, check_operating_point
+from ...model.parameters import DEFAULT_PSI0, Parameters, check_number, check_operating_point
 from . import nes_range
 from .summaries import simulation_summary
 from .response import (DECAYED_FRACTION, ResponseType, classify_run, dominant_frequency, peak_amplitude,
@@ -28,7 +28,6 @@ from .response import (DECAYED_FRACTION, ResponseType, classify_run, dominant_fr
 #: Largest simulated time and the densest output accepted (service limits build on these).
 MAX_T_END = 3600.0
 MAX_SAMPLES = 5_000_000
-DEFAULT_PSI0 = 0.001
 
 #: What each integrator status means, as a result's message (ground runs use the same).
 STATUS_MESSAGES = {

@@ -298,11 +298,13 @@ def _origin(runs: _Runs, options: MarginOptions, n: int) -> Origin:
     return Origin(orbit["states"][:, :n], tuple(range(0, rows, steps)), np.arange(rows) / rows, info)
 
 
-def _outcome(found: PointAttractors, end: tuple, size: float, unit: str, l_g: float) -> dict[str, Any]:
-    """A check run's end: the size it started from (in ``unit``), the attractor it ends on (None: none), its mode."""
+def _outcome(found: PointAttractors, end: tuple, size: float, unit: str, l_g: float, x0: np.ndarray) -> dict[str, Any]:
+    """A check run's end: the size it started from (in ``unit``) and its whole start state ``x0`` (a simulation's
+    ``x0``), the attractor it ends on (None: none), its mode."""
     label, psi, delta, t, _ = end
     mode = found.attractors[label]["mode"] if label >= 0 else ("failed" if label == FAILED else "unsettled")
-    return {"size": size, "unit": unit, "ends_on": label if label >= 0 else None, "mode": mode,
+    return {"size": size, "unit": unit, "x0": [float(x) for x in x0], "ends_on": label if label >= 0 else None,
+            "mode": mode,
             "amplitude": {"psi": None if math.isnan(psi) else psi,
                           "lateral": None if math.isnan(delta) else l_g * delta},
             "t_s": t}
@@ -363,7 +365,8 @@ def _minimum(found: PointAttractors, options: MarginOptions, d: Direction, norm,
         def convert(size: float) -> float:
             return float(size * d.scales[0])
         value, tolerance = convert(t.value), convert(t.tolerance)
-    sides = {side: None if check[side] is None else _outcome(found, check[side][1], convert(check[side][0]), unit, l_g)
+    sides = {side: None if check[side] is None else _outcome(found, check[side][1], convert(check[side][0]), unit, l_g,
+                                                             check[side][2])
              for side in ("below", "above")}
     below_ok = sides["below"] is None or sides["below"]["ends_on"] != label
     confirmed = bool(below_ok and sides["above"] is not None and sides["above"]["ends_on"] == label)
@@ -501,8 +504,8 @@ def margins(config: Configuration | str, V: float, Fz: float, *, params: Paramet
                 starts.append(_state(origin.states[hit.row], d.names, d.scales, size * hit.u))
     ends = runs.run(starts, full=True)
     checked: dict[int, dict[str, Any]] = {}
-    for (label, side, size), end in zip(checks, ends, strict=True):
-        checked.setdefault(label, {"below": None, "above": None})[side] = (size, end)
+    for (label, side, size), end, start in zip(checks, ends, starts, strict=True):
+        checked.setdefault(label, {"below": None, "above": None})[side] = (size, end, start)
     warnings: list[str] = [f"the orbit kicked: {origin.info['warning']}"] if "warning" in origin.info else []
     minima = []
     for label, attractor in enumerate(found.attractors):
