@@ -2,8 +2,10 @@
 
 At `original` (50 m/s, 550 kN), where a lateral and a torsional cycle coexist, on the local process pool
 (opened once; medians of N after one warm-up call, which loads the compiled code): the smallest yaw kick
-to each attractor (``margins``, direction psi), the smallest energy over all directions (direction
-energy) and basin fractions of 200 kicks up to 0.2 rad. Each with the one-parameter diagram at the load
+to each attractor (``margins``, direction psi), the same from the lateral cycle the standard start
+reaches (origin standard_attractor, 8 phases and the best located between them), along a mix of yaw angle
+and rate, the smallest energy over all directions (direction energy) and basin fractions of 200 kicks up
+to 0.2 rad. Each with the one-parameter diagram at the load
 kept for the process (as repeated questions at one load have it) and with it computed afresh.
 
 Then margin maps (``margin_map``): for original and nes, the smallest yaw kick to torsional shimmy in every cell of
@@ -112,6 +114,10 @@ def points(args) -> None:
               f"{describe()}")
         cases = {"yaw kick (psi)": lambda: margins(*POINT, direction="psi", executor=pool),
                  "all directions (energy)": lambda: margins(*POINT, direction="energy", executor=pool),
+                 "yaw kick, from the cycle": lambda: margins(*POINT, direction="psi", origin="standard_attractor",
+                                                             executor=pool),
+                 "mix psi=0.01,dpsi=0.1": lambda: margins(*POINT, direction="mix", mix="psi=0.01,dpsi=0.1",
+                                                          executor=pool),
                  "basins, 200 kicks": lambda: basins(*POINT, samples=200, executor=pool)}
         print(f"{'question':<25}{'diagram kept (s)':>17}{'diagram fresh (s)':>19}{'runs':>7}  answer")
         for name, fn in cases.items():
