@@ -546,10 +546,13 @@ def _at(axis, k):
 def _margin_lines(fig, result):
     """Iso-margin lines over the cells with margins, each labelled in rad, over a white halo (no hover: the
     markers keep theirs; no colour bar: the markers' says rad). None where nothing is to contour: no square of
-    neighbouring cells with margins, or all margins equal."""
+    neighbouring cells with margins, or all margins equal within twice the largest margin's tolerance."""
     V, Fz, z = _cropped(*margin_grid(result))
     reached = [m for row in z for m in row if not math.isnan(m)]
-    levels = margin_levels(min(reached, default=0.0), max(reached, default=0.0))
+    low, high = min(reached, default=0.0), max(reached, default=0.0)
+    # margins within their own bisection tolerances of each other: lines would draw the tolerance, not the margin
+    noise = 2.0 * max((p["tolerance"] or 0.0 for p in result["points"] if p["margin"]), default=0.0)
+    levels = margin_levels(low, high) if high - low > noise else []
     if not levels or not _square(z):
         return
     contours = {"coloring": "lines", "start": levels[0], "end": levels[-1],

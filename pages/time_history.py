@@ -13,6 +13,7 @@ from shimmy.errors import InvalidParameterError
 import shimmy.model.units as units
 from shimmy.model.configurations import STATE_NAMES, STATE_UNITS
 from shimmy.service import analyses, settings
+from shimmy.service import schemas
 from shimmy.service.schemas import MIX_EXAMPLE
 from ui import components as ui
 from ui import fields, formats, ids, jobs
@@ -176,8 +177,8 @@ def _requests(V, fz_kn, _autorun, _kick, config, t_end, psi0, lateral0, torque, 
               "series_dt": series_dt, **ui.exact_nes(config, torque), **design}
     kick = _kick if isinstance(_kick, dict) else {}
     if kick.get("x0") and kick.get("point") == [config, common["V"], common["Fz"]] and \
-            (psi0, lateral0) == (kick.get("psi0"), kick.get("lateral0")):
-        return [{**common, "x0": kick["x0"]}]  # a margin's kick, the boxes untouched since it was set
+            (psi0, lateral0) == (kick.get("psi0"), kick.get("lateral0")) and kick.get("design") == _params_of(design):
+        return [{**common, "x0": kick["x0"]}]  # a margin's kick, its point, design and boxes unchanged since
     starts = [(PSI0.read(psi0), LATERAL0.read(lateral0))]
     if bistable:
         large = [(PSI0.read(p), LATERAL0.read(q)) for key in ("torsional", "lateral") for _, p, q in [STARTS[key]]]
@@ -276,6 +277,14 @@ def _kick(m, max_size):
     return text
 
 
+def _params_of(design) -> dict | None:
+    """The complete parameters of the design store's data (as a result's ``params``), None if refused."""
+    try:
+        return schemas.design((design or {}).get("params") or {}, (design or {}).get("material"))
+    except InvalidParameterError:
+        return None
+
+
 def _run_start(m):
     """The whole start of a row's run: that of its check run just above the smallest kick (None where no kick
     reaches the attractor)."""
@@ -330,13 +339,17 @@ def margins_table(result):
 
 
 def _margin_csv(results):
+    """Each attractor with its smallest kick, in the kick's unit (rad, rad/s or J), the bracket, whether its check
+    runs confirm it, with a mix the multiple of it, from an orbit the phase."""
     r = results[0]
-    rows = [[a["mode"], a["kind"], a["amplitude"]["psi"], units.to_mm(a["amplitude"]["lateral"]), a["standard_start"],
-             a["min_disturbance"]["value"], a["min_disturbance"]["tolerance"], a["min_disturbance"].get("lower"),
-             a["min_disturbance"].get("upper"), (a["min_disturbance"]["check"] or {}).get("confirmed")]
-            for a in r["attractors"]]
+    rows = []
+    for a in r["attractors"]:
+        m = a["min_disturbance"]
+        rows.append([a["mode"], a["kind"], a["amplitude"]["psi"], units.to_mm(a["amplitude"]["lateral"]),
+                     a["standard_start"], m["value"], m["tolerance"], m.get("lower"), m.get("upper"), m["unit"],
+                     (m["check"] or {}).get("confirmed"), m.get("factor"), m.get("phase")])
     return ["mode", "kind", "psi_amplitude_rad", "lateral_amplitude_mm", "standard_start", "min_kick", "tolerance",
-            "lower", "upper", "confirmed"], rows
+            "lower", "upper", "unit", "confirmed", "times_the_mix", "phase_of_period"], rows
 
 
 jobs.register(
@@ -385,7 +398,8 @@ def run_from_kick(clicks, requests, t_end, config, V, fz_kn):
     # a start the boxes cannot say: run from x0 while the boxes hold the values set here (its psi and l_g delta)
     psi0, lateral0 = float(f"{x0[0]:.6g}"), float(f"{result['params']['l_g'] * x0[2] / units.MM:.6g}")
     return psi0, lateral0, t, *moved, {**kick, "x0": x0, "psi0": psi0, "lateral0": lateral0,
-                                       "point": [result["config"], result["V"], result["Fz"]]}
+                                       "point": [result["config"], result["V"], result["Fz"]],
+                                       "design": result["params"]}
 
 
 # A run asked from the margins' table is drawn at the top of the page: it scrolls up there (the start in the boxes,

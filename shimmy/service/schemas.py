@@ -324,9 +324,16 @@ def _check_robustness(out: dict[str, Any]) -> None:
                                     "points each)")
 
 
+#: The ranges of a simulation's whole start state ``x0``, by index: (name, bound, unit) with |x0[k]| <= bound (for
+#: delta: |l_g delta| <= bound m). Wide enough for every start a margin's check run makes (a kick up to the largest
+#: max_size, 1 rad of yaw or the same energy, added to a cycle), far beyond the physical gear.
+X0_BOUNDS = (("psi", 2.0, "rad"), ("dpsi", 100.0, "rad/s"), ("l_g delta", 1.5, "m"), ("ddelta", 100.0, "rad/s"),
+             ("lam", 1.0, "m"), ("psis", 2.0, "rad"), ("dpsis", 100.0, "rad/s"))
+
+
 def _check_simulate(out: dict[str, Any]) -> None:
-    """``x0``: one number per state of the configuration, psi and l_g delta within the ranges of psi0 and lateral0,
-    and not together with a psi0 or lateral0 of its own."""
+    """``x0``: one number per state of the configuration, each within ``X0_BOUNDS``, and not together with a psi0 or
+    lateral0 of its own."""
     if out.get("x0") is None:
         return
     x0, config = out["x0"], out["config"]
@@ -335,11 +342,14 @@ def _check_simulate(out: dict[str, Any]) -> None:
         raise InvalidParameterError("x0", x0, f"{n} numbers for {config} (psi, dpsi, delta, ddelta, lambda"
                                     + (", the NES rotation and rate)" if n == 7 else ")"), "has the wrong length")
     l_g = Parameters.from_dict(out["params"]).gear.l_g
-    if abs(x0[0]) > 0.5:
-        raise InvalidParameterError("x0[0]", x0[0], "a number in [-0.5, 0.5] rad (psi)", "is out of range")
-    if abs(l_g * x0[2]) > 0.5:
-        raise InvalidParameterError("x0[2]", x0[2], f"delta in [{-0.5 / l_g:.4g}, {0.5 / l_g:.4g}] rad (l_g delta "
-                                    "within [-0.5, 0.5] m)", "is out of range")
+    for k, (name, bound, unit) in enumerate(X0_BOUNDS[:n]):
+        if name == "l_g delta":
+            if abs(l_g * x0[k]) > bound:
+                raise InvalidParameterError(f"x0[{k}]", x0[k], f"delta in [{-bound / l_g:.4g}, {bound / l_g:.4g}] rad "
+                                            f"(l_g delta within [{-bound:g}, {bound:g}] {unit})", "is out of range")
+        elif abs(x0[k]) > bound:
+            raise InvalidParameterError(f"x0[{k}]", x0[k], f"a number in [{-bound:g}, {bound:g}] {unit} ({name})",
+                                        "is out of range")
     for name, default in (("psi0", DEFAULT_PSI0), ("lateral0", 0.0)):
         if out[name] != default:
             raise InvalidParameterError(name, out[name], f"its default ({default:g}) when x0 is given",
@@ -452,8 +462,8 @@ SCHEMAS: dict[str, RequestSchema] = {
               high=0.5, unit="m"),
         Field("x0", "numbers", "the whole initial state instead of psi0 and lateral0, one number per state of the "
               "configuration: psi (rad), dpsi (rad/s), delta (rad), ddelta (rad/s), lambda, and with the NES its "
-              "rotation and rate (a margin's start, origin_state plus the kick); psi and l_g delta within "
-              "[-0.5, 0.5] as psi0 and lateral0", high=7),
+              "rotation and rate (a margin's start, origin_state plus the kick); angles within 2 rad, rates within "
+              "100 rad/s, l_g delta within 1.5 m, lambda within 1 m", high=7),
         PARAMS, MATERIAL)),
     "hopf": RequestSchema("hopf", "Hopf points of straight rolling in V at one load", (
         _config(), FZ, _range("v_min", V_RANGE[0], V_RANGE, "m/s", "lowest speed"),

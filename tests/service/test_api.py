@@ -382,6 +382,8 @@ RESULT_JOBS = [
      "constraints": ["max_psi<=0.5"], "params": {"k_s": 1.3e6}},
     {"analysis": "robustness", "config": "nes", "tolerances": ["k_lam=0.05", "k_s=0.05:uniform"], "samples": 16},
     {"analysis": "margins", "config": "original", "V": 50, "Fz": 550000},
+    {"analysis": "margins", "config": "original", "V": 50, "Fz": 550000, "direction": "mix",
+     "mix": "psi=0.01,dpsi=0.1", "origin": "standard_attractor", "phases": 2},
     {"analysis": "basins", "config": "original", "V": 50, "Fz": 550000, "samples": 10},
     {"analysis": "margin_map", "config": "original", "n_v": 4, "n_fz": 3},
 ]

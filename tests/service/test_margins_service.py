@@ -47,8 +47,11 @@ def test_canonical_requests_fill_the_defaults_of_the_analysis():
     ("margin_map", {"max_size": 0.001}, "max_size", r"allowed: a number in \[0.002, 1\] rad"),
     ("margin_map", {"V": 50}, "V", "unknown field"),
     ("simulate", {"x0": [0.1, 0, 0]}, "x0", "5 numbers for original"),
-    ("simulate", {"x0": [0.6, 0, 0, 0, 0]}, "x0[0]", r"allowed: a number in \[-0.5, 0.5\] rad"),
-    ("simulate", {"x0": [0.1, 0, 0.3, 0, 0]}, "x0[2]", r"l_g delta within \[-0.5, 0.5\] m"),
+    ("simulate", {"x0": [2.5, 0, 0, 0, 0]}, "x0[0]", r"allowed: a number in \[-2, 2\] rad \(psi\)"),
+    ("simulate", {"x0": [0.1, 0, 0.7, 0, 0]}, "x0[2]", r"l_g delta within \[-1.5, 1.5\] m"),
+    ("simulate", {"x0": [0.1, 1e300, 0, 0, 0]}, "x0[1]", r"\[-100, 100\] rad/s \(dpsi\)"),
+    ("simulate", {"config": "nes", "x0": [0.1, 0, 0, 0, 0, 0, -150]}, "x0[6]", r"\(dpsis\)"),
+    ("simulate", {"x0": [0.1, 0, 0, 0, 2.0]}, "x0[4]", r"\[-1, 1\] m \(lam\)"),
     ("simulate", {"x0": [0.1, 0, 0, 0, 0], "lateral0": 0.1}, "lateral0", "is given together with x0"),
     ("simulate", {"x0": [0.1, None, 0, 0, 0]}, "x0[1]", "is not a number"),
 ])

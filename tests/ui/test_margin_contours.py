@@ -124,11 +124,14 @@ def test_each_level_is_labelled_once_on_its_line_between_two_cells_with_margins(
         assert a["showarrow"] is False and a["bgcolor"].startswith("rgba(255,255,255")
 
 
-@pytest.mark.parametrize("case", ["one cell", "a row", "equal margins", "none reached"])
+@pytest.mark.parametrize("case", ["one cell", "a row", "equal margins", "within their tolerances", "none reached"])
 def test_nothing_to_contour_draws_no_lines_and_keeps_the_markers(page, case):
     points = {"one cell": [_point(30.0, 250e3, 0.05), _point(50.0, 250e3, None), _point(30.0, 350e3, None)],
               "a row": [_point(v, 250e3, smooth(v, 250e3)) for v in V_CENTRES],
               "equal margins": [_point(v, f, 0.0) for v in (30.0, 50.0) for f in (250e3, 350e3)],
+              # 0.1 to 0.10015 rad, each +- 1e-4: the spread is the bisection's, lines would draw its noise
+              "within their tolerances": [_point(v, f, 0.1 + 5e-5 * k) for k, (v, f) in
+                                          enumerate((v, f) for v in (30.0, 50.0) for f in (250e3, 350e3))],
               "none reached": [_point(v, f, None) for v in (30.0, 50.0) for f in (250e3, 350e3)]}[case]
     fig = page.margin_figure(_result(points)).to_dict()
     assert not [t for t in fig["data"] if t["type"] == "contour"]

@@ -236,9 +236,11 @@ def _steady_measures(states: np.ndarray, x0: np.ndarray, params: Parameters,
 
     psi_amp, delta_amp, e_t, e_l = energies(final)
     _, _, e_t_prev, e_l_prev = energies(previous)
-    e_initial = 0.5 * k_psi * x0[0] ** 2 + 0.5 * k_delta * x0[2] ** 2
+    # the start's energy: elastic and kinetic (a start kicked in a rate only, as a margin's along dpsi, has energy)
+    e_initial = (0.5 * k_psi * x0[0] ** 2 + 0.5 * k_delta * x0[2] ** 2
+                 + 0.5 * params.gear.Iz * x0[1] ** 2 + 0.5 * params.gear.Ix * x0[3] ** 2)
     if e_initial == 0.0:
-        e_initial = np.inf  # no torsion/bending at start: judge by decay alone
+        e_initial = np.inf  # at rest in torsion and bending at start: judge by decay alone
     response = classify_run(e_initial, e_t, e_l, e_t_prev + e_l_prev)
     amplitude = {"psi": psi_amp, "lateral": l_g * delta_amp, "lam": peak_amplitude(final[4])}
     if states.shape[0] == 7:

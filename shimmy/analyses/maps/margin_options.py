@@ -4,7 +4,7 @@ loading the integrator."""
 
 from __future__ import annotations
 
-import math
+import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,18 +25,32 @@ LIMITS = {"max_size": (0.002, 1.0, "rad", False), "min_size": (1e-5, 0.1, "rad",
           "radius": (1e-3, 1.0, "rad", False), "samples": (10, 5000, "", True), "seed": (0, 2 ** 31 - 1, "", True),
           "n_v": (2, 60, "", True), "n_fz": (2, 40, "", True), "phases": (1, 32, "", True)}
 MIX_EXAMPLE = "psi=0.01,dpsi=0.2"
+#: The phases of an orbit kicked by default: an even number, so that kicks u over a whole period also cover -u
+#: (half a period later, on the gear's symmetric cycles).
+PHASES = 8
+
+
+#: A mix's value as typed: a plain decimal number, optionally signed and with an exponent.
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", re.ASCII)
+#: The magnitudes a mix's nonzero values may have (in their units): only the direction counts, and one far
+#: outside these would put the others below the direction's rounding.
+MIX_MAGNITUDE = (1e-9, 1e6)
 
 
 def parse_mix(value: Any) -> str:
     """The canonical text of a mix of components (``"psi=0.01,dpsi=0.2"``: each the component's value in its
     unit, rad or rad/s; only the direction counts, the size is searched): the named components in state order,
-    zeros left out. Refused with the field ``mix`` named: not text, an unknown component, a value that is not a
-    finite number, a component twice, all zero."""
-    allowed = f"components and values such as '{MIX_EXAMPLE}' (of {', '.join(COMPONENTS)}; rad, rad/s)"
+    zeros left out. Refused with the field ``mix`` named: not text, an empty part, an unknown component, a value
+    that is not a plain number or whose magnitude is outside ``MIX_MAGNITUDE``, a component twice, all zero."""
+    low, high = MIX_MAGNITUDE
+    allowed = (f"components and values such as '{MIX_EXAMPLE}' (of {', '.join(COMPONENTS)}; rad, rad/s; each 0 or "
+               f"of magnitude {low:g} to {high:g})")
     if not isinstance(value, str) or not value.strip():
         raise InvalidParameterError("mix", value, allowed, "is not a list of component=value")
     values: dict[str, float] = {}
     for part in value.split(","):
+        if not part.strip():
+            raise InvalidParameterError("mix", value, allowed, "has an empty part (two commas, or one at an end)")
         name, sep, number = (piece.strip() for piece in part.partition("="))
         if not sep:
             raise InvalidParameterError("mix", value, allowed, f"has '{part.strip()}' without '='")
@@ -44,13 +58,12 @@ def parse_mix(value: Any) -> str:
             raise InvalidParameterError("mix", value, allowed, f"names an unknown component '{name}'")
         if name in values:
             raise InvalidParameterError("mix", value, allowed, f"names {name} twice")
-        try:
-            values[name] = float(number)
-        except ValueError:
-            raise InvalidParameterError("mix", value, allowed, f"gives {name} the value '{number}', not a number") \
-                from None
-        if not math.isfinite(values[name]):
-            raise InvalidParameterError("mix", value, allowed, f"gives {name} the value {number}, not finite")
+        if not _NUMBER.fullmatch(number):
+            raise InvalidParameterError("mix", value, allowed, f"gives {name} the value '{number}', not a number")
+        values[name] = float(number) + 0.0  # -0 is 0
+        if values[name] and not low <= abs(values[name]) <= high:
+            raise InvalidParameterError("mix", value, allowed, f"gives {name} the value {number}, of a magnitude "
+                                        f"outside {low:g} to {high:g}")
     if not any(values.values()):
         raise InvalidParameterError("mix", value, allowed, "is zero in every component: no direction")
     return ",".join(f"{name}={values[name]!r}" for name in COMPONENTS if values.get(name))
@@ -83,7 +96,7 @@ class MarginOptions:
     t_max: float = 80.0
     mix: str | None = None
     origin: str = "straight_rolling"
-    phases: int = 8
+    phases: int = PHASES
 
     def __post_init__(self):
         if self.direction not in DIRECTIONS:
@@ -99,6 +112,10 @@ class MarginOptions:
         if self.origin not in ORIGINS:
             raise unknown_name_error(str(self.origin), ORIGINS, "origin")
         object.__setattr__(self, "phases", _check("phases", self.phases))
+        if self.origin == "straight_rolling" and self.phases != PHASES:
+            raise InvalidParameterError("phases", self.phases, f"{PHASES} (the default) unless origin is "
+                                        "standard_attractor", "is given with origin straight_rolling, which does not "
+                                        "read it")
         object.__setattr__(self, "max_size", _check("max_size", self.max_size))
         object.__setattr__(self, "min_size", _check("min_size", self.min_size))
         if not self.min_size < self.max_size:

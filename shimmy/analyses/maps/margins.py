@@ -9,8 +9,9 @@ the gear reaches depends on the size and the kind of the disturbance. At a point
   smallest disturbance that ends on it, added to straight rolling (``origin="straight_rolling"``, the
   rest of the state at rest) or to the attractor the standard start reaches
   (``origin="standard_attractor"``: at ``phases`` equally spaced phases of its orbit, phase 0 at a yaw
-  maximum, each threshold the smallest over the phases; kicks of both signs are covered, a kick -u
-  at one phase being the kick u half a period later on the gear's symmetric cycles):
+  maximum, each threshold the smallest over the phases; with an even number of phases, as the
+  default 8, kicks of both signs are covered, a kick -u at one phase being the kick u half a period
+  later on the gear's symmetric cycles (its vector field is odd); with an odd number only +u):
   along one component (``direction`` psi, dpsi, delta or ddelta) or a given mix of them
   (``direction="mix"``, ``mix="psi=0.01,dpsi=0.2"``: the direction of that vector in the energy
   norm; the threshold also as a multiple of the mix, ``factor``): a bracketing scan on a geometric
@@ -228,8 +229,9 @@ class Direction:
             names = tuple(given)
             scales = norm.scales(names)
             z = np.array([given[name] for name in names]) / scales
-            length = float(np.linalg.norm(z))
-            return cls("mix", names, scales, z / length, length)
+            top = float(np.abs(z).max())  # the norm of z / top: no overflow or underflow on the way
+            length = top * float(np.linalg.norm(z / top))
+            return cls("mix", names, scales, (z / top) / float(np.linalg.norm(z / top)), length)
         names = (options.direction,)
         return cls("component", names, norm.scales(names), np.array([1.0]))
 
@@ -275,6 +277,10 @@ def _origin(runs: _Runs, options: MarginOptions, n: int) -> Origin:
     attractor = found.attractors[label]
     if attractor["kind"] == "equilibrium":
         return _straight(n, "the standard start ends on straight rolling: the disturbance is added to it")
+    if attractor["kind"] == "simulation":  # found by a run, not a cycle of the diagram: no period to kick at
+        raise InvalidParameterError("origin", options.origin, "straight_rolling at this point", "has no period here: "
+                                    f"the standard start settles on a motion the diagram does not have at V = "
+                                    f"{runs.V:g} m/s, Fz = {kn(runs.Fz)} (quasi-periodic, perhaps)")
     x0 = np.zeros(n)
     x0[0] = DISCOVERY_STARTS[0][2]
     steps = PHASE_STEPS if options.phases > 1 else 1
@@ -517,8 +523,9 @@ def margins(config: Configuration | str, V: float, Fz: float, *, params: Paramet
         if not minima[-1]["check"]["confirmed"]:
             warnings.append(f"the threshold of the {attractor['mode']} attractor is not confirmed by its check runs")
     report(1.0, "done")
-    return MarginsResult(config, V, Fz, params, options, found, minima, runs.count + found.runs, runs.unsettled,
-                         time.perf_counter() - clock, type(executor).__name__, warnings, origin.info)
+    orbit_runs = 1 if origin.info["kind"] == "standard_attractor" else 0
+    return MarginsResult(config, V, Fz, params, options, found, minima, runs.count + found.runs + orbit_runs,
+                         runs.unsettled, time.perf_counter() - clock, type(executor).__name__, warnings, origin.info)
 
 
 def basins(config: Configuration | str, V: float, Fz: float, *, params: Parameters | None = None,

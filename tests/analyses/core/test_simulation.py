@@ -177,3 +177,14 @@ def test_the_spectrum_can_be_skipped_and_nothing_else_changes():
     assert math.isfinite(full.frequency_hz) and math.isnan(bare.frequency_hz)
     np.testing.assert_array_equal(full.states, bare.states)
     assert (full.amplitude, full.steady, full.response_type) == (bare.amplitude, bare.steady, bare.response_type)
+
+
+def test_a_start_kicked_in_a_rate_only_is_judged_by_its_energy():
+    """A start with psi = delta = 0 and a yaw rate (a margin's kick along dpsi) has energy: it ends torsional at
+    original (50 m/s, 550 kN) from dpsi0 = 1.6 rad/s (the margin along dpsi is 1.569 rad/s) and decays at 5 m/s,
+    150 kN (below the first Hopf speed), each judged as from a yaw angle of the same energy."""
+    run = simulate("original", 50.0, 550e3, x0=[0.0, 1.6, 0.0, 0.0, 0.0], t_end=60.0)
+    assert run.response_type is ResponseType.TORSION and run.steady
+    assert run.amplitude["psi"] == pytest.approx(0.187, rel=0.02)
+    quiet = simulate("original", 5.0, 150e3, x0=[0.0, 1.6, 0.0, 0.0, 0.0], t_end=60.0)
+    assert quiet.response_type is ResponseType.STABLE
