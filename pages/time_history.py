@@ -158,12 +158,17 @@ def start(choice, psi0, lateral0):
 
 
 def _bistable_note(map_type):
-    """What the page says when it was opened from a point the map shades Bistable (or Both)."""
+    """What the page says when it was opened from a point the map shades Bistable or Latent."""
     if map_type == "Bistable":
         return ("The stability map shades this point Bistable: a torsional and a lateral limit cycle coexist, and "
                 "which one the gear ends on depends on the kick. Run runs the start chosen above and the two large "
                 "starts, and says which cycle each ends on; compute the disturbance margins below to see how large "
                 "a yaw kick reaches each, and run from there.")
+    if map_type == "Latent":
+        return ("The stability map shades this point Latent: straight rolling is stable, and a limit cycle is stable "
+                "beside it. The standard start decays; a large enough kick starts shimmy. Run runs the start chosen "
+                "above and the two large starts, and says where each ends; compute the disturbance margins below to "
+                "see how large a kick reaches the cycle, and run from there.")
     return None
 
 

@@ -10,9 +10,10 @@ import plotly.io as pio
 CONFIG_COLOURS = {"original": "#000000", "nes": "#E69F00", "pd": "#0072B2", "nes_pd": "#009E73"}
 CONFIG_LABELS = {"original": "original", "nes": "NES", "pd": "PD", "nes_pd": "NES + PD"}
 #: The shading of a map's regions. Torsion is Okabe–Ito yellow, not the NES's orange: a NES curve drawn over
-#: the torsion lobe stays visible (and every curve has a halo, :data:`HALO`); Both a dark green.
+#: the torsion lobe stays visible (and every curve has a halo, :data:`HALO`); Both a dark green; Latent (straight
+#: rolling stable beside a stable cycle) a grey.
 SHIMMY_TYPE_COLOURS = {"Stable": "#FFFFFF", "Torsion": "#F0E442", "Lateral": "#56B4E9", "Bistable": "#CC79A7",
-                       "Both": "#117733"}
+                       "Both": "#117733", "Latent": "#AAAAAA"}
 #: One colour per compared design (dark and saturated: readable on white and over the map's shading,
 #: apart from the configurations' colours, which stay with the configurations).
 DESIGN_COLOURS = ("#1A1A1A", "#D55E00", "#0057B8", "#A0329A")

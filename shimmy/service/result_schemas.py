@@ -189,7 +189,7 @@ RESULTS: dict[str, Schema] = {
                                 {"fz_min": nullable(VP), "fz_max": nullable(VP), "turning_points": arr(_CODIM2),
                                  "crossings": arr(_CODIM2), "ends": arr(_CODIM2), "codim2_points": arr(_CODIM2)})),
         "codim2_points": arr(_CODIM2), "V": NUMBERS, "Fz": NUMBERS,
-        "types": arr(STRINGS, "region type of each (Fz, V) grid cell: Stable, Torsion, Lateral, Bistable, Both"),
+        "types": arr(STRINGS, "region type of each (Fz, V) grid cell: Stable, Torsion, Lateral, Bistable, Both, Latent"),
         "min_shimmy_Fz": nullable(num("lowest load with shimmy (N)")),
         "min_shimmy": nullable(obj({"Fz": NUM, "V": NUM, "source": STR})),
         "slices": arr({"type": "object"}, "the one-parameter diagram summary of each load"),

@@ -166,7 +166,7 @@ def test_map_command_json_carries_the_curves_grid_and_minimum_load(tmp_path):
     assert all(len(row) == 25 for row in data["types"])
     shading = data["shading"]
     assert len(shading["Fz"]) >= 180 and all(len(row) == 25 for row in shading["types"])
-    types = {"Stable", "Torsion", "Lateral", "Bistable", "Both"}
+    types = {"Stable", "Torsion", "Lateral", "Bistable", "Both", "Latent"}
     assert data["regions"] and {r["type"] for r in data["regions"]} <= types
     assert data["min_shimmy_Fz"] == pytest.approx(100000.0)  # shimmy on the lowest slice already
     assert data["metrics"]["torsion_area"] > 0

@@ -110,11 +110,15 @@ class ShimmyType(StrEnum):
     LATERAL = "Lateral"
     BISTABLE = "Bistable"  # a torsional and a lateral cycle both stable
     BOTH = "Both"  # one cycle with both modes
+    LATENT = "Latent"  # straight rolling stable, and a limit cycle stable beside it: a large enough kick starts shimmy
 
 
 def shimmy_type(attractors: list[dict]) -> ShimmyType:
-    """The map's type at a point from its stable attractors (``{"kind", "mode", ...}`` dicts)."""
+    """The map's type at a point from its stable attractors (``{"kind", "mode", ...}`` dicts): Latent where
+    straight rolling is stable beside a stable limit cycle (whatever the cycle's mode), else by the cycles' modes."""
     modes = {a["mode"] for a in attractors if a["kind"] != "equilibrium"}
+    if modes and any(a["kind"] == "equilibrium" for a in attractors):
+        return ShimmyType.LATENT
     if Mode.TORSIONAL in modes and Mode.LATERAL in modes:
         return ShimmyType.BISTABLE
     if Mode.BOTH in modes:

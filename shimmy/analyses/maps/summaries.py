@@ -18,14 +18,15 @@ from ..core.response import ShimmyType
 def map_summary(result: dict[str, Any]) -> str:
     """The short table ``python -m shimmy map`` prints, from ``StabilityMap.to_dict()`` and, under "metrics",
     :func:`~shimmy.analyses.maps.design_metrics.metrics` of that map: slices and grid, grid points by type,
-    curves, the minimum shimmy load, the pure-torsion area (with metrics), the warnings."""
+    curves, the minimum shimmy load, the pure-torsion area (with metrics), the warnings. Types no grid point has are
+    left out."""
     shading = result["shading"]
     counts = {t: sum(row.count(t) for row in shading["types"]) for t in ShimmyType}
     v_range, fz_range = result["v_range"], result["fz_range"]
     lines = [f"{result['config']}: {len(result['Fz'])} classified slices, {len(shading['Fz'])} x {len(result['V'])} "
              f"grid, V {v_range[0]:g}..{v_range[1]:g} m/s, Fz {kn_range(*fz_range)} "
              f"({result['elapsed_s']:.1f} s, {result['executor']})",
-             "  grid points by type: " + ", ".join(f"{t} {n}" for t, n in counts.items())
+             "  grid points by type: " + ", ".join(f"{t} {n}" for t, n in counts.items() if n)
              + f"; {len(result['regions'])} region polygons",
              f"  Hopf curves {len(result['hopf_curves'])}, GH points {len(result['gh_points'])}, "
              f"fold curves {len(result['fold_curves'])}, torus curves {len(result['torus_curves'])}"]
