@@ -8,8 +8,9 @@ import pathlib
 import socket
 import tempfile
 
-#: Bumped whenever the JSON of any analysis result changes shape: old cache entries then miss.
-SCHEMA_VERSION = 1
+#: Bumped whenever the JSON of any analysis result changes shape or meaning: old cache entries (and the warm
+#: starts kept beside them) then miss. 2: the Latent map type, margins from an orbit and along a mix, simulate's x0.
+SCHEMA_VERSION = 2
 
 #: Limits on what one request may ask for (refused with 4xx naming the limit).
 MAX_BODY_BYTES = 64 * 1024
