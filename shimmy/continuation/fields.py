@@ -57,6 +57,9 @@ class TwoParameterField:
     #: Optional ``evaluate(x, p) -> (f, dfdx, dfdp)`` in one pass (a compiled field's fast path).
     evaluate: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None
     smooth: bool = True
+    #: Whether ``dfdx`` takes complex columns (n, m) too, returning (m, n, n): the first Lyapunov coefficient's
+    #: eight complex evaluations are then one call (:func:`~shimmy.continuation.first_lyapunov_coefficient`).
+    complex_columns: bool = False
 
     def all_at(self, x: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(f, dfdx, dfdp with both parameters stacked) at columns x."""

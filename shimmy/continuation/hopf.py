@@ -105,7 +105,8 @@ class HopfCurveProblem:
 
     def lyapunov(self, u) -> float:
         x, _, _, _, p = self.split(u)
-        return lyapunov.first_lyapunov_coefficient(lambda z: self.system.dfdx(x + z, p), self.n)
+        columns = (lambda Z: self.system.dfdx(x[:, None] + Z, p)) if self.system.complex_columns else None
+        return lyapunov.first_lyapunov_coefficient(lambda z: self.system.dfdx(x + z, p), self.n, columns=columns)
 
 
 @dataclass

@@ -40,7 +40,8 @@ def hopf_eigenvectors(A: np.ndarray, omega_hint: float | None = None):
 
 
 def first_lyapunov_coefficient(jacobian: Callable[[np.ndarray], np.ndarray], n: int,
-                               h: float = 1e-20, eps: float = 1e-4, omega_hint: float | None = None) -> float:
+                               h: float = 1e-20, eps: float = 1e-4, omega_hint: float | None = None,
+                               columns: Callable[[np.ndarray], np.ndarray] | None = None) -> float:
     """l1 at a Hopf point of the equilibrium x = 0 of x' = f(x) (Kuznetsov eq. 3.20).
 
     ``jacobian(x)`` must return df/dx and accept complex ``x`` (complex-analytic f).
@@ -49,28 +50,35 @@ def first_lyapunov_coefficient(jacobian: Callable[[np.ndarray], np.ndarray], n: 
     point (the pair at a + i w) the same formula with that pair's vectors and w is a smooth function
     of the parameters equal to l1 on the Hopf curve: a test function whose zero on it is a
     generalised Hopf point.
+
+    ``columns(X)``, optional: the Jacobians at the columns of a complex X (n, m) at once, (m, n, n) (a
+    field vectorised over columns, as :class:`~shimmy.continuation.fields.TwoParameterField`'s): the
+    eight complex evaluations then are one call, each column's arithmetic that of ``jacobian`` on it.
     """
     zero = np.zeros(n)
     A = jacobian(zero).real
     omega, q, p = hopf_eigenvectors(A, omega_hint)
-
-    def B_matrix(u, base=zero):
-        # d/dt J(base + t u) at t = 0, by a complex step on the analytic Jacobian.
-        return jacobian(base + 1j * h * u).imag / h
-
-    def C_matrix(u, w):
-        # d/ds B_{s u}(w, .) at s = 0, central difference.
-        return (B_matrix(w, eps * u) - B_matrix(w, -eps * u)) / (2.0 * eps)
-
     a, b = q.real, q.imag
-    Ba, Bb = B_matrix(a), B_matrix(b)
+    # B_w(base) = d/dt J(base + t w) at t = 0, by a complex step on the analytic Jacobian, at the eight
+    # (w, base) the formula needs: B_a, B_b at 0, and at +-eps u the central differences in s of B_w(s u)
+    # that make C(u, w) for (u, w) = (a, a), (b, b), (a, b)
+    steps = ((a, zero), (b, zero), (a, eps * a), (a, -eps * a), (b, eps * b), (b, -eps * b), (b, eps * a),
+             (b, -eps * a))
+    points = [base + 1j * h * w for w, base in steps]
+    if columns is not None:
+        J = columns(np.stack(points, axis=1))
+        Bs = [J[k].imag / h for k in range(len(points))]
+    else:
+        Bs = [jacobian(x).imag / h for x in points]
+    Ba, Bb = Bs[0], Bs[1]
+    C_aa, C_bb, C_ab = ((Bs[k] - Bs[k + 1]) / (2.0 * eps) for k in (2, 4, 6))
 
     def B(x_is_q: bool, y):  # B(q, y) or B(conj(q), y) for complex y
         return Ba @ y + (1j if x_is_q else -1j) * (Bb @ y)
 
     Bqq = Ba @ a - Bb @ b + 2j * (Ba @ b)
     Bqqbar = Ba @ a + Bb @ b
-    Cqq = C_matrix(a, a) - C_matrix(b, b) + 2j * C_matrix(a, b)
+    Cqq = C_aa - C_bb + 2j * C_ab
     Cqqqbar = Cqq @ np.conj(q)
     term1 = np.vdot(p, Cqqqbar)
     term2 = -2.0 * np.vdot(p, B(True, np.linalg.solve(A, Bqqbar)))

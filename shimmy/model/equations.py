@@ -56,7 +56,7 @@ class Model:
     coefficients: np.ndarray
     exact_nes: bool = False
 
-    @property
+    @functools.cached_property  # read on every evaluation (the single-state path's check)
     def n_states(self) -> int:
         return self.config.n_states
 

@@ -145,7 +145,7 @@ def gear_two_parameter_field(config: Configuration, params: Parameters) -> TwoPa
     return TwoParameterField(model.n_states, lambda x, p: rhs(model, x, p[0], p[1]),
                              lambda x, p: jacobian(model, x, p[0], p[1]),
                              lambda x, p: np.stack(parameter_jacobian(model, x, p[0], p[1])),
-                             f"{config.value} in (V, Fz)", evaluate, smooth=config.is_smooth)
+                             f"{config.value} in (V, Fz)", evaluate, smooth=config.is_smooth, complex_columns=True)
 
 
 def hopf_curves(config: Configuration | str, *, params: Parameters | None = None,
