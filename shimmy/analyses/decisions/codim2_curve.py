@@ -49,7 +49,7 @@ from ..core.stability import Linearisation, first_lyapunov_coefficient
 from ..diagrams.hopf_curves import hopf_curves
 from .min_shimmy_curve import N_GRID
 from .sensitivity import critical_pair, model_with, newton_in_plane
-from .study_curves import StudyCurve, parameter_range, value_grid
+from .study_curves import StudyCurve, is_count, on_whole_values, parameter_range, value_grid, whole_values
 
 #: Newton's method is converged when a step is below this fraction of the scales (10 m/s, 100 kN).
 TOL = 1e-10
@@ -192,7 +192,8 @@ def codim2_curves(config: Configuration | str, parameter: str, *, params: Parame
     hopf = hopf or hopf_curves(config, params=params, v_range=v_range, fz_range=fz_range)
     starts: list[tuple[str, dict[str, Any]]] = [("gh", g) for g in sorted(hopf.gh_points, key=lambda g: g["V"])]
     starts += [("double_hopf", g) for g in sorted(hopf.double_hopf_points, key=lambda g: g["V"])]
-    grid = sorted({float(t) for t in value_grid(lo, hi, n)} | {base} | {float(v) for v in values if lo <= v <= hi})
+    spread = whole_values(lo, hi) if is_count(parameter) else value_grid(lo, hi, n)  # a count: its whole values
+    grid = sorted({float(t) for t in spread} | {base} | {float(v) for v in values if lo <= v <= hi})
     k0 = grid.index(base)
     base_model = model_with(config, params, parameter, base)
     curves: list[StudyCurve] = []
@@ -222,9 +223,10 @@ def codim2_curves(config: Configuration | str, parameter: str, *, params: Parame
         fz_name, v_name = QUANTITIES[kind]
         for quantity, column in ((fz_name, 1), (v_name, 0)):
             marks = [dict(e, value=e["Fz"] if column else e["V"]) for e in ends]
-            curves.append(StudyCurve(config.value, quantity, parameter, thetas,
-                                     [solved[t][column] if t in solved else None for t in thetas],
-                                     sorted(marks, key=lambda e: e["p"]), point=numbers[kind]))
+            curve = StudyCurve(config.value, quantity, parameter, thetas,
+                               [solved[t][column] if t in solved else None for t in thetas],
+                               sorted(marks, key=lambda e: e["p"]), point=numbers[kind])
+            curves.append(on_whole_values(curve) if is_count(parameter) else curve)
         for e in ends:
             side = "below" if e["p"] < base else "above"
             warnings.append(f"{label} ends {side} {parameter} = {e['p']:.8g} ({e['why']}); no value past it, not zero")

@@ -34,7 +34,7 @@ from ...model.parameters import DIAGRAM_V_RANGE, FZ_RANGE, Parameters
 from ...model.units import kn
 from ..diagrams.hopf_curves import hopf_curves
 from .sensitivity import model_with, polish_lowest_point
-from .study_curves import StudyCurve, parameter_range
+from .study_curves import StudyCurve, is_count, on_whole_values, parameter_range, whole_values
 
 #: Grid values of theta over its range (plus the base value and any asked for).
 N_GRID = 41
@@ -67,7 +67,8 @@ def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Par
     if not starts:
         raise ConvergenceError(f"{config.value}: the Hopf curves have no lowest point inside the box at "
                                f"{parameter} = {base:g}: no minimum shimmy load to follow")
-    grid = sorted({float(t) for t in np.linspace(lo, hi, n)} | {base} | {float(v) for v in values if lo <= v <= hi})
+    spread = whole_values(lo, hi) if is_count(parameter) else np.linspace(lo, hi, n)  # a count: its whole values
+    grid = sorted({float(t) for t in spread} | {base} | {float(v) for v in values if lo <= v <= hi})
     k0 = grid.index(base)
     # solutions[j][k]: (V, Fz) of minimum j at grid[k], or None past its end
     solutions: list[list[tuple[float, float] | None]] = [[None] * len(grid) for _ in starts]
@@ -120,7 +121,7 @@ def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Par
                             "lower point not followed from the base design")
     curve = StudyCurve(config.value, "min_shimmy_Fz", parameter, grid, curve_values,
                        sorted(special, key=lambda s: s["p"]))
-    return curve, warnings
+    return (on_whole_values(curve) if is_count(parameter) else curve), warnings
 
 
 def _predict(grid, solutions, path, k) -> tuple[float, float]:

@@ -290,8 +290,13 @@ class HopfSpeedCurves:
         lo, hi = self.p_range
         events = self.events()
         fixed = sorted({lo, hi, *(float(v) for v in values)})
+        if is_count(self.param):  # a count: its whole values only (the events snap to them, not located)
+            fixed = sorted(set(fixed) | set(whole_values(lo, hi)))
+            for e in events:
+                e["located"] = False
         grid = list(fixed)
-        candidates = sorted([e["p"] for e in events] + [float(t) for c in self.curves for t in c.p[:, 1]])
+        candidates = [] if is_count(self.param) else \
+            sorted([e["p"] for e in events] + [float(t) for c in self.curves for t in c.p[:, 1]])
         snap = SNAP * (hi - lo)
         for t in candidates:
             if lo <= t <= hi and all(abs(t - g) > snap for g in fixed) and (len(grid) == len(fixed) or
@@ -310,7 +315,38 @@ class HopfSpeedCurves:
                 if here and abs(pick(here) - e["V"]) <= 1e-6 * max(e["V"], 1.0):
                     special.append({"kind": str(e["kind"]), "p": e["p"], "value": e["V"], "located": e["located"]})
             out.append(StudyCurve(self.config.value, quantity, self.param, grid, vals, special))
-        return out
+        return [on_whole_values(c) for c in out] if is_count(self.param) else out
+
+
+def is_count(parameter: str) -> bool:
+    """Whether ``parameter`` is a count (an integer parameter: the particle damper's segments ``n``): its
+    study curves take its whole values only."""
+    spec = PARAMETER_SPECS.get(parameter)
+    return bool(spec is not None and spec.integer)
+
+
+def whole_values(lo: float, hi: float) -> list[float]:
+    """The whole values in [lo, hi]."""
+    return [float(k) for k in range(math.ceil(lo), math.floor(hi) + 1)]
+
+
+def on_whole_values(curve: "StudyCurve") -> "StudyCurve":
+    """A curve in a count at its whole values only: its points at whole p (each exact there: the curves
+    are continued in the count as a real number, but only the whole ones are designs); a special point
+    between two whole values is reported at the next one (the last, past the end), not located, with the
+    two whole values it lies between and the value there."""
+    points = [(p, v) for p, v in zip(curve.p, curve.values, strict=True) if float(p).is_integer()]
+    at = dict(points)
+    special = []
+    for q in curve.special_points:
+        if float(q["p"]).is_integer():
+            special.append(q)
+            continue
+        whole = min(float(math.ceil(q["p"])), points[-1][0]) if points else float(math.ceil(q["p"]))
+        special.append({**q, "p": whole, "value": at.get(whole), "located": False,
+                        "between": [float(math.floor(q["p"])), float(math.ceil(q["p"]))]})
+    return StudyCurve(curve.config, curve.quantity, curve.param, [p for p, _ in points], [v for _, v in points],
+                      sorted(special, key=lambda q: q["p"]), curve.point)
 
 
 def value_grid(lo: float, hi: float, n: int) -> np.ndarray:

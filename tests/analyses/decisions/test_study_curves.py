@@ -104,3 +104,26 @@ def test_bad_input_names_the_field_the_value_and_the_range():
         hopf_speed_curves("nes", "r2", Fz=5.0)
     with pytest.raises(InvalidParameterError, match="p_max"):
         hopf_speed_curves("nes", "r2", p_range=(0.07, 0.1))
+
+
+def test_a_count_is_studied_at_its_whole_values_only():
+    """The particle damper's segment count n is an integer: its study curves take whole values only (1 to 100),
+    each exact there (the Hopf speeds against hopf_points of that design), and a special point between two
+    counts is reported at the next one, not located."""
+    from shimmy.analyses.decisions.study_curves import StudyCurve, on_whole_values
+
+    start, end = hopf_speed_curves("nes_pd", "n").study_curves(values=[24.0])
+    assert start.p == [float(k) for k in range(1, 101)] and end.p == start.p
+    for n in (1.0, 24.0, 57.0):
+        found = [h.V for h in hopf_points("nes_pd", 150e3, params=Parameters().with_overrides({"n": n}),
+                                          v_range=(1.0, 200.0)).hopf_points]
+        assert start.value_at(n) == pytest.approx(min(found), rel=1e-9)
+        assert end.value_at(n) == pytest.approx(max(found), rel=1e-9)
+    curve = StudyCurve("nes_pd", "hopf_V_start", "n", [1.0, 1.5, 2.0, 3.0], [5.0, 5.5, 6.0, 7.0],
+                       [{"kind": "hopf", "p": 2.4, "value": 6.4, "located": True},
+                        {"kind": "end", "p": 3.0, "value": 7.0}])
+    whole = on_whole_values(curve)
+    assert whole.p == [1.0, 2.0, 3.0] and whole.values == [5.0, 6.0, 7.0]
+    assert whole.special_points[0] == {"kind": "hopf", "p": 3.0, "value": 7.0, "located": False,
+                                       "between": [2.0, 3.0]}
+    assert whole.special_points[1] == {"kind": "end", "p": 3.0, "value": 7.0}
