@@ -14,7 +14,6 @@ import shimmy.model.units as units
 from shimmy.model.configurations import STATE_NAMES, STATE_UNITS
 from shimmy.service import analyses, settings
 from shimmy.service import schemas
-from shimmy.service.schemas import MIX_EXAMPLE
 from ui import components as ui
 from ui import fields, formats, ids, jobs
 from ui import style
@@ -115,7 +114,7 @@ def layout(config: str | None = None, V: str | None = None, Fz: str | None = Non
         html.Div([ui.field("Kick along", dcc.Dropdown(id=ids.THM_DIRECTION, value="psi", clearable=False,
                                                       style={"width": "220px"},
                                                       options=[{"label": v, "value": k} for k, v in KICKS.items()])),
-                  ui.field("Mix", dcc.Input(id=ids.THM_MIX, type="text", placeholder=MIX_EXAMPLE, debounce=True,
+                  ui.field("Mix", dcc.Input(id=ids.THM_MIX, type="text", placeholder=schemas.MIX_EXAMPLE, debounce=True,
                                             disabled=True, style={"width": "190px"})),
                   ui.field("Kick added to", dcc.Dropdown(id=ids.THM_ORIGIN, value="straight_rolling", clearable=False,
                                                          style={"width": "290px"}, options=[

@@ -37,8 +37,8 @@ import numpy as np
 from ...continuation.errors import ContinuationError as EngineError
 from ...errors import ShimmyError
 from ...model.configurations import Configuration
-from ...model.parameters import PARAMETER_SPECS, Parameters
-from .study_curves import SNAP, StudyCurve, parameter_range
+from ...model.parameters import Parameters
+from .study_curves import SNAP, StudyCurve, is_count, parameter_range
 
 #: Grid values of theta over its whole range, the ends included (plus the sampled and base values).
 N_GRID = 9
@@ -64,7 +64,7 @@ def grid(parameter: str, params: Parameters, values: Sequence[float] = ()) -> li
     lo, hi = parameter_range(parameter, params)
     base = float(getattr(params, parameter))
     even = np.linspace(lo, hi, N_GRID)
-    if _integer(parameter):  # a count takes whole values only
+    if is_count(parameter):  # a count takes whole values only
         even = np.unique(np.round(even))
     wanted = sorted(set(even.tolist()) | {float(v) for v in values} | ({base} if lo <= base <= hi else set()))
     out: list[float] = []
@@ -83,14 +83,9 @@ def substeps(a: float, b: float, parameter: str | None = None) -> list[float]:
     interval meet at equal theta; for an integer ``parameter`` (a count) the whole values among them."""
     lo, hi = min(a, b), max(a, b)
     inner = [lo + (hi - lo) * k / SUBSTEPS for k in range(1, SUBSTEPS)]
-    if parameter is not None and _integer(parameter):  # the whole values between, at most as many
+    if parameter is not None and is_count(parameter):  # the whole values between, at most as many
         inner = sorted({float(round(x)) for x in inner} - {lo, hi})
     return [*(inner if a < b else inner[::-1]), b]
-
-
-def _integer(parameter: str) -> bool:
-    spec = PARAMETER_SPECS.get(parameter)
-    return bool(spec is not None and spec.integer)
 
 
 def orbit_of(result) -> tuple[np.ndarray, int, np.ndarray] | None:
