@@ -39,7 +39,7 @@ MAX_KICK = Quantity("margin_map", "max_size", "largest kick", "rad")
 WAITING = "Press Compute: tens of seconds per configuration cold on 2 cores, instant from the cache"
 MARGIN_WAITING = ("Press Compute margins: the smallest yaw kick to torsional shimmy in each cell of the plane where "
                   "it coexists with another attractor (20 to 40 s for 20 x 10 cells on 2 cores)")
-HEIGHT, BOTTOM = 740, 176
+HEIGHT, BOTTOM = 750, 190
 FAINT, FAINT_REGIONS = 0.35, 0.16  # a previous design's curves and regions under the map being made
 MARGIN_REGIONS = 0.4  # the map's regions under the margins
 #: The iso-margin lines and their labels (rad): dark, the lines over a white halo and the labels on white, to read
@@ -359,7 +359,9 @@ def _finish(fig, series, what, inside, v_range, fz_range):
     fig.update_xaxes(range=list(v_range))
     fig.update_yaxes(range=list(fz_range))
     fig.update_layout(margin={**style.MARGIN, "b": BOTTOM})
-    style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM)
+    # the curves-and-points row wraps onto a second line at 1024 px: the shading row starts below it
+    style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM,
+                  rows=[1, 1.45, 1])
 
 
 def _regions(fig, result, opacity):

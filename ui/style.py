@@ -113,14 +113,24 @@ def legend_key(fig, name: str, legend: str = "legend", group: str | None = None,
                     showlegend=True, hoverinfo="skip", **trace)
 
 
-def legends(fig, titles: list[str], height: int, bottom: int) -> None:
+LEGEND_ROW = 34  # px from one legend row to the next: one line of entries and its wrap at 1024 px
+
+
+def legends(fig, titles: list[str], height: int, bottom: int, rows: list[float] | None = None) -> None:
     """Separate legends (legend, legend2, ...) stacked under the plot, each with its title on its left:
     which colour is which configuration apart from what a line style or a marker kind means.
-    ``bottom`` is the figure's bottom margin (px) they live in."""
+    ``bottom`` is the figure's bottom margin (px) they live in; ``rows`` gives each legend's height
+    in rows of ``LEGEND_ROW`` px (1 each by default; more for a legend whose entries wrap onto a
+    further line at 1024 px, so the next one starts below its last line)."""
+    rows = [1.0] * len(titles) if rows is None else rows
+    if len(rows) != len(titles):
+        raise ValueError(f"legends: {len(rows)} row heights for {len(titles)} legends")
     layout = {}
+    y_px = bottom - 54
     for k, text in enumerate(titles):
         key = "legend" if k == 0 else f"legend{k + 1}"
-        y_px = bottom - 54 - 34 * k  # room for one wrapped line at 1024 px
+        if k:
+            y_px -= LEGEND_ROW * rows[k - 1]
         layout[key] = {"title": {"text": text + ":", "side": "left"}, "orientation": "h", "x": 0, "xanchor": "left",
                        "y": y_px / height, "yref": "container", "yanchor": "top", "font": {"size": 11},
                        "bgcolor": "rgba(255,255,255,0)", "tracegroupgap": 4}

@@ -217,3 +217,19 @@ def test_downloads_write_loads_in_kn_and_lateral_displacements_in_mm(pages):
     assert "max_lateral_mm" in columns and rows[-1][columns.index("max_lateral_mm")] == pytest.approx(28.0)
     columns, _ = pages["stability_map"]._csv_rows([_map()])
     assert columns[1] == "Fz_kN"
+
+
+def test_stacked_legends_leave_a_wrapped_row_its_room(figures):
+    """The legends under a figure stack down from its plot; the map's "curves, points" row wraps onto a
+    second line at 1024 px (six entries), so the shading row starts that much lower (it overlapped the
+    wrapped "HH: double Hopf" entry), and every legend stays inside the bottom margin."""
+    for name in ("stability map", "stability map designs", "bifurcation", "study"):
+        layout = figures[name]["layout"]
+        keys = sorted((k for k in layout if k.startswith("legend")), key=lambda k: int(k[6:] or 1))
+        height, bottom = layout["height"], layout["margin"]["b"]
+        tops = [layout[k]["y"] * height for k in keys]  # px above the figure's bottom edge
+        assert tops[0] < bottom - 40 and tops[-1] > 20, (name, tops, bottom)
+        gaps = [a - b for a, b in zip(tops, tops[1:])]
+        assert all(g >= style.LEGEND_ROW - 1e-9 for g in gaps), (name, gaps)
+    layout = figures["stability map"]["layout"]
+    assert (layout["legend2"]["y"] - layout["legend3"]["y"]) * layout["height"] >= 1.4 * style.LEGEND_ROW
