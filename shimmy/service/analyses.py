@@ -87,11 +87,21 @@ def hopf(request: dict[str, Any], progress: Progress | None = None) -> dict[str,
 @serves("stability", sync=True, job=False)
 def stability(request: dict[str, Any], progress: Progress | None = None) -> dict[str, Any]:
     """Largest real part of the eigenvalues of x = 0 against V, and the Hopf points, per configuration."""
-    from ..analyses.core.stability import growth_rates
+    from ..analyses.core.stability import growth_rate, growth_speeds
+    from ..model.configurations import Configuration
 
-    rates = growth_rates(request["Fz"], params=_params(request), v_range=(request["v_min"], request["v_max"]),
-                         n_points=request["n_points"])
-    return {"Fz": request["Fz"], "V": rates["V"], "params": request["params"], "configs": rates["configs"]}
+    params = _params(request)
+    v_range = (request["v_min"], request["v_max"])
+    configs = {}
+    for config in Configuration:  # each from the shared cache by the parameters of its own model: a slider
+        # step of one device recomputes only the configurations that have that device
+        part = {"config": config.value, "Fz": request["Fz"], "v_min": request["v_min"], "v_max": request["v_max"],
+                "n_points": request["n_points"], "params": request["params"]}
+        configs[config.value], _ = cache.get_or_compute(
+            "growth", part, lambda c=config: growth_rate(c, request["Fz"], params=params, v_range=v_range,
+                                                         n_points=request["n_points"]))
+    return {"Fz": request["Fz"], "V": growth_speeds(v_range, request["n_points"]).tolist(),
+            "params": request["params"], "configs": configs}
 
 
 @serves("devices", sync=True, job=False)

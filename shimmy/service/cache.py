@@ -114,7 +114,7 @@ def results() -> diskcache.Cache:
 #: so the map of ``original`` is one entry however the NES and damper sliders stand. (Analyses that
 #: report parameter values, sample or search them, or cover several configurations key them all.)
 MODEL_ONLY = frozenset({"map", "hopf", "bifurcation", "hopf_curves", "simulate", "ground_run", "margins",
-                        "margin_map"})
+                        "margin_map", "growth"})  # growth: one configuration's part of "stability"
 
 
 def key(analysis: str, request: dict[str, Any]) -> str:
@@ -165,7 +165,10 @@ def put(k: str, value: dict[str, Any]) -> None:
 
 def get_or_compute(analysis: str, request: dict[str, Any],
                    compute: Callable[[], dict[str, Any]]) -> tuple[dict[str, Any], bool]:
-    """(result, True if it came from the cache)."""
+    """(result, True if it came from the cache); within :func:`bypassed` computed, the cache neither
+    read nor written (an analysis's parts asked through here follow its ``--no-cache``)."""
+    if is_bypassed():
+        return compute(), False
     k = key(analysis, request)
     found = as_asked(get_key(k), request)
     if found is not None:

@@ -57,6 +57,34 @@ def test_a_shared_entry_answers_with_the_askers_parameters(tmp_path, monkeypatch
     assert {k: v for k, v in again.items() if k != "params"} == {k: v for k, v in first.items() if k != "params"}
 
 
+def test_a_design_step_recomputes_the_growth_rates_of_the_configurations_it_enters(tmp_path, monkeypatch):
+    """The Overview's growth rates of the four configurations are cached each by its own model's
+    parameters: an NES step (r2) recomputes nes and nes_pd only, and the answer equals the one
+    computed whole (:func:`~shimmy.analyses.core.stability.growth_rates`); ``--no-cache`` reads and
+    writes none of them."""
+    monkeypatch.setenv("SHIMMY_CACHE_DIR", str(tmp_path))
+    from shimmy.analyses.core import stability
+    from shimmy.service import analyses
+
+    computed = []
+    real = stability.growth_rate
+    monkeypatch.setattr(stability, "growth_rate", lambda config, *a, **kw: computed.append(config.value) or real(
+        config, *a, **kw))
+    body = {"Fz": 150000, "v_max": 200, "n_points": 40}
+    analyses.run("stability", {**body, "params": {"r2": 0.08}})
+    assert sorted(computed) == ["nes", "nes_pd", "original", "pd"]
+    computed.clear()
+    stepped, cached = analyses.run("stability", {**body, "params": {"r2": 0.082}})
+    assert not cached and sorted(computed) == ["nes", "nes_pd"]
+    whole = stability.growth_rates(150000, params=Parameters().with_overrides({"r2": 0.082}), v_range=(1.0, 200.0),
+                                   n_points=40)
+    assert stepped["configs"] == whole["configs"] and stepped["V"] == whole["V"]
+    computed.clear()
+    with cache.bypassed():
+        analyses.RUNNERS["stability"](schemas.validate("stability", {**body, "params": {"r2": 0.082}}))
+    assert sorted(computed) == ["nes", "nes_pd", "original", "pd"]
+
+
 @pytest.mark.parametrize("body,field", [
     ({"config": "nes", "V": 30, "Fz": 150000, "params": {"r2": 0.2}}, "params.r2"),
     ({"config": "nes", "V": 30, "Fz": 150000, "params": {"n": 2.5}}, "params.n"),

@@ -277,22 +277,38 @@ def growth_rates(Fz: float, *, params: Parameters | None = None, v_range: tuple[
                  n_points: int = 200) -> dict[str, Any]:
     """Straight rolling's leading eigenvalue against V on a geometric grid of ``n_points`` speeds in
     ``v_range`` (m/s), with the Hopf points and unstable intervals, for every configuration:
-    ``{"V": [...], "configs": {name: {"max_real" (1/s), "frequency_hz", "hopf_points", "unstable_intervals"}}}``."""
+    ``{"V": [...], "configs": {name: {"max_real" (1/s), "frequency_hz", "hopf_points", "unstable_intervals"}}}``
+    (each configuration's part is :func:`growth_rate`'s)."""
     params = params or Parameters()
     v_min, v_max, Fz = check_speeds_and_load(v_range, Fz)
     n_points = int(check_number("n_points", n_points, 10, 2000, integer=True))
-    V = np.geomspace(v_min, v_max, n_points)
-    out: dict[str, Any] = {"V": V.tolist(), "configs": {}}
-    for config in Configuration:
-        lin = Linearisation(build_model(config, params), Fz)
-        ev = lin.eigenvalues(V)
-        k = np.argmax(ev.real, axis=1)
-        lead = ev[np.arange(V.size), k]
-        # A coarse grid suffices: the near-axis extremum scan catches pairs between grid points
-        # (tests/analyses/core/test_stability.py: 12 points find what 20 000 do); 1e-7 m/s is far below display.
-        h = hopf_points(config, Fz, params=params, v_range=(v_min, v_max), n_grid=80, v_tol=1e-7)
-        out["configs"][config.value] = {
-            "max_real": lead.real.tolist(), "frequency_hz": (np.abs(lead.imag) / (2 * np.pi)).tolist(),
+    return {"V": growth_speeds((v_min, v_max), n_points).tolist(),
+            "configs": {c.value: growth_rate(c, Fz, params=params, v_range=(v_min, v_max), n_points=n_points)
+                        for c in Configuration}}
+
+
+def growth_speeds(v_range: tuple[float, float], n_points: int) -> np.ndarray:
+    """The speeds (m/s) :func:`growth_rate` evaluates: ``n_points`` on a geometric grid over ``v_range``."""
+    return np.geomspace(float(v_range[0]), float(v_range[1]), int(n_points))
+
+
+def growth_rate(config: Configuration | str, Fz: float, *, params: Parameters | None = None,
+                v_range: tuple[float, float] = V_RANGE, n_points: int = 200) -> dict[str, Any]:
+    """One configuration's part of :func:`growth_rates`: ``{"max_real" (1/s), "frequency_hz"}`` of the
+    leading eigenvalue at :func:`growth_speeds`, and its ``hopf_points`` and ``unstable_intervals``. It
+    depends on the design only through the configuration's model (a cache may key it so)."""
+    config = Configuration.parse(config)
+    params = params or Parameters()
+    v_min, v_max, Fz = check_speeds_and_load(v_range, Fz)
+    n_points = int(check_number("n_points", n_points, 10, 2000, integer=True))
+    V = growth_speeds((v_min, v_max), n_points)
+    lin = Linearisation(build_model(config, params), Fz)
+    ev = lin.eigenvalues(V)
+    k = np.argmax(ev.real, axis=1)
+    lead = ev[np.arange(V.size), k]
+    # A coarse grid suffices: the near-axis extremum scan catches pairs between grid points
+    # (tests/analyses/core/test_stability.py: 12 points find what 20 000 do); 1e-7 m/s is far below display.
+    h = hopf_points(config, Fz, params=params, v_range=(v_min, v_max), n_grid=80, v_tol=1e-7)
+    return {"max_real": lead.real.tolist(), "frequency_hz": (np.abs(lead.imag) / (2 * np.pi)).tolist(),
             "hopf_points": [p.to_dict() for p in h.hopf_points],
             "unstable_intervals": [list(iv) for iv in h.unstable_intervals]}
-    return out
