@@ -358,7 +358,7 @@ def _finish(fig, series, what, inside, v_range, fz_range):
                                  "opacity": 0.75, "line": {"width": 1, "color": "#888"}})
     fig.update_xaxes(range=list(v_range))
     fig.update_yaxes(range=list(fz_range))
-    fig.update_layout(margin={**style.MARGIN, "b": BOTTOM})
+    fig.update_layout(margin={"b": BOTTOM})  # (merged: a taller title's top margin stays)
     # the curves-and-points row wraps onto a second line at 1024 px: the shading row starts below it
     style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM,
                   rows=[1, 1.45, 1])
@@ -586,10 +586,11 @@ def margin_figure(result, smap=None, why=""):
     max_size = result["options"]["max_size"]
     reached = [p for p in result["points"] if p["margin"] is not None]
     crossed = [p for p in result["points"] if p["margin"] is None]
-    head = (f"{label}: smallest yaw kick from straight rolling to torsional shimmy, in the {len(result['points'])} "
-            f"cells where it coexists with another attractor"
-            + ("" if smap is not None else f" ({why or 'compute the map above to see its regions under them'})"))
-    fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    sub = (f"from straight rolling, in the {len(result['points'])} cells where it coexists with another attractor"
+           + ("" if smap is not None else f"<br>({why or 'compute the map above to see its regions under them'})"))
+    fig = style.figure("", "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    fig.update_layout(title=style.title(f"{label}: smallest yaw kick to torsional shimmy", sub),
+                      margin={**style.MARGIN, "t": style.MARGIN["t"] + style.SUBTITLE_LINE * (sub.count("<br>") + 1)})
     if smap is not None:
         _regions(fig, smap, MARGIN_REGIONS)
         _curves(fig, [smap], series, "configuration")

@@ -43,10 +43,21 @@ MESSAGE_WIDTH = 72
 MARGIN = {"l": 64, "r": 16, "t": 76, "b": 52}
 
 
-def title(text: str) -> dict:
-    """A title just above the plot area, left-aligned: under the toolbar at the top right, whatever the width."""
-    return {"text": text, "x": 0, "xref": "paper", "xanchor": "left", "y": 1, "yref": "paper", "yanchor": "bottom",
-            "pad": {"b": 12}, "font": {"size": 15}}
+def title(text: str, subtitle: str | None = None) -> dict:
+    """A title just above the plot area, left-aligned: under the toolbar at the top right, whatever the width.
+    Plotly does not wrap a title: one longer than a 1024 px window's plot (about 70 characters) says what
+    the figure is in ``text`` and the rest in ``subtitle``, smaller, under it (lines split by ``<br>``;
+    :data:`SUBTITLE_LINE` px each, for the top margin)."""
+    out = {"text": text, "x": 0, "xref": "paper", "xanchor": "left", "y": 1, "yref": "paper", "yanchor": "bottom",
+           "pad": {"b": 12}, "font": {"size": 15}}
+    if subtitle:  # drawn under the title's line: the title stands that much higher above the plot
+        out["subtitle"] = {"text": subtitle, "font": {"size": 12, "color": "#444"}}
+        out["pad"] = {"b": 12 + SUBTITLE_LINE * (subtitle.count("<br>") + 1)}
+    return out
+
+
+#: the height (px) of a line of a title's subtitle
+SUBTITLE_LINE = 17
 
 
 _title = title

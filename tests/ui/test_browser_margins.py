@@ -27,6 +27,9 @@ PLANE = ("/stability-map?shade=original&v_min=40&v_max=120&fz_min=500&fz_max=900
 
 #: A figure's title (none on a placeholder figure, while a run is made).
 TITLE = "return (g.layout.title && g.layout.title.text) || '';"
+#: a title with its subtitle, if any
+HEADING = ("const t = g.layout.title || {}; "
+           "return (t.text || '') + ' | ' + ((t.subtitle && t.subtitle.text) || '');")
 
 
 def _small(browser) -> None:
@@ -134,7 +137,10 @@ def test_margins_on_the_map_over_its_regions_and_a_click_runs_from_the_kick(serv
         [contours["start"] + k * contours["size"] for k in range(levels)])
     # over the map: its regions (filled) and curves drawn under the margins
     assert on_figure(browser, "mapm-graph", "return g.data.filter(t => t.fill === 'toself').length;") > 0
-    assert "compute the map above" not in on_figure(browser, "mapm-graph", TITLE)
+    heading = on_figure(browser, "mapm-graph", HEADING)
+    assert "smallest yaw kick to torsional shimmy | from straight rolling, in the " in heading
+    assert heading.endswith(" cells where it coexists with another attractor")
+    assert "compute the map above" not in heading
     assert [r[0] for r in table_rows(browser, "#mapm-summary tbody tr")] == ["600", "800"]
     assert not browser.find_element(By.ID, "mapm-csv").get_attribute("disabled")
     idle(browser)

@@ -170,3 +170,26 @@ def test_levels_number_4_to_8_whatever_the_spread(page):
         assert low < levels[0] and levels[-1] < high
         steps = {round(b - a, 12) for a, b in zip(levels, levels[1:])}
         assert len({float(f"{s:.6g}") for s in steps}) == 1
+
+
+def test_the_long_heading_is_a_title_and_a_subtitle_above_the_plot(page, region):
+    """Plotly does not wrap a title: the margins' heading (cut at 1024 px when it was one line) is a short
+    title and a subtitle, the reason the map is missing on a line of its own, the top margin and the
+    title's pad grown by a line for each subtitle line."""
+    from ui import style
+
+    without = page.margin_figure(region, None, "").to_dict()["layout"]
+    title = without["title"]
+    assert title["text"] == f"{style.CONFIG_LABELS['original']}: smallest yaw kick to torsional shimmy"
+    assert len(title["text"]) < 70
+    lines = title["subtitle"]["text"].split("<br>")
+    assert lines == [f"from straight rolling, in the {len(region['points'])} cells where it coexists with another "
+                     "attractor", "(compute the map above to see its regions under them)"]
+    assert all(len(line) < 90 for line in lines)
+    assert without["margin"]["t"] == style.MARGIN["t"] + 2 * style.SUBTITLE_LINE
+    assert title["pad"]["b"] == 12 + 2 * style.SUBTITLE_LINE
+    assert without["margin"]["b"] == page.BOTTOM  # the legends' room, set after
+    mapped = page.margin_figure(region, {"regions": [], "hopf_curves": [], "fold_curves": [], "torus_curves": []},
+                                "").to_dict()["layout"]
+    assert "<br>" not in mapped["title"]["subtitle"]["text"]
+    assert mapped["margin"]["t"] == style.MARGIN["t"] + style.SUBTITLE_LINE
