@@ -180,16 +180,17 @@ def download(_csv, _json, data):
 
 @dash.callback(Output(ids.OV_CMP.designs, "children"), Output(ids.OV_CMP_GRAPH, "figure"),
                Output(ids.OV_CMP_TABLE, "children"), Output(ids.OV_CMP.error, "children"),
-               *compare.SELECTION, Input(ids.design_store(ids.OV), "data"), Input(ids.OV_FZ,
-                                                                                  "value"), Input(ids.OV_VMAX, "value"))
-def compare_designs(selection, saved, current, fz_kn, v_max):
+               *compare.SELECTION, Input(ids.design_store(ids.OV), "data"), Input(ids.OV_FZ, "value"),
+               Input(ids.OV_VMAX, "value"), State(ids.OV_CMP.designs, "children"))
+def compare_designs(selection, saved, current, fz_kn, v_max, line):
     """Linear stability of each compared design (quick: asked of the service at once, the current
     design's answer shared with the figure above through the cache)."""
     try:
         chosen = compare.chosen(selection, saved, current)
     except InvalidParameterError as exc:
-        message = style.message_figure(str(exc), 200)
-        return html.Span(str(exc), className="hint"), message, None, ""
+        if compare.shows(line, exc):  # refused as before: nothing to send or draw again
+            return no_update, no_update, no_update, no_update
+        return compare.refusal(exc), style.message_figure(str(exc), 200), None, ""
     names = [d.name for d in chosen]
     try:
         body = {"Fz": FZ.read(fz_kn), "v_max": V_MAX.read(v_max), "n_points": 120}

@@ -10,7 +10,7 @@ from html import escape
 from typing import Any
 
 import dash
-from dash import Input, Output, html
+from dash import Input, Output, State, html
 
 from shimmy.errors import InvalidParameterError
 
@@ -49,15 +49,30 @@ def swatches(names: list[str]) -> list:
     return out
 
 
+def refusal(exc: InvalidParameterError) -> html.Span:
+    """The line that says what to tick, in place of the compared designs' swatches."""
+    return html.Span(str(exc), className="hint")
+
+
+def shows(line: Any, exc: InvalidParameterError) -> bool:
+    """True if ``line`` (the designs line's children as the browser holds them) already is
+    :func:`refusal` of ``exc``: a design step that leaves the comparison refused for the same reason
+    sends nothing, and nothing is drawn again (on the Overview that redraw delayed the growth figure's
+    on every slider step)."""
+    props = line.get("props", {}) if isinstance(line, dict) else {}
+    return props.get("children") == str(exc) and props.get("className") == "hint"
+
+
 def register_selection(group: Group, page_id: str) -> None:
     """The line that says which designs the page's comparison would show (or what to tick)."""
 
-    @dash.callback(Output(group.designs, "children"), *SELECTION, Input(ids.design_store(page_id), "data"))
-    def _designs(selection, saved, current):
+    @dash.callback(Output(group.designs, "children"), *SELECTION, Input(ids.design_store(page_id), "data"),
+                   State(group.designs, "children"))
+    def _designs(selection, saved, current, line):
         try:
             return swatches([d.name for d in chosen(selection, saved, current)])
         except InvalidParameterError as exc:
-            return html.Span(str(exc), className="hint")
+            return dash.no_update if shows(line, exc) else refusal(exc)
 
 
 def table(comparison: dict[str, Any], table_id: str) -> html.Table:
