@@ -23,6 +23,7 @@ import logging
 from typing import Any
 
 import flask
+from dash import _callback as dash_callback
 from werkzeug.exceptions import HTTPException
 
 from shimmy.service.admission import Busy
@@ -43,17 +44,25 @@ def install(app) -> None:
     security headers to every response of its server."""
     path = app.config.routes_pathname_prefix + "_dash-update-component"
     server = app.server
-    policy: list[str] = []
+    policy: list[tuple[int, str]] = [(-1, "")]  # (number of inline scripts, the policy naming their hashes)
 
     @server.after_request
     def _headers(response):
-        if not policy:  # the inline scripts are known once every callback is registered
-            policy.append("; ".join([
+        # Dash registers one more inline script (dash pages' document.title callback) in a hook of the
+        # first request; a response of another thread served meanwhile must not fix the policy without
+        # it (it did: under load every page then broke on "Executing inline script violates ..."). The
+        # policy is made again whenever the count of inline scripts changes (Dash has no public count),
+        # and replaced whole (one assignment: a thread reads the old one or the new one).
+        count = len(app._inline_scripts) + len(dash_callback.GLOBAL_INLINE_SCRIPTS)
+        known, text = policy[0]
+        if known != count:
+            text = "; ".join([
                 "default-src 'self'", "script-src 'self' " + " ".join(app.csp_hashes()),
                 "style-src 'self' 'unsafe-inline'", "img-src 'self' data: blob:", "font-src 'self' data:",
                 "connect-src 'self'", "object-src 'none'", "base-uri 'self'", "form-action 'self'",
-                "frame-ancestors 'none'"]))
-        response.headers["Content-Security-Policy"] = policy[0]
+                "frame-ancestors 'none'"])
+            policy[0] = (count, text)
+        response.headers["Content-Security-Policy"] = text
         response.headers["X-Content-Type-Options"] = "nosniff"
         response.headers["X-Frame-Options"] = "DENY"
         response.headers["Referrer-Policy"] = "no-referrer"

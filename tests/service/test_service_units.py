@@ -268,3 +268,42 @@ def test_design_schemas_name_what_the_analyses_take():
     b = schemas.validate("robustness", {"config": "nes", "tolerances": [{"name": "k_s", "relative": 0.05,
                                                                          "distribution": "uniform"}]})
     assert a == b and a["tolerances"] == [{"name": "k_s", "relative": 0.05, "distribution": "uniform"}]
+
+
+CSP_PROBE = r"""
+import base64, hashlib, re, sys
+import app
+
+server = app.server
+# a response served before Dash's first-request hook has registered the pages' document.title script
+# (under load another thread's response did come first), then the page itself
+with server.test_request_context("/api/v1/health"):
+    early = server.process_response(server.make_response(("ok", 200)))
+page = server.test_client().get("/")
+policy = page.headers["Content-Security-Policy"]
+allowed = set(re.findall(r"'sha256-([^']+)'", policy))
+html = re.sub(r"<!--\[if IE\]>.*?<!\[endif\]-->", "", page.get_data(as_text=True), flags=re.S)  # never run
+scripts = re.findall(r"<script>(.*?)</script>", html, re.S)
+scripts += re.findall(r'<script id="_dash-renderer" type="application/javascript">(.*?)</script>', html, re.S)
+missing = [s[:80] for s in scripts if base64.b64encode(hashlib.sha256(s.encode()).digest()).decode() not in allowed]
+print(len(scripts), "inline scripts;", "missing:", missing)
+sys.exit(1 if missing or "document.title" not in "".join(scripts) else 0)
+"""
+
+
+def test_the_pages_policy_names_every_inline_script_even_after_an_early_response(tmp_path):
+    """The Content-Security-Policy allows exactly Dash's inline scripts by their hashes. Dash registers the
+    last of them (dash pages' document.title callback) in a hook of the first request; a response another
+    thread served before that hook had run fixed the policy without it, and every page then failed
+    ("Executing inline script violates ..."). In a fresh process: a response first, then the page: every
+    inline script of the page is in the page's policy."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "SHIMMY_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(root)}
+    run = subprocess.run([sys.executable, "-c", CSP_PROBE], cwd=root, env=env, capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr[-3000:]
