@@ -23,7 +23,6 @@ import logging
 from typing import Any
 
 import flask
-from dash import _callback as dash_callback
 from werkzeug.exceptions import HTTPException
 
 from shimmy.service.admission import Busy
@@ -51,9 +50,11 @@ def install(app) -> None:
         # Dash registers one more inline script (dash pages' document.title callback) in a hook of the
         # first request; a response of another thread served meanwhile must not fix the policy without
         # it (it did: under load every page then broke on "Executing inline script violates ..."). The
-        # policy is made again whenever the count of inline scripts changes (Dash has no public count),
-        # and replaced whole (one assignment: a thread reads the old one or the new one).
-        count = len(app._inline_scripts) + len(dash_callback.GLOBAL_INLINE_SCRIPTS)
+        # policy is made again whenever the app's count of inline scripts differs from the one it was
+        # made at (Dash has no public count; csp_hashes() itself moves dash.clientside_callback's
+        # scripts into that list, so the first policy is made twice), and replaced whole (one
+        # assignment: a thread reads the old one or the new one).
+        count = len(app._inline_scripts)
         known, text = policy[0]
         if known != count:
             text = "; ".join([

@@ -170,10 +170,13 @@ def test_slider_move_updates_the_linear_stability_figure_and_the_url(server, bro
                             timeout=20, what="the NES growth-rate trace to change")
     assert traces_after != traces_before
     wait_for(lambda: "r2=" in browser.current_url, timeout=10, what="the URL to carry r2")
-    # The link reproduces the view.
+    idle(browser)
+    stepped = table_rows(browser, "#ov-hopf-table tbody tr")
+    # The link reproduces the view: the whole table.
     url = browser.current_url
     browser.get(url)
     assert wait_for(lambda: _nes_onset(browser), what="the table after reload") == after
+    assert table_rows(browser, "#ov-hopf-table tbody tr") == stepped
     browser.save_screenshot(str(SHOTS / "overview-after-slider.png"))
     assert severe(browser) == []
 
