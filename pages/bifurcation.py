@@ -72,6 +72,7 @@ def layout(Fz: str | None = None, v_min: str | None = None, v_max: str | None = 
         html.Div([ui.field("Configuration", ui.configurations(ids.BIFC_CONFIG, compared)),
                   *jobs.controls(ids.BIFC, "Compare")], className="controls"),
         html.Div(id=ids.BIFC.designs, className="compare-designs"),
+        compare.follower(ids.BIF),
         html.Div(bad_compared, id=ids.BIFC.error, className="error", role="alert"),
         ui.graph(ids.BIFC_GRAPH, figure=style.message_figure(compare.waiting_text("about 2-5 s per design cold, "
                                                                                 "instant from the cache"), 360)),

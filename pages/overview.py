@@ -48,6 +48,7 @@ def layout(Fz: str | None = None, vmax: str | None = None, **query):
                "at this load: where straight rolling is unstable for each configuration, one colour per design, "
                "with the change of the onset speed against the first design.", className="hint"),
         html.Div(id=ids.OV_CMP.designs, className="compare-designs"),
+        compare.follower(ids.OV),
         html.Div(id=ids.OV_CMP.error, className="error", role="alert"),
         ui.graph(ids.OV_CMP_GRAPH, figure=style.message_figure(
             f"Tick {designs.COMPARE[0]} to {designs.COMPARE[1]} designs under Compare in the design panel "
@@ -180,9 +181,9 @@ def download(_csv, _json, data):
 
 @dash.callback(Output(ids.OV_CMP.designs, "children"), Output(ids.OV_CMP_GRAPH, "figure"),
                Output(ids.OV_CMP_TABLE, "children"), Output(ids.OV_CMP.error, "children"),
-               *compare.SELECTION, Input(ids.design_store(ids.OV), "data"), Input(ids.OV_FZ, "value"),
-               Input(ids.OV_VMAX, "value"), State(ids.OV_CMP.designs, "children"))
-def compare_designs(selection, saved, current, fz_kn, v_max, line):
+               *compare.SELECTION, Input(ids.OV_FZ, "value"), Input(ids.OV_VMAX, "value"),
+               *compare.follows_design(ids.OV), State(ids.OV_CMP.designs, "children"))
+def compare_designs(selection, saved, fz_kn, v_max, _design_step, current, line):
     """Linear stability of each compared design (quick: asked of the service at once, the current
     design's answer shared with the figure above through the cache)."""
     try:

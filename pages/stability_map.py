@@ -126,6 +126,7 @@ def layout(shade: str | None = None, overlay: str | None = None, fz_min: str | N
                   METRICS_FZ.field("Figures at Fz (kN)", ids.MAPC_FZ, merit_fz),
                   *jobs.controls(ids.MAPC, "Compare")], className="controls"),
         html.Div(id=ids.MAPC.designs, className="compare-designs"),
+        compare.follower(ids.MAP),
         html.Div(" ".join(p for p in (bad_compared, bad_merit_fz) if p), id=ids.MAPC.error, className="error",
                  role="alert"),
         ui.graph(ids.MAPC_GRAPH, figure=style.message_figure(compare.waiting_text(

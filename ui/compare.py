@@ -6,11 +6,12 @@ changes against the first. The logic is :mod:`ui.designs`; this is the Dash side
 
 from __future__ import annotations
 
+import json
 from html import escape
 from typing import Any
 
 import dash
-from dash import Input, Output, State, html
+from dash import Input, Output, State, dcc, html
 
 from shimmy.errors import InvalidParameterError
 
@@ -19,6 +20,33 @@ from .ids import Group
 
 #: The inputs that say which designs are compared (the panel's, on every page).
 SELECTION = (Input(ids.DESIGN_COMPARE, "value"), Input(ids.SAVED, "data"))
+
+
+def follower_id(page: Any) -> str:
+    return f"{page}-compare-follows-design"
+
+
+def follower(page: Any) -> dcc.Store:
+    """A store of ``page``'s layout that takes the page's design only while the current design is
+    ticked for the comparison: a comparison of saved designs alone does not depend on it, so a slider
+    step then sends no request for it (:func:`follows_design` registers its browser callback)."""
+    return dcc.Store(id=follower_id(page))
+
+
+def follows_design(page: Any) -> tuple[Input, State]:
+    """Register the browser's callback that fills :func:`follower` of ``page``; (the Input that fires
+    when the comparison may change with the design, the State of the design itself)."""
+    dash.clientside_callback(
+        """
+        function(design, selection) {
+            return (selection || []).includes(%s) ? design : window.dash_clientside.no_update;
+        }
+        """ % json.dumps(designs.CURRENT),
+        Output(follower_id(page), "data"),
+        Input(ids.design_store(page), "data"), State(ids.DESIGN_COMPARE, "value"),
+        prevent_initial_call=True,
+    )
+    return Input(follower_id(page), "data"), State(ids.design_store(page), "data")
 
 
 def chosen(selection: Any, saved: Any, current: Any) -> list[designs.Design]:
@@ -66,9 +94,9 @@ def shows(line: Any, exc: InvalidParameterError) -> bool:
 def register_selection(group: Group, page_id: str) -> None:
     """The line that says which designs the page's comparison would show (or what to tick)."""
 
-    @dash.callback(Output(group.designs, "children"), *SELECTION, Input(ids.design_store(page_id), "data"),
+    @dash.callback(Output(group.designs, "children"), *SELECTION, *follows_design(page_id),
                    State(group.designs, "children"))
-    def _designs(selection, saved, current, line):
+    def _designs(selection, saved, _design_step, current, line):
         try:
             return swatches([d.name for d in chosen(selection, saved, current)])
         except InvalidParameterError as exc:

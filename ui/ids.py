@@ -129,6 +129,7 @@ def design_store(page: Any) -> dict[str, Any]:
 
 # -- saved designs (the panel's block, ui.sessions) --------------------------------------------------------
 
+DESIGNS_FOLLOW = "designs-follow-design"  # the page's design while designs are saved (the saved list marks it)
 SAVED = "designs-saved"  # the localStorage store of the saved designs (shared by every page and tab)
 DESIGNS = "designs"
 DESIGN_ASK = "design-ask"

@@ -23,7 +23,7 @@ def section() -> html.Details:
     """The panel's block of saved designs (the ids are the same on every page: one panel at a time)."""
     return html.Details([
         html.Summary("Saved designs"),
-        dcc.Store(id=ids.SAVED, storage_type="local"),
+        dcc.Store(id=ids.SAVED, storage_type="local"), dcc.Store(id=ids.DESIGNS_FOLLOW),
         dcc.Store(id=ids.DESIGN_ASK), dcc.Store(id=ids.DESIGN_UPLOAD_ASK), dcc.Store(id=ids.DESIGN_OPEN),
         html.Div(id=ids.DESIGN_OPEN_SINK, hidden=True),
         html.Div([dcc.Input(id=ids.DESIGN_NAME, type="text", placeholder="name this design", maxLength=designs.MAX_NAME,
@@ -142,11 +142,26 @@ def download(ask, stores):
     return {"content": design.text(), "filename": design.filename(), "type": "application/json"}
 
 
+# The saved list depends on the page's design only through which saved design it is ("shown now"):
+# with nothing saved, a slider step sends no request for it.
+dash.clientside_callback(
+    """
+    function(stores, saved) {
+        const some = saved && Array.isArray(saved.designs) && saved.designs.length > 0;
+        return some ? stores : window.dash_clientside.no_update;
+    }
+    """,
+    Output(ids.DESIGNS_FOLLOW, "data"),
+    Input(ids.design_store(ALL), "data"), State(ids.SAVED, "data"),
+    prevent_initial_call=True,
+)
+
+
 @dash.callback(Output(ids.DESIGNS_LIST, "children"), Output(ids.DESIGN_COMPARE, "options"),
                Output(ids.DESIGN_NAME, "value"),
-               Input(ids.SAVED, "data"), Input(ids.design_store(ALL), "data"), State(ids.DESIGN_NAME, "value"),
-               State(ids.DESIGNS_LIST, "children"))
-def show(saved, stores, name, shown):
+               Input(ids.SAVED, "data"), Input(ids.DESIGNS_FOLLOW, "data"), State(ids.design_store(ALL), "data"),
+               State(ids.DESIGN_NAME, "value"), State(ids.DESIGNS_LIST, "children"))
+def show(saved, _design_step, stores, name, shown):
     """The saved designs (the current one marked, one that can no longer be used says why) and the
     compare choices; an empty name box takes the name of the saved design shown."""
     entries = designs.saved_list(saved)

@@ -15,6 +15,7 @@ from shimmy.model.parameters import PARAMETER_SPECS
 
 pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.webdriver.common.keys import Keys  # noqa: E402
 
 from browser import (DOWNLOADS, SHOTS, browser_fixture, by_id, idle, open_page, severe, text_of,  # noqa: E402
                      trace_count, type_into, wait_for)
@@ -230,4 +231,53 @@ def test_two_designs_compared_on_the_bifurcation_page_both_show(server, browser)
                                      ".map(th => th.innerText)")
     assert columns == ["figure", "■ A wide track (reference)", "■ B stiff spring"]
     assert trace_count(browser, "ov-cmp-graph") > 8
+    assert severe(browser) == []
+
+
+def _comparison(driver):
+    """The Overview comparison's table rows (text), once it has them."""
+    return driver.execute_script("return [...document.querySelectorAll('#ov-cmp-summary tbody tr')]"
+                                 ".map(r => r.innerText);")
+
+
+def test_the_overview_comparison_follows_the_slider_only_with_the_current_design_ticked(server, browser):
+    """A comparison with the current design ticked follows a slider step; one of saved designs alone does
+    not depend on it (the page then sends no request for it: its callback's design input only fires while
+    the current design is ticked)."""
+    _fresh(browser, server)
+    _save(browser, server, *A)
+    open_page(browser, server, "/")
+    _tick(browser, "current design", A[0])
+    first = wait_for(lambda: len(_comparison(browser)) > 1 and _comparison(browser), timeout=20,
+                     what="the comparison of the current design and A")
+    handle = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]  # r2
+    handle.click()
+    for _ in range(10):
+        handle.send_keys(Keys.ARROW_LEFT)
+    moved = wait_for(lambda: (rows := _comparison(browser)) != first and rows, timeout=20,
+                     what="the comparison to follow the current design")
+    assert len(moved) == len(first)
+    # saved designs alone: a step sends nothing for the comparison and leaves it as it is
+    _save(browser, server, *B)
+    open_page(browser, server, "/")
+    _tick(browser, A[0], B[0])
+    idle(browser)
+    browser.execute_script("""const l = [...document.querySelectorAll('#design-compare label')]
+        .find(l => l.innerText.trim() === 'current design'); if (l.querySelector('input').checked) { l.click(); }""")
+    idle(browser)
+    saved_only = wait_for(lambda: (rows := _comparison(browser)) and "B stiff spring" in text_of(
+        browser, "ov-cmp-designs") and rows, timeout=20, what="the comparison of A and B")
+    assert "current design" not in text_of(browser, "ov-cmp-designs")
+    browser.execute_script("""window.__asked = []; const f = window.fetch;
+        window.fetch = function(url, opts) { window.__asked.push((opts && opts.body) || ''); return f.apply(this, arguments); };""")
+    handle = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]
+    handle.click()
+    for _ in range(5):
+        handle.send_keys(Keys.ARROW_LEFT)
+    wait_for(lambda: any("ov-growth.figure" in b for b in browser.execute_script("return window.__asked;")),
+             timeout=20, what="the growth figure's request")
+    idle(browser)
+    asked = browser.execute_script("return window.__asked;")
+    assert not any("ov-cmp-graph.figure" in b for b in asked), [json.loads(b).get("changedPropIds") for b in asked if b]
+    assert _comparison(browser) == saved_only
     assert severe(browser) == []
