@@ -53,9 +53,14 @@ jobs.install(app)
 
 # Dash sets itself up on a worker's first request (copying the registered callbacks into its map);
 # two first requests on a threaded worker raced there ("dictionary changed size during iteration",
-# a 500 for a page's scripts or layout). Done once here, at import, before any request.
+# a 500 for a page's scripts or layout). Done once here, at import, before any request: that set-up,
+# then every before-request hook on a request of the API's health path (no sign-in, no callback check),
+# among them dash pages' router, which registers the page-routing callback and the document.title
+# clientside script (served meanwhile, a page lacked that script and a callback of it was refused).
 with server.test_request_context("/"):
     app._setup_server()
+with server.test_request_context(PREFIX + "/health"):
+    server.preprocess_request()
 
 if __name__ == "__main__":
     app.run(host="127.0.0.1", port=int(os.environ.get("PORT", "8050")), debug=False)

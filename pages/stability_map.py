@@ -294,10 +294,14 @@ def figure(results, series=None, what="configuration"):
     scale = []
     for k, t in enumerate(TYPES):  # a stepped scale: code k -> its type's colour
         scale += [[k / n, style.SHIMMY_TYPE_COLOURS[t]], [(k + 1) / n, style.SHIMMY_TYPE_COLOURS[t]]]
-    head = (f"Shimmy type of {style.CONFIG_LABELS[shaded['config']]} (shaded)" if what == "configuration" else
-            f"{style.CONFIG_LABELS[shaded['config']]}: curves of {len(results)} designs, shimmy type of "
-            f"{series[0][0]} (shaded)")
-    fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    label = style.CONFIG_LABELS[shaded["config"]]
+    fig = style.figure("", "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    if what == "configuration":
+        fig.update_layout(title=style.title(f"Shimmy type of {label} (shaded)"))
+    else:  # a design's name is the user's (up to 80 characters): under the title, where it has the width
+        fig.update_layout(title=style.title(f"{label}: curves of {len(results)} designs",
+                                            f"shimmy type of {series[0][0]} (shaded)"),
+                          margin={"t": style.MARGIN["t"] + style.SUBTITLE_LINE})
     regions = shaded.get("regions") or []
     # the regions as polygons (their edges on the curves at every row); the grid stays underneath,
     # transparent, for the hover text and the click that opens a time history
@@ -359,10 +363,13 @@ def _finish(fig, series, what, inside, v_range, fz_range):
                                  "opacity": 0.75, "line": {"width": 1, "color": "#888"}})
     fig.update_xaxes(range=list(v_range))
     fig.update_yaxes(range=list(fz_range))
-    fig.update_layout(margin={"b": BOTTOM})  # (merged: a taller title's top margin stays)
-    # the curves-and-points row wraps onto a second line at 1024 px: the shading row starts below it
-    style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM,
-                  rows=[1, 1.45, 1])
+    # the curves-and-points row wraps onto a second line at 1024 px: the shading row starts below it; long
+    # design names wrap the first row too: the figure grows by the lines they take (the plot keeps its size)
+    first = style.legend_lines(f"{what} (colour)", [label for label, _ in series])
+    extra = int(style.LEGEND_ROW * (first - 1))
+    fig.update_layout(height=HEIGHT + extra, margin={"b": BOTTOM + extra})  # (merged: a taller title's top stays)
+    style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT + extra,
+                  BOTTOM + extra, rows=[first, 1.45, 1])
 
 
 def _regions(fig, result, opacity):
@@ -380,10 +387,11 @@ def sketch_figure(sketches, previous=None, live=False):
     series = [(style.CONFIG_LABELS[s["config"]], style.CONFIG_COLOURS[s["config"]]) for s in known]
     curves = sum(len(s["fold_curves"]) + len(s["torus_curves"]) for s in known)
     what = "the new design's map" if live else "the map"
-    head = (f"Making {what}: Hopf curves so far; the fold and torus curves, then the shading, follow" if not curves
-            else f"Making {what}: Hopf curves and {curves} fold / torus curve{'s' if curves != 1 else ''} so far; "
-                 "the shading follows")
-    fig = style.figure(head, "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    done = ("Hopf curves so far; the fold and torus curves, then the shading, follow" if not curves
+            else f"Hopf curves and {curves} fold / torus curve{'s' if curves != 1 else ''} so far; the shading follows")
+    fig = style.figure("", "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
+    fig.update_layout(title=style.title(f"Making {what}", done),  # (one line was cut at 1024 px)
+                      margin={"t": style.MARGIN["t"] + style.SUBTITLE_LINE})
     v_range = known[0]["v_range"]
     fz_range = [f / units.KN for f in known[0]["fz_range"]]
     before = [r for r in previous or [] if r.get("config") == known[0]["config"]  # the same map, earlier

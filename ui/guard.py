@@ -48,11 +48,11 @@ def install(app) -> None:
     @server.after_request
     def _headers(response):
         # Dash registers one more inline script (dash pages' document.title callback) in a hook of the
-        # first request; a response of another thread served meanwhile must not fix the policy without
-        # it (it did: under load every page then broke on "Executing inline script violates ..."). The
-        # policy is made again whenever the app's count of inline scripts differs from the one it was
-        # made at (Dash has no public count; csp_hashes() itself moves dash.clientside_callback's
-        # scripts into that list, so the first policy is made twice), and replaced whole (one
+        # first request (app.py runs that hook at import; this stays the safety net): a response of
+        # another thread served meanwhile must not fix the policy without it (it did: under load every
+        # page then broke on "Executing inline script violates ..."). The policy is made again whenever
+        # the app's count of inline scripts differs from the one it was made at (Dash has no public
+        # count; the list only grows, the count is read before the hashes), and replaced whole (one
         # assignment: a thread reads the old one or the new one).
         count = len(app._inline_scripts)
         known, text = policy[0]

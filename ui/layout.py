@@ -168,20 +168,22 @@ dash.clientside_callback(
         if (!update) { return window.dash_clientside.no_update; }
         // written in a task of its own: a slider step's requests are sent first, the address follows
         return new Promise(resolve => setTimeout(() => {
-            const params = new URLSearchParams(window.location.search);
-            for (const [k, v] of Object.entries(update)) {
-                if (v === null || v === undefined || v === "") { params.delete(k); } else { params.set(k, String(v)); }
-            }
-            const s = params.toString();
-            window.history.replaceState(window.history.state, "", window.location.pathname + (s ? "?" + s : ""));
-            const design = new URLSearchParams();
-            const keys = %s;
-            for (const [k, v] of params.entries()) { if (keys.includes(k)) { design.set(k, v); } }
-            const d = design.toString();
-            document.querySelectorAll("a.nav-link").forEach(a => {
-                a.href = a.getAttribute("href").split("?")[0] + (d ? "?" + d : "");
-            });
-            resolve(s);
+            let s = window.dash_clientside.no_update;  // (resolved whatever happens: never left pending)
+            try {
+                const params = new URLSearchParams(window.location.search);
+                for (const [k, v] of Object.entries(update)) {
+                    if (v === null || v === undefined || v === "") { params.delete(k); } else { params.set(k, String(v)); }
+                }
+                s = params.toString();
+                window.history.replaceState(window.history.state, "", window.location.pathname + (s ? "?" + s : ""));
+                const design = new URLSearchParams();
+                const keys = %s;
+                for (const [k, v] of params.entries()) { if (keys.includes(k)) { design.set(k, v); } }
+                const d = design.toString();
+                document.querySelectorAll("a.nav-link").forEach(a => {
+                    a.href = a.getAttribute("href").split("?")[0] + (d ? "?" + d : "");
+                });
+            } finally { resolve(s); }
         }, 0));
     }
     """ % json.dumps([*PARAMETER_SPECS, "material"]),

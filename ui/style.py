@@ -127,6 +127,23 @@ def legend_key(fig, name: str, legend: str = "legend", group: str | None = None,
 LEGEND_ROW = 34  # px from one legend row to the next: one line of entries and its wrap at 1024 px
 
 
+#: the width (px) a legend row has at a 1024 px window, and what its title and each entry take
+LEGEND_WIDTH, LEGEND_TITLE_CHAR, LEGEND_ENTRY, LEGEND_CHAR = 560, 7.0, 52, 6.6
+
+
+def legend_lines(title: str, names: list[str]) -> int:
+    """How many lines a legend row titled ``title`` with entries ``names`` takes at a 1024 px window
+    (Plotly wraps a horizontal legend; an estimate from the characters, on the safe side): design
+    names typed by a user (up to 80 characters each) wrap where configuration names do not."""
+    width, lines = LEGEND_TITLE_CHAR * (len(title) + 2), 1
+    for name in names:
+        entry = LEGEND_ENTRY + LEGEND_CHAR * len(name)
+        if width + entry > LEGEND_WIDTH and width > 0:
+            lines, width = lines + 1, 0.0
+        width += entry
+    return lines
+
+
 def legends(fig, titles: list[str], height: int, bottom: int, rows: list[float] | None = None) -> None:
     """Separate legends (legend, legend2, ...) stacked under the plot, each with its title on its left:
     which colour is which configuration apart from what a line style or a marker kind means.

@@ -17,7 +17,8 @@ PAGE = "/stability-map?shade=nes&fz_min=300&fz_max=900&resolution=4"
 
 
 def _title(browser) -> str:
-    return on_figure(browser, "map-graph", "return (g.layout.title && g.layout.title.text) || '';") or ""
+    return on_figure(browser, "map-graph", "const t = g.layout.title || {}; return (t.text || '') + "
+                                           "(t.subtitle && t.subtitle.text ? ' | ' + t.subtitle.text : '');") or ""
 
 
 def _faded(browser) -> bool:
@@ -32,7 +33,7 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
     idle(browser)
     run.click()
     # the curves are drawn as they are known, before the slices and the shading
-    wait_for(lambda: "Making the map: Hopf curves" in _title(browser), timeout=240, interval=0.1,
+    wait_for(lambda: "Making the map | Hopf curves" in _title(browser), timeout=240, interval=0.1,
              what="the first map's curves before its shading")
     assert on_figure(browser, "map-graph", "return g.data.filter(t => t.fill === 'toself').length;") == 0
     browser.save_screenshot(str(SHOTS / "live-map-sketch-1440.png"))

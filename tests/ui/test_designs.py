@@ -308,7 +308,8 @@ def test_the_page_figures_name_each_design_in_its_colour():
     hopf = [t for t in fig["data"] if t.get("name", "").endswith(": Hopf")]
     assert [(t["name"], t["line"]["color"], t["x"][0]) for t in hopf] == [
         ("A wide track: Hopf", series[0][1], 10.0), ("B stiff: Hopf", series[1][1], 15.0)]
-    assert "shimmy type of A wide track (shaded)" in fig["layout"]["title"]["text"]
+    assert fig["layout"]["title"]["text"] == "NES: curves of 2 designs"
+    assert fig["layout"]["title"]["subtitle"]["text"] == "shimmy type of A wide track (shaded)"
     assert (fig["layout"]["xaxis"]["title"]["text"], fig["layout"]["yaxis"]["title"]["text"]) == (
         "forward speed V (m/s)", "vertical load Fz (kN)")
 

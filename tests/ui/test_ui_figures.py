@@ -233,3 +233,27 @@ def test_stacked_legends_leave_a_wrapped_row_its_room(figures):
         assert all(g >= style.LEGEND_ROW - 1e-9 for g in gaps), (name, gaps)
     layout = figures["stability map"]["layout"]
     assert (layout["legend2"]["y"] - layout["legend3"]["y"]) * layout["height"] >= 1.4 * style.LEGEND_ROW
+
+
+def test_long_design_names_give_their_legend_row_the_lines_they_take(pages):
+    """Up to four design names of up to 80 characters wrap the first legend row at 1024 px: the rows
+    below start under its last line, and the figure grows by those lines (the plot keeps its height)."""
+    from ui import compare
+
+    names = ["A design named at length to say what changed in it"] * 1 + ["B " + "x" * 60, "C short", "D " + "y" * 40]
+    series = compare.series(names)
+    lines = style.legend_lines("design (colour)", [label for label, _ in series])
+    assert lines >= 3
+    for name, fig, short in (
+            ("map", pages["stability_map"].figure([_map()] * 4, series, what="design").to_dict(),
+             pages["stability_map"].figure([_map(), _map()], compare.series(["A", "B"]), what="design").to_dict()),
+            ("bifurcation", pages["bifurcation"].figure([_diagram()] * 4, series, what="design").to_dict(),
+             pages["bifurcation"].figure([_diagram()] * 2, compare.series(["A", "B"]), what="design").to_dict())):
+        layout, base = fig["layout"], short["layout"]
+        extra = int(style.LEGEND_ROW * (lines - 1))
+        assert layout["height"] == base["height"] + extra and layout["margin"]["b"] == base["margin"]["b"] + extra
+        tops = [layout[k]["y"] * layout["height"] for k in ("legend", "legend2", "legend3")]
+        assert tops[0] - tops[1] >= lines * style.LEGEND_ROW - 1e-9, name
+        assert tops[0] == pytest.approx(base["legend"]["y"] * base["height"] + extra), name  # as far under the plot
+        assert tops[2] > 20, name
+    assert style.legend_lines("configuration (colour)", ["Original", "NES", "PD", "NES+PD"]) == 1
