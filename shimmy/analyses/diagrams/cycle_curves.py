@@ -58,6 +58,11 @@ PLAIN = {PointKind.FOLD_OF_CYCLES: "fold-of-cycles", PointKind.TORUS: "torus",
 FZ_SCALE = 1.0e5  # N: a unit step in the curves' arclength is ~10 m/s or ~100 kN
 CURVE_OPTIONS = CycleCurveOptions(continuation=ContinuationOptions(ds=0.05, ds_max=2.0, max_steps=400,
                                                                    max_angle=0.3))
+#: A warm trace's first step: its seed is an interior point of a curve already traced, whose points were
+#: steps of 0.1-1.4 apart, not a located point of a one-parameter branch; starting at the cold start's
+#: 0.05 spent its first few steps growing to that (the nes map's four curves again: 4.98 s of work at
+#: 0.05, 4.46 s at 0.15, 4.43 s at 0.3, the same ends; 0.15: the step control takes over from there).
+WARM_FIRST_STEP = 0.15
 #: A torus start whose multiplier pair lies within this angle (rad per period) of +1 or -1 is a strong
 #: resonance, not a torus: nes_pd's diagram at 278.5 kN reported a torus point at its fold of cycles at
 #: 130.25 m/s with the pair at 6.6e-6 rad (two multipliers at +1), where no torus curve passes (the
@@ -506,7 +511,10 @@ class WarmUnit:
         first, last = s.end_amplitudes
         towards = {1: last if s.plus_to_last else first, -1: first if s.plus_to_last else last}
         end = towards.get(self.direction, min((a for a in (first, last) if a is not None), default=None))
-        options = CURVE_OPTIONS if end is None else dataclasses.replace(CURVE_OPTIONS, amplitude_end_below=end)
+        options = dataclasses.replace(CURVE_OPTIONS, continuation=dataclasses.replace(CURVE_OPTIONS.continuation,
+                                                                                      ds=WARM_FIRST_STEP))
+        if end is not None:
+            options = dataclasses.replace(options, amplitude_end_below=end)
         return continue_start(self.config, self.params, start, self.box, self.loads,
                               (self.direction,) if self.direction else (1, -1), options)
 

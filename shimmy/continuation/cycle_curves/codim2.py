@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from ..core import ContinuationOptions, CurvePoint, locate_between
+from ..core import ContinuationOptions, CurvePoint, locate_between, weighted_norm
 from ..periodic_orbits import multiplier_crossing_test
 from ..results import SpecialPoint
 
@@ -62,8 +62,11 @@ def _crossing_test(problem: CycleCurveProblem, which: str) -> Callable[[CurvePoi
 def codim2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, before: dict, after: dict,
                   reference: np.ndarray, index: int, copts: ContinuationOptions) -> list[SpecialPoint]:
     """The codimension-2 points in the step from ``prev`` to ``new`` (the test functions at both,
-    ``before`` and ``after``), each located, as point ``index`` of the curve."""
+    ``before`` and ``after``), each located, as point ``index`` of the curve, in their order along the
+    step (two in one step came in the order of the tests: the nes map's R4 and LPNS, a larger step apart,
+    listed the other way round than the trace with smaller steps, and its arrangement check failed)."""
     found = []
+    along = []  # each point's distance from prev (weighted), for their order along the step
     defining = problem.defining
     for name, a in before.items():
         b = after[name]
@@ -76,5 +79,6 @@ def codim2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint,
         hit = locate_between(problem, prev, new, g, a, b, copts, tolerance, with_tangent=name in defining.tangent_tests)
         at = hit[0] if hit is not None else new
         found.append(problem.special_point(name, at.u, index, located=hit is not None))
+        along.append(weighted_norm(at.u - prev.u, problem.weights))
     problem.cycle_u(new.u)
-    return found
+    return [found[k] for k in sorted(range(len(found)), key=lambda k: along[k])]  # stable for equal ones

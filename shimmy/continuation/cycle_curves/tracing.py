@@ -375,7 +375,8 @@ def join_halves(plus: CycleCurve, minus: CycleCurve) -> CycleCurve:
         return plus
     count = len(minus.p)
     order = np.arange(count - 1, 0, -1, dtype=int)  # reversed, without the shared start point
-    special = [replace(s, index=count - 1 - s.index) for s in minus.special_points]  # its start: the shared point
+    # its start: the shared point; reversed, so that two points of one step keep their order along the curve
+    special = [replace(s, index=count - 1 - s.index) for s in reversed(minus.special_points)]
     special += [replace(s, index=count - 1 + s.index) for s in plus.special_points]
     special.sort(key=lambda s: s.index)
 
@@ -401,7 +402,9 @@ def _join(kind: PointKind, halves, stops, steps) -> CycleCurve:
         if len(halves) == 2 and h_index == 0:
             order = list(range(count - 1, 0, -1))  # reversed, without the shared start point
             position = {i: k for k, i in enumerate(order)}
-            for s in pts:  # one at the start is at the shared point, where the other half begins
+            # one at the start is at the shared point, where the other half begins; reversed, so that two
+            # points of one step keep their order along the curve (the sort below is stable)
+            for s in reversed(pts):
                 special.append(replace(s, index=position.get(s.index, len(order))))
         else:
             order = list(range(count))
