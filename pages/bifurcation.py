@@ -253,14 +253,11 @@ def figure(results, series=None, what="configuration"):
     fz = units.to_kn(results[0]["Fz"]) if results else 0
     head = ("Bifurcation diagram" if what == "configuration"
             else f"Bifurcation diagrams of {style.CONFIG_LABELS[results[0]['config']]}, {len(results)} designs")
+    fig.update_layout(title=style.title(f"{head} at Fz = {fz:g} kN"), template=style.TEMPLATE,
+                      margin={**style.MARGIN, "l": 70}, hovermode="closest")
     # long design names wrap the first legend row at 1024 px: the figure grows by the lines they take
-    first = style.legend_lines(f"{what} (colour)", list(dict.fromkeys(label for label, _ in series)))
-    extra = int(style.LEGEND_ROW * (first - 1))
-    fig.update_layout(title=style.title(f"{head} at Fz = {fz:g} kN"), height=HEIGHT + extra,
-                      template=style.TEMPLATE, margin={**style.MARGIN, "l": 70, "b": BOTTOM + extra},
-                      hovermode="closest")
-    style.legends(fig, [f"{what} (colour)", "stability (line)", "special points (marker)"], HEIGHT + extra,
-                  BOTTOM + extra, rows=[first, 1, 1])
+    style.legends(fig, [f"{what} (colour)", "stability (line)", "special points (marker)"], HEIGHT, BOTTOM,
+                  first_names=list(dict.fromkeys(label for label, _ in series)))
     fig.update_xaxes(title_text="forward speed V (m/s)", row=3, col=1)
     fig.update_yaxes(title_text="max |psi| (rad)", row=1, col=1)
     fig.update_yaxes(title_text="max |l_g delta| (mm)", row=2, col=1)

@@ -297,11 +297,9 @@ def figure(results, series=None, what="configuration"):
     label = style.CONFIG_LABELS[shaded["config"]]
     fig = style.figure("", "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
     if what == "configuration":
-        fig.update_layout(title=style.title(f"Shimmy type of {label} (shaded)"))
+        style.titled(fig, f"Shimmy type of {label} (shaded)")
     else:  # a design's name is the user's (up to 80 characters): under the title, where it has the width
-        fig.update_layout(title=style.title(f"{label}: curves of {len(results)} designs",
-                                            f"shimmy type of {series[0][0]} (shaded)"),
-                          margin={"t": style.MARGIN["t"] + style.SUBTITLE_LINE})
+        style.titled(fig, f"{label}: curves of {len(results)} designs", f"shimmy type of {series[0][0]} (shaded)")
     regions = shaded.get("regions") or []
     # the regions as polygons (their edges on the curves at every row); the grid stays underneath,
     # transparent, for the hover text and the click that opens a time history
@@ -365,11 +363,8 @@ def _finish(fig, series, what, inside, v_range, fz_range):
     fig.update_yaxes(range=list(fz_range))
     # the curves-and-points row wraps onto a second line at 1024 px: the shading row starts below it; long
     # design names wrap the first row too: the figure grows by the lines they take (the plot keeps its size)
-    first = style.legend_lines(f"{what} (colour)", [label for label, _ in series])
-    extra = int(style.LEGEND_ROW * (first - 1))
-    fig.update_layout(height=HEIGHT + extra, margin={"b": BOTTOM + extra})  # (merged: a taller title's top stays)
-    style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT + extra,
-                  BOTTOM + extra, rows=[first, 1.45, 1])
+    style.legends(fig, [f"{what} (colour)", "curves, points", "shimmy type (shading)"], HEIGHT, BOTTOM,
+                  rows=[1, 1.45, 1], first_names=[label for label, _ in series])
 
 
 def _regions(fig, result, opacity):
@@ -390,8 +385,7 @@ def sketch_figure(sketches, previous=None, live=False):
     done = ("Hopf curves so far; the fold and torus curves, then the shading, follow" if not curves
             else f"Hopf curves and {curves} fold / torus curve{'s' if curves != 1 else ''} so far; the shading follows")
     fig = style.figure("", "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
-    fig.update_layout(title=style.title(f"Making {what}", done),  # (one line was cut at 1024 px)
-                      margin={"t": style.MARGIN["t"] + style.SUBTITLE_LINE})
+    style.titled(fig, f"Making {what}", done)  # (one line was cut at 1024 px)
     v_range = known[0]["v_range"]
     fz_range = [f / units.KN for f in known[0]["fz_range"]]
     before = [r for r in previous or [] if r.get("config") == known[0]["config"]  # the same map, earlier
@@ -598,8 +592,7 @@ def margin_figure(result, smap=None, why=""):
     sub = (f"from straight rolling, in the {len(result['points'])} cells where it coexists with another attractor"
            + ("" if smap is not None else f"<br>({why or 'compute the map above to see its regions under them'})"))
     fig = style.figure("", "forward speed V (m/s)", "vertical load Fz (kN)", height=HEIGHT)
-    fig.update_layout(title=style.title(f"{label}: smallest yaw kick to torsional shimmy", sub),
-                      margin={**style.MARGIN, "t": style.MARGIN["t"] + style.SUBTITLE_LINE * (sub.count("<br>") + 1)})
+    style.titled(fig, f"{label}: smallest yaw kick to torsional shimmy", sub)
     if smap is not None:
         _regions(fig, smap, MARGIN_REGIONS)
         _curves(fig, [smap], series, "configuration")

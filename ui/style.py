@@ -60,6 +60,13 @@ def title(text: str, subtitle: str | None = None) -> dict:
 SUBTITLE_LINE = 17
 
 
+def titled(fig, text: str, subtitle: str | None = None) -> None:
+    """Give ``fig`` the house :func:`title` (with ``subtitle``, if any) and a top margin that makes room for
+    the subtitle's lines above the plot."""
+    lines = subtitle.count("<br>") + 1 if subtitle else 0
+    fig.update_layout(title=title(text, subtitle), margin={"t": MARGIN["t"] + SUBTITLE_LINE * lines})
+
+
 _title = title
 
 
@@ -144,15 +151,24 @@ def legend_lines(title: str, names: list[str]) -> int:
     return lines
 
 
-def legends(fig, titles: list[str], height: int, bottom: int, rows: list[float] | None = None) -> None:
+def legends(fig, titles: list[str], height: int, bottom: int, rows: list[float] | None = None,
+            first_names: list[str] | None = None) -> None:
     """Separate legends (legend, legend2, ...) stacked under the plot, each with its title on its left:
     which colour is which configuration apart from what a line style or a marker kind means.
     ``bottom`` is the figure's bottom margin (px) they live in; ``rows`` gives each legend's height
     in rows of ``LEGEND_ROW`` px (1 each by default; more for a legend whose entries wrap onto a
-    further line at 1024 px, so the next one starts below its last line)."""
-    rows = [1.0] * len(titles) if rows is None else rows
+    further line at 1024 px, so the next one starts below its last line). ``first_names``: the first
+    legend's entries where they are the user's (design names): that row takes the lines they take
+    (:func:`legend_lines`), and the figure's height and bottom margin grow by them (the plot keeps its
+    size). The figure's height and bottom margin are set here."""
+    rows = [1.0] * len(titles) if rows is None else list(rows)
     if len(rows) != len(titles):
         raise ValueError(f"legends: {len(rows)} row heights for {len(titles)} legends")
+    if first_names is not None:
+        rows[0] = legend_lines(titles[0], first_names)
+        extra = int(LEGEND_ROW * (rows[0] - 1))
+        height, bottom = height + extra, bottom + extra
+    fig.update_layout(height=height, margin={"b": bottom})
     layout = {}
     y_px = bottom - 54
     for k, text in enumerate(titles):

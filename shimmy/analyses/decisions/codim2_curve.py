@@ -226,7 +226,7 @@ def codim2_curves(config: Configuration | str, parameter: str, *, params: Parame
             curve = StudyCurve(config.value, quantity, parameter, thetas,
                                [solved[t][column] if t in solved else None for t in thetas],
                                sorted(marks, key=lambda e: e["p"]), point=numbers[kind])
-            curves.append(on_whole_values(curve) if is_count(parameter) else curve)
+            curves.append(on_whole_values(curve))
         for e in ends:
             side = "below" if e["p"] < base else "above"
             warnings.append(f"{label} ends {side} {parameter} = {e['p']:.8g} ({e['why']}); no value past it, not zero")

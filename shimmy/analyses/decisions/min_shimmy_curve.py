@@ -121,7 +121,7 @@ def min_shimmy_curve(config: Configuration | str, parameter: str, *, params: Par
                             "lower point not followed from the base design")
     curve = StudyCurve(config.value, "min_shimmy_Fz", parameter, grid, curve_values,
                        sorted(special, key=lambda s: s["p"]))
-    return (on_whole_values(curve) if is_count(parameter) else curve), warnings
+    return on_whole_values(curve), warnings
 
 
 def _predict(grid, solutions, path, k) -> tuple[float, float]:

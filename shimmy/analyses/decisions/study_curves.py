@@ -315,7 +315,7 @@ class HopfSpeedCurves:
                 if here and abs(pick(here) - e["V"]) <= 1e-6 * max(e["V"], 1.0):
                     special.append({"kind": str(e["kind"]), "p": e["p"], "value": e["V"], "located": e["located"]})
             out.append(StudyCurve(self.config.value, quantity, self.param, grid, vals, special))
-        return [on_whole_values(c) for c in out] if is_count(self.param) else out
+        return [on_whole_values(c) for c in out]
 
 
 def is_count(parameter: str) -> bool:
@@ -334,7 +334,9 @@ def on_whole_values(curve: "StudyCurve") -> "StudyCurve":
     """A curve in a count at its whole values only: its points at whole p (each exact there: the curves
     are continued in the count as a real number, but only the whole ones are designs); a special point
     between two whole values is reported at the next one (the last, past the end), not located, with the
-    two whole values it lies between and the value there."""
+    two whole values it lies between and the value there. A curve in any other parameter as it is."""
+    if not is_count(curve.param):
+        return curve
     points = [(p, v) for p, v in zip(curve.p, curve.values, strict=True) if float(p).is_integer()]
     at = dict(points)
     special = []
