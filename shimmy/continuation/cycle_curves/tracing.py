@@ -255,7 +255,12 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         new_monitors = codim2.monitors(problem, new, mu, reference)
         special.extend(codim2.codim2_points(problem, prev, new, monitors, new_monitors, reference,
                                             len(rows["p"]) - 1, copts))
-        monitors = new_monitors
+        # a test unresolved here (NaN: a multiplier within its accuracy of the circle) keeps its last value, so
+        # that a crossing over the unresolved stretch is seen where the test is resolved again (pd's second
+        # torus curve ran from +0.01 through a NaN point to -1e-5 past its LPNS at 136.3 m/s, which the warm
+        # traces lost and the cold one, its points elsewhere, found)
+        monitors = {k: v if np.isfinite(v) or not np.isfinite(monitors.get(k, math.nan)) else monitors[k]
+                    for k, v in new_monitors.items()}
         reference = p_direction(new)
         # the curve type's own tests at `new` against its own direction (the cusp's compares directions)
         monitors.update(problem.defining.own_monitors(problem, new, reference))
@@ -269,6 +274,14 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         if amp < options.amplitude_min * amp_peak and amp < options.amplitude_end_below and amp < amp_last:
             stop = Stop(StopReason.ZERO_AMPLITUDE, f"amplitude shrank to zero near p = ({p_new[0]:.6g}, "
                         f"{p_new[1]:.6g}): the curve ends at a codimension-2 point of the equilibrium")
+            # The step into that end crossed where the curve degenerates (the cycle shrinks onto the equilibrium's
+            # GH or double-Hopf point, which the Hopf curves locate): a test that changed sign over it and could
+            # not be located is that end, not a point of the curve. (The nes map's low-speed fold curve traced
+            # again from its seed at the same design reported an unlocated cusp at its end, 4.584 m/s, 480.2 kN,
+            # which the cold trace did not, and the warm map went cold.)
+            last = len(rows["p"]) - 1
+            special = [q for q in special if not (q.index == last and q.kind in problem.defining.codim2
+                                                  and q.located is False)]
             special.append(SpecialPoint(PointKind.ZERO_AMPLITUDE, float(p_new[0]), len(rows["p"]) - 1,
                                         {"p2": float(p_new[1]), "amplitude": amp}))
             break
