@@ -211,6 +211,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
 
     reference = p_direction(start)
     monitors = codim2.monitors(problem, start, mu, reference)
+    carried: frozenset = frozenset()  # tests whose value in `monitors` is an earlier point's (unresolved since)
     amp_peak = _amplitude(problem, rows["xmax"][0], rows["xmin"][0])
     amp_last = amp_peak
     stop = Stop(StopReason.STEP_BUDGET, f"step budget of {copts.max_steps} steps used")
@@ -254,13 +255,14 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         special.extend(_p2_points(problem, prev, new, marks, rows, copts))
         new_monitors = codim2.monitors(problem, new, mu, reference)
         special.extend(codim2.codim2_points(problem, prev, new, monitors, new_monitors, reference,
-                                            len(rows["p"]) - 1, copts))
+                                            len(rows["p"]) - 1, copts, carried))
         # a test unresolved here (NaN: a multiplier within its accuracy of the circle) keeps its last value, so
         # that a crossing over the unresolved stretch is seen where the test is resolved again (pd's second
         # torus curve ran from +0.01 through a NaN point to -1e-5 past its LPNS at 136.3 m/s, which the warm
         # traces lost and the cold one, its points elsewhere, found)
-        monitors = {k: v if np.isfinite(v) or not np.isfinite(monitors.get(k, math.nan)) else monitors[k]
-                    for k, v in new_monitors.items()}
+        carried = frozenset(k for k, v in new_monitors.items()
+                            if not np.isfinite(v) and np.isfinite(monitors.get(k, math.nan)))
+        monitors = {k: monitors[k] if k in carried else v for k, v in new_monitors.items()}
         reference = p_direction(new)
         # the curve type's own tests at `new` against its own direction (the cusp's compares directions)
         monitors.update(problem.defining.own_monitors(problem, new, reference))
