@@ -1,6 +1,5 @@
 """Service pieces without a server: canonical requests, cache keys, the URL design state."""
 
-import contextlib
 import time
 
 import pytest
@@ -311,8 +310,6 @@ def test_the_pages_policy_names_every_inline_script_even_after_an_early_response
                          timeout=300)
     assert run.returncode == 0, run.stdout + run.stderr[-3000:]
 
-
-
 def test_the_write_ahead_log_is_truncated_once_a_reader_lets_go(tmp_path):
     """While a reader holds an older snapshot SQLite's checkpoints cannot start the log over, and the
     log grows with the writes (with readers always present, as under a flood of requests on several
@@ -324,15 +321,17 @@ def test_the_write_ahead_log_is_truncated_once_a_reader_lets_go(tmp_path):
     path = tmp_path / "jobs"
     cache.open_store(path).set("first", 1)
     reader = sqlite3.connect(str(path / "cache.db"), isolation_level=None)
-    reader.execute("BEGIN")
-    reader.execute("SELECT count(*) FROM Cache").fetchone()  # a snapshot held
-    value = "x" * 8000
-    for k in range(1200):  # ~10 MB
-        cache.open_store(path).set(("job", k % 100), {"log": value, "k": k})
-    held = (path / "cache.db-wal").stat().st_size
-    assert held > cache.WAL_LIMIT  # nothing could be done while the snapshot was held
-    reader.execute("COMMIT")
-    reader.close()
+    try:
+        reader.execute("BEGIN")
+        reader.execute("SELECT count(*) FROM Cache").fetchone()  # a snapshot held
+        value = "x" * 8000
+        for k in range(1200):  # ~10 MB
+            cache.open_store(path).set(("job", k % 100), {"log": value, "k": k})
+        held = (path / "cache.db-wal").stat().st_size
+        assert held > cache.WAL_LIMIT  # nothing could be done while the snapshot was held
+        reader.execute("COMMIT")
+    finally:
+        reader.close()
     time.sleep(cache.WAL_EVERY_S)
     cache.open_store(path).set(("job", 0), {"log": value, "k": -1})
     assert (path / "cache.db-wal").stat().st_size <= cache.WAL_LIMIT, held

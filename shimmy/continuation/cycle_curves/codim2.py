@@ -63,10 +63,12 @@ def codim2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint,
                   reference: np.ndarray, index: int, copts: ContinuationOptions,
                   carried: frozenset = frozenset()) -> list[SpecialPoint]:
     """The codimension-2 points in the step from ``prev`` to ``new`` (the test functions at both,
-    ``before`` and ``after``), each located, as point ``index`` of the curve, in their order along the
-    step (two in one step came in the order of the tests: the nes map's R4 and LPNS, a larger step apart,
-    listed the other way round than the trace with smaller steps, and its arrangement check failed).
-    ``carried``: the tests whose value in ``before`` is an earlier point's, unresolved at ``prev``."""
+    ``before`` and ``after``), each located (or said not to be), as point ``index`` of the curve, in
+    their order along the step (two in one step came in the order of the tests: the nes map's R4 and
+    LPNS, a larger step apart, listed the other way round than the trace with smaller steps, and its
+    arrangement check failed).
+    ``carried``: the multiplier tests whose value in ``before`` is an earlier point's, unresolved at
+    ``prev``: a crossing of one is told at ``new``, unlocated, and listed after the step's located ones."""
     found = []
     along = []  # each point's distance from prev (weighted), for their order along the step
     defining = problem.defining

@@ -260,8 +260,8 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         # that a crossing over the unresolved stretch is seen where the test is resolved again (pd's second
         # torus curve ran from +0.01 through a NaN point to -1e-5 past its LPNS at 136.3 m/s, which the warm
         # traces lost and the cold one, its points elsewhere, found)
-        carried = frozenset(k for k, v in new_monitors.items()
-                            if not np.isfinite(v) and np.isfinite(monitors.get(k, math.nan)))
+        carried = frozenset(k for k, v in new_monitors.items() if k in problem.defining.crossings
+                            and not np.isfinite(v) and np.isfinite(monitors.get(k, math.nan)))
         monitors = {k: monitors[k] if k in carried else v for k, v in new_monitors.items()}
         reference = p_direction(new)
         # the curve type's own tests at `new` against its own direction (the cusp's compares directions)
@@ -280,7 +280,8 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
             # GH or double-Hopf point, which the Hopf curves locate): a test that changed sign over it and could
             # not be located is that end, not a point of the curve. (The nes map's low-speed fold curve traced
             # again from its seed at the same design reported an unlocated cusp at its end, 4.584 m/s, 480.2 kN,
-            # which the cold trace did not, and the warm map went cold.)
+            # which the cold trace did not, and the warm map went cold.) A crossing carried over an unresolved
+            # stretch and told in that step goes with them: it is as unresolved as the end.
             last = len(rows["p"]) - 1
             special = [q for q in special if not (q.index == last and q.kind in problem.defining.codim2
                                                   and q.located is False)]
