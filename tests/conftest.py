@@ -83,6 +83,46 @@ def pytest_collection_modifyitems(config, items):
     items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))
 
 
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item, call):
+    """A failed test that used a server says what the server was doing: its jobs (analysis,
+    configuration, status, message, times) and the end of its log, so that a wait that timed out
+    on a loaded machine names why."""
+    report = yield
+    servers = [v for v in getattr(item, "funcargs", {}).values() if isinstance(v, Server)]
+    if report.failed and call.when == "call" and servers:
+        for server in servers:
+            report.sections.append((f"server {server.base}: its jobs", _jobs_summary(server)))
+            log = server.cache_dir / "gunicorn.log"
+            tail = log.read_text(errors="replace")[-3000:] if log.exists() else "(no log)"
+            report.sections.append((f"server {server.base}: the end of its log", tail))
+    return report
+
+
+def _jobs_summary(server: "Server") -> str:
+    try:
+        from shimmy.service import jobs
+
+        with server.cache_env():
+            s = jobs.store()
+            found = [s.get(k) for k in list(s) if isinstance(k, tuple) and len(k) == 2 and k[0] == "job"]
+            running = dict(s.get("running", {}))
+    except Exception as exc:  # noqa: BLE001 - a report of a failure must not fail
+        return f"(job store unreadable: {type(exc).__name__}: {exc})"
+    found = sorted((j for j in found if j is not None), key=lambda j: j.get("created", 0))
+    from shimmy.model.parameters import Parameters
+
+    base, now = Parameters().to_dict(), time.time()
+    lines = [f"{len(found)} jobs, running slots: {sorted(running)}"]
+    for j in found[-40:]:
+        request = j.get("request") or {}
+        lines.append(f"{j['id'][:8]} {j.get('analysis')} {request.get('config', '')} {j.get('status')} "
+                     f"created {now - j.get('created', now):.1f} s ago, updated {now - j.get('updated', now):.1f} s "
+                     f"ago: {j.get('message')} {j.get('error') or ''}; design changes "
+                     f"{ {k: v for k, v in (request.get('params') or {}).items() if base.get(k) != v} }")
+    return "\n".join(lines)
+
+
 def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))

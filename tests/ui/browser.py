@@ -83,11 +83,19 @@ def severe(driver) -> list[str]:
     return [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"]
 
 
+#: The shortest a wait waits before it fails, whatever ``timeout`` a test gives: a callback round trip
+#: that takes 0.1 s on a quiet machine took over 10 s in CI with both cores taken by the other xdist
+#: worker, Chromium and the server's jobs. A wait returns as soon as its condition holds, so this only
+#: bounds how long a real failure takes to be reported; no test asserts a speed with it.
+MIN_WAIT_S = 45.0
+
+
 def wait_for(predicate, timeout=60.0, interval=0.1, what="condition"):
     """``predicate()`` once it is true; ``what`` (text, or a function giving it when the wait fails:
     the page's state then) names what was waited for. An element the page replaced while the predicate
-    read it (Dash re-rendered it: StaleElementReferenceException) counts as not yet."""
-    deadline = time.time() + timeout
+    read it (Dash re-rendered it: StaleElementReferenceException) counts as not yet. ``timeout`` (s)
+    is raised to :data:`MIN_WAIT_S`."""
+    deadline = time.time() + max(timeout, MIN_WAIT_S)
     while time.time() < deadline:
         try:
             value = predicate()
