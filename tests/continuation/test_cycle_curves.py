@@ -8,8 +8,8 @@ import pytest
 from textbook_systems import (TWO_PARAMETER_SYSTEMS, bautin, cusp_of_cycles, flip_two_parameter, fold_near_torus,
                               torus_two_parameter)
 
-from shimmy.continuation import (CycleCurveProblem, InvalidInputError, Mesh, OrbitGuess, PeriodicOptions,
-                                 ContinuationOptions, cycle_curve, hopf_guess, periodic_branch)
+from shimmy.continuation import (CycleCurveOptions, CycleCurveProblem, InvalidInputError, Mesh, OrbitGuess,
+                                 PeriodicOptions, ContinuationOptions, cycle_curve, hopf_guess, periodic_branch)
 
 BOX = ((-2.0, 2.0), (-1.0, 1.0))
 
@@ -186,6 +186,29 @@ def test_turning_points_in_p2_and_crossings_of_marked_loads_are_located():
     assert abs(turns[0].p) < 1e-7 and abs(turns[0].data["p2"]) < 1e-7
     marks = sorted(s.p for s in kinds(curve, "P2_MARK"))
     np.testing.assert_allclose(marks, [-0.5, 0.5], atol=1e-8)
+
+
+def test_a_marked_load_crossed_twice_in_a_step_around_a_turn_gives_both_crossings():
+    """p2 = p1^2 traced in long steps (chord tolerance 1: a coarse polyline): the step across the
+    minimum at p1 = 0 has both ends above a load the curve crosses twice inside it, marked at half
+    the lower end's p2; both crossings are located, on either side of the located turn."""
+    system = swapped(torus_two_parameter())
+    options = CycleCurveOptions(chord_tol=1.0, continuation=ContinuationOptions(ds=0.2, ds_max=0.5, max_steps=300))
+
+    def trace(marks):
+        return cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.3), 0.09,
+                           box=((-1.0, 1.0), (-1.0, 2.0)), scale=np.ones(4), p_scale=(1.0, 1.0),
+                           kappa=math.cos(2 * math.pi * 0.33), p2_marks=marks, options=options)
+
+    p1 = trace(()).p[:, 0]
+    k = next(k for k in range(len(p1) - 1) if p1[k] < 0 < p1[k + 1])
+    mark = 0.5 * min(p1[k], p1[k + 1], key=abs) ** 2
+    curve = trace((mark,))
+    np.testing.assert_array_equal(curve.p[:, 0], p1)  # the same steps: the mark moves none
+    turn = kinds(curve, "P2_TURN")
+    assert len(turn) == 1 and abs(turn[0].p) < 1e-7
+    marks = sorted(s.p for s in kinds(curve, "P2_MARK"))
+    np.testing.assert_allclose(marks, [-math.sqrt(mark), math.sqrt(mark)], atol=1e-8)
 
 
 def test_double_hopf_point_of_two_uncoupled_oscillators_is_located_on_the_hopf_curve():

@@ -336,20 +336,27 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
         t_p = q.tangent[i2 - 1:i2 + 1] * np.sqrt(problem.weights[i2 - 1:i2 + 1])
         return float(t_p[1] / max(np.linalg.norm(t_p), 1e-300))
 
+    pieces = [(prev, new)]  # stretches of the step on which p2 is monotone
     if prev.tangent[i2] * new.tangent[i2] < 0:
         hit = locate_between(problem, prev, new, slope, slope(prev), slope(new), copts, codim2.LOCATE_TOL)
         at = hit[0] if hit is not None else new
         found.append(problem.special_point(PointKind.P2_TURN, at.u, len(rows["p"]) - 1,
                                            {"turn": "max" if prev.tangent[i2] > 0 else "min"}, hit is not None))
+        if hit is not None:  # a mark between the turn's p2 and both ends' is crossed twice in the step
+            pieces = [(prev, hit[0]), (hit[0], new)]
+    tiny = 1e-9 * problem.p_scale[1]
     for mark in marks:
-        a, b = prev.u[i2] - mark, new.u[i2] - mark
-        if abs(b) <= 1e-9 * problem.p_scale[1]:  # the step ends on the mark (a box edge)
+        if abs(new.u[i2] - mark) <= tiny:  # the step ends on the mark (a box edge)
             found.append(problem.special_point(PointKind.P2_MARK, new.u, len(rows["p"]) - 1))
-        elif a * b < 0 and abs(a) > 1e-9 * problem.p_scale[1]:  # (a step from the mark: told there)
-            at = point_at(problem, prev, new, i2, mark, copts)  # p2 held at the mark: one Newton solve
+            continue
+        for one, other in pieces:
+            a, b = one.u[i2] - mark, other.u[i2] - mark
+            if not (a * b < 0 and abs(a) > tiny):  # (a step from the mark: told there)
+                continue
+            at = point_at(problem, one, other, i2, mark, copts)  # p2 held at the mark: one Newton solve
             if at is None:
-                hit = locate_between(problem, prev, new, lambda q, m=mark: q.u[i2] - m, a, b, copts,
-                                     1e-9 * problem.p_scale[1], with_tangent=False)
+                hit = locate_between(problem, one, other, lambda q, m=mark: q.u[i2] - m, a, b, copts, tiny,
+                                     with_tangent=False)
                 at = None if hit is None else hit[0]
             if at is not None:
                 found.append(problem.special_point(PointKind.P2_MARK, at.u, len(rows["p"]) - 1))
