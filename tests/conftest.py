@@ -89,13 +89,15 @@ def pytest_runtest_makereport(item, call):
     configuration, status, message, times) and the end of its log, so that a wait that timed out
     on a loaded machine names why."""
     report = yield
-    servers = [v for v in getattr(item, "funcargs", {}).values() if isinstance(v, Server)]
-    if report.failed and call.when == "call" and servers:
-        for server in servers:
-            report.sections.append((f"server {server.base}: its jobs", _jobs_summary(server)))
-            log = server.cache_dir / "gunicorn.log"
-            tail = log.read_text(errors="replace")[-3000:] if log.exists() else "(no log)"
-            report.sections.append((f"server {server.base}: the end of its log", tail))
+    if report.failed and call.when == "call":
+        try:  # a report of a failure must not fail (an error here would end the xdist worker)
+            for server in [v for v in (getattr(item, "funcargs", None) or {}).values() if isinstance(v, Server)]:
+                report.sections.append((f"server {server.base}: its jobs", _jobs_summary(server)))
+                log = server.cache_dir / "gunicorn.log"
+                tail = log.read_text(errors="replace")[-3000:] if log.exists() else "(no log)"
+                report.sections.append((f"server {server.base}: the end of its log", tail))
+        except Exception as exc:  # noqa: BLE001
+            report.sections.append(("server state", f"(unavailable: {type(exc).__name__}: {exc})"))
     return report
 
 
@@ -116,7 +118,7 @@ def _jobs_summary(server: "Server") -> str:
     lines = [f"{len(found)} jobs, running slots: {sorted(running)}"]
     for j in found[-40:]:
         request = j.get("request") or {}
-        lines.append(f"{j['id'][:8]} {j.get('analysis')} {request.get('config', '')} {j.get('status')} "
+        lines.append(f"{str(j.get('id'))[:8]} {j.get('analysis')} {request.get('config', '')} {j.get('status')} "
                      f"created {now - j.get('created', now):.1f} s ago, updated {now - j.get('updated', now):.1f} s "
                      f"ago: {j.get('message')} {j.get('error') or ''}; design changes "
                      f"{ {k: v for k, v in (request.get('params') or {}).items() if base.get(k) != v} }")

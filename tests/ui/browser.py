@@ -86,7 +86,8 @@ def severe(driver) -> list[str]:
 #: The shortest a wait waits before it fails, whatever ``timeout`` a test gives: a callback round trip
 #: that takes 0.1 s on a quiet machine took over 10 s in CI with both cores taken by the other xdist
 #: worker, Chromium and the server's jobs. A wait returns as soon as its condition holds, so this only
-#: bounds how long a real failure takes to be reported; no test asserts a speed with it.
+#: bounds how long a real failure takes to be reported: a wait is no speed test (speeds are measured
+#: by benchmarks/, in medians, not by a test's timeout on a shared machine).
 MIN_WAIT_S = 45.0
 
 

@@ -25,9 +25,9 @@ little: the curves move, but where their arrangement stays the same the regions 
    on a curve to that curve's new crossing, an end where a cycle's mode changes stays, held in its
    interval between the curves), its Hopf points are located again by the eigenvalue scan, its
    fold and torus points are the new curves' located crossings of its load (each point moved with
-   its curve's drawn crossing, then matched to the located crossing within half a cell of there or
-   of anywhere between there and where it was; a point the slice lists twice, found on two of its
-   branches, matched once). Its diagram is not
+   its curve's drawn crossing, then matched to the located crossing within half a cell of there, or
+   else to the one crossing between there and where it was; a point the slice lists twice, found on
+   two of its branches, matched once). Its diagram is not
    recomputed, so it reports no largest amplitude (``max_psi`` None, ``"carried": true``). A slice
    whose load the curves now cross otherwise, or with a Hopf point more or less, or with a point
    on no curve of the map (a period doubling), is computed again; and, as a cold map does, a slice
@@ -68,6 +68,9 @@ from ...model.units import kn
 #: Kinds of a slice's special points that lie on the map's curves (carried to the curves' crossings);
 #: a slice with any other (a period doubling, a branch point of cycles) is not carried.
 ON_CURVES = (PointKind.FOLD_OF_CYCLES, PointKind.TORUS)
+#: Two fold or torus points of one kind on a slice within this fraction of half a grid cell are one
+#: point the slice's diagram found on two of its branches (measured: 0.024 m/s apart, a cell ~2 m/s).
+DUPLICATE = 0.1
 #: A slice is carried only within this largest relative parameter change from the design its
 #: diagram was computed at (a mode change inside an interval stays where that diagram put it: the
 #: farther the design, the farther it may be off); farther, it is computed again. One slider step of
@@ -212,16 +215,24 @@ def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameter
         if q["kind"] not in ON_CURVES:
             raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a {q['kind']} point, on no curve of the map")
         V = on_curve(q["V"], str(q["kind"]))
-        # the new curve's located crossing of this load where the point was carried, each used once; a
-        # point the slice lists twice, found on two of its branches (located on each to the diagram's
-        # tolerance: 17.887 and 17.863 m/s on one of pd's), is one point: it takes the crossing the
-        # other took when no other is there
-        # (within half a cell of where the drawn curves moved it, or of anywhere between that and where it
-        # was: near a turn of a curve in Fz its polyline's crossing of the load moves by more than a cell
-        # when the curve is traced again through other points: 45.64 m/s on pd's fold curve at 233.7 kN)
-        reach = tol + abs(V - q["V"])
-        near = [x for x in crossings.get(str(q["kind"]), []) if abs(x - V) <= reach]
-        located = [x for x in near if x not in taken] or [x for x in near if abs(taken[x] - q["V"]) <= tol]
+        # the new curves' located crossing of this load where the point was carried (within half a cell),
+        # each used once
+        crossed = crossings.get(str(q["kind"]), [])
+        free = [x for x in crossed if x not in taken]
+        located = [x for x in free if abs(x - V) <= tol]
+        lo, hi = sorted((V, q["V"]))
+        if not located:  # near a turn of a curve in Fz its drawn crossing of the load moves by more than a
+            # cell when the curve is traced again through other points (45.64 m/s on pd's fold curve at
+            # 233.7 kN moved 1.24 m/s, its located crossing 2e-5 m/s): the one crossing between there and
+            # where it was, half a cell either side
+            located = [x for x in free if lo - tol <= x <= hi + tol]
+            if len(located) > 1:
+                raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a {q['kind']} point at V = {q['V']:.5g} m/s "
+                              f"that {len(located)} crossings of the map's curves may stand for")
+        if not located:  # a point the slice lists twice, found on two of its branches and located on each to
+            # the diagram's tolerance (17.887 and 17.863 m/s on pd's at 213.9 kN), is one point
+            located = [x for x in crossed if x in taken and lo - tol <= x <= hi + tol
+                       and abs(taken[x] - q["V"]) <= DUPLICATE * tol]
         if not located:
             raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a {q['kind']} point at V = {q['V']:.5g} m/s that "
                           "no curve of the map crosses there now")
@@ -242,6 +253,9 @@ def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameter
     for iv in old["intervals"]:
         a = float(v_range[0]) if iv["V_start"] <= v_range[0] else moved(iv["V_start"])
         b = float(v_range[1]) if iv["V_end"] >= v_range[1] else moved(iv["V_end"])
+        if a > b:  # its ends went to crossings the other way round: the points were matched wrongly
+            raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has an interval from {iv['V_start']:.5g} to "
+                          f"{iv['V_end']:.5g} m/s whose ends would go to {a:.5g} and {b:.5g} m/s")
         intervals.append({"type": iv["type"], "V_start": a, "V_end": b})
     coarse, fine = speed_grids(*v_range, n_v)
     fine_types = [map_shading.type_at(intervals, float(v)) for v in fine]

@@ -343,13 +343,16 @@ def _p2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint, ma
         found.append(problem.special_point(PointKind.P2_TURN, at.u, len(rows["p"]) - 1,
                                            {"turn": "max" if prev.tangent[i2] > 0 else "min"}, hit is not None))
         if hit is not None:  # a mark between the turn's p2 and both ends' is crossed twice in the step
-            pieces = [(prev, hit[0]), (hit[0], new)]
+            pieces = [(prev, hit[0]), (hit[0], new)]  # (a turn not located: such a mark is not told, and a
+            # warm map that needs that crossing is computed cold)
     tiny = 1e-9 * problem.p_scale[1]
     for mark in marks:
-        if abs(new.u[i2] - mark) <= tiny:  # the step ends on the mark (a box edge)
+        ends_on = abs(new.u[i2] - mark) <= tiny
+        if ends_on:  # the step ends on the mark (a box edge)
             found.append(problem.special_point(PointKind.P2_MARK, new.u, len(rows["p"]) - 1))
-            continue
         for one, other in pieces:
+            if ends_on and other is new:  # told above
+                continue
             a, b = one.u[i2] - mark, other.u[i2] - mark
             if not (a * b < 0 and abs(a) > tiny):  # (a step from the mark: told there)
                 continue

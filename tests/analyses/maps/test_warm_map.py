@@ -254,6 +254,10 @@ def test_a_damper_step_of_pd_is_warmed_to_the_cold_maps_arrangement_and_shading(
     same = warm_map(start, params=Parameters())
     assert same.warmed_from["slices"]["computed_again"] == [], same.warmed_from["slices"]
     assert same.warmed_from["slices"]["carried"] == len(start["slices"])
+    for old, s in zip(start["slices"], same.slices, strict=True):  # each point at its own crossing
+        assert [q["kind"] for q in s.special_points] == [q["kind"] for q in old["special_points"]]
+        for q, p in zip(old["special_points"], s.special_points, strict=True):
+            assert abs(p["V"] - q["V"]) <= 0.05, (old["Fz"], q, p)  # a point listed twice: 0.024 m/s apart
     warm = stability_map("pd", params=params, warm_from=start)
     assert warm.warmed_from is not None, warm.warm_refused
     cold = stability_map("pd", params=params)
