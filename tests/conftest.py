@@ -105,13 +105,11 @@ def _jobs_summary(server: "Server") -> str:
     try:
         from shimmy.service import jobs
 
+        found = sorted(server.job_records().values(), key=lambda j: j.get("created", 0))
         with server.cache_env():
-            s = jobs.store()
-            found = [s.get(k) for k in list(s) if isinstance(k, tuple) and len(k) == 2 and k[0] == "job"]
-            running = dict(s.get("running", {}))
+            running = dict(jobs.store().get("running", {}))
     except Exception as exc:  # noqa: BLE001 - a report of a failure must not fail
         return f"(job store unreadable: {type(exc).__name__}: {exc})"
-    found = sorted((j for j in found if j is not None), key=lambda j: j.get("created", 0))
     from shimmy.model.parameters import Parameters
 
     base, now = Parameters().to_dict(), time.time()
@@ -147,6 +145,15 @@ class Server:
                 os.environ.pop("SHIMMY_CACHE_DIR", None)
             else:
                 os.environ["SHIMMY_CACHE_DIR"] = before
+
+    def job_records(self) -> dict[str, dict]:
+        """Every job its job store holds, by id (queued, running and finished ones)."""
+        from shimmy.service import jobs
+
+        with self.cache_env():
+            s = jobs.store()
+            found = (s.get(k) for k in list(s) if isinstance(k, tuple) and len(k) == 2 and k[0] == "job")
+            return {j["id"]: j for j in found if j is not None}
 
     def request(self, method: str, path: str, body=None, raw: bytes | None = None, timeout: float = 60.0,
                 headers: dict[str, str] | None = None):

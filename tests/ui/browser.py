@@ -169,12 +169,7 @@ def trace_count(driver, graph_id: str) -> int:
 
 def job_records(server) -> dict[str, dict]:
     """Every job the server's job store holds, by id (queued, running and finished ones)."""
-    from shimmy.service import jobs
-
-    with server.cache_env():
-        s = jobs.store()
-        found = (s.get(k) for k in list(s) if isinstance(k, tuple) and len(k) == 2 and k[0] == "job")
-        return {j["id"]: j for j in found if j is not None}
+    return server.job_records()
 
 
 def on_figure(driver, graph_id: str, script: str):
