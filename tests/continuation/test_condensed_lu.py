@@ -84,6 +84,30 @@ def test_bordered_test_matrices_of_cycle_curves_are_solved_like_dense_matrices(k
     np.testing.assert_allclose(newton @ x, b, atol=1e-11 * np.abs(x).max())
 
 
+@pytest.mark.parametrize("kind,system,kappa", [("LPC", bautin, None), ("PD", flip_two_parameter, None),
+                                               ("NS", torus_two_parameter, 0.3)])
+def test_the_test_matrix_applied_without_assembly_is_the_assembled_matrix(kind, system, kappa):
+    """M z and M^T z from the collocation blocks and boundary entries (the refinement's products)
+    equal the assembled sparse matrix's, for one and several right-hand sides, on a graded mesh."""
+    system = system()
+    mesh = Mesh(np.sort(np.concatenate([[0.0, 1.0], np.random.default_rng(2).uniform(0, 1, 6)])), 3)
+    problem = CycleCurveProblem(system, kind, mesh, np.ones(system.n), 2 * np.pi, np.ones(2))
+    rng = np.random.default_rng(7)
+    theta = 2 * np.pi * mesh.node_times
+    X = np.zeros((mesh.n_nodes, system.n))
+    X[:, 0], X[:, 1] = np.cos(theta), np.sin(theta)
+    u = np.concatenate([X.ravel(), [2 * np.pi, 0.04, 0.2]] + ([[kappa]] if kind == "NS" else []))
+    problem.cycle.accept(problem.cycle_u(u))
+    u = u + 1e-2 * rng.standard_normal(u.size)
+    operator = problem._operator(u)
+    M = problem._bordered(u)
+    for shape in [(M.shape[0],), (M.shape[0], 2)]:
+        z = rng.standard_normal(shape)
+        np.testing.assert_allclose(operator.matvec(z), M @ z, rtol=0, atol=1e-12 * np.abs(M @ z).max())
+        np.testing.assert_allclose(operator.rmatvec(z), M.T @ z, rtol=0, atol=1e-12 * np.abs(M.T @ z).max())
+    assert (operator.sparse() != M).nnz == 0
+
+
 def random_chain(rng, links=5, n=2, interior=(3, 0, 2, 4, 1), g=2):
     """A random matrix of a chain layout with links of different interior sizes (one without)."""
     size = 0

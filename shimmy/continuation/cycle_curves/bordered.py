@@ -11,7 +11,8 @@ Jacobian (step 1e-6 of v's size in the weighted norm: relative error ~1e-10, whi
 enters the Newton matrix; the residuals are exact). The borders are moved to the last kernel
 vectors at every accepted point. The bordered matrix is factored by the condensed LU of
 :mod:`shimmy.continuation.condensed_lu` (SuperLU where that meets a zero pivot), and its solves are refined on the
-last factors, so that most Newton iterates and trial points do not factor it.
+last factors, so that most Newton iterates and trial points do not factor it; the refinement's products
+are taken from the collocation blocks without assembling the matrix (:mod:`.bordered_operator`).
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from ..results import SpecialPoint
 from .defining_system import DefiningSystem
 from .fold_of_cycles import FoldOfCycles
 from .period_doubling import PeriodDoubling
+from .bordered_operator import BorderedOperator
 from .torus import Torus
 
 #: The defining system of each curve type.
@@ -106,13 +108,22 @@ class CycleCurveProblem:
         """Roles of the rows and columns of the bordered test matrix [[A, B], [C^T, 0]]."""
         return self.defining.test_layout(self)
 
-    def _factor(self, M: sp.csc_matrix):
-        """LU factors of the bordered test matrix: condensed (:mod:`.condensed_lu`); SuperLU if
-        that meets a zero pivot."""
+    def _factor(self, M: BorderedOperator, u: np.ndarray):
+        """LU factors of the bordered test matrix M at u: condensed (:mod:`.condensed_lu`), its input
+        summed straight from the matrix's entries (no sparse matrix); SuperLU if that meets a zero
+        pivot."""
+        lay = self.test_layout
+        if not hasattr(self, "_slot"):
+            self._structure()
+        if not hasattr(self, "_destinations"):
+            self._destinations = lay.destinations(*self._entries)
+        buffer = np.bincount(self._destinations, weights=self._values(u), minlength=lay.buffer_size)
+        split = lay.links * lay.r_max * lay.width
+        parts = (buffer[:split].reshape(lay.links, lay.r_max, lay.width), buffer[split:].reshape(lay.q, lay.size))
         try:
-            return CondensedLU(M, self.test_layout)
+            return CondensedLU(None, lay, parts)
         except np.linalg.LinAlgError:
-            return splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+            return splu(M.sparse(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
 
     def factor_bordered(self, u: np.ndarray, row: np.ndarray):
         """LU factors of the Newton matrix [jacobian(u); row] (``solve(b)``, ``row``), condensed
@@ -199,6 +210,7 @@ class CycleCurveProblem:
         rows += [border_r.ravel(), m + border_c.ravel()]  # B, then C^T
         cols += [m + border_c.ravel(), border_r.ravel()]
         rows, cols = np.concatenate(rows), np.concatenate(cols)
+        self._entries = (rows, cols)
         size = m + k
         key = cols.astype(np.int64) * size + rows
         unique, slot = np.unique(key, return_inverse=True)
@@ -222,18 +234,29 @@ class CycleCurveProblem:
         size = self.m + self.k
         return sp.csc_matrix((data, self._indices, self._indptr), shape=(size, size))
 
-    def _solve(self, M: sp.csc_matrix, rhs: np.ndarray, trans: bool, sweeps: int | None = None) -> np.ndarray | None:
+    def _operator(self, u: np.ndarray) -> BorderedOperator:
+        """The bordered test matrix at u as an operator (its products without assembly; the sparse
+        matrix assembled only if it is factored)."""
+        if not hasattr(self, "_boundary"):
+            rows, cols = self.defining.boundary_entries(self)
+            self._boundary = (np.concatenate(rows), np.concatenate(cols))
+        cu = self.cycle_u(u)
+        blocks, F, _, _ = self.cycle.collocation_blocks(cu)
+        values = np.concatenate(self.defining.boundary_values(self, u, F))
+        return BorderedOperator(self, blocks, *self._boundary, values, lambda: self._bordered(u))
+
+    def _solve(self, M: BorderedOperator, rhs: np.ndarray, trans: bool, sweeps: int | None = None) -> np.ndarray | None:
         """M^-1 rhs (or M^-T rhs) by iterative refinement on the last LU factors (those of a nearby
         point: a Newton iterate, the previous point); None if the residual does not reach 1e-13
         of the solution (a looser 1e-12 leaves the test functions noisy enough to slow Newton), or
         stops shrinking fast (by 4 per sweep: the factors are too far off, better refactor)."""
         if self._lu is None:
             return None
-        op = M.T if trans else M
+        apply = M.rmatvec if trans else M.matvec
         mode = "T" if trans else "N"
         scale = max(float(np.abs(rhs).max()), 1e-300)
         sweeps = self.defining.refine_sweeps if sweeps is None else sweeps
-        return refine(lambda b: self._lu.solve(b, trans=mode), lambda z: op @ z, rhs,
+        return refine(lambda b: self._lu.solve(b, trans=mode), apply, rhs,
                       lambda z: 1e-13 * scale * max(1.0, float(np.abs(z).max())), sweeps)
 
     def analyse(self, u: np.ndarray, left: bool = True) -> dict:
@@ -244,7 +267,7 @@ class CycleCurveProblem:
         key = u.tobytes()
         if self._memo is not None and self._memo[0] == key and (not left or "W" in self._memo[1]):
             return self._memo[1]
-        M = self._bordered(u)
+        M = self._operator(u)
         k, m = self.k, self.m
         rhs = np.zeros((m + k, k))
         rhs[m:, :] = np.eye(k)
@@ -254,11 +277,11 @@ class CycleCurveProblem:
             right = self._solve(M, rhs, False)
         solved = right is not None and (not left or (lhs := self._solve(M, rhs, True)) is not None)
         if not solved:  # refactor; the solves are refined on the new factors too
-            self._lu = self._factor(M)
+            self._lu = self._factor(M, u)
             right = self._solve(M, rhs, False, FRESH_SWEEPS)
             lhs = self._solve(M, rhs, True, FRESH_SWEEPS) if left and right is not None else None
             if right is None or (left and lhs is None):  # fresh condensed factors not accurate: SuperLU
-                self._lu = splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+                self._lu = splu(M.sparse(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
                 right = self._solve(M, rhs, False, FRESH_SWEEPS)
                 right = self._lu.solve(rhs) if right is None else right
                 if left:
@@ -293,7 +316,8 @@ class CycleCurveProblem:
 
     def accept(self, u: np.ndarray) -> None:
         self.cycle.accept(self.cycle_u(u))
-        self._memo = None  # accepting moves the phase condition: the bordered matrix at u changes
+        if self.defining.reads_phase:
+            self._memo = None  # accepting moves the phase condition: the bordered matrix at u changes
         self.update_borders(u)
 
     def update_borders(self, u: np.ndarray, sweeps: int = 1) -> None:

@@ -33,6 +33,8 @@ class DefiningSystem:
     has_kappa = False
     #: periods A spans: copies of the cycle's collocation blocks in it
     periods = 1
+    #: whether A holds the cycle's phase row (which moves with the reference when a point is accepted)
+    reads_phase = False
     #: refinement sweeps of the test matrix's solves on the last factors before it is factored
     #: afresh (see ``FRESH_SWEEPS`` in :mod:`.bordered`)
     refine_sweeps = 6

@@ -25,6 +25,7 @@ class FoldOfCycles(DefiningSystem):
     # with fewer sweeps one of the original gear's fold curves took shorter steps (28 points with 2
     # or 3 sweeps, 42 with 1, 26 with 6)
     refine_sweeps = 6
+    reads_phase = True  # A is the Jacobian of the cycle equations, the phase row among them
     crossings = {PointKind.FOLD_TORUS: "complex", PointKind.FOLD_FLIP: "negative"}
     codim2 = (PointKind.CUSP_OF_CYCLES, PointKind.FOLD_TORUS, PointKind.FOLD_FLIP)
     tangent_tests = frozenset({PointKind.CUSP_OF_CYCLES})
