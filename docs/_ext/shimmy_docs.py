@@ -180,6 +180,8 @@ class Limits(SphinxDirective):
             ["threads per web worker", f"{settings.WEB_THREADS}", _literal("SHIMMY_WEB_THREADS")],
             ["heartbeat of a job worker on another host", f"{settings.JOB_STALE_SECONDS:g} s",
              _literal("SHIMMY_JOB_STALE_SECONDS")],
+            ["a job worker with no job left waits idle for the next one", f"{settings.JOB_WORKER_LINGER_SECONDS:g} s",
+             _literal("SHIMMY_JOB_WORKER_LINGER_SECONDS")],
             ["requests per workbench action", f"{settings.MAX_PAGE_REQUESTS}", "–"],
             ["jobs queued or running per user", f"{settings.MAX_JOBS_PER_USER}",
              _literal("SHIMMY_MAX_JOBS_PER_USER")],

@@ -18,7 +18,11 @@ A queued job holds no process. :func:`pump` (called on every submit, read and ca
 worker when it finishes) starts a worker for the first queued jobs while slots are free:
 ``python -m shimmy.service.worker ID`` in its own session, so that it outlives the request and
 its whole process group (process pool, forkserver, resource tracker) can be ended at once. A
-worker that finishes takes the next queued job itself, in the same slot.
+worker that finishes takes the next queued job itself, in the same slot; with none queued it stays
+idle for ``JOB_WORKER_LINGER_SECONDS`` (holding no slot, listed in the store's idle workers), and
+:func:`pump` hands the next job to it rather than starting a process: the next slider step's map
+starts with the imports, the compiled kernels and the process pool warm. The server's stop ends the
+idle workers with the running ones; its start ends any a crash left.
 
 A job is failed only when its process is gone: the process is identified by pid and start
 time (psutil), so a late heartbeat under load fails nothing, and a dead one never stays
@@ -422,6 +426,12 @@ def server_started() -> dict[str, list[str]]:
     jobs are started by the web workers (:func:`pump`). (What was queued again and what failed, by id.)"""
     s = store()
     s.delete("draining")
+    with s.transact():  # idle workers left by a server that did not stop cleanly: never handed a job now
+        idle = dict(s.get("idle", {}))
+        s.set("idle", {key: h for key, h in idle.items() if h.get("host") != HOST})
+    for holder in idle.values():
+        if holder.get("host") == HOST and _is_process(holder):
+            _signal_group(holder, signal.SIGKILL)
     gone = [(job_id, holder) for job_id, holder in list(s.get("running", {}).items())
             if not _alive(s, job_id, holder)]
     for _, holder in gone:
@@ -452,6 +462,10 @@ def server_stopping(grace: float = 5.0) -> list[str]:
     the head of the queue, so that they start again when the server does. The ids queued again."""
     s = store()
     holders = {job_id: h for job_id, h in s.get("running", {}).items() if h.get("host") == HOST}
+    with s.transact():  # idle workers end with the server (the next one starts its own, with its code)
+        idle = dict(s.get("idle", {}))
+        holders.update({("idle", key): h for key, h in idle.items() if h.get("host") == HOST})
+        s.set("idle", {key: h for key, h in idle.items() if h.get("host") != HOST})
     for holder in holders.values():
         _signal_group(holder, signal.SIGTERM)
     deadline = time.time() + grace
@@ -490,14 +504,21 @@ def pump() -> None:
             return
         running = dict(s.get("running", {}))
         queue = list(s.get("queue", []))
+        idle = dict(s.get("idle", {}))
+        waiting = [key for key, holder in idle.items() if _idle_alive(holder)]
         while len(running) < settings.MAX_RUNNING_JOBS:
             job_id, owner = _choose(s, queue, running)
             if job_id is None:
                 break
+            if waiting:  # an idle worker takes it (it reads the running map): warm, no process to start
+                holder = idle.pop(waiting.pop(0))
+                running[job_id] = {**holder, "claimed": _now(), "user": owner}
+                continue
             running[job_id] = {"pid": None, "started": None, "host": HOST, "claimed": _now(), "user": owner}
             starting.append(job_id)
         s.set("queue", queue)
         s.set("running", running)
+        s.set("idle", {key: idle[key] for key in waiting})
     for job_id in starting:
         _start(s, job_id)
 
@@ -584,10 +605,15 @@ def _alive(s: diskcache.Cache, job_id: str, holder: dict[str, Any]) -> bool:
         return job is not None and _now() - job["heartbeat"] <= settings.JOB_STALE_SECONDS
     if holder.get("pid") is None:  # being started: Popen returns within milliseconds
         return _now() - holder.get("claimed", 0) < settings.JOB_START_SECONDS
+    return _is_process(holder)
+
+
+def _is_process(holder: dict[str, Any]) -> bool:
+    """The process ``holder`` names (pid and start time, on this host) is running."""
     try:
         p = psutil.Process(holder["pid"])
         return p.status() != psutil.STATUS_ZOMBIE and abs(p.create_time() - holder["started"]) < 0.05
-    except (psutil.NoSuchProcess, psutil.AccessDenied, TypeError):
+    except (psutil.NoSuchProcess, psutil.AccessDenied, TypeError, KeyError):
         return False
 
 
@@ -629,14 +655,16 @@ POOLED = frozenset({"map", "margin_map", "margins", "study", "robustness", "opti
 
 def run(job_id: str) -> None:
     """Run job ``job_id`` in this process (``python -m shimmy.service.worker``), then the next
-    queued jobs in the same slot until the queue is empty."""
+    queued jobs in the same slot until the queue is empty, then those handed to it while it waits
+    idle (:func:`_linger`)."""
     me = {"pid": os.getpid(), "started": _create_time(os.getpid()), "host": HOST}
     stop = threading.Event()
     current = [job_id]
 
     def beat():
         while not stop.wait(1.0):
-            update(current[0], heartbeat=_now())
+            if current[0] is not None:
+                update(current[0], heartbeat=_now())
 
     # running from now (the slot is this process's); then the slot's process pool, forked before the
     # heartbeat thread exists: warm for every job of the slot
@@ -649,13 +677,16 @@ def run(job_id: str) -> None:
                 if not _run_one(job_id):  # cancelled: the canceller's SIGTERM for this group is on its way
                     return
                 job_id = _next(job_id, me)
+                if job_id is None:
+                    current[0] = None  # no job's heartbeat while idle
+                    job_id = _linger(me)
         finally:
             stop.set()
 
 
 def _run_one(job_id: str) -> bool:
     """Run one job; False if it was cancelled."""
-    job = update(job_id, status="running", message="running", heartbeat=_now())
+    job = update(job_id, status="running", message="running", heartbeat=_now(), worker=os.getpid())
     if job is None or job["status"] != "running":
         return job is not None and job["status"] != "cancelled"
 
@@ -690,6 +721,55 @@ class _Progress:
     def _check(now: dict[str, Any] | None) -> None:
         if now is None or now["status"] == "cancelled":
             raise Cancelled()
+
+
+#: How often an idle worker reads the store for a job (seconds).
+IDLE_POLL_SECONDS = 0.05
+
+
+def _linger(me: dict[str, Any]) -> str | None:
+    """After its last job: stay idle for ``JOB_WORKER_LINGER_SECONDS``, registered in the store's idle
+    workers, until :func:`pump` hands this process a job (an entry of the running map with its pid) or a
+    job is queued while a slot is free; that job's id, or None when the time is up or the jobs drain (the
+    process then ends). Polls by reads; a transaction only to take a job or to leave."""
+    if settings.JOB_WORKER_LINGER_SECONDS <= 0:
+        return None
+    s = store()
+    key = str(me["pid"])
+    with s.transact():
+        s.set("idle", {**s.get("idle", {}), key: me})
+    deadline = time.monotonic() + settings.JOB_WORKER_LINGER_SECONDS
+    while True:
+        last = time.monotonic() >= deadline
+        running = s.get("running", {})
+        handed = any(_same_process(h, me) for h in running.values())
+        free = s.get("queue") and len(running) < settings.MAX_RUNNING_JOBS
+        if handed or free or last or s.get("draining") is not None:
+            with s.transact():
+                running = dict(s.get("running", {}))
+                mine = next((job_id for job_id, h in running.items() if _same_process(h, me)), None)
+                queue = list(s.get("queue", []))
+                if mine is None and s.get("draining") is None and len(running) < settings.MAX_RUNNING_JOBS:
+                    mine, owner = _choose(s, queue, running)
+                    if mine is not None:
+                        running[mine] = {**me, "claimed": _now(), "user": owner}
+                        s.set("queue", queue)
+                        s.set("running", running)
+                if mine is not None or last or s.get("draining") is not None:
+                    idle = dict(s.get("idle", {}))
+                    idle.pop(key, None)
+                    s.set("idle", idle)
+                    return mine
+        time.sleep(IDLE_POLL_SECONDS)
+
+
+def _same_process(holder: dict[str, Any], me: dict[str, Any]) -> bool:
+    return holder.get("pid") == me["pid"] and holder.get("host") == me["host"] and holder.get("started") == me["started"]
+
+
+def _idle_alive(holder: dict[str, Any]) -> bool:
+    """An idle worker of this host whose process is the one registered."""
+    return holder.get("host") == HOST and _is_process(holder)
 
 
 def _next(finished: str, me: dict[str, Any]) -> str | None:

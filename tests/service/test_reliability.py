@@ -197,11 +197,16 @@ def test_callback_fuzz_campaign_gives_no_5xx(srv):
 
 
 def _workers(srv):
-    """Job worker processes of this server's cache (by their command line and environment)."""
+    """Job worker processes of this server's cache (by their command line and environment) that run or
+    start a job: not those idle in the store's list, waiting for the next job (they hold no slot)."""
+    from shimmy.service import jobs
+
+    with srv.cache_env():
+        idle = {int(pid) for pid in jobs.store().get("idle", {})}
     out = []
     for p in psutil.process_iter(["cmdline", "pid"]):
         try:
-            if "shimmy.service.worker" in (p.info["cmdline"] or []) and \
+            if "shimmy.service.worker" in (p.info["cmdline"] or []) and p.pid not in idle and \
                     p.environ().get("SHIMMY_CACHE_DIR") == str(srv.cache_dir):
                 out.append(p)
         except psutil.Error:

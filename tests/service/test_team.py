@@ -576,3 +576,46 @@ def test_queued_and_running_jobs_survive_a_restart_and_run_after_it(tmp_path):
         print("restart (kill -9 of the server and its job): the job queued again at the start and done")
     finally:
         stop_server(server)
+
+
+def test_a_finished_worker_waits_idle_for_the_next_job_and_ends_with_the_server(tmp_path):
+    """A worker with no job left stays idle (listed in the store, holding no slot) and the next job is
+    handed to it: the same warm process runs it. Its linger time up, it ends by itself; the server's stop
+    ends it too."""
+    from shimmy.service import jobs
+
+    def run(server, V):
+        _, _, job = server.request("POST", "/api/v1/jobs", {"analysis": "simulate", "config": "nes", "V": V,
+                                                            "Fz": 150000, "t_end": 2})
+        done = until(lambda: (j := server.request("GET", f"/api/v1/jobs/{job['id']}")[2])["status"] in (
+            "done", "failed") and j, 120, f"the job at V = {V} to finish")
+        assert done["status"] == "done", done
+        with cache_env(tmp_path):
+            return jobs.store().get(("job", job["id"]))["worker"]
+
+    def idle():
+        with cache_env(tmp_path):
+            s = jobs.store()
+            return s.get("running", {}) == {} and {int(pid) for pid in s.get("idle", {})}
+
+    server = start_server(tmp_path, {"SHIMMY_JOB_WORKER_LINGER_SECONDS": "60"})
+    try:
+        first = run(server, 41)
+        assert until(idle, 30, "the worker to be listed idle") == {first}
+        assert [p.pid for p in job_workers(tmp_path)] == [first]
+        assert run(server, 42) == first  # handed to the idle worker: no new process
+        assert until(idle, 30, "the worker idle again") == {first}
+    finally:
+        stop_server(server)
+    assert not job_workers(tmp_path)  # the idle worker ended with the server
+    with cache_env(tmp_path):
+        assert jobs.store().get("idle") == {}
+    server = start_server(tmp_path, {"SHIMMY_JOB_WORKER_LINGER_SECONDS": "1"})
+    try:
+        third = run(server, 43)
+        until(lambda: not job_workers(tmp_path), 60, "the idle worker to end after its linger time")
+        with cache_env(tmp_path):
+            assert jobs.store().get("idle") == {}
+        assert run(server, 44) != third  # a new process: nobody was waiting
+    finally:
+        stop_server(server)
