@@ -76,6 +76,35 @@ def test_minimally_augmented_jacobian_matches_finite_differences(kind, system, r
         np.testing.assert_allclose(J @ d, fd, rtol=1e-5, atol=1e-6 * np.abs(fd).max())
 
 
+def test_second_derivatives_taken_together_are_those_taken_one_by_one():
+    """second_many (one field evaluation for all displaced points) against second per direction, and
+    a direction that moves the parameters (evaluated apart) against central differences of the
+    cycle Jacobian's rows."""
+    system = torus_two_parameter()
+    mesh = Mesh.uniform(8, 3)
+    problem = CycleCurveProblem(system, "NS", mesh, np.ones(system.n), 2 * np.pi, np.ones(2))
+    u = np.concatenate([circle(mesh, 1.0, system.n).ravel(), [2 * np.pi, 0.04, 0.2, 0.3]])
+    problem.cycle.accept(problem.cycle_u(u))
+    rng = np.random.default_rng(11)
+    u = u + 1e-3 * rng.standard_normal(u.size)
+    pairs = []
+    for moves in (False, False, True):
+        d = rng.standard_normal(u.size)
+        if not moves:
+            d[problem.n_x + 1:] = 0.0
+        pairs.append((d, rng.standard_normal(problem.n_coll)))
+    together = problem.second_many(u, pairs[:2]) + problem.second_many(u, pairs[2:])  # one call, then apart
+    mixed = problem.second_many(u, pairs)  # a direction moves the parameters: every point apart
+    for (d, w), row, other in zip(pairs, together, mixed):
+        np.testing.assert_allclose(other, row, rtol=0, atol=1e-12 * np.abs(row).max())
+        np.testing.assert_allclose(row, problem.second(u, d, w), rtol=0, atol=1e-12 * np.abs(row).max())
+        eps = 1e-6
+        J_plus = problem.cycle_jacobian(u + eps * d)[:problem.n_coll].T @ w
+        J_minus = problem.cycle_jacobian(u - eps * d)[:problem.n_coll].T @ w
+        fd = (J_plus - J_minus) / (2 * eps)
+        np.testing.assert_allclose(row[:fd.size], fd, rtol=0, atol=1e-6 * np.abs(fd).max())
+
+
 def test_fold_of_cycles_curve_of_the_bautin_normal_form():
     """From the located LPC of a one-parameter branch to b1 = -b2^2 / 4, ending at GH (0, 0)."""
     system = bautin()

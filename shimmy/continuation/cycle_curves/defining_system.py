@@ -73,8 +73,11 @@ class DefiningSystem:
         """The values of those entries at u (F: the field at the collocation points)."""
         raise NotImplementedError
 
-    def gradient(self, problem: CycleCurveProblem, u: np.ndarray, V: np.ndarray, W: np.ndarray) -> np.ndarray:
-        """d g / du = -W^T A_u V for the right and left vectors V, W of one entry g of G."""
+    def gradient_terms(self, problem: CycleCurveProblem, u: np.ndarray, V: np.ndarray,
+                       W: np.ndarray) -> tuple[list[tuple[np.ndarray, np.ndarray]], np.ndarray | None]:
+        """d g / du = -W^T A_u V for the right and left vectors V, W of one entry g of G, as the
+        (direction, w) pairs whose second derivatives (``problem.second_many``) it subtracts and a row
+        it adds (A's entries beside the collocation blocks that depend on u), or None."""
         raise NotImplementedError
 
     def transferred_border(self, problem: CycleCurveProblem, nodes: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:

@@ -50,12 +50,10 @@ class FoldOfCycles(DefiningSystem):
         coeff = np.einsum("j,k,kl,jkn->jln", mesh.h, cycle.basis.gauss[1], cycle.basis.L, cycle.reference_derivative)
         return [(-mesh.h[:, None, None] * F).ravel(), ones, -ones, coeff.ravel()]
 
-    def gradient(self, problem: CycleCurveProblem, u: np.ndarray, V: np.ndarray, W: np.ndarray) -> np.ndarray:
-        grad = np.zeros(problem.size)
+    def gradient_terms(self, problem: CycleCurveProblem, u: np.ndarray, V: np.ndarray, W: np.ndarray):
         d = np.zeros(problem.size)
         d[:problem.n_x + 1] = V
-        grad -= problem.second(u, d, W[:problem.n_coll])
-        return grad
+        return [(d, W[:problem.n_coll])], None
 
     def transferred_border(self, problem: CycleCurveProblem, nodes: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
         return np.vstack([nodes(problem.C[:problem.n_x]), problem.C[problem.n_x:]])

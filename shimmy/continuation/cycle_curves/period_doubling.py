@@ -38,12 +38,10 @@ class PeriodDoubling(DefiningSystem):
         ones = np.ones(problem.n)
         return [ones, ones]
 
-    def gradient(self, problem: CycleCurveProblem, u: np.ndarray, V: np.ndarray, W: np.ndarray) -> np.ndarray:
-        grad = np.zeros(problem.size)
+    def gradient_terms(self, problem: CycleCurveProblem, u: np.ndarray, V: np.ndarray, W: np.ndarray):
         d = np.zeros(problem.size)
         d[:problem.n_x] = V
-        grad -= problem.second(u, d, W[:problem.n_coll])
-        return grad
+        return [(d, W[:problem.n_coll])], None
 
     def transferred_border(self, problem: CycleCurveProblem, nodes: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
         return nodes(problem.C)

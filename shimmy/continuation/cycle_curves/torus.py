@@ -64,16 +64,17 @@ class Torus(DefiningSystem):
         ones = np.ones(problem.n)
         return [-ones, ones, ones, np.full(problem.n, -2.0 * problem.kappa(u)), ones]
 
-    def gradient(self, problem: CycleCurveProblem, u: np.ndarray, V: np.ndarray, W: np.ndarray) -> np.ndarray:
+    def gradient_terms(self, problem: CycleCurveProblem, u: np.ndarray, V: np.ndarray, W: np.ndarray):
         n, n_x, n_coll = problem.n, problem.n_x, problem.n_coll
-        grad = np.zeros(problem.size)
+        pairs = []
         for copy in range(2):
             d = np.zeros(problem.size)
             d[:n_x] = V[copy * n_x:(copy + 1) * n_x]
-            grad -= problem.second(u, d, W[copy * n_coll:(copy + 1) * n_coll])
+            pairs.append((d, W[copy * n_coll:(copy + 1) * n_coll]))
+        extra = np.zeros(problem.size)
         w_bc = W[2 * n_coll + n:]  # rows of V0(0) - 2 kappa V0(1) + V1(1)
-        grad[n_x + 3] = 2.0 * w_bc @ V[n_x - n:n_x]  # -w^T (dA/dkappa) v, dA/dkappa = -2 at V0(1)
-        return grad
+        extra[n_x + 3] = 2.0 * w_bc @ V[n_x - n:n_x]  # -w^T (dA/dkappa) v, dA/dkappa = -2 at V0(1)
+        return pairs, extra
 
     def transferred_border(self, problem: CycleCurveProblem, nodes: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
         return np.vstack([nodes(problem.C[:problem.n_x]), nodes(problem.C[problem.n_x:])])

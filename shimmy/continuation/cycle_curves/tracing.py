@@ -192,6 +192,11 @@ def _record(problem: CycleCurveProblem, rows: dict, point: CurvePoint) -> np.nda
     return mu
 
 
+#: Within ``amplitude_min`` of a zero-amplitude end a step is halved at most down to this fraction of
+#: the last step taken (then the curve ends there).
+END_ZONE_STEPS = 1.0 / 64.0
+
+
 def _amplitude(problem: CycleCurveProblem, xmax, xmin) -> float:
     return float(np.max(0.5 * (np.asarray(xmax) - np.asarray(xmin)) / problem.cycle.scale))
 
@@ -221,6 +226,13 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         adv = tracer.advance()
         if adv is None:
             stop = tracer.failed
+            if amp_last < options.amplitude_min * amp_peak:  # Newton gave out where the cycles shrink onto the end
+                p_last = prev.u[n_x + 1:n_x + 3]
+                stop = Stop(StopReason.ZERO_AMPLITUDE, f"amplitude shrank to {amp_last:.3g} near p = "
+                            f"({p_last[0]:.6g}, {p_last[1]:.6g}), where the continuation could not go on: the curve "
+                            "ends at a codimension-2 point of the equilibrium")
+                special.append(SpecialPoint(PointKind.ZERO_AMPLITUDE, float(p_last[0]), len(rows["p"]) - 1,
+                                            {"p2": float(p_last[1]), "amplitude": amp_last}))
             break
         new, h = adv
         p_new = new.u[n_x + 1:n_x + 3]
@@ -290,6 +302,11 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
             break
         if amp < amp_last:
             tracer.limit_step(max(0.7 * amp * h / max(amp_last - amp, 1e-300), copts.ds_min))
+        if amp < options.amplitude_min * amp_peak and tracer.options.ds_min < END_ZONE_STEPS * h:
+            # near a zero-amplitude end the system degenerates: a step that fails there is not halved down
+            # to ds_min (a warm trace of the nes map's low-speed fold curve spent 41 failed corrections, 0.5 s,
+            # halving towards 1e-7 at amplitude 0.0047 before it stopped)
+            tracer.options = replace(tracer.options, ds_min=END_ZONE_STEPS * h)
         amp_last = amp
         if options.adapt_every and steps % options.adapt_every == 0:
             problem = _remesh(problem, tracer, copts)
