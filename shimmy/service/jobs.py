@@ -21,8 +21,9 @@ its whole process group (process pool, forkserver, resource tracker) can be ende
 worker that finishes takes the next queued job itself, in the same slot; with none queued it stays
 idle for ``JOB_WORKER_LINGER_SECONDS`` (holding no slot, listed in the store's idle workers), and
 :func:`pump` hands the next job to it rather than starting a process: the next slider step's map
-starts with the imports, the compiled kernels and the process pool warm. The server's stop ends the
-idle workers with the running ones; its start ends any a crash left.
+starts with the imports and the compiled kernels warm (and the process pool, if the worker's first job
+made one). The server's stop ends the idle workers with the running ones; its start ends any a crash
+left and begins a new generation: a worker of an earlier server (its code) takes no further job.
 
 A job is failed only when its process is gone: the process is identified by pid and start
 time (psutil), so a late heartbeat under load fails nothing, and a dead one never stays
@@ -343,7 +344,8 @@ def listing(status: str | None = None, user: str | None = None, limit: int = 100
 
 # -- bounded storage ---------------------------------------------------------------------------
 
-#: Entries of the store besides the records: queue, running, draining, the active index, health probes.
+#: Entries of the store besides the records: queue, running, idle, generation, draining, the active index,
+#: health probes.
 _BOOKKEEPING = 16
 
 
@@ -426,10 +428,11 @@ def server_started() -> dict[str, list[str]]:
     jobs are started by the web workers (:func:`pump`). (What was queued again and what failed, by id.)"""
     s = store()
     s.delete("draining")
-    with s.transact():  # idle workers left by a server that did not stop cleanly: never handed a job now
+    with s.transact():  # a new generation: workers of an earlier server (its code) take no further job
+        s.set("generation", uuid.uuid4().hex)
         idle = dict(s.get("idle", {}))
         s.set("idle", {key: h for key, h in idle.items() if h.get("host") != HOST})
-    for holder in idle.values():
+    for holder in idle.values():  # idle workers left by a server that did not stop cleanly
         if holder.get("host") == HOST and _is_process(holder):
             _signal_group(holder, signal.SIGKILL)
     gone = [(job_id, holder) for job_id, holder in list(s.get("running", {}).items())
@@ -461,10 +464,10 @@ def server_stopping(grace: float = 5.0) -> list[str]:
     running on this host (SIGTERM, then SIGKILL after ``grace`` seconds) and queue those jobs again at
     the head of the queue, so that they start again when the server does. The ids queued again."""
     s = store()
-    holders = {job_id: h for job_id, h in s.get("running", {}).items() if h.get("host") == HOST}
     with s.transact():  # idle workers end with the server (the next one starts its own, with its code)
+        holders = {job_id: h for job_id, h in s.get("running", {}).items() if h.get("host") == HOST}
         idle = dict(s.get("idle", {}))
-        holders.update({("idle", key): h for key, h in idle.items() if h.get("host") == HOST})
+        holders.update({("idle", key): h for key, h in idle.items() if h.get("host") == HOST and _is_process(h)})
         s.set("idle", {key: h for key, h in idle.items() if h.get("host") != HOST})
     for holder in holders.values():
         _signal_group(holder, signal.SIGTERM)
@@ -505,7 +508,9 @@ def pump() -> None:
         running = dict(s.get("running", {}))
         queue = list(s.get("queue", []))
         idle = dict(s.get("idle", {}))
-        waiting = [key for key, holder in idle.items() if _idle_alive(holder)]
+        generation = s.get("generation")
+        mine = {key: h for key, h in idle.items() if h.get("host") == HOST}
+        waiting = [key for key, h in mine.items() if h.get("generation") == generation and _is_process(h)]
         while len(running) < settings.MAX_RUNNING_JOBS:
             job_id, owner = _choose(s, queue, running)
             if job_id is None:
@@ -518,7 +523,8 @@ def pump() -> None:
             starting.append(job_id)
         s.set("queue", queue)
         s.set("running", running)
-        s.set("idle", {key: idle[key] for key in waiting})
+        # this host's entries: those still waiting (the dead and the earlier generation's dropped); others' kept
+        s.set("idle", {**{key: h for key, h in idle.items() if key not in mine}, **{key: idle[key] for key in waiting}})
     for job_id in starting:
         _start(s, job_id)
 
@@ -657,7 +663,8 @@ def run(job_id: str) -> None:
     """Run job ``job_id`` in this process (``python -m shimmy.service.worker``), then the next
     queued jobs in the same slot until the queue is empty, then those handed to it while it waits
     idle (:func:`_linger`)."""
-    me = {"pid": os.getpid(), "started": _create_time(os.getpid()), "host": HOST}
+    me = {"pid": os.getpid(), "started": _create_time(os.getpid()), "host": HOST,
+          "generation": store().get("generation")}
     stop = threading.Event()
     current = [job_id]
 
@@ -728,34 +735,38 @@ IDLE_POLL_SECONDS = 0.05
 
 
 def _linger(me: dict[str, Any]) -> str | None:
-    """After its last job: stay idle for ``JOB_WORKER_LINGER_SECONDS``, registered in the store's idle
-    workers, until :func:`pump` hands this process a job (an entry of the running map with its pid) or a
-    job is queued while a slot is free; that job's id, or None when the time is up or the jobs drain (the
-    process then ends). Polls by reads; a transaction only to take a job or to leave."""
-    if settings.JOB_WORKER_LINGER_SECONDS <= 0:
+    """After its last job, listed idle by :func:`_next`: wait up to ``JOB_WORKER_LINGER_SECONDS`` until
+    :func:`pump` hands this process a job (an entry of the running map with its pid and start time) or a
+    job is queued that a free slot may take; that job's id, or None (the process then ends) when the time
+    is up, the jobs drain, another server generation starts or this process is no longer listed (the
+    server's stop). Polls by reads; a transaction only to take a job or to leave."""
+    if settings.JOB_WORKER_LINGER_SECONDS <= 0:  # not listed by _next: nothing can be handed to it
         return None
     s = store()
-    key = str(me["pid"])
-    with s.transact():
-        s.set("idle", {**s.get("idle", {}), key: me})
+    key = _idle_key(me)
     deadline = time.monotonic() + settings.JOB_WORKER_LINGER_SECONDS
     while True:
-        last = time.monotonic() >= deadline
         running = s.get("running", {})
         handed = any(_same_process(h, me) for h in running.values())
-        free = s.get("queue") and len(running) < settings.MAX_RUNNING_JOBS
-        if handed or free or last or s.get("draining") is not None:
+        leave = (time.monotonic() >= deadline or s.get("draining") is not None or key not in s.get("idle", {})
+                 or s.get("generation") != me.get("generation"))
+        free = False
+        if not (handed or leave) and s.get("queue") and len(running) < settings.MAX_RUNNING_JOBS:
+            free = _choose(s, list(s.get("queue", [])), dict(running))[0] is not None  # reads only
+        if handed or leave or free:
             with s.transact():
                 running = dict(s.get("running", {}))
                 mine = next((job_id for job_id, h in running.items() if _same_process(h, me)), None)
-                queue = list(s.get("queue", []))
-                if mine is None and s.get("draining") is None and len(running) < settings.MAX_RUNNING_JOBS:
+                listed = key in s.get("idle", {})
+                if mine is None and listed and s.get("draining") is None and \
+                        s.get("generation") == me.get("generation") and len(running) < settings.MAX_RUNNING_JOBS:
+                    queue = list(s.get("queue", []))
                     mine, owner = _choose(s, queue, running)
                     if mine is not None:
                         running[mine] = {**me, "claimed": _now(), "user": owner}
                         s.set("queue", queue)
                         s.set("running", running)
-                if mine is not None or last or s.get("draining") is not None:
+                if mine is not None or leave or not listed:
                     idle = dict(s.get("idle", {}))
                     idle.pop(key, None)
                     s.set("idle", idle)
@@ -767,23 +778,27 @@ def _same_process(holder: dict[str, Any], me: dict[str, Any]) -> bool:
     return holder.get("pid") == me["pid"] and holder.get("host") == me["host"] and holder.get("started") == me["started"]
 
 
-def _idle_alive(holder: dict[str, Any]) -> bool:
-    """An idle worker of this host whose process is the one registered."""
-    return holder.get("host") == HOST and _is_process(holder)
-
-
 def _next(finished: str, me: dict[str, Any]) -> str | None:
-    """Hand this process's slot from ``finished`` to the first queued job, or give it up."""
+    """Hand this process's slot from ``finished`` to the first queued job, or give it up (and, in the same
+    transaction, list this process among the idle workers, see :func:`_linger`). A worker of an earlier
+    server generation takes no further job."""
     s = store()
     with s.transact():
         running = dict(s.get("running", {}))
         running.pop(finished, None)
         queue = list(s.get("queue", []))
         nxt = None
-        if s.get("draining") is None and len(running) < settings.MAX_RUNNING_JOBS:
+        current = s.get("generation") == me.get("generation")
+        if current and s.get("draining") is None and len(running) < settings.MAX_RUNNING_JOBS:
             nxt, owner = _choose(s, queue, running)
             if nxt is not None:
                 running[nxt] = {**me, "claimed": _now(), "user": owner}
         s.set("queue", queue)
         s.set("running", running)
+        if nxt is None and current and s.get("draining") is None and settings.JOB_WORKER_LINGER_SECONDS > 0:
+            s.set("idle", {**s.get("idle", {}), _idle_key(me): me})
     return nxt
+
+
+def _idle_key(me: dict[str, Any]) -> str:
+    return f"{me['host']}:{me['pid']}"

@@ -88,7 +88,8 @@ def test_bordered_test_matrices_of_cycle_curves_are_solved_like_dense_matrices(k
                                                ("NS", torus_two_parameter, 0.3)])
 def test_the_test_matrix_applied_without_assembly_is_the_assembled_matrix(kind, system, kappa):
     """M z and M^T z from the collocation blocks and boundary entries (the refinement's products)
-    equal the assembled sparse matrix's, for one and several right-hand sides, on a graded mesh."""
+    equal the assembled sparse matrix's, for one and several right-hand sides, on a graded mesh; the
+    condensed factors made from the same entries solve with the assembled matrix."""
     system = system()
     mesh = Mesh(np.sort(np.concatenate([[0.0, 1.0], np.random.default_rng(2).uniform(0, 1, 6)])), 3)
     problem = CycleCurveProblem(system, kind, mesh, np.ones(system.n), 2 * np.pi, np.ones(2))
@@ -105,7 +106,12 @@ def test_the_test_matrix_applied_without_assembly_is_the_assembled_matrix(kind, 
         z = rng.standard_normal(shape)
         np.testing.assert_allclose(operator.matvec(z), M @ z, rtol=0, atol=1e-12 * np.abs(M @ z).max())
         np.testing.assert_allclose(operator.rmatvec(z), M.T @ z, rtol=0, atol=1e-12 * np.abs(M.T @ z).max())
-    assert (operator.sparse() != M).nnz == 0
+    lu = problem._factor(operator, u)  # the condensed LU's input summed from the entries, not from M
+    assert isinstance(lu, CondensedLU)
+    for trans in ("N", "T"):
+        b = rng.standard_normal(M.shape[0])
+        x = lu.solve(b, trans=trans)
+        np.testing.assert_allclose((M.T if trans == "T" else M) @ x, b, rtol=0, atol=1e-10 * np.abs(b).max())
 
 
 def random_chain(rng, links=5, n=2, interior=(3, 0, 2, 4, 1), g=2):

@@ -25,8 +25,10 @@ from conftest import process_group, start_server, stop_server
 
 pytestmark = pytest.mark.slow
 
+# Job workers end with their last job here (no idle wait): the kill tests find the job's worker as the one
+# process of its kind, started by a web worker for that job (idle workers: tests/service/test_team.py).
 LIMITS = {"SHIMMY_MAX_RUNNING_JOBS": "1", "SHIMMY_MAX_QUEUED_JOBS": "3", "SHIMMY_JOB_RETRY_AFTER_SECONDS": "7",
-          "SHIMMY_BODY_READ_SECONDS": "3", "SHIMMY_HEADER_READ_SECONDS": "3"}
+          "SHIMMY_BODY_READ_SECONDS": "3", "SHIMMY_HEADER_READ_SECONDS": "3", "SHIMMY_JOB_WORKER_LINGER_SECONDS": "0"}
 OK = {
     "/api/v1/simulate": {"config": "nes_pd", "V": 30, "Fz": 150000, "t_end": 5},
     "/api/v1/hopf": {"config": "nes", "Fz": 150000, "v_max": 200},
@@ -202,7 +204,7 @@ def _workers(srv):
     from shimmy.service import jobs
 
     with srv.cache_env():
-        idle = {int(pid) for pid in jobs.store().get("idle", {})}
+        idle = {holder["pid"] for holder in jobs.store().get("idle", {}).values()}
     out = []
     for p in psutil.process_iter(["cmdline", "pid"]):
         try:

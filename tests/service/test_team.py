@@ -596,7 +596,7 @@ def test_a_finished_worker_waits_idle_for_the_next_job_and_ends_with_the_server(
     def idle():
         with cache_env(tmp_path):
             s = jobs.store()
-            return s.get("running", {}) == {} and {int(pid) for pid in s.get("idle", {})}
+            return s.get("running", {}) == {} and {holder["pid"] for holder in s.get("idle", {}).values()}
 
     server = start_server(tmp_path, {"SHIMMY_JOB_WORKER_LINGER_SECONDS": "60"})
     try:
@@ -616,6 +616,6 @@ def test_a_finished_worker_waits_idle_for_the_next_job_and_ends_with_the_server(
         until(lambda: not job_workers(tmp_path), 60, "the idle worker to end after its linger time")
         with cache_env(tmp_path):
             assert jobs.store().get("idle") == {}
-        assert run(server, 44) != third  # a new process: nobody was waiting
+        assert run(server, 44) != third  # a new process (the old one ended: waited for above)
     finally:
         stop_server(server)

@@ -296,3 +296,61 @@ def test_the_rate_per_user_refills(monkeypatch, private):
     admission.take_rate("hopf", "bob")  # another user's bucket is full
     time.sleep(0.3)
     admission.take_rate("hopf", "alice")  # refilled at 4 a second
+
+
+# -- idle job workers ---------------------------------------------------------------------------
+
+
+def _me() -> dict:
+    """This process as a job worker of the store's current generation."""
+    return {"pid": os.getpid(), "started": jobs._create_time(os.getpid()), "host": jobs.HOST,
+            "generation": jobs.store().get("generation")}
+
+
+def test_an_idle_worker_is_handed_the_next_job_and_leaves_when_the_server_stops(held, monkeypatch):
+    """A worker whose queue is empty is listed idle (in the same transaction that frees its slot); pump
+    hands the next job to it (no process started); the server's stop unlists it and it leaves."""
+    monkeypatch.setattr(settings, "MAX_RUNNING_JOBS", 1)
+    monkeypatch.setattr(settings, "JOB_WORKER_LINGER_SECONDS", 30.0)
+    monkeypatch.setattr(jobs, "_start", lambda s, job_id: pytest.fail("a process was started for " + job_id))
+    jobs.server_started()
+    me, s = _me(), jobs.store()
+    with s.transact():
+        s.set("running", {"finished": {**me, "claimed": time.time(), "user": None}})
+    assert jobs._next("finished", me) is None
+    assert list(s.get("idle").values()) == [me] and s.get("running") == {}
+    job = jobs.submit_canonical("map", _map(3))  # submit pumps: handed to this process
+    assert s.get("running")[job["id"]]["pid"] == me["pid"] and s.get("idle") == {}
+    assert jobs._linger(me) == job["id"]
+    jobs._release(s, job["id"])
+    assert jobs._next(job["id"], me) is None and len(s.get("idle")) == 1
+    with s.transact():  # the server's stop unlists it (and signals its group: not this test process)
+        s.set("idle", {})
+    clock = time.monotonic()
+    assert jobs._linger(me) is None and time.monotonic() - clock < 5  # no longer listed: it leaves at once
+
+
+def test_a_worker_of_an_earlier_server_takes_no_further_job(held, monkeypatch):
+    """After a restart (a new generation) a worker that outlived the old server, running old code, is
+    neither listed idle nor handed jobs, nor does it take the next queued one."""
+    monkeypatch.setattr(settings, "MAX_RUNNING_JOBS", 1)
+    monkeypatch.setattr(settings, "JOB_WORKER_LINGER_SECONDS", 30.0)
+    started = []
+    monkeypatch.setattr(jobs, "_start", lambda s, job_id: started.append(job_id))
+    jobs.server_started()
+    old, s = _me(), jobs.store()
+    with s.transact():
+        s.set("running", {"finished": {**old, "claimed": time.time(), "user": None}})
+    jobs.server_started()  # the server restarts while that worker runs its job
+    waiting = jobs.submit_canonical("map", _map(4))
+    assert started == [] and s.get("queue") == [waiting["id"]]  # its slot is still held
+    assert jobs._next("finished", old) is None  # the queued job is not its to take
+    assert s.get("idle", {}) == {} and jobs._linger(old) is None
+    jobs.pump()  # the slot is free: a new worker starts for it
+    assert started == [waiting["id"]]
+    stale = {**old, "generation": "earlier"}
+    with s.transact():  # an idle entry of an earlier generation is never handed a job (and is dropped)
+        s.set("running", {})
+        s.set("idle", {jobs._idle_key(stale): stale})
+    another = jobs.submit_canonical("map", _map(5))
+    assert started[-1] == another["id"] and s.get("idle") == {}

@@ -192,9 +192,30 @@ def _record(problem: CycleCurveProblem, rows: dict, point: CurvePoint) -> np.nda
     return mu
 
 
-#: Within ``amplitude_min`` of a zero-amplitude end a step is halved at most down to this fraction of
-#: the last step taken (then the curve ends there).
+#: Below ``amplitude_min`` of a curve's largest amplitude (near a zero-amplitude end) a step is halved at
+#: most down to this fraction of the largest step taken there; if Newton still gives out and the amplitude
+#: was falling, the curve ends there as at a zero-amplitude end.
 END_ZONE_STEPS = 1.0 / 64.0
+
+
+def _zero_amplitude_end(problem: CycleCurveProblem, special: list[SpecialPoint], rows: dict, p: np.ndarray,
+                        amp: float, how: str = "") -> tuple[Stop, list[SpecialPoint]]:
+    """The stop and the special points of a curve ending where its cycles shrink onto the equilibrium
+    (at its last recorded point p, amplitude ``amp``).
+
+    The step into that end crossed where the curve degenerates (the cycle shrinks onto the equilibrium's
+    GH or double-Hopf point, which the Hopf curves locate): a test that changed sign over it and could
+    not be located is that end, not a point of the curve. (The nes map's low-speed fold curve traced
+    again from its seed at the same design reported an unlocated cusp at its end, 4.584 m/s, 480.2 kN,
+    which the cold trace did not, and the warm map went cold.) A crossing carried over an unresolved
+    stretch and told in that step goes with them: it is as unresolved as the end."""
+    where = f"near p = ({p[0]:.6g}, {p[1]:.6g})" + (f", {how}" if how else "")
+    stop = Stop(StopReason.ZERO_AMPLITUDE, f"amplitude shrank to {'zero' if not how else f'{amp:.3g}'} {where}: "
+                "the curve ends at a codimension-2 point of the equilibrium")
+    last = len(rows["p"]) - 1
+    kept = [q for q in special if not (q.index == last and q.kind in problem.defining.codim2 and q.located is False)]
+    kept.append(SpecialPoint(PointKind.ZERO_AMPLITUDE, float(p[0]), last, {"p2": float(p[1]), "amplitude": amp}))
+    return stop, kept
 
 
 def _amplitude(problem: CycleCurveProblem, xmax, xmin) -> float:
@@ -219,6 +240,8 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
     carried: frozenset = frozenset()  # tests whose value in `monitors` is an earlier point's (unresolved since)
     amp_peak = _amplitude(problem, rows["xmax"][0], rows["xmin"][0])
     amp_last = amp_peak
+    zone_step = 0.0  # the largest step taken near a zero-amplitude end (below amplitude_min of the peak)
+    shrinking = False  # the amplitude fell over the last step
     stop = Stop(StopReason.STEP_BUDGET, f"step budget of {copts.max_steps} steps used")
     steps = 0
     for steps in range(1, copts.max_steps + 1):  # noqa: B007
@@ -226,13 +249,10 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         adv = tracer.advance()
         if adv is None:
             stop = tracer.failed
-            if amp_last < options.amplitude_min * amp_peak:  # Newton gave out where the cycles shrink onto the end
+            if zone_step > 0.0 and shrinking:  # Newton gave out where the cycles shrink onto the end
                 p_last = prev.u[n_x + 1:n_x + 3]
-                stop = Stop(StopReason.ZERO_AMPLITUDE, f"amplitude shrank to {amp_last:.3g} near p = "
-                            f"({p_last[0]:.6g}, {p_last[1]:.6g}), where the continuation could not go on: the curve "
-                            "ends at a codimension-2 point of the equilibrium")
-                special.append(SpecialPoint(PointKind.ZERO_AMPLITUDE, float(p_last[0]), len(rows["p"]) - 1,
-                                            {"p2": float(p_last[1]), "amplitude": amp_last}))
+                stop, special = _zero_amplitude_end(problem, special, rows, p_last, amp_last,
+                                                    "where the continuation could not go on")
             break
         new, h = adv
         p_new = new.u[n_x + 1:n_x + 3]
@@ -286,28 +306,21 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         amp = _amplitude(problem, rows["xmax"][-1], rows["xmin"][-1])
         amp_peak = max(amp_peak, amp)
         if amp < options.amplitude_min * amp_peak and amp < options.amplitude_end_below and amp < amp_last:
-            stop = Stop(StopReason.ZERO_AMPLITUDE, f"amplitude shrank to zero near p = ({p_new[0]:.6g}, "
-                        f"{p_new[1]:.6g}): the curve ends at a codimension-2 point of the equilibrium")
-            # The step into that end crossed where the curve degenerates (the cycle shrinks onto the equilibrium's
-            # GH or double-Hopf point, which the Hopf curves locate): a test that changed sign over it and could
-            # not be located is that end, not a point of the curve. (The nes map's low-speed fold curve traced
-            # again from its seed at the same design reported an unlocated cusp at its end, 4.584 m/s, 480.2 kN,
-            # which the cold trace did not, and the warm map went cold.) A crossing carried over an unresolved
-            # stretch and told in that step goes with them: it is as unresolved as the end.
-            last = len(rows["p"]) - 1
-            special = [q for q in special if not (q.index == last and q.kind in problem.defining.codim2
-                                                  and q.located is False)]
-            special.append(SpecialPoint(PointKind.ZERO_AMPLITUDE, float(p_new[0]), len(rows["p"]) - 1,
-                                        {"p2": float(p_new[1]), "amplitude": amp}))
+            stop, special = _zero_amplitude_end(problem, special, rows, p_new, amp)
             break
         if amp < amp_last:
             tracer.limit_step(max(0.7 * amp * h / max(amp_last - amp, 1e-300), copts.ds_min))
-        if amp < options.amplitude_min * amp_peak and tracer.options.ds_min < END_ZONE_STEPS * h:
-            # near a zero-amplitude end the system degenerates: a step that fails there is not halved down
-            # to ds_min (a warm trace of the nes map's low-speed fold curve spent 41 failed corrections, 0.5 s,
-            # halving towards 1e-7 at amplitude 0.0047 before it stopped)
-            tracer.options = replace(tracer.options, ds_min=END_ZONE_STEPS * h)
-        amp_last = amp
+        # near a zero-amplitude end the system degenerates: there a step is halved at most to END_ZONE_STEPS
+        # of the largest step taken since the amplitude fell below amplitude_min of its peak, not down to
+        # ds_min (a warm trace of the nes map's fold curve towards its GH end spent 41 failed corrections,
+        # 0.5 s, halving towards 1e-7 at amplitude 0.0047, its accepted steps shrinking with the halvings);
+        # the last of those halvings is the tracer's last chance (a converged step is taken whatever its turn
+        # or chord). Away from the end the options' own ds_min holds again.
+        zone_step = max(zone_step, h) if amp < options.amplitude_min * amp_peak else 0.0
+        floor = max(copts.ds_min, END_ZONE_STEPS * zone_step)
+        if tracer.options.ds_min != floor:
+            tracer.options = replace(tracer.options, ds_min=floor)
+        shrinking, amp_last = amp < amp_last, amp
         if options.adapt_every and steps % options.adapt_every == 0:
             problem = _remesh(problem, tracer, copts)
     return rows, special, stop, steps
