@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ipaddress
+import math
 import os
 import pathlib
 import socket
@@ -90,10 +91,28 @@ LOGIN_ATTEMPTS_PER_MINUTE = int(os.environ.get("SHIMMY_LOGIN_ATTEMPTS_PER_MINUTE
 SESSION_HOURS = float(os.environ.get("SHIMMY_SESSION_HOURS", "12"))
 #: A worker being started that has not been recorded after this long is taken for dead.
 JOB_START_SECONDS = 60.0
+
+
+class JobSettingError(ValueError):
+    """A job setting from the environment that is not a number in its range."""
+
+
+def _seconds(name: str, default: str, high: float) -> float:
+    """The environment's ``name`` as seconds in [0, high]; a value that is not is refused by name."""
+    raw = os.environ.get(name, default)
+    try:
+        value = float(raw)
+    except ValueError:
+        value = math.nan
+    if not 0.0 <= value <= high:  # NaN too
+        raise JobSettingError(f"{name}={raw!r} is not a number of seconds in [0, {high:g}]")
+    return value
+
+
 #: A job worker whose queue is empty stays this long, idle and registered, for the next job
-#: (SHIMMY_JOB_WORKER_LINGER_SECONDS; 0: it ends at once): a slider step's map then starts in a
-#: process whose imports, kernels and process pool are warm (~0.8 s sooner than a new worker).
-JOB_WORKER_LINGER_SECONDS = float(os.environ.get("SHIMMY_JOB_WORKER_LINGER_SECONDS", "60"))
+#: (SHIMMY_JOB_WORKER_LINGER_SECONDS, 0 to 3600; 0: it ends at once): a slider step's map then starts in a
+#: process whose imports and kernels are warm (~0.8 s sooner than a new worker).
+JOB_WORKER_LINGER_SECONDS = _seconds("SHIMMY_JOB_WORKER_LINGER_SECONDS", "60", 3600.0)
 #: Only for a worker on another host sharing the directory: no heartbeat for this long means it is gone
 #: (SHIMMY_JOB_STALE_SECONDS). Workers on this host are judged by their process, never by a late beat.
 JOB_STALE_SECONDS = float(os.environ.get("SHIMMY_JOB_STALE_SECONDS", "30"))

@@ -354,3 +354,13 @@ def test_a_worker_of_an_earlier_server_takes_no_further_job(held, monkeypatch):
         s.set("idle", {jobs._idle_key(stale): stale})
     another = jobs.submit_canonical("map", _map(5))
     assert started[-1] == another["id"] and s.get("idle") == {}
+
+
+@pytest.mark.parametrize("value", ["abc", "-1", "nan", "5000"])
+def test_a_bad_idle_wait_is_refused_by_name_with_its_range(value):
+    """SHIMMY_JOB_WORKER_LINGER_SECONDS out of [0, 3600] s (or not a number) stops the import that reads it."""
+    env = {**os.environ, "SHIMMY_JOB_WORKER_LINGER_SECONDS": value, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, "-c", "import shimmy.service.settings"], env=env, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode != 0
+    assert f"SHIMMY_JOB_WORKER_LINGER_SECONDS={value!r} is not a number of seconds in [0, 3600]" in done.stderr

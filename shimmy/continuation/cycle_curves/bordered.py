@@ -228,6 +228,7 @@ class CycleCurveProblem:
             rows.append(cyc._rows + c * n_coll)
             cols.append(cyc._cols + c * n_x)
         boundary_rows, boundary_cols = self.defining.boundary_entries(self)
+        self._boundary = (np.concatenate(boundary_rows), np.concatenate(boundary_cols))  # the operator's
         rows += boundary_rows
         cols += boundary_cols
         border_r, border_c = np.meshgrid(np.arange(m), np.arange(k), indexing="ij")
@@ -261,9 +262,8 @@ class CycleCurveProblem:
     def _operator(self, u: np.ndarray) -> BorderedOperator:
         """The bordered test matrix at u as an operator (its products without assembly; the sparse
         matrix assembled only if it is factored)."""
-        if not hasattr(self, "_boundary"):
-            rows, cols = self.defining.boundary_entries(self)
-            self._boundary = (np.concatenate(rows), np.concatenate(cols))
+        if not hasattr(self, "_slot"):
+            self._structure()
         cu = self.cycle_u(u)
         blocks, F, _, _ = self.cycle.collocation_blocks(cu)
         values = np.concatenate(self.defining.boundary_values(self, u, F))

@@ -31,6 +31,7 @@ class BorderedOperator:
         self.N, self.m_n, self.n = mesh.ntst, mesh.ncol * problem.n, problem.n
         self.periods = problem.defining.periods
         self.n_coll, self.n_x, self.m, self.k = problem.n_coll, problem.n_x, problem.m, problem.k
+        self.node_index = mesh.node_index  # (N, ncol + 1): the nodes of each interval
         self.blocks = blocks.reshape(self.N, self.m_n, self.m_n + self.n)  # (N, ncol n, (ncol + 1) n)
         self.rows, self.cols, self.values = rows, cols, values  # the boundary entries of A
         self.B, self.C = problem.B, problem.C
@@ -44,10 +45,7 @@ class BorderedOperator:
 
     def _windows(self, x: np.ndarray) -> np.ndarray:
         """The node values of each interval, (N, (ncol + 1) n, r), from one period's x (n_x, r)."""
-        N, m_n, n = self.N, self.m_n, self.n
-        inner = x[:N * m_n].reshape(N, m_n, -1)
-        right = x[m_n:].reshape(-1, n, x.shape[1])[::m_n // n][:N]  # node (j + 1) ncol of interval j
-        return np.concatenate([inner, right], axis=1)
+        return x.reshape(-1, self.n, x.shape[1])[self.node_index].reshape(self.N, self.m_n + self.n, -1)
 
     def matvec(self, z: np.ndarray) -> np.ndarray:
         flat = z.ndim == 1
@@ -75,6 +73,8 @@ class BorderedOperator:
             y = Z[c * n_coll:(c + 1) * n_coll].reshape(N, m_n, -1)
             parts = np.matmul(self.blocks.transpose(0, 2, 1), y)  # (N, (ncol + 1) n, r)
             x = top[c * n_x:(c + 1) * n_x]
+            # the transpose of _windows' gather, as two slices (np.add.at on node_index is slower): each
+            # interval's nodes but its last, then its last node (ncol (j + 1)), shared with the next interval
             x[:N * m_n] += parts[:, :m_n].reshape(N * m_n, -1)
             x[m_n:].reshape(-1, n, Z.shape[1])[::m_n // n][:N] += parts[:, m_n:]
         for r in range(Z.shape[1]):
