@@ -95,8 +95,13 @@ class CycleCurveProblem:
             self.cycle._factors_memo = None  # nothing computed from it at another p2 is reused
         return u[:self.n_x + 2]
 
+    @property
+    def kappa_index(self) -> int:
+        """Where kappa is in u (after p2; only when the defining system has it)."""
+        return self.n_x + 3
+
     def kappa(self, u: np.ndarray) -> float:
-        return float(u[self.n_x + 3]) if self.defining.has_kappa else math.nan
+        return float(u[self.kappa_index]) if self.defining.has_kappa else math.nan
 
     @cached_property
     def chain_layout(self) -> ChainLayout:

@@ -1,6 +1,7 @@
 """Codimension-2 points along a curve of cycle bifurcations: detected by sign changes of their test
 functions between consecutive points, located by the secant method (``locate_between`` of
-:mod:`shimmy.continuation.core`).
+:mod:`shimmy.continuation.core`), or, where the test function is an unknown minus a value (the torus
+curve's resonances: kappa), by one Newton solve with the unknown held there (``point_at``).
 
 Two families of test function: a further multiplier crossing the unit circle (every curve type;
 ``crossing_value``, which multipliers the curve's own condition holds at left out), and the
@@ -14,7 +15,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from ..core import ContinuationOptions, CurvePoint, locate_between, weighted_norm
+from ..core import ContinuationOptions, CurvePoint, locate_between, point_at, weighted_norm
 from ..periodic_orbits import multiplier_crossing_test
 from ..results import SpecialPoint
 
@@ -83,11 +84,18 @@ def codim2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint,
             found.append(problem.special_point(name, new.u, index, located=False))
             along.append(weighted_norm(new.u - prev.u, problem.weights))
             continue
-        if name in defining.crossings:
-            g, tolerance = _crossing_test(problem, defining.crossings[name]), MULTIPLIER_TOL
-        else:
-            g, tolerance = defining.own_test(problem, name, reference), LOCATE_TOL
-        hit = locate_between(problem, prev, new, g, a, b, copts, tolerance, with_tangent=name in defining.tangent_tests)
+        level = None if name in defining.crossings else defining.own_level(problem, name)
+        hit = None
+        if level is not None:  # an unknown's value (a torus curve's kappa): one Newton solve with it held there
+            at = point_at(problem, prev, new, *level, copts, with_tangent=name in defining.tangent_tests)
+            hit = None if at is None else (at, 0.0)
+        if hit is None:
+            if name in defining.crossings:
+                g, tolerance = _crossing_test(problem, defining.crossings[name]), MULTIPLIER_TOL
+            else:
+                g, tolerance = defining.own_test(problem, name, reference), LOCATE_TOL
+            hit = locate_between(problem, prev, new, g, a, b, copts, tolerance,
+                                 with_tangent=name in defining.tangent_tests)
         at = hit[0] if hit is not None else new
         found.append(problem.special_point(name, at.u, index, located=hit is not None))
         along.append(weighted_norm(at.u - prev.u, problem.weights))

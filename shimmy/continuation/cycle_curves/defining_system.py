@@ -97,3 +97,8 @@ class DefiningSystem:
                  reference: np.ndarray) -> Callable[[CurvePoint], float]:
         """The test function of one of those points along the curve, to locate it."""
         raise KeyError(name)
+
+    def own_level(self, problem: CycleCurveProblem, name: PointKind) -> tuple[int, float] | None:
+        """(index, value) if that test function is an unknown of the curve minus a value (the point
+        is then one Newton solve with the unknown held there, not a search), else None."""
+        return None

@@ -94,3 +94,6 @@ class Torus(DefiningSystem):
                  reference: np.ndarray) -> Callable[[CurvePoint], float]:
         target = RESONANCES[name]
         return lambda q: problem.kappa(q.u) - target
+
+    def own_level(self, problem: CycleCurveProblem, name: PointKind) -> tuple[int, float] | None:
+        return problem.kappa_index, RESONANCES[name]
