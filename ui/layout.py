@@ -233,6 +233,8 @@ dash.clientside_callback(
         let outValues = names.map(() => C.no_update), outBoxes = boxNames.map(() => C.no_update);
         let outMaterial = C.no_update;
         const typed = trig && typeof trig === "object" && trig.type === ID.box ? trig.name : null;
+        // a typed value, a material or a reset is committed: the pages following the design take it at once
+        window.shimmyDesignCommitted = Boolean(typed) || trig === ID.reset || trig === ID.material;
         if (trig === ID.reset) {
             material = DEFAULT; cur = Object.assign({}, BASE[DEFAULT]); outMaterial = DEFAULT;
             outValues = names.map(n => cur[n]); outBoxes = boxNames.map(n => cur[n]);

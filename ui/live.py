@@ -3,8 +3,11 @@ faint while the next is made.
 
 The design store of a page follows a slider while it is dragged (the linear plots redraw on every
 step); a computation of seconds follows the design only once it stands still: :func:`settled`
-is a store that takes the design :data:`SETTLE_MS` after its last change (a slider released, a
-value typed), by a timer in the browser restarted by every change (no server round trip).
+is a store that takes the design, in the browser (no server round trip), at once when it was
+committed (a value typed and entered, a material chosen, the design reset) or a slider was let go
+(the pointer released: at the release, however long the drag); after a change by the arrow keys,
+which may be pressed again, :data:`SETTLE_MS` after the last one (a timer restarted by every
+change). ``assets/input.js`` tells which: the pointer's state and the last input's kind.
 :func:`fading` is what a page shows while the next answer is made: the previous figure under a
 white veil, its title saying what is computed and for how long (a partial update of the figure:
 nothing of it is sent again).
@@ -19,6 +22,7 @@ from dash import Input, Output, Patch, dcc
 
 from . import ids, style
 
+#: the quiet time after a change by the arrow keys before the design counts as standing still
 SETTLE_MS = 600
 #: over the previous figure while the next is made: its curves and regions stay, faint, for comparison
 VEIL = {"type": "rect", "xref": "paper", "yref": "paper", "x0": 0, "x1": 1, "y0": 0, "y1": 1, "layer": "above",
@@ -42,8 +46,17 @@ def follow_settled(page: Any) -> Input:
         function(design) {
             const C = window.dash_clientside, key = "shimmySettle_" + %s;
             window[key] = (window[key] || 0) + 1;
-            const seq = window[key];
-            return new Promise(resolve => setTimeout(() => resolve(seq === window[key] ? design : C.no_update), %d));
+            const seq = window[key], input = window.shimmyInput || {last: null, onRelease: []};
+            return new Promise(resolve => {
+                const settle = () => resolve(seq === window[key] ? design : C.no_update);  // a later change: not this
+                if (window.shimmyDesignCommitted || (input.last === "pointer" && !input.pointerDown)) {
+                    settle();
+                } else if (input.last === "pointer") {  // a slider held: at its release
+                    input.onRelease.push(settle);
+                } else {
+                    setTimeout(settle, %d);
+                }
+            });
         }
         """ % (repr(str(page)), SETTLE_MS),
         Output(settled_id(page), "data"),

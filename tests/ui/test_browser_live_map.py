@@ -4,11 +4,14 @@ neighbour waits for Compute and says so. Real Chromium against gunicorn (tests/u
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
 selenium = pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
 
+from ui import live  # noqa: E402
 from browser import (SHOTS, browser_fixture, by_id, idle, job_records, on_figure, pattern, severe,  # noqa: E402
                      text_of, type_into, wait_for)
 
@@ -108,4 +111,39 @@ def test_the_overview_boundary_follows_the_design(server, browser):
     wait_for(lambda: on_figure(browser, "ov-boundary-graph", "return g.layout.title.text;") ==
              "Hopf curves of straight rolling", timeout=60, what="the new boundary drawn")
     assert on_figure(browser, "ov-boundary-graph", "return g.data.length;") >= 4
+    assert severe(browser) == []
+
+
+def test_a_held_slider_starts_nothing_until_it_is_let_go(server, browser):
+    """The boundary follows the design once it stands still: a slider dragged and held (longer than
+    the arrow keys' quiet time) starts no job; at its release the design it was let go at is computed,
+    and no design it passed on the way. (The linear growth plot follows the drag meanwhile.)"""
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    browser.get(server.base + "/?e_p=0.00105")
+    wait_for(lambda: browser.find_elements(By.ID, "ov-boundary-graph"), what="the boundary figure")
+    idle(browser)
+    before = set(job_records(server))
+    slider = by_id(browser, pattern("e_p", "param"))
+    handle = slider.find_element(By.CSS_SELECTOR, "[role='slider']")
+    width = slider.size["width"]
+    drag = ActionChains(browser).click_and_hold(handle)
+    for _ in range(3):
+        drag = drag.move_by_offset(width // 30, 0).pause(0.2)
+    drag.perform()
+    held = float(handle.get_attribute("aria-valuenow"))
+    assert held > 0.00105
+    wait_for(lambda: f"e_p={held:g}" in browser.current_url, timeout=30, what="the dragged value in the address")
+    time.sleep(3 * live.SETTLE_MS / 1000)  # held still, longer than the keys' quiet time
+    new = [(j["analysis"], j["request"].get("config"), j["request"]["params"]["e_p"])
+           for i, j in job_records(server).items() if i not in before]
+    assert new == [], f"jobs started while the slider was held: {new}"
+    ActionChains(browser).release().perform()
+
+    def boundary_jobs():
+        return [j for i, j in job_records(server).items() if i not in before and j["analysis"] == "hopf_curves"]
+
+    wait_for(lambda: {"nes", "nes_pd"} <= {j["request"]["config"] for j in boundary_jobs()}, timeout=60,
+             what="the boundary's jobs at the release")
+    assert {j["request"]["params"]["e_p"] for j in boundary_jobs()} == {held}
     assert severe(browser) == []
