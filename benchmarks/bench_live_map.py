@@ -12,8 +12,8 @@ Stability map page in headless Chromium at 1440x900 with the default plane (V 1-
   panel: value entered -> the previous map faint, -> the first curves of the new design drawn,
   -> the new map shaded; with the warm map's own time (``elapsed_s``) and what it carried.
 
-A step's time includes the panel's settle delay (ui.live.SETTLE_MS), the job's queueing and
-process start, and drawing.
+A step's time includes the job's queueing and start, its computation, the page's poll and the
+drawing (a typed value is followed at once: no settle delay, which only the arrow keys have).
 """
 
 from __future__ import annotations

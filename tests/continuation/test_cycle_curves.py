@@ -162,6 +162,33 @@ def test_torus_curve_with_its_strong_resonances():
     assert np.all(np.diff(p2) > 0)  # one curve, ordered along it
 
 
+def test_a_resonance_test_told_by_an_earlier_points_value_is_searched_not_solved(monkeypatch):
+    """The test values before a step may be an earlier point's (a new mesh moves the point, and kappa
+    with it): a sign change of kappa - value there with kappa on one side at both ends of the step
+    is not one Newton solve's (point_at refuses it) but the search's, and the curve goes on (it was
+    dropped whole: "not continued")."""
+    from shimmy.continuation.cycle_curves import codim2, tracing
+
+    system = torus_two_parameter()
+    told = []
+    original = codim2.codim2_points
+
+    def stale(problem, prev, new, before, after, *args, **kwargs):
+        level = problem.kappa_index
+        if not told and prev.u[level] < 0.0 and new.u[level] < 0.0:  # a step before R4 (kappa rises to 0)
+            before = {**before, "R4": -after["R4"]}  # as if the point before had kappa > 0
+            told.append(new.u[level])
+        return original(problem, prev, new, before, after, *args, **kwargs)
+
+    monkeypatch.setattr(tracing.codim2, "codim2_points", stale)
+    curve = cycle_curve(system, "NS", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, box=((-1.0, 2.0), (-1.0, 1.0)),
+                        scale=np.ones(4), p_scale=(1.0, 1.0), kappa=math.cos(0.6 * math.pi), directions=(-1,))
+    assert told  # the stale value was told
+    assert curve.p[:, 1].min() == pytest.approx(-1.0)  # traced on to the box's edge
+    r4 = kinds(curve, "R4")
+    assert any(pt.located and pt.data["p2"] == pytest.approx(-0.5, abs=1e-9) for pt in r4)
+
+
 def test_period_doubling_curve():
     system = flip_two_parameter()
     curve = cycle_curve(system, "PD", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, box=((-1.0, 2.0), (-1.0, 1.0)),

@@ -131,9 +131,14 @@ def test_a_held_slider_starts_nothing_until_it_is_let_go(server, browser):
     for _ in range(3):
         drag = drag.move_by_offset(width // 30, 0).pause(0.2)
     drag.perform()
-    held = float(handle.get_attribute("aria-valuenow"))
+
+    def dragged():  # the slider's value once the address carries it (the design the panel holds)
+        value = float(handle.get_attribute("aria-valuenow"))
+        return value if f"e_p={value:g}" in browser.current_url else None
+
+    held = wait_for(dragged, timeout=30, what=lambda: f"the dragged value in the address ({browser.current_url}, "
+                    f"slider at {handle.get_attribute('aria-valuenow')})")
     assert held > 0.00105
-    wait_for(lambda: f"e_p={held:g}" in browser.current_url, timeout=30, what="the dragged value in the address")
     time.sleep(3 * live.SETTLE_MS / 1000)  # held still, longer than the keys' quiet time
     new = [(j["analysis"], j["request"].get("config"), j["request"]["params"]["e_p"])
            for i, j in job_records(server).items() if i not in before]

@@ -86,7 +86,9 @@ def codim2_points(problem: CycleCurveProblem, prev: CurvePoint, new: CurvePoint,
             continue
         level = None if name in defining.crossings else defining.own_level(problem, name)
         hit = None
-        if level is not None:  # an unknown's value (a torus curve's kappa): one Newton solve with it held there
+        if level is not None and (prev.u[level[0]] - level[1]) * (new.u[level[0]] - level[1]) < 0:
+            # an unknown's value (a torus curve's kappa), crossed between the two points (``before`` may be
+            # an earlier point's: a new mesh moves kappa by up to ~6e-6): one Newton solve with it held there
             at = point_at(problem, prev, new, *level, copts, with_tangent=name in defining.tangent_tests)
             hit = None if at is None else (at, 0.0)
         if hit is None:
