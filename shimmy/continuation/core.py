@@ -414,23 +414,37 @@ class Tracer:
         self.h = max(min(self.h, h_max), self.options.ds_min)
 
 
+#: In a search whose g may jump (:func:`locate` with ``report``): a trial whose |g| is over this many
+#: times both ends' of the step is across a jump (the pd torus curve's multiplier test: ends -5.7e-4
+#: and +2.7e-4, a trial +3.5). A g that stays within its ends' size is searched as any other.
+JUMP_RATIO = 100.0
+
+
 def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[CurvePoint], float],
            g_start: float, g_end: float, options: ContinuationOptions,
-           with_tangent: bool = True) -> tuple[CurvePoint, float] | None:
+           with_tangent: bool = True, x_tol: float = 1e-4,
+           report: dict | None = None) -> tuple[CurvePoint, float] | None:
     """Zero of g between ``start`` (h = 0) and the point at step h_end (Illinois secant on h).
 
     Returns (point, g at it), or None if a trial step fails to converge. ``with_tangent=False``
     when g does not read the tangent: the trial points then carry the start's (one
     factorisation fewer per trial).
+
+    With ``report`` (a dict; a g that may jump, whose sign change then has no zero to reach):
+    once a trial finds a jump (``JUMP_RATIO``) the search bisects (the secant creeps towards a
+    jump: a bracket from -2e-4 to +3.4 took 15 trials to move off its near end) and ends, with
+    ``report["collapsed"] = True``, once the bracket is narrower than ``x_tol`` times h_end.
     """
     a, b, ga, gb = 0.0, h_end, g_start, g_end
     best = None
     side = 0
+    jump = False  # a trial found g jumping (searched with ``report`` only)
+    big = JUMP_RATIO * max(abs(g_start), abs(g_end))
     if math.isfinite(options.max_correction):  # bracketed by two accepted points: no branch to jump to
         options = dataclasses.replace(options, max_correction=math.inf)
     for _ in range(options.max_locate):
         h = b - gb * (b - a) / (gb - ga) if gb != ga else 0.5 * (a + b)
-        if not (min(a, b) < h < max(a, b)):
+        if not (min(a, b) < h < max(a, b)) or jump:
             h = 0.5 * (a + b)
         trial = step(problem, start, h, options, with_tangent)
         if trial is None:  # e.g. landed exactly on a singular point (a branch point): nudge off it
@@ -440,7 +454,13 @@ def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[
             return best
         gh = g(trial)
         best = (trial, gh)
-        if abs(gh) <= options.locate_tol or abs(b - a) <= 1e-13 * abs(h_end):
+        if abs(gh) <= options.locate_tol:
+            return best
+        jump = jump or (report is not None and abs(gh) > big)
+        if jump and abs(b - a) <= x_tol * abs(h_end):
+            report["collapsed"] = True
+            return best
+        if abs(b - a) <= 1e-13 * abs(h_end):
             return best
         if gh * gb < 0:
             a, ga = b, gb
@@ -487,17 +507,24 @@ def point_at(problem: CurveProblem, a: CurvePoint, b: CurvePoint, index: int, va
 
 def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Callable[[CurvePoint], float],
                    g_a: float, g_b: float, options: ContinuationOptions, tolerance: float,
-                   splits: int = 6, with_tangent: bool = True) -> tuple[CurvePoint, float] | None:
+                   splits: int = 6, with_tangent: bool = True,
+                   x_tol: float | None = None) -> tuple[CurvePoint, float] | None:
     """Zero of g between two points of a curve, to |g| <= ``tolerance``: :func:`locate` from a;
     where a trial step fails (a long step across a sharp bend), the step is halved on the curve
-    and the half that holds the sign change is searched, at most ``splits`` times."""
+    and the half that holds the sign change is searched, at most ``splits`` times.
+
+    ``x_tol``: for a g that may jump (its sign change then no zero), the search ends, None, once
+    its bracket is narrower than this fraction of the step, and is not split again (the split
+    halves would only close in on the jump again)."""
     h = weighted_norm(b.u - a.u, problem.weights)
     if options.locate_tol != tolerance:
         options = replace(options, locate_tol=tolerance)
-    hit = locate(problem, a, h, g, g_a, g_b, options, with_tangent)
+    report: dict = {}
+    hit = locate(problem, a, h, g, g_a, g_b, options, with_tangent,
+                 **({} if x_tol is None else {"x_tol": x_tol, "report": report}))
     if hit is not None and abs(hit[1]) <= tolerance:
         return hit
-    if splits == 0:
+    if splits == 0 or report.get("collapsed"):
         return None
     mid = step(problem, a, 0.5 * h, options)
     if mid is None:
@@ -508,5 +535,5 @@ def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Calla
     if abs(g_mid) <= tolerance:
         return mid, g_mid
     if g_a * g_mid < 0:
-        return locate_between(problem, a, mid, g, g_a, g_mid, options, tolerance, splits - 1, with_tangent)
-    return locate_between(problem, mid, b, g, g_mid, g_b, options, tolerance, splits - 1, with_tangent)
+        return locate_between(problem, a, mid, g, g_a, g_mid, options, tolerance, splits - 1, with_tangent, x_tol)
+    return locate_between(problem, mid, b, g, g_mid, g_b, options, tolerance, splits - 1, with_tangent, x_tol)

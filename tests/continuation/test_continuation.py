@@ -227,6 +227,44 @@ def test_point_at_a_level_of_one_unknown_is_the_circles_point_there():
     np.testing.assert_allclose(point_at(circle, below, a, 1, 0.0, options).u, [R, 0.0], atol=1e-12)
 
 
+def test_a_search_across_a_jump_ends_in_a_few_trials_and_a_smooth_one_is_unchanged():
+    """locate_between with x_tol (a g that may jump: a multiplier test whose multiplier pairs off with
+    another and leaves the real axis, the test then reading a third one): between angles 0.3 and 0.9 of
+    the circle g goes from -4e-5 to +2e-5, but jumps to +3 on [0.6, 0.8) (the pair). The search bisects
+    once a trial sees the jump and gives up (None) when the bracket is 1e-4 of the step, in at most 20
+    trials (the secant search took over 200 on such a jump of the pd map); a smooth g finds the same
+    point, through the same trials, with or without x_tol."""
+    from shimmy.continuation.core import CurvePoint, locate_between
+
+    R = 2.0
+    options = ContinuationOptions(tol=1e-12, residual_tol=1e-12)
+    circle = _Circle(R)
+    a = CurvePoint(np.array([R * np.cos(0.3), R * np.sin(0.3)]), np.array([-np.sin(0.3), np.cos(0.3)]))
+    b = CurvePoint(np.array([R * np.cos(0.9), R * np.sin(0.9)]), np.array([-np.sin(0.9), np.cos(0.9)]))
+    trials = []
+
+    def jump(q):
+        angle = math.atan2(q.u[1], q.u[0])
+        trials.append(angle)
+        return 3.0 if 0.6 <= angle < 0.8 else 1e-4 * (angle - 0.7)
+
+    assert locate_between(circle, a, b, jump, jump(a), jump(b), options, 1e-5, x_tol=1e-4) is None
+    assert 3 < len(trials) - 2 <= 20
+    assert abs(trials[-1] - 0.6) < 1e-3  # closed in on the jump
+
+    def smooth(q):
+        trials.append(q.u[0])
+        return q.u[0] - 1.5
+
+    found = []
+    for x_tol in (None, 1e-4):
+        trials.clear()
+        hit = locate_between(circle, a, b, smooth, smooth(a), smooth(b), options, 1e-10, x_tol=x_tol)
+        found.append((hit[0].u, list(trials)))
+    np.testing.assert_allclose(found[0][0], [1.5, np.sqrt(R * R - 2.25)], atol=1e-9)
+    assert np.array_equal(found[0][0], found[1][0]) and found[0][1] == found[1][1]
+
+
 def test_a_step_leaving_the_range_ends_on_its_bound_and_one_starting_outside_does_not_fail():
     """advance_within: a step across the bound ends on the circle's point there (found with x held);
     a tracer already outside the range (a start moved past it) still gets an answer, not an error."""
