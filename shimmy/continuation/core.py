@@ -416,8 +416,11 @@ class Tracer:
 
 #: In a search whose g may jump (:func:`locate` with ``report``): a trial whose |g| is over this many
 #: times both ends' of the step is across a jump (the pd torus curve's multiplier test: ends -5.7e-4
-#: and +2.7e-4, a trial +3.5). A g that stays within its ends' size is searched as any other.
+#: and +2.7e-4, a trial +3.5), and so is a step with one end over this many times the other's and
+#: over JUMP_SIZE (a half of a split step ending inside the jump: -9e-4 and +3.77). A g that stays
+#: within its ends' size is searched as any other.
 JUMP_RATIO = 100.0
+JUMP_SIZE = 0.1
 
 
 def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[CurvePoint], float],
@@ -438,8 +441,10 @@ def locate(problem: CurveProblem, start: CurvePoint, h_end: float, g: Callable[[
     a, b, ga, gb = 0.0, h_end, g_start, g_end
     best = None
     side = 0
-    jump = False  # a trial found g jumping (searched with ``report`` only)
     big = JUMP_RATIO * max(abs(g_start), abs(g_end))
+    small, large = sorted((abs(g_start), abs(g_end)))
+    # g jumping (searched with ``report`` only): a trial found it, or one end is on the far side of a jump
+    jump = report is not None and large > max(JUMP_RATIO * small, JUMP_SIZE)
     if math.isfinite(options.max_correction):  # bracketed by two accepted points: no branch to jump to
         options = dataclasses.replace(options, max_correction=math.inf)
     for _ in range(options.max_locate):

@@ -231,9 +231,9 @@ def test_a_search_across_a_jump_ends_in_a_few_trials_and_a_smooth_one_is_unchang
     """locate_between with x_tol (a g that may jump: a multiplier test whose multiplier pairs off with
     another and leaves the real axis, the test then reading a third one): between angles 0.3 and 0.9 of
     the circle g goes from -4e-5 to +2e-5, but jumps to +3 on [0.6, 0.8) (the pair). The search bisects
-    once a trial sees the jump and gives up (None) when the bracket is 1e-4 of the step, in at most 20
-    trials (the secant search took over 200 on such a jump of the pd map); a smooth g finds the same
-    point, through the same trials, with or without x_tol."""
+    once a trial sees the jump (or at once, a step ending inside it) and gives up (None) when the bracket
+    is 1e-4 of the step, in at most 20 trials (the secant search took over 200 on such a jump of the pd
+    map); a smooth g finds the same point, through the same trials, with or without x_tol."""
     from shimmy.continuation.core import CurvePoint, locate_between
 
     R = 2.0
@@ -251,6 +251,10 @@ def test_a_search_across_a_jump_ends_in_a_few_trials_and_a_smooth_one_is_unchang
     assert locate_between(circle, a, b, jump, jump(a), jump(b), options, 1e-5, x_tol=1e-4) is None
     assert 3 < len(trials) - 2 <= 20
     assert abs(trials[-1] - 0.6) < 1e-3  # closed in on the jump
+    inside = CurvePoint(np.array([R * np.cos(0.7), R * np.sin(0.7)]), np.array([-np.sin(0.7), np.cos(0.7)]))
+    trials.clear()  # a step ending inside the jump (a half of a split step): jumping from its ends
+    assert locate_between(circle, a, inside, jump, jump(a), jump(inside), options, 1e-5, x_tol=1e-4) is None
+    assert len(trials) - 2 <= 20 and abs(trials[-1] - 0.6) < 1e-3
 
     def smooth(q):
         trials.append(q.u[0])
