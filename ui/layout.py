@@ -285,12 +285,15 @@ dash.clientside_callback(
         const refused = Object.keys(problems);
         const summary = refused.length ? "Not applied: " + refused.join(", ") + " (see the field" +
                         (refused.length > 1 ? "s" : "") + ")" : "";
-        const openAdvanced = refused.some(n => ADVANCED.includes(n)) ? true : C.no_update;
-        // only the fields whose message changes are redrawn (a slider step redraws none of them)
-        const errors = errorIds.map((i, k) => ((problems[i.name] || "") === (shown[k] || "") ? C.no_update
-                                                                                             : (problems[i.name] || "")));
-        return [outValues, outBoxes, outMaterial, url, stores.map(() => ({material: material, params: params})),
-                summary === (shownSummary || "") ? C.no_update : summary, errors, openAdvanced];
+        // The messages are set only where they change (a slider step sets none), through set_props: as
+        // declared outputs they cost every step ~10-20 ms of the renderer's time, nearly all no_update.
+        errorIds.forEach((i, k) => {
+            const message = problems[i.name] || "";
+            if (message !== (shown[k] || "")) { C.set_props(i, {children: message}); }
+        });
+        if (summary !== (shownSummary || "")) { C.set_props(ID.summary, {children: summary}); }
+        if (refused.some(n => ADVANCED.includes(n))) { C.set_props(ID.advanced, {open: true}); }
+        return [outValues, outBoxes, outMaterial, url, stores.map(() => ({material: material, params: params}))];
     }
     """ % {"spec": json.dumps({n: {"low": s.low, "high": s.high, "integer": s.integer, "allowed": s.allowed,
                                    "unit": s.unit, "range": f"[{s.low:g}, {s.high:g}] {s.unit}".rstrip(),
@@ -300,15 +303,12 @@ dash.clientside_callback(
            "base": json.dumps({m: state.material_params(m) for m in MATERIALS}),
            "default": json.dumps(state.DEFAULT_MATERIAL), "advanced": json.dumps(list(ADVANCED)),
            "ids": json.dumps({"box": ids.PARAM_BOX_TYPE, "param": ids.PARAM_TYPE, "reset": ids.RESET_DESIGN,
-                              "material": ids.MATERIAL})},
+                              "material": ids.MATERIAL, "summary": ids.DESIGN_ERROR, "advanced": ids.ADVANCED})},
     Output(ids.param(ALL), "value"),
     Output(ids.param_box(ALL), "value"),
     Output(ids.MATERIAL, "value"),
     Output(ids.URL_UPDATE, "data", allow_duplicate=True),
     Output(ids.design_store(ALL), "data"),
-    Output(ids.DESIGN_ERROR, "children"),
-    Output(ids.param_error(ALL), "children"),
-    Output(ids.ADVANCED, "open"),
     Input(ids.param(ALL), "value"),
     Input(ids.param_box(ALL), "value"),
     Input(ids.MATERIAL, "value"),

@@ -115,7 +115,13 @@ def test_refusals_are_at_the_field_in_its_unit_quoting_what_was_typed(server, br
     wait_for(lambda: text_of(browser, pattern("r2", "param-error")), timeout=10, what="the error at r2")
     assert text_of(browser, pattern("r2", "param-error")).startswith("r2 = 0.2 m is outside [0.07, 0.09] m")
     assert "r2=0.2" not in browser.current_url
+    assert text_of(browser, "design-error") == "Not applied: r2, k_psi (see the fields)"
     browser.save_screenshot(str(SHOTS / "design-errors-at-the-field.png"))
+    type_into(by_id(browser, pattern("r2", "param-box")), "0.085")  # accepted: its message goes, the other stays
+    wait_for(lambda: "r2=0.085" in browser.current_url, timeout=10, what="the accepted r2 in the address")
+    wait_for(lambda: text_of(browser, pattern("r2", "param-error")) == "", timeout=10, what="the r2 message gone")
+    assert text_of(browser, "design-error") == "Not applied: k_psi (see the field)"
+    assert text_of(browser, pattern("k_psi", "param-error")).startswith("k_psi = -5 N m/rad")
 
     open_page(browser, server, "/bifurcation?configs=original")
     type_into(browser.find_element(By.ID, "bif-fz"), "5")
