@@ -95,8 +95,13 @@ class DefiningSystem:
 
     def own_test(self, problem: CycleCurveProblem, name: PointKind,
                  reference: np.ndarray) -> Callable[[CurvePoint], float]:
-        """The test function of one of those points along the curve, to locate it."""
-        raise KeyError(name)
+        """The test function of one of those points along the curve, to locate it (by default the
+        unknown minus the value of :meth:`own_level`)."""
+        level = self.own_level(problem, name)
+        if level is None:
+            raise KeyError(name)
+        index, value = level
+        return lambda q: float(q.u[index]) - value
 
     def own_level(self, problem: CycleCurveProblem, name: PointKind) -> tuple[int, float] | None:
         """(index, value) if that test function is an unknown of the curve minus a value (the point

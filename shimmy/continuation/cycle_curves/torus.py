@@ -90,10 +90,5 @@ class Torus(DefiningSystem):
         kappa = problem.kappa(point.u)
         return {name: kappa - value for name, value in RESONANCES.items()}
 
-    def own_test(self, problem: CycleCurveProblem, name: PointKind,
-                 reference: np.ndarray) -> Callable[[CurvePoint], float]:
-        target = RESONANCES[name]
-        return lambda q: problem.kappa(q.u) - target
-
     def own_level(self, problem: CycleCurveProblem, name: PointKind) -> tuple[int, float] | None:
         return problem.kappa_index, RESONANCES[name]
