@@ -33,6 +33,10 @@ myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 
 html_theme = "furo"
+# The API's functions and classes are not entries of the table of contents (its modules' headings are):
+# with them, furo copied a tree of ~500 entries into each of the 95 pages (the source pages included),
+# half of the build's time.
+toc_object_entries = False
 html_title = f"shimmy {release}"
 html_static_path = ["_static"]
 html_css_files = ["shimmy.css"]
