@@ -397,10 +397,9 @@ try:
         r = client.submit(shimmy.simulate, "nes_pd", 30, 150e3, t_end=1).result(timeout=120)
         print(f"dask worker ran shimmy.simulate: success={r.success}, {r.t.size} samples, {r.response_type}")
         ok = bool(r.success)
-finally:
-    for p in reversed(procs):
+finally:  # the worker first, then the scheduler (a worker told at once with its scheduler hangs
+    for p in reversed(procs):  # 8 s on the closing connection before its nanny kills it)
         p.terminate()
-    for p in procs:
         try:
             p.wait(30)
         except subprocess.TimeoutExpired:
