@@ -583,26 +583,44 @@ def _wait(proc: subprocess.Popen, job_id: str) -> None:
         s = store()
         for held, holder in list(s.get("running", {}).items()):
             if holder.get("pid") == proc.pid and holder.get("host") == HOST:
-                _release(s, held, holder)
-                update(held, status="failed", error=_death(code))
+                _lost(s, held, holder, code)
         pump()
     except Exception:  # noqa: BLE001 - a broken store is reported by health; this thread must not die loudly
         log.exception("after the worker of job %s", job_id)
 
 
-def _death(code: int | None = None) -> str:
+def _death(code: int | None = None, requeued: int | None = None) -> str:
+    """Why a job failed when its process ended: while running it, or (``requeued``: how often it was
+    queued again already) before starting it."""
     how = "" if code is None else (f" (killed by signal {-code})" if code < 0 else f" (exit status {code})")
+    if requeued is not None:
+        return (f"the process this job was handed to ended before starting it{how}, and it had been queued "
+                f"again {requeued} time(s) already; submit it again")
     return f"the process running this job ended without a result{how}; submit it again"
 
 
+def _lost(s: diskcache.Cache, job_id: str, holder: dict[str, Any], code: int | None = None) -> None:
+    """The slot holder of ``job_id`` ended. A job it ran is failed (the job may be what ended it); one it
+    had not started yet (a worker that died starting, an idle one killed after the job was handed to it)
+    is queued again at the head of the queue, at most ``JOB_RESTARTS`` times, then failed saying so."""
+    with s.transact():
+        job = s.get(("job", job_id))
+        unstarted = job is not None and job["status"] == "queued" and s.get("running", {}).get(job_id) == holder
+        if unstarted and job.get("restarts", 0) < settings.JOB_RESTARTS:
+            _requeue(s, [job_id], "queued again: the process it was handed to ended before starting it",
+                     restart=True)
+            return
+    _release(s, job_id, holder)
+    update(job_id, status="failed", error=_death(code, job.get("restarts", 0) if unstarted else None))
+
+
 def _reap(s: diskcache.Cache) -> None:
-    """Fail every job whose slot holder is gone, and end what is left of its process group."""
+    """Settle every job whose slot holder is gone (:func:`_lost`), and end what is left of its process group."""
     gone = [(job_id, holder) for job_id, holder in list(s.get("running", {}).items())
             if not _alive(s, job_id, holder)]
     for job_id, holder in gone:
         _signal_group(holder, signal.SIGKILL)
-        _release(s, job_id, holder)
-        update(job_id, status="failed", error=_death())
+        _lost(s, job_id, holder)
 
 
 def _alive(s: diskcache.Cache, job_id: str, holder: dict[str, Any]) -> bool:

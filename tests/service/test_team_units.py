@@ -238,6 +238,43 @@ def test_a_job_whose_process_ended_with_the_server_is_queued_again_once_then_fai
     assert failed["status"] == "failed" and "submit it again" in failed["error"] and s.get("running") == {}
 
 
+def test_a_job_whose_worker_ended_before_starting_it_is_queued_again_once_then_failed(held):
+    """A job handed to a process that ends before starting it (a worker that died starting, an idle one
+    killed) never ran: queued again at the head of the queue (JOB_RESTARTS times), whether the ending is
+    seen by the server's check of slot holders (pump) or by the thread that started the process; then
+    failed, saying it never started. A job that was running when its process ended is failed at once."""
+    job = jobs.submit_canonical("map", _map(6), user="alice")
+    s = jobs.store()
+
+    def handed_to_a_process_that_ends(status: str) -> subprocess.Popen:
+        proc = subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"])
+        holder = {"pid": proc.pid, "started": jobs._create_time(proc.pid), "host": jobs.HOST,
+                  "claimed": time.time(), "user": "alice"}
+        with s.transact():
+            s.set("queue", [q for q in s.get("queue") if q != job["id"]])
+            s.set("running", {job["id"]: holder})
+        if status != "queued":
+            jobs.update(job["id"], status=status, message=status)
+        proc.wait(30)
+        return proc
+
+    handed_to_a_process_that_ends("queued")
+    jobs.pump()  # finds the slot holder gone
+    again = jobs.get(job["id"])
+    assert again["status"] == "queued" and again["restarts"] == 1, again
+    assert "ended before starting it" in again["message"]
+    assert s.get("queue")[0] == job["id"] and s.get("running") == {}
+    jobs._wait(handed_to_a_process_that_ends("queued"), job["id"])  # the starting thread sees it end
+    failed = jobs.get(job["id"])
+    assert failed["status"] == "failed" and s.get("running") == {} and job["id"] not in s.get("queue")
+    assert "ended before starting it (exit status 3)" in failed["error"] and "submit it again" in failed["error"]
+    ran = jobs.submit_canonical("map", _map(7), user="alice")
+    jobs._wait(handed_to_a_process_that_ends("running"), ran["id"])
+    failed = jobs.get(ran["id"])
+    assert failed["status"] == "failed" and failed["restarts"] == 0
+    assert "ended without a result (exit status 3)" in failed["error"]
+
+
 def test_draining_starts_nothing_until_resumed(held, monkeypatch):
     monkeypatch.setattr(settings, "MAX_RUNNING_JOBS", 2)
     jobs.drain()
