@@ -189,6 +189,32 @@ def test_a_resonance_test_told_by_an_earlier_points_value_is_searched_not_solved
     assert any(pt.located and pt.data["p2"] == pytest.approx(-0.5, abs=1e-9) for pt in r4)
 
 
+def test_after_a_new_mesh_a_step_compares_tests_of_one_discretisation(monkeypatch):
+    """The signs a step compares are the tests at both ends on the step's own mesh: after the mesh is
+    adapted, the tests at the point are taken again on the new one (before, the values of the old mesh
+    were compared with the new mesh's, a difference of discretisations that could read as a crossing)."""
+    from shimmy.continuation.cycle_curves import codim2, tracing
+
+    system = torus_two_parameter()
+    compared = []
+    original = codim2.codim2_points
+
+    def check(problem, prev, new, before, after, reference, *args, **kwargs):
+        again = codim2.monitors(problem, prev, problem.multipliers(prev.u), reference)
+        carried = args[-1] if args else kwargs.get("carried", frozenset())
+        compared.append(max((abs(before[k] - again[k]) for k in again
+                             if k not in carried and np.isfinite(again[k]) and np.isfinite(before[k])), default=0.0))
+        return original(problem, prev, new, before, after, reference, *args, **kwargs)
+
+    monkeypatch.setattr(tracing.codim2, "codim2_points", check)
+    # a coarse uniform first mesh: the adapted meshes (every second step) move the points
+    curve = cycle_curve(system, "NS", start(Mesh.uniform(6, 3), 1.0, 4, 0.0), 0.0, box=((-1.0, 2.0), (-1.0, 1.0)),
+                        scale=np.ones(4), p_scale=(1.0, 1.0), kappa=math.cos(0.6 * math.pi), ncol=3,
+                        options=CycleCurveOptions(adapt_every=2), directions=(1,))
+    assert len(compared) >= 6 and curve.p[:, 1].max() == pytest.approx(1.0)
+    assert max(compared) <= 1e-12, compared
+
+
 def test_period_doubling_curve():
     system = flip_two_parameter()
     curve = cycle_curve(system, "PD", start(Mesh.uniform(20, 4), 1.0, 4, 0.0), 0.0, box=((-1.0, 2.0), (-1.0, 1.0)),

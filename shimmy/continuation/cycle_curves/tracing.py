@@ -288,13 +288,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         new_monitors = codim2.monitors(problem, new, mu, reference)
         special.extend(codim2.codim2_points(problem, prev, new, monitors, new_monitors, reference,
                                             len(rows["p"]) - 1, copts, carried))
-        # a test unresolved here (NaN: a multiplier within its accuracy of the circle) keeps its last value, so
-        # that a crossing over the unresolved stretch is seen where the test is resolved again (pd's second
-        # torus curve ran from +0.01 through a NaN point to -1e-5 past its LPNS at 136.3 m/s, which the warm
-        # traces lost and the cold one, its points elsewhere, found)
-        carried = frozenset(k for k, v in new_monitors.items() if k in problem.defining.crossings
-                            and not np.isfinite(v) and np.isfinite(monitors.get(k, math.nan)))
-        monitors = {k: monitors[k] if k in carried else v for k, v in new_monitors.items()}
+        monitors, carried = _carry(problem, monitors, new_monitors)
         reference = p_direction(new)
         # the curve type's own tests at `new` against its own direction (the cusp's compares directions)
         monitors.update(problem.defining.own_monitors(problem, new, reference))
@@ -322,8 +316,24 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
             tracer.options = replace(tracer.options, ds_min=floor)
         shrinking, amp_last = amp < amp_last, amp
         if options.adapt_every and steps % options.adapt_every == 0:
-            problem = _remesh(problem, tracer, copts)
+            remeshed = _remesh(problem, tracer, copts)
+            if remeshed is not problem:  # the tests again at the point on its new mesh: the next step's
+                problem = remeshed       # signs compare values of one discretisation, not of two
+                point = tracer.point
+                monitors, carried = _carry(problem, monitors, codim2.monitors(
+                    problem, point, problem.multipliers(point.u), reference))
     return rows, special, stop, steps
+
+
+def _carry(problem: CycleCurveProblem, monitors: dict, fresh: dict) -> tuple[dict, frozenset]:
+    """The tests' values at a new point (``fresh``) over those of the last (``monitors``), and the tests
+    that keep their last value: a crossing test unresolved at the new point (NaN: a multiplier within its
+    accuracy of the circle) keeps its last value, so that a crossing over the unresolved stretch is seen
+    where the test is resolved again (pd's second torus curve ran from +0.01 through a NaN point to -1e-5
+    past its LPNS at 136.3 m/s, which the warm traces lost and the cold one, its points elsewhere, found)."""
+    carried = frozenset(k for k, v in fresh.items() if k in problem.defining.crossings
+                        and not np.isfinite(v) and np.isfinite(monitors.get(k, math.nan)))
+    return {k: monitors[k] if k in carried else v for k, v in fresh.items()}, carried
 
 
 def _chord_ratio(problem: CycleCurveProblem, a: CurvePoint, b: CurvePoint, h: float, tol: float) -> float:
