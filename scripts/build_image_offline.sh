@@ -404,6 +404,7 @@ finally:  # the worker first, then the scheduler (a worker told at once with its
             p.wait(30)
         except subprocess.TimeoutExpired:
             p.kill()
+            p.wait(10)
 sys.exit(0 if ok else 1)
 PY
     dport=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')

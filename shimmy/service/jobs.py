@@ -182,7 +182,7 @@ def _check_share(s: diskcache.Cache, user: str, queue: list[str], running: dict[
 
 
 def get(job_id: str) -> dict[str, Any] | None:
-    """The job, after failing jobs whose process is gone and starting queued ones on free slots."""
+    """The job, after settling jobs whose process is gone (:func:`_lost`) and starting queued ones on free slots."""
     pump()
     return store().get(("job", job_id))
 
@@ -498,7 +498,7 @@ def _group_alive(holder: dict[str, Any]) -> bool:
 
 
 def pump() -> None:
-    """Fail jobs whose process is gone, then start workers for queued jobs on free slots."""
+    """Settle jobs whose process is gone (:func:`_lost`), then start workers for queued jobs on free slots."""
     s = store()
     _reap(s)
     starting = []
@@ -515,6 +515,7 @@ def pump() -> None:
             job_id, owner = _choose(s, queue, running)
             if job_id is None:
                 break
+            _handed(s, job_id)
             if waiting:  # an idle worker takes it (it reads the running map): warm, no process to start
                 holder = idle.pop(waiting.pop(0))
                 running[job_id] = {**holder, "claimed": _now(), "user": owner}
@@ -527,6 +528,15 @@ def pump() -> None:
         s.set("idle", {**{key: h for key, h in idle.items() if key not in mine}, **{key: idle[key] for key in waiting}})
     for job_id in starting:
         _start(s, job_id)
+
+
+def _handed(s: diskcache.Cache, job_id: str) -> None:
+    """Inside the transaction that hands ``job_id`` to a slot: its heartbeat is now (a holder on another host
+    is judged by it: a job queued for a while would read as stale until its worker's first update)."""
+    job = s.get(("job", job_id))
+    if job is not None:
+        job["heartbeat"] = _now()
+        _put(s, job)
 
 
 def _choose(s: diskcache.Cache, queue: list[str], running: dict[str, Any]) -> tuple[str | None, str | None]:
@@ -603,15 +613,17 @@ def _lost(s: diskcache.Cache, job_id: str, holder: dict[str, Any], code: int | N
     """The slot holder of ``job_id`` ended. A job it ran is failed (the job may be what ended it); one it
     had not started yet (a worker that died starting, an idle one killed after the job was handed to it)
     is queued again at the head of the queue, at most ``JOB_RESTARTS`` times, then failed saying so."""
-    with s.transact():
+    with s.transact():  # (one transaction: a second caller that saw the same holder finds it gone and stops)
+        if s.get("running", {}).get(job_id) != holder:
+            return  # settled already (by another process's check, or the starter's), or handed on since
         job = s.get(("job", job_id))
-        unstarted = job is not None and job["status"] == "queued" and s.get("running", {}).get(job_id) == holder
+        unstarted = job is not None and job["status"] == "queued"
         if unstarted and job.get("restarts", 0) < settings.JOB_RESTARTS:
             _requeue(s, [job_id], "queued again: the process it was handed to ended before starting it",
                      restart=True)
             return
-    _release(s, job_id, holder)
-    update(job_id, status="failed", error=_death(code, job.get("restarts", 0) if unstarted else None))
+        _release(s, job_id, holder)
+        update(job_id, status="failed", error=_death(code, job.get("restarts", 0) if unstarted else None))
 
 
 def _reap(s: diskcache.Cache) -> None:
@@ -781,6 +793,7 @@ def _linger(me: dict[str, Any]) -> str | None:
                     queue = list(s.get("queue", []))
                     mine, owner = _choose(s, queue, running)
                     if mine is not None:
+                        _handed(s, mine)
                         running[mine] = {**me, "claimed": _now(), "user": owner}
                         s.set("queue", queue)
                         s.set("running", running)
@@ -810,6 +823,7 @@ def _next(finished: str, me: dict[str, Any]) -> str | None:
         if current and s.get("draining") is None and len(running) < settings.MAX_RUNNING_JOBS:
             nxt, owner = _choose(s, queue, running)
             if nxt is not None:
+                _handed(s, nxt)
                 running[nxt] = {**me, "claimed": _now(), "user": owner}
         s.set("queue", queue)
         s.set("running", running)

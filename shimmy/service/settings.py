@@ -69,7 +69,8 @@ QUEUE_RESERVED = int(os.environ.get("SHIMMY_QUEUE_RESERVED", str(max(1, MAX_QUEU
 JOB_RETENTION_HOURS = float(os.environ.get("SHIMMY_JOB_RETENTION_HOURS", "168"))
 MAX_JOB_RECORDS = int(os.environ.get("SHIMMY_MAX_JOB_RECORDS", "5000"))
 #: A job whose process was found gone when the server started (killed with the server, the machine
-#: restarted) is queued again this many times, then failed with a message saying so.
+#: restarted), or whose worker ended before starting it, is queued again this many times in all, then
+#: failed with a message saying so.
 JOB_RESTARTS = 1
 #: Admission control of the quick analyses answered in the request (POST /simulate, /hopf, /stability,
 #: /devices, /sensitivity and the pages that draw them): per web worker at most MAX_FAST_COMPUTATIONS

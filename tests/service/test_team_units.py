@@ -246,33 +246,49 @@ def test_a_job_whose_worker_ended_before_starting_it_is_queued_again_once_then_f
     job = jobs.submit_canonical("map", _map(6), user="alice")
     s = jobs.store()
 
-    def handed_to_a_process_that_ends(status: str) -> subprocess.Popen:
+    def handed_to_a_process_that_ends(job_id: str, status: str) -> tuple[subprocess.Popen, dict]:
         proc = subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"])
         holder = {"pid": proc.pid, "started": jobs._create_time(proc.pid), "host": jobs.HOST,
                   "claimed": time.time(), "user": "alice"}
         with s.transact():
-            s.set("queue", [q for q in s.get("queue") if q != job["id"]])
-            s.set("running", {job["id"]: holder})
+            s.set("queue", [q for q in s.get("queue") if q != job_id])
+            s.set("running", {job_id: holder})
         if status != "queued":
-            jobs.update(job["id"], status=status, message=status)
+            jobs.update(job_id, status=status, message=status)
         proc.wait(30)
-        return proc
+        return proc, holder
 
-    handed_to_a_process_that_ends("queued")
+    proc, holder = handed_to_a_process_that_ends(job["id"], "queued")
     jobs.pump()  # finds the slot holder gone
     again = jobs.get(job["id"])
     assert again["status"] == "queued" and again["restarts"] == 1, again
     assert "ended before starting it" in again["message"]
     assert s.get("queue")[0] == job["id"] and s.get("running") == {}
-    jobs._wait(handed_to_a_process_that_ends("queued"), job["id"])  # the starting thread sees it end
+    jobs._lost(s, job["id"], holder, 3)  # another process that saw the same holder: settled already, no change
+    assert jobs.get(job["id"])["status"] == "queued" and s.get("queue")[0] == job["id"]
+    jobs._wait(handed_to_a_process_that_ends(job["id"], "queued")[0], job["id"])  # the starter sees it end
     failed = jobs.get(job["id"])
     assert failed["status"] == "failed" and s.get("running") == {} and job["id"] not in s.get("queue")
     assert "ended before starting it (exit status 3)" in failed["error"] and "submit it again" in failed["error"]
     ran = jobs.submit_canonical("map", _map(7), user="alice")
-    jobs._wait(handed_to_a_process_that_ends("running"), ran["id"])
+    jobs._wait(handed_to_a_process_that_ends(ran["id"], "running")[0], ran["id"])
     failed = jobs.get(ran["id"])
     assert failed["status"] == "failed" and failed["restarts"] == 0
     assert "ended without a result (exit status 3)" in failed["error"]
+
+
+def test_a_job_handed_to_a_slot_has_a_fresh_heartbeat(held, monkeypatch):
+    """A holder on another host is judged alive by its job's heartbeat: a job queued for an hour and then
+    handed on must not read as stale (and be settled under its new worker) before that worker's first update."""
+    job = jobs.submit_canonical("map", _map(8))
+    jobs.update(job["id"], heartbeat=time.time() - 3600)
+    monkeypatch.setattr(settings, "MAX_RUNNING_JOBS", 1)
+    monkeypatch.setattr(jobs, "_start", lambda s, job_id: None)  # the slot is taken; no process starts
+    jobs.pump()
+    s = jobs.store()
+    assert list(s.get("running")) == [job["id"]] and time.time() - jobs.get(job["id"])["heartbeat"] < 60
+    elsewhere = {"pid": 1, "started": 1.0, "host": "another-host", "claimed": time.time(), "user": None}
+    assert jobs._alive(s, job["id"], elsewhere)
 
 
 def test_draining_starts_nothing_until_resumed(held, monkeypatch):

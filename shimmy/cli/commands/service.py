@@ -97,7 +97,7 @@ def _cmd_jobs_drain(args) -> int:
     drain()
     deadline = time.time() + args.wait
     while True:
-        pump()  # fails jobs whose process is gone; starts nothing while draining
+        pump()  # settles jobs whose process is gone; starts nothing while draining
         now = counts()
         if not now["running"] or time.time() >= deadline:
             break

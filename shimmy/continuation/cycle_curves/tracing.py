@@ -317,11 +317,17 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
         shrinking, amp_last = amp < amp_last, amp
         if options.adapt_every and steps % options.adapt_every == 0:
             remeshed = _remesh(problem, tracer, copts)
-            if remeshed is not problem:  # the tests again at the point on its new mesh: the next step's
-                problem = remeshed       # signs compare values of one discretisation, not of two
+            if remeshed is not problem:
+                # the tests again at the point on its new mesh: the next step compares values of one
+                # discretisation, not of two; a test carried (an earlier point's value over an unresolved
+                # stretch) stays carried, even where the new mesh resolves it past its crossing
+                problem = remeshed
                 point = tracer.point
-                monitors, carried = _carry(problem, monitors, codim2.monitors(
-                    problem, point, problem.multipliers(point.u), reference))
+                kept = {k: monitors[k] for k in carried}
+                monitors, carried = _carry(problem, monitors,
+                                           codim2.monitors(problem, point, problem.multipliers(point.u), reference))
+                monitors.update(kept)
+                carried |= frozenset(kept)
     return rows, special, stop, steps
 
 
