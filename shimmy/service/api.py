@@ -27,6 +27,7 @@ from ..continuation import errors as engine_errors
 from ..errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
 from ..model.parameters import PARAMETER_SPECS
 from . import admission, analyses, auth, cache, jobs, result_schemas, schemas, settings
+from .request_fields import field_key
 from .analyses import JOB_ANALYSES, SYNC_ANALYSES
 
 PREFIX = "/api/v1"
@@ -78,6 +79,17 @@ def _parse_int(text: str):
     return int(text) if len(text) <= 18 else float(text)
 
 
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object whose keys are all different (a key given twice is refused: which value was meant?)."""
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise RequestRefused(f"body gives {field_key(key)} twice ({reprlib.repr(out[key])} and "
+                                 f"{reprlib.repr(value)}); allowed: each key once", field_key(key), "each key once")
+        out[key] = value
+    return out
+
+
 def parse_json(req) -> Any:
     """The JSON body of ``req``: application/json only, at most MAX_BODY_BYTES, read within
     BODY_READ_SECONDS, nested at most as deep as the parser allows; RequestRefused otherwise."""
@@ -111,7 +123,7 @@ def parse_json(req) -> Any:
         raise RequestRefused("body is empty; allowed: a JSON object", "body", "a JSON object")
     try:
         # NaN/Infinity parse to floats and are refused by the field they are in
-        return json.loads(raw, parse_int=_parse_int)
+        return json.loads(raw, parse_int=_parse_int, object_pairs_hook=_unique_keys)
     except RecursionError:
         raise RequestRefused("body is nested too deeply", "body", "a JSON object nested at most a few hundred "
                              "levels") from None
@@ -165,6 +177,8 @@ def _shimmy(exc: Exception):
     return error(str(exc), None, None, 422)
 
 
+@api.route("", defaults={"anything": ""}, methods=["GET", "POST", "PUT", "PATCH", "DELETE"])
+@api.route("/", defaults={"anything": ""}, methods=["GET", "POST", "PUT", "PATCH", "DELETE"])
 @api.route("/<path:anything>", methods=["GET", "POST", "PUT", "PATCH", "DELETE"])
 def _unmatched(anything: str):
     """Everything under /api/v1 that no endpoint takes: 405 for a known path, else 404 (JSON)."""
@@ -296,7 +310,7 @@ def list_jobs():
         return error(f"status={reprlib.repr(status)} is not a job status", "status", "one of " + ", ".join(statuses),
                      422)
     raw_limit = request.args.get("limit", "100")
-    if not raw_limit.isdigit() or not 1 <= int(raw_limit) <= 1000:
+    if not (raw_limit.isascii() and raw_limit.isdigit()) or not 1 <= int(raw_limit) <= 1000:  # "²" is a digit too
         return error(f"limit={reprlib.repr(raw_limit)} is not an integer in [1, 1000]", "limit",
                      "an integer in [1, 1000]", 422)
     user = request.args.get("user")

@@ -130,7 +130,7 @@ def session_principal(cookie: str) -> Principal | None:
     if len(cookie) > 256:
         return None
     parts = cookie.split(".")
-    if len(parts) != 4 or not parts[1].isdigit():
+    if len(parts) != 4 or not (parts[1].isascii() and parts[1].isdigit()):
         return None
     payload = ".".join(parts[:3])
     if not hmac.compare_digest(_sign(payload).encode(), parts[3].encode("utf-8", "replace")):

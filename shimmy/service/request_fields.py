@@ -39,6 +39,8 @@ class Field:
     choices: tuple[str, ...] | None = None
     item: str = ""
     items: Any = None
+    #: a number must be a whole multiple of this (in the field's unit), not rounded to one
+    multiple: float | None = None
 
     @property
     def allowed(self) -> str:
@@ -46,7 +48,8 @@ class Field:
             return "one of " + ", ".join(self.choices)
         if self.kind in ("number", "integer"):
             kind = "an integer" if self.kind == "integer" else "a number"
-            return f"{kind} in [{self.low:g}, {self.high:g}] {self.unit}".rstrip()
+            step = f", a multiple of {self.multiple:g} {self.unit}".rstrip() if self.multiple else ""
+            return f"{kind} in [{self.low:g}, {self.high:g}] {self.unit}".rstrip() + step
         if self.kind == "boolean":
             return "true or false"
         if self.kind == "object":
@@ -66,6 +69,11 @@ class Field:
             if isinstance(value, str):  # JSON numbers only: "30" is a type error in a body
                 raise InvalidParameterError(self.name, value, self.allowed, "is not a number")
             number = check_number(self.name, huge(value), self.low, self.high, self.unit, self.kind == "integer")
+            if self.multiple:
+                steps = number / self.multiple
+                if abs(steps - round(steps)) > 1e-9 * max(1.0, abs(steps)):
+                    raise InvalidParameterError(self.name, value, self.allowed,
+                                                f"is not a multiple of {self.multiple:g} {self.unit}".rstrip())
             return int(number) if self.kind == "integer" else number
         if self.kind == "boolean":
             if not isinstance(value, bool):

@@ -454,7 +454,7 @@ SCHEMAS: dict[str, RequestSchema] = {
         Field("t_end", "number", "simulated time", default=60.0, low=0.1, high=settings.MAX_T_END, unit="s"),
         Field("include_series", "boolean", "return the time series (t, states, lateral)", default=False),
         Field("series_dt", "number", "sampling interval of the returned series (a multiple of 1 ms)",
-              default=0.002, low=0.001, high=0.1, unit="s"),
+              default=0.002, low=0.001, high=0.1, unit="s", multiple=0.001),
         Field("exact_nes", "boolean", "exact NES torque instead of the cubic fit", default=False),
         Field("psi0", "number", "initial torsion psi (the standard start: 0.001 rad; the rest of the state zero "
               "unless lateral0 is given)", default=DEFAULT_PSI0, low=-0.5, high=0.5, unit="rad"),
@@ -529,7 +529,7 @@ SCHEMAS: dict[str, RequestSchema] = {
         Field("lateral_threshold", "number", "lateral amplitude l_g delta counted as shimmy", default=0.001,
               low=1e-7, high=1.0, unit="m"),
         Field("series_dt", "number", "sampling interval of the returned series (a multiple of 1 ms)", default=0.01,
-              low=0.001, high=1.0, unit="s"),
+              low=0.001, high=1.0, unit="s", multiple=0.001),
         Field("fold_torus", "boolean", "also the crossings of the fold and torus curves of cycles (seconds per "
               "configuration)", default=False),
         Field("hopf_curves", "boolean", "include the configuration's Hopf curves (V 1-500 m/s, Fz 10-900 kN)",

@@ -70,6 +70,13 @@ BAD = [
     ("/api/v1/simulate", {"config": "nes", "V": 30, "Fz": 150000, "t_end": 1e5}, 422, "t_end"),
     ("/api/v1/simulate", {"config": "nes", "V": 30, "Fz": 150000, "t_end": 600, "include_series": True,
                           "series_dt": 0.001}, 422, "series_dt"),
+    # a sampling interval off the 1 ms grid is refused, not rounded to it
+    ("/api/v1/simulate", {"config": "nes", "V": 30, "Fz": 150000, "include_series": True, "series_dt": 0.0015}, 422,
+     "series_dt"),
+    ("/api/v1/jobs", {"analysis": "ground_run", "config": "nes", "series_dt": 0.0155}, 422, "series_dt"),
+    # a key given twice: which value was meant? (the parser kept the last)
+    ("/api/v1/hopf", b'{"Fz": 1, "config": "original", "Fz": 150000}', 400, "Fz"),
+    ("/api/v1/simulate", b'{"config": "nes", "V": 30, "Fz": 150000, "params": {"r2": 0.08, "r2": 0.09}}', 400, "r2"),
     ("/api/v1/simulate", {"config": "nesx", "V": 30, "Fz": 150000}, 422, "config"),
     ("/api/v1/simulate", {"config": "nes", "V": True, "Fz": 150000}, 422, "V"),
     ("/api/v1/simulate", b'{"config": "nes", "V": NaN, "Fz": 150000}', 422, "V"),
@@ -163,8 +170,12 @@ def test_bad_input_gets_4xx_naming_the_field(server, path, body, status, field):
 
 
 def test_unknown_paths_methods_and_jobs(server):
-    status, _, body = server.request("GET", "/api/v1/nothing")
-    assert status == 404 and body["field"] == "path"
+    for path in ("/api/v1/nothing", "/api/v1", "/api/v1/"):  # the bare prefix too (it was the workbench's page)
+        status, _, body = server.request("GET", path)
+        assert status == 404 and body["field"] == "path", (path, body)
+    for limit in ("%C2%B2", "%EF%BC%95", "0", "1001", "5x"):  # "²" and "５" are digits to str.isdigit (a 500)
+        status, _, body = server.request("GET", f"/api/v1/jobs?limit={limit}")
+        assert status == 422 and body["field"] == "limit", (limit, body)
     status, headers, body = server.request("GET", "/api/v1/simulate")
     assert status == 405 and body["allowed"] == "POST" and headers["Allow"] == "POST"
     status, headers, body = server.request("PUT", "/api/v1/jobs/abc", {})
