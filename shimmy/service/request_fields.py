@@ -53,7 +53,7 @@ class Field:
         if self.kind == "boolean":
             return "true or false"
         if self.kind == "object":
-            return "an object {parameter name: number}; names and ranges from GET /api/v1/parameters"
+            return self.item or "an object {parameter name: number}; names and ranges from GET /api/v1/parameters"
         if self.kind == "numbers":
             return f"a list of 1 to {self.high:g} numbers"
         if self.kind == "strings":
@@ -86,17 +86,22 @@ class Field:
                 raise unknown_name_error(value, self.choices, self.name)
             return value
         if self.kind == "numbers":
-            if not isinstance(value, list) or not 1 <= len(value) <= self.high:
-                raise InvalidParameterError(self.name, value, self.allowed)
+            if not isinstance(value, list):
+                raise InvalidParameterError(self.name, value, self.allowed, "is not a list")
+            if not 1 <= len(value) <= self.high:
+                raise InvalidParameterError(self.name, f"{len(value)} items", self.allowed,
+                                            message=f"{self.name} has {len(value)} items; allowed: {self.allowed}")
             out = []
             for k, v in enumerate(value):
-                if isinstance(v, (str, bool)) or v is None:
+                if not isinstance(v, (int, float)) or isinstance(v, bool):
                     raise InvalidParameterError(f"{self.name}[{k}]", v, "a number", "is not a number")
                 out.append(check_number(f"{self.name}[{k}]", huge(v), -1e300, 1e300))  # ranges: per parameter
             return out
         if self.kind == "strings":
-            if not isinstance(value, list) or not value:
-                raise InvalidParameterError(self.name, value, self.allowed)
+            if not isinstance(value, list):
+                raise InvalidParameterError(self.name, value, self.allowed, "is not a list")
+            if not value:
+                raise InvalidParameterError(self.name, value, self.allowed, "is empty")
             choices = list(self.choices or ())
             for k, v in enumerate(value):
                 if not isinstance(v, str):
@@ -118,9 +123,11 @@ class Field:
                                             message=f"{self.name} has {len(value)} items; allowed: {self.allowed}")
             return list(value)
         if self.kind == "table":  # the rows themselves are checked by the analysis's profile check, by row
-            if not isinstance(value, list) or not 2 <= len(value) <= self.high:
-                size = f"{len(value)} rows" if isinstance(value, list) else type(value).__name__
-                raise InvalidParameterError(self.name, size, self.allowed)
+            if not isinstance(value, list):
+                raise InvalidParameterError(self.name, value, self.allowed, "is not a list of rows")
+            if not 2 <= len(value) <= self.high:
+                raise InvalidParameterError(self.name, f"{len(value)} rows", self.allowed,
+                                            message=f"{self.name} has {len(value)} rows; allowed: {self.allowed}")
             return [list(row) if isinstance(row, list) else row for row in value]
         if not isinstance(value, Mapping):
             raise InvalidParameterError(self.name, value, self.allowed, "is not an object")

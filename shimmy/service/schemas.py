@@ -523,7 +523,8 @@ SCHEMAS: dict[str, RequestSchema] = {
               "with yaw), the kick's fields given taking the place of theirs", default="takeoff",
               choices=(*PRESETS, *kicks.KICK_PRESETS)),
         Field("preset_options", "object", "the preset's settings {name: value}; the rest at their defaults",
-              default={}),
+              default={}, item="an object {setting name: number}: settings of the preset, each with a default and "
+                               "a range (the table of ground-run settings in the numerics documentation)"),
         Field("psi_threshold", "number", "torsional amplitude counted as shimmy", default=0.01, low=1e-6, high=1.0,
               unit="rad"),
         Field("lateral_threshold", "number", "lateral amplitude l_g delta counted as shimmy", default=0.001,

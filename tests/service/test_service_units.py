@@ -101,6 +101,24 @@ def test_refusals_name_the_field(body, field):
     assert info.value.field == field
 
 
+@pytest.mark.parametrize("analysis,body,message", [
+    # a value of the wrong type says so, with the value as given (not "out of range", not its type's name)
+    ("ground_run", {"config": "nes", "profile": "x"}, "profile='x' is not a list of rows"),
+    ("ground_run", {"config": "nes", "profile": [[0, 30, 1e5]]}, "profile has 1 rows; allowed: a list of 2 to"),
+    ("simulate", {"config": "nes", "V": 30, "Fz": 150000, "x0": "x"}, "x0='x' is not a list"),
+    ("simulate", {"config": "nes", "V": 30, "Fz": 150000, "x0": [[1]]}, "x0[0]=[1] is not a number"),
+    ("sensitivity", {"config": "nes", "names": "r2"}, "names='r2' is not a list"),
+    ("sensitivity", {"config": "nes", "names": []}, "names=[] is empty"),
+    ("ground_run", {"config": "nes", "preset_options": "x"}, "allowed: an object {setting name: number}: settings"),
+    ("simulate", {"config": "nes", "V": 30, "Fz": 150000, "series_dt": 0.0024},
+     "series_dt=0.0024 is not a multiple of 0.001 s"),
+])
+def test_refusals_say_what_is_wrong_with_the_value(analysis, body, message):
+    with pytest.raises(InvalidParameterError) as info:
+        schemas.validate(analysis, body)
+    assert message in str(info.value)
+
+
 def test_every_analysis_is_declared_once_with_its_schema_and_runner():
     """The registries derive from one declaration per analysis (schema, runner, sync or job)."""
     from shimmy.service import analyses
