@@ -25,7 +25,7 @@ from werkzeug.exceptions import HTTPException
 from ..version import __version__
 from ..continuation import errors as engine_errors
 from ..errors import ConvergenceError, GeometryError, InvalidParameterError, ShimmyError
-from ..model.parameters import PARAMETER_SPECS
+from ..model.parameters import PARAMETER_SPECS, unknown_name_error
 from . import admission, analyses, auth, cache, jobs, result_schemas, schemas, settings
 from .request_fields import field_key
 from .analyses import JOB_ANALYSES, SYNC_ANALYSES
@@ -301,9 +301,19 @@ def submit_job():
     return _json(jobs.public(job, with_result=False), 202, headers={"Location": f"{PREFIX}/jobs/{job['id']}"})
 
 
+#: the query parameters of GET /jobs
+LIST_QUERY = ("status", "limit", "user")
+
+
 @api.get("/jobs")
 def list_jobs():
     """Every job record with who asked for it, the total, the queue and the jobs per user (admin scope)."""
+    for key in request.args:  # a misspelt one would leave its setting at the default without a word
+        if key not in LIST_QUERY:
+            raise unknown_name_error(key, LIST_QUERY, "query parameter")
+        if len(request.args.getlist(key)) > 1:
+            return error(f"query parameter {key!r} given {len(request.args.getlist(key))} times", key,
+                         "each at most once", 422)
     status = request.args.get("status")
     statuses = ("queued", "running", "done", "failed", "cancelled")
     if status is not None and status not in statuses:

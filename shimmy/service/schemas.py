@@ -125,7 +125,7 @@ def _check_study(out: dict[str, Any]) -> None:
 def _check_ground_run(out: dict[str, Any]) -> None:
     """The profile as checked rows (a table) or as the preset's complete settings; the run and its series
     within the service's limits."""
-    from ..analyses.ground.ground_profiles import preset, profile_from_table
+    from ..analyses.ground.ground_profiles import preset, preset_fields, profile_from_table
 
     given = {name: out[name] for name in kicks.FIELDS}
     if out["profile"] is not None and out["preset"] in kicks.KICK_PRESETS:
@@ -143,9 +143,12 @@ def _check_ground_run(out: dict[str, Any]) -> None:
         out["preset"], out["preset_options"] = None, {}
         out["profile"] = profile.rows()
     else:
+        ranges = {f["name"]: f"a number in [{f['low']:g}, {f['high']:g}] {f['unit']}".rstrip()
+                  for f in preset_fields(out["preset"])}
         for name, value in out["preset_options"].items():  # JSON numbers only, as for every other number
-            if isinstance(value, (str, bool)) or value is None:
-                raise InvalidParameterError(f"preset_options.{_key(name)}", value, "a number", "is not a number")
+            if isinstance(value, (str, bool)) or value is None:  # (an unknown name: refused by preset() below)
+                raise InvalidParameterError(f"preset_options.{_key(name)}", value, ranges.get(name, "a number"),
+                                            "is not a number")
         profile = preset(out["preset"], {k: _huge(v) for k, v in out["preset_options"].items()})
         out["preset_options"] = dict(profile.settings)
     if profile.duration > settings.MAX_T_END:

@@ -176,6 +176,13 @@ def test_unknown_paths_methods_and_jobs(server):
     for limit in ("%C2%B2", "%EF%BC%95", "0", "1001", "5x"):  # "²" and "５" are digits to str.isdigit (a 500)
         status, _, body = server.request("GET", f"/api/v1/jobs?limit={limit}")
         assert status == 422 and body["field"] == "limit", (limit, body)
+    # a misspelt or repeated query parameter is refused, not left at its default or taken once
+    status, _, body = server.request("GET", "/api/v1/jobs?limt=5")
+    assert status == 422 and body["field"] == "query parameter" and "did you mean limit" in body["error"], body
+    status, _, body = server.request("GET", "/api/v1/jobs?status=done&status=foo")
+    assert status == 422 and body["field"] == "status" and "2 times" in body["error"], body
+    status, _, body = server.request("GET", "/api/v1/jobs?status=done&limit=5")
+    assert status == 200 and len(body["jobs"]) <= 5, body
     status, headers, body = server.request("GET", "/api/v1/simulate")
     assert status == 405 and body["allowed"] == "POST" and headers["Allow"] == "POST"
     status, headers, body = server.request("PUT", "/api/v1/jobs/abc", {})

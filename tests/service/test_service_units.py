@@ -110,6 +110,8 @@ def test_refusals_name_the_field(body, field):
     ("sensitivity", {"config": "nes", "names": "r2"}, "names='r2' is not a list"),
     ("sensitivity", {"config": "nes", "names": []}, "names=[] is empty"),
     ("ground_run", {"config": "nes", "preset_options": "x"}, "allowed: an object {setting name: number}: settings"),
+    ("ground_run", {"config": "nes", "preset": "landing", "preset_options": {"V_touchdown": "70"}},
+     "preset_options.V_touchdown='70' is not a number; allowed: a number in [20, 150] m/s"),
     ("simulate", {"config": "nes", "V": 30, "Fz": 150000, "series_dt": 0.0024},
      "series_dt=0.0024 is not a multiple of 0.001 s"),
 ])
