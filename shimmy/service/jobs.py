@@ -515,12 +515,10 @@ def pump() -> None:
             job_id, owner = _choose(s, queue, running)
             if job_id is None:
                 break
-            _handed(s, job_id)
             if waiting:  # an idle worker takes it (it reads the running map): warm, no process to start
-                holder = idle.pop(waiting.pop(0))
-                running[job_id] = {**holder, "claimed": _now(), "user": owner}
+                _hand(s, running, job_id, idle.pop(waiting.pop(0)), owner)
                 continue
-            running[job_id] = {"pid": None, "started": None, "host": HOST, "claimed": _now(), "user": owner}
+            _hand(s, running, job_id, {"pid": None, "started": None, "host": HOST}, owner)
             starting.append(job_id)
         s.set("queue", queue)
         s.set("running", running)
@@ -530,9 +528,12 @@ def pump() -> None:
         _start(s, job_id)
 
 
-def _handed(s: diskcache.Cache, job_id: str) -> None:
-    """Inside the transaction that hands ``job_id`` to a slot: its heartbeat is now (a holder on another host
-    is judged by it: a job queued for a while would read as stale until its worker's first update)."""
+def _hand(s: diskcache.Cache, running: dict[str, Any], job_id: str, holder: dict[str, Any],
+          owner: str | None) -> None:
+    """Inside the transaction that hands ``job_id`` to a slot: ``holder`` takes it in ``running`` (the caller
+    stores that map), and the job's heartbeat is now (a holder on another host is judged by it: a job queued
+    for a while would read as stale until its worker's first update)."""
+    running[job_id] = {**holder, "claimed": _now(), "user": owner}
     job = s.get(("job", job_id))
     if job is not None:
         job["heartbeat"] = _now()
@@ -793,8 +794,7 @@ def _linger(me: dict[str, Any]) -> str | None:
                     queue = list(s.get("queue", []))
                     mine, owner = _choose(s, queue, running)
                     if mine is not None:
-                        _handed(s, mine)
-                        running[mine] = {**me, "claimed": _now(), "user": owner}
+                        _hand(s, running, mine, me, owner)
                         s.set("queue", queue)
                         s.set("running", running)
                 if mine is not None or leave or not listed:
@@ -823,8 +823,7 @@ def _next(finished: str, me: dict[str, Any]) -> str | None:
         if current and s.get("draining") is None and len(running) < settings.MAX_RUNNING_JOBS:
             nxt, owner = _choose(s, queue, running)
             if nxt is not None:
-                _handed(s, nxt)
-                running[nxt] = {**me, "claimed": _now(), "user": owner}
+                _hand(s, running, nxt, me, owner)
         s.set("queue", queue)
         s.set("running", running)
         if nxt is None and current and s.get("draining") is None and settings.JOB_WORKER_LINGER_SECONDS > 0:

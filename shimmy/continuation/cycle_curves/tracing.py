@@ -323,22 +323,21 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
                 # stretch) stays carried, even where the new mesh resolves it past its crossing
                 problem = remeshed
                 point = tracer.point
-                kept = {k: monitors[k] for k in carried}
                 monitors, carried = _carry(problem, monitors,
-                                           codim2.monitors(problem, point, problem.multipliers(point.u), reference))
-                monitors.update(kept)
-                carried |= frozenset(kept)
+                                           codim2.monitors(problem, point, problem.multipliers(point.u), reference),
+                                           keep=carried)
     return rows, special, stop, steps
 
 
-def _carry(problem: CycleCurveProblem, monitors: dict, fresh: dict) -> tuple[dict, frozenset]:
+def _carry(problem: CycleCurveProblem, monitors: dict, fresh: dict,
+           keep: frozenset = frozenset()) -> tuple[dict, frozenset]:
     """The tests' values at a new point (``fresh``) over those of the last (``monitors``), and the tests
-    that keep their last value: a crossing test unresolved at the new point (NaN: a multiplier within its
-    accuracy of the circle) keeps its last value, so that a crossing over the unresolved stretch is seen
+    that keep their last value: those in ``keep``, and a crossing test unresolved at the new point (NaN: a
+    multiplier within its accuracy of the circle), so that a crossing over the unresolved stretch is seen
     where the test is resolved again (pd's second torus curve ran from +0.01 through a NaN point to -1e-5
     past its LPNS at 136.3 m/s, which the warm traces lost and the cold one, its points elsewhere, found)."""
-    carried = frozenset(k for k, v in fresh.items() if k in problem.defining.crossings
-                        and not np.isfinite(v) and np.isfinite(monitors.get(k, math.nan)))
+    carried = frozenset(k for k, v in fresh.items() if k in keep or (
+        k in problem.defining.crossings and not np.isfinite(v) and np.isfinite(monitors.get(k, math.nan))))
     return {k: monitors[k] if k in carried else v for k, v in fresh.items()}, carried
 
 
