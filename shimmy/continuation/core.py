@@ -14,7 +14,8 @@ Each step: predictor u_pred = u + h t + h^2/2 dt/ds (t the unit tangent in the w
 curvature term from the last step, orthogonal to t: :meth:`Tracer.curvature`), corrector =
 Newton on [F(u); <t, u - u_pred>_w] = 0 with the bordered Jacobian [F_u; (w t)^T]
 (sparse LU when F_u is sparse). Converged when the w-norm of the Newton correction is
-below ``tol`` and |F|_inf below ``residual_tol``; chord iterations, the Jacobian refactored
+below ``tol`` and |F|_inf below ``residual_tol`` (at the corrected point, or already at the point
+the correction starts from: F is then not evaluated again); chord iterations, the Jacobian refactored
 when a correction fails to halve, at most ``max_newton`` factorisations and 3 ``max_newton``
 iterations. Step control: h grows by ``grow`` after a step that converged in <= 4
 iterations with the tangent turned by at most half of ``max_angle``, shrinks by ``shrink``
@@ -227,8 +228,8 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
 
     Chord iterations: the bordered Jacobian is factored at the predictor and refreshed
     only when a correction fails to shrink by half. Converged when the correction is below
-    ``tol`` and |F| below ``residual_tol``, or at the noise floor (``NOISE_RESIDUAL``,
-    ``NOISE_CORRECTION``, ``NOISE_STALL``). Returns the solution, the number of iterations and
+    ``tol`` and |F| below ``residual_tol`` (after the correction, or before it), or at the noise floor
+    (``NOISE_RESIDUAL``, ``NOISE_CORRECTION``, ``NOISE_STALL``). Returns the solution, the number of iterations and
     the last factors (a nearby matrix for the tangent's refinement).
     """
     w = problem.weights
@@ -266,6 +267,10 @@ def correct(problem: CurveProblem, u_pred: np.ndarray, t: np.ndarray,
             last_fresh = size
         fresh, last = False, size
         u = u + du
+        if size <= options.tol and np.max(np.abs(F)) <= options.residual_tol:
+            # F was within tolerance before this correction, and the correction is: the corrected u
+            # is nearer still, and F there need not be evaluated (one residual of the ~4 a step takes)
+            return u, it, lu
         F = problem.residual(u)
         if size <= options.tol and np.all(np.isfinite(F)) and np.max(np.abs(F)) <= options.residual_tol:
             return u, it, lu
@@ -305,6 +310,13 @@ def step(problem: CurveProblem, point: CurvePoint, h: float, options: Continuati
     return CurvePoint(u, t, iterations)
 
 
+#: A guided step (:meth:`Tracer.advance_to`) may be this much longer than a limit set on the tracer's
+#: next step (:meth:`Tracer.limit_step`): a step's h is its predictor's length, a guided one's the
+#: distance it went, and the nearby curve's points kept the limit as h (at 1.0, nes's torus curves
+#: took 56 points where the nearby curve had 47, their guides refused there).
+GUIDED_CAP = 1.5
+
+
 class Tracer:
     """Successive points of a curve with step-size control.
 
@@ -321,6 +333,7 @@ class Tracer:
         self.point = start
         self.h = options.ds
         self.failed: Stop | None = None
+        self.cap = math.inf  # the next step's limit (limit_step), for a guided step
         #: (problem, point, previous tangent, step between them) after an accepted step: the
         #: curvature estimate's data, valid while the problem and the point are those
         self._last: tuple | None = None
@@ -367,6 +380,7 @@ class Tracer:
                 self.problem.accept(new.u)
                 self._last = (self.problem, new, self.point.tangent, taken)
                 self.point = new
+                self.cap = math.inf
                 return new, taken
             if new is not None and angle <= opts.max_angle:  # refused for its chord: to ~0.8 of the limit
                 self.h *= min(opts.shrink, max(0.2, 0.9 / math.sqrt(chord)))
@@ -376,6 +390,50 @@ class Tracer:
                 self.failed = Stop(StopReason.NEWTON_FAILED, f"Newton did not converge with step "
                                    f"{self.h / opts.shrink:.2g} (minimum {opts.ds_min:g})")
                 return None
+
+    def advance_to(self, predictor: np.ndarray, direction: np.ndarray) -> tuple[CurvePoint, float] | None:
+        """The next point from a given predictor (a guide's: a point of a nearby curve moved by the
+        last shift, :mod:`~shimmy.continuation.cycle_curves.guide`) and a direction (that curve's
+        chord there): Newton on the hyperplane through the predictor normal to the direction. Taken
+        as :meth:`advance` takes a step (converged, ahead of the current point, within
+        ``max_correction`` of the predictor, turned and off its chord within the limits, no longer
+        than ``ds_max`` or ``GUIDED_CAP`` times the step :meth:`limit_step` set) and then
+        returned with its step, the next step length being this one; else None, the tracer unchanged."""
+        opts, problem = self.options, self.problem
+        w = problem.weights
+        size = weighted_norm(direction, w)
+        if not (math.isfinite(size) and size > 0.0):
+            return None
+        t = direction / size
+        out = correct(problem, predictor, t, opts)
+        if out is None:
+            return None
+        u, iterations, _ = out
+        d = u - self.point.u
+        h = weighted_norm(d, w)
+        # ahead, and within the tracer's limits on its own steps (ds_max; a step limited near an end,
+        # with room for the distance between points being longer than the step that predicted them)
+        if not (h > 0.0 and float(np.sum(w * d * self.point.tangent)) > 0.0
+                and h <= min(opts.ds_max, GUIDED_CAP * self.cap)):
+            return None
+        if math.isfinite(opts.max_correction) and weighted_norm(u - predictor, w) > opts.max_correction * h:
+            return None
+        try:
+            t_new = tangent(problem, u, t)
+        except (RuntimeError, ValueError, np.linalg.LinAlgError):
+            return None
+        if not np.all(np.isfinite(t_new)):
+            return None
+        new = CurvePoint(u, t_new, iterations)
+        strays = self.chord is not None and self.chord(problem, self.point, new, h) > 1.0
+        if self._turn(new) > opts.max_angle or strays:
+            return None
+        problem.accept(new.u)
+        self._last = (problem, new, self.point.tangent, h)
+        self.point = new
+        self.h = min(max(h, opts.ds_min), opts.ds_max)
+        self.cap = math.inf
+        return new, h
 
     def _turn(self, new: CurvePoint) -> float:
         """Angle (rad) between the tangents before and after a step, in the weighted inner product."""
@@ -411,7 +469,9 @@ class Tracer:
         return prev, at, h, bound
 
     def limit_step(self, h_max: float) -> None:
+        """The next step at most h_max (at least ``ds_min``), a guided one (:meth:`advance_to`) too."""
         self.h = max(min(self.h, h_max), self.options.ds_min)
+        self.cap = max(h_max, self.options.ds_min)
 
 
 #: In a search whose g may jump (:func:`locate` with ``report``): a trial whose |g| is over this many
@@ -481,7 +541,8 @@ def point_at(problem: CurveProblem, a: CurvePoint, b: CurvePoint, index: int, va
              options: ContinuationOptions, with_tangent: bool = False) -> CurvePoint | None:
     """The point of the curve between two of its points a and b where unknown ``index`` equals
     ``value`` (which it crosses between them): one Newton solve with that unknown held at the value
-    (the corrector with the bordering row e_index), from the chord between a and b. Cheaper than a
+    (the corrector with the bordering row e_index), from the cubic through a and b with their
+    tangents (``_hermite_at``; from the chord between them where that fails). Cheaper than a
     secant search (:func:`locate`), which corrects a whole trial step per iteration. None if Newton
     does not converge, or converges farther from the chord than the distance from a to b (another
     part of the curve, or one where it is tangent to the level): callers then :func:`locate`.
@@ -490,17 +551,22 @@ def point_at(problem: CurveProblem, a: CurvePoint, b: CurvePoint, index: int, va
     if not ga * gb < 0:
         raise InvalidInputError("value", value, f"a value of unknown {index} crossed between the two points "
                                 f"({a.u[index]:g} and {b.u[index]:g})")
-    guess = a.u + (ga / (ga - gb)) * (b.u - a.u)
-    guess[index] = value
-    hold = np.zeros_like(guess)
-    hold[index] = 1.0 / problem.weights[index]  # bordering row w * hold = e_index: u[index] = value
-    out = correct(problem, guess, hold, options)
+    w = problem.weights
+    hold = np.zeros_like(a.u)
+    hold[index] = 1.0 / w[index]  # bordering row w * hold = e_index: u[index] = value
+    chord = ga / (ga - gb)
+    out = None
+    for guess in (_hermite_at(a, b, index, value, chord, w), a.u + chord * (b.u - a.u)):
+        if guess is None:
+            continue
+        guess[index] = value
+        out = correct(problem, guess, hold, options)
+        if out is not None and weighted_norm(out[0] - guess, w) <= weighted_norm(b.u - a.u, w):
+            break
+        out = None
     if out is None:
         return None
     u, iterations, _ = out
-    w = problem.weights
-    if weighted_norm(u - guess, w) > weighted_norm(b.u - a.u, w):
-        return None
     if not with_tangent:
         return CurvePoint(u, a.tangent, iterations)
     try:
@@ -508,6 +574,33 @@ def point_at(problem: CurveProblem, a: CurvePoint, b: CurvePoint, index: int, va
     except (RuntimeError, ValueError, np.linalg.LinAlgError):
         return None
     return CurvePoint(u, t, iterations) if np.all(np.isfinite(t)) else None
+
+
+def _hermite_at(a: CurvePoint, b: CurvePoint, index: int, value: float, theta: float,
+                w: np.ndarray) -> np.ndarray | None:
+    """The point where unknown ``index`` equals ``value`` on the cubic through a and b with their
+    tangents (arclength the chord's, weighted): nearer the curve than the chord (its error ~h^4,
+    the chord's ~h^2), so Newton from it takes fewer iterations. ``theta`` (the chord's fraction)
+    starts a scalar Newton on the cubic's ``index`` component; None where that leaves [0, 1] or
+    the tangents point against the chord (a tangent carried from an earlier point)."""
+    d = b.u - a.u
+    h = weighted_norm(d, w)
+    if not (h > 0.0 and np.sum(w * d * a.tangent) > 0.0 and np.sum(w * d * b.tangent) > 0.0):
+        return None
+    p0, p1, m0, m1 = a.u[index], b.u[index], h * a.tangent[index], h * b.tangent[index]
+    for _ in range(8):
+        s2, s3 = theta * theta, theta * theta * theta
+        f = (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + theta) * m0 + (-2 * s3 + 3 * s2) * p1 + (s3 - s2) * m1 - value
+        df = ((6 * s2 - 6 * theta) * p0 + (3 * s2 - 4 * theta + 1) * m0 + (-6 * s2 + 6 * theta) * p1
+              + (3 * s2 - 2 * theta) * m1)
+        if df == 0.0:
+            return None
+        theta -= f / df
+        if not 0.0 <= theta <= 1.0:
+            return None
+    s2, s3 = theta * theta, theta * theta * theta
+    return ((2 * s3 - 3 * s2 + 1) * a.u + (s3 - 2 * s2 + theta) * h * a.tangent + (-2 * s3 + 3 * s2) * b.u
+            + (s3 - s2) * h * b.tangent)
 
 
 def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Callable[[CurvePoint], float],

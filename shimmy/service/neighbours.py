@@ -1,8 +1,8 @@
 """The nearest cached design: where a map one slider step away is warmed from.
 
 Every map the service computes leaves its warm start
-(:meth:`~shimmy.analyses.maps.stability_map.StabilityMap.warm_start`: its curves' seeds, slices and
-arrangement, about 100-150 kB) in the shared result cache, and its design in an
+(:meth:`~shimmy.analyses.maps.stability_map.StabilityMap.warm_start`: its curves' seeds with their
+points, slices and arrangement, ~1.2 MB for `nes`) in the shared result cache, and its design in an
 index of the maps of the same question but the design (configuration, plane, grid, options: the
 request without ``params``). :func:`nearest` reads that index (one small entry, however many
 designs it lists) and returns the warm start of the nearest design within :data:`MAX_DISTANCE`, so

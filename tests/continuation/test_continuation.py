@@ -227,6 +227,57 @@ def test_point_at_a_level_of_one_unknown_is_the_circles_point_there():
     np.testing.assert_allclose(point_at(circle, below, a, 1, 0.0, options).u, [R, 0.0], atol=1e-12)
 
 
+def test_point_at_starts_from_the_cubic_through_both_points(monkeypatch):
+    """point_at's Newton starts from the cubic through both points with their tangents, not from
+    their chord: the same point (the circle's where x = c), in fewer iterations; a tangent that
+    points against the chord (carried from an earlier point) leaves the chord's start."""
+    from shimmy.continuation import core
+    from shimmy.continuation.core import CurvePoint, point_at
+
+    R = 2.0
+    options = ContinuationOptions(tol=1e-12, residual_tol=1e-12)
+    circle = _Circle(R)
+
+    def on(angle):
+        return CurvePoint(np.array([R * np.cos(angle), R * np.sin(angle)]), np.array([-np.sin(angle), np.cos(angle)]))
+
+    a, b, c = on(0.2), on(1.0), 1.2
+    cubic = point_at(circle, a, b, 0, c, options)
+    np.testing.assert_allclose(cubic.u, [c, np.sqrt(R * R - c * c)], rtol=0.0, atol=1e-12)
+    guess = core._hermite_at(a, b, 0, c, 0.5, circle.weights)
+    assert abs(np.hypot(*guess) - R) < 1e-3 * R  # the cubic's point lies next to the circle
+    assert abs(np.hypot(*(0.5 * (a.u + b.u))) - R) > 0.05 * R  # the chord's middle does not
+    monkeypatch.setattr(core, "_hermite_at", lambda *args: None)
+    chord = point_at(circle, a, b, 0, c, options)
+    np.testing.assert_allclose(chord.u, cubic.u, rtol=0.0, atol=1e-12)
+    assert cubic.iterations < chord.iterations
+    monkeypatch.undo()
+    assert core._hermite_at(a, CurvePoint(b.u, -b.tangent), 0, c, 0.5, circle.weights) is None
+
+
+def test_advance_to_takes_a_guided_point_on_its_hyperplane_or_leaves_the_tracer_as_it_was():
+    """Tracer.advance_to: from a predictor (a point of a nearby curve, a circle of radius 1.05 R) and
+    a direction, the point of this curve (radius R) on the hyperplane through the predictor normal
+    to the direction, with its tangent, the step length its distance; a predictor behind the
+    current point, or a step that turns more than max_angle, is refused with the tracer unchanged."""
+    from shimmy.continuation.core import CurvePoint, Tracer
+
+    R = 2.0
+    options = ContinuationOptions(ds=0.1, ds_max=1.0, tol=1e-12, residual_tol=1e-12, max_angle=0.5)
+    tracer = Tracer(_Circle(R), CurvePoint(np.array([R, 0.0]), np.array([0.0, 1.0])), options)
+    near = 1.05 * R
+    predictor, direction = near * np.array([np.cos(0.3), np.sin(0.3)]), np.array([-np.sin(0.3), np.cos(0.3)])
+    new, h = tracer.advance_to(predictor, direction)
+    assert abs(new.u @ new.u - R * R) < 1e-10 and abs(direction @ (new.u - predictor)) < 1e-12
+    np.testing.assert_allclose(new.tangent, [-new.u[1] / R, new.u[0] / R], atol=1e-12)
+    assert h == pytest.approx(np.linalg.norm(new.u - np.array([R, 0.0]))) and tracer.h == pytest.approx(h)
+    assert tracer.point is new
+    before = tracer.point
+    assert tracer.advance_to(near * np.array([1.0, 0.0]), np.array([0.0, 1.0])) is None  # behind
+    assert tracer.advance_to(near * np.array([np.cos(1.2), np.sin(1.2)]), np.array([-np.sin(1.2), np.cos(1.2)])) is None
+    assert tracer.point is before and tracer.h == pytest.approx(h)
+
+
 def test_a_search_across_a_jump_ends_in_a_few_trials_and_a_smooth_one_is_unchanged():
     """locate_between with x_tol (a g that may jump: a multiplier test whose multiplier pairs off with
     another and leaves the real axis, the test then reading a third one): between angles 0.3 and 0.9 of

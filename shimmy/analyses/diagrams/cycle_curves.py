@@ -33,6 +33,7 @@ import numpy as np
 from ...version import __version__
 from ...continuation import (CYCLE_BIFURCATIONS, ContinuationOptions, CycleCurve, CycleCurveOptions, PointKind,
                              SpecialPoint, cycle_curve, join_halves, start_beside)
+from ...continuation.cycle_curves.guide import Guide, decode, encode, guide_points
 from ...continuation.errors import ContinuationError
 from ...continuation.periodic_orbits import FOLD_PAIR_ANGLE
 from ...errors import InvalidParameterError
@@ -411,7 +412,7 @@ def reversed_curve(curve: GearCycleCurve) -> GearCycleCurve:
     c = curve.curve
     last = len(c.p) - 1
     flipped = CycleCurve(c.kind, c.p[::-1].copy(), c.period[::-1].copy(), c.x_max[::-1].copy(), c.x_min[::-1].copy(),
-                         c.kappa[::-1].copy(), c.multipliers[::-1].copy(), c.solutions[::-1],
+                         c.kappa[::-1].copy(), c.multipliers[::-1].copy(), c.solutions[::-1], c.guided,
                          special_points=sorted((dataclasses.replace(s, index=last - s.index) for s in c.special_points),
                                                key=lambda s: s.index),
                          stops=list(c.stops)[::-1], steps=c.steps, closed=c.closed)
@@ -440,6 +441,10 @@ class CurveSeed:
     end_amplitudes: tuple[float | None, float | None] = (None, None)
     #: whether the trace towards higher Fz from the seed runs towards the curve's last point
     plus_to_last: bool = True
+    #: the curve's points from the seed on, each way ({+1: the way Fz first rises, -1: the other}; a
+    #: closed curve's all round), each (mesh points, u = (x, T, V, Fz[, kappa])): what the traces
+    #: from the seed follow (:mod:`~shimmy.continuation.cycle_curves.guide`); none from an older cache
+    guides: dict[int, list[tuple[np.ndarray, np.ndarray]]] | None = field(default=None, repr=False, compare=False)
 
     @classmethod
     def of(cls, curve: GearCycleCurve, n: int) -> CurveSeed:
@@ -469,12 +474,15 @@ class CurveSeed:
                 ends[0 if q.index <= (count - 1) / 2 else 1] = float(q.data["amplitude"])
         rising = c.p[min(i + 1, count - 1), 1] - c.p[max(i - 1, 0), 1] >= 0
         return cls(curve.kind, curve.origin, np.asarray(mesh, float), np.asarray(u, float), float(c.p[i, 1]), ncol,
-                   kappa, (ends[0], ends[1]), bool(rising))
+                   kappa, (ends[0], ends[1]), bool(rising), guide_points(c, i, bool(rising)))
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind.value, "origin": self.origin, "mesh": self.mesh.tolist(), "u": self.u.tolist(),
                 "Fz": self.Fz, "ncol": self.ncol, "kappa": self.kappa, "end_amplitudes": list(self.end_amplitudes),
-                "plus_to_last": self.plus_to_last}
+                "plus_to_last": self.plus_to_last,
+                **({} if self.guides is None else
+                   {"guides": {str(d): [[encode(m), encode(u)] for m, u in points]
+                               for d, points in self.guides.items()}})}
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> CurveSeed:
@@ -482,15 +490,19 @@ class CurveSeed:
                    np.asarray(data["u"], float), float(data["Fz"]), int(data["ncol"]),
                    None if data["kappa"] is None else float(data["kappa"]),
                    tuple(None if a is None else float(a) for a in data.get("end_amplitudes", (None, None))),
-                   bool(data.get("plus_to_last", True)))
+                   bool(data.get("plus_to_last", True)),
+                   None if "guides" not in data else
+                   {int(d): [(decode(m), decode(u)) for m, u in points] for d, points in data["guides"].items()})
 
 
 @dataclass(frozen=True, eq=False)
 class WarmUnit:
     """A curve of a nearby design continued again at this one from its seed: (curve or None,
     warning or None). The seed is corrected by Newton at its load, then the curve traced both
-    ways exactly as from any start (its points, crossings and codimension-2 points those of the
-    curve at this design, to the location tolerance). With ``direction`` +1 or -1 only that half
+    ways, each step predicted from the old curve's next point where the seed has them
+    (:mod:`~shimmy.continuation.cycle_curves.guide`) and taken as from any start (its points,
+    crossings and codimension-2 points those of the curve at this design, to the location
+    tolerance). With ``direction`` +1 or -1 only that half
     is traced (a :class:`~shimmy.continuation.cycle_curves.CycleCurve` half, or None and a
     warning): the two halves run as two units and :func:`joined_halves` makes the curve."""
 
@@ -515,8 +527,10 @@ class WarmUnit:
                                                                                       ds=WARM_FIRST_STEP))
         if end is not None:
             options = dataclasses.replace(options, amplitude_end_below=end)
-        return continue_start(self.config, self.params, start, self.box, self.loads,
-                              (self.direction,) if self.direction else (1, -1), options)
+        directions = (self.direction,) if self.direction else (1, -1)
+        n = self.config.n_states
+        guides = None if s.guides is None else {d: Guide(s.guides[d], s.ncol, n) for d in directions}
+        return continue_start(self.config, self.params, start, self.box, self.loads, directions, options, guides)
 
     def describe(self) -> str:
         half = {1: ", towards higher Fz", -1: ", towards lower Fz"}.get(self.direction, "")
@@ -603,10 +617,11 @@ def starts_of_diagram(diagram, Fz: float) -> list[Start]:
 
 
 def continue_start(config: Configuration, params: Parameters, start: Start, box, loads: tuple[float, ...],
-                   directions: tuple[int, ...] = (1, -1), options: CycleCurveOptions | None = None
-                   ) -> tuple[GearCycleCurve | None, str | None]:
+                   directions: tuple[int, ...] = (1, -1), options: CycleCurveOptions | None = None,
+                   guides: dict[int, Guide] | None = None) -> tuple[GearCycleCurve | None, str | None]:
     """One curve continued from one start (a unit of :func:`cycle_curves`); with one of
-    ``directions``, the half traced that way (whatever its length: the other half may hold the rest)."""
+    ``directions``, the half traced that way (whatever its length: the other half may hold the rest);
+    ``guides``: the same curve's points at a nearby design each half follows (a warm start's)."""
     system = gear_two_parameter_field(config, params)
     angle = start.point.data["torus_angle"] if start.kind == PointKind.TORUS else None
     if angle is not None and not RESONANCE_ANGLE < angle < math.pi - RESONANCE_ANGLE:
@@ -617,7 +632,7 @@ def continue_start(config: Configuration, params: Parameters, start: Start, box,
         curve = cycle_curve(system, start.kind, start.point.solution, start.Fz, box=box,
                             options=options or CURVE_OPTIONS,
                             scale=STATE_SCALE[:system.n], p_scale=(V_SCALE, FZ_SCALE), kappa=kappa, ncol=start.ncol,
-                            p2_marks=loads, directions=directions)
+                            p2_marks=loads, directions=directions, guides=guides)
     except ContinuationError as exc:
         return None, f"{about} not continued: {exc}"
     extent = np.ptp(curve.p / np.array([V_SCALE, FZ_SCALE]), axis=0).max() if len(curve.p) else 0.0

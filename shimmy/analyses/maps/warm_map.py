@@ -10,10 +10,11 @@ little: the curves move, but where their arrangement stays the same the regions 
    the same computation as a cold map's, so the same curves, GH and double-Hopf points).
 2. **Every fold and torus curve** is continued again from its seed, a point of the old curve with
    its cycle, corrected by Newton at the new design on the seed's load and then traced both ways
-   exactly as a cold map traces it (:class:`~shimmy.analyses.diagrams.cycle_curves.WarmUnit`): its
-   points, crossings of the slices' loads, turning points and codimension-2 points are the new
-   design's to the location tolerance. The search for curve starts (branches beside GH and
-   double-Hopf points, the slices' diagrams) is what is saved.
+   (:class:`~shimmy.analyses.diagrams.cycle_curves.WarmUnit`, the longest half first), each step
+   predicted from the old curve's next point (:mod:`shimmy.continuation.cycle_curves.guide`) and
+   taken as a cold trace's steps are: its points, crossings of the slices' loads, turning points
+   and codimension-2 points are the new design's to the location tolerance. The search for curve
+   starts (branches beside GH and double-Hopf points, the slices' diagrams) is what is saved.
 3. **The arrangement is checked** (:func:`same_arrangement`): the same number of Hopf curves (and
    their closure), GH and double-Hopf points, the same fold and torus curves (kind, closure,
    codimension-2 points in order along each). Where that fails (a curve appeared, vanished or
@@ -45,6 +46,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
@@ -193,18 +195,17 @@ def _on_curve(old_boundaries, new_boundaries, Fz: float, carry: _Carrier, tol: f
     return moved
 
 
-def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameters, v_range, n_v: int,
+def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameters, v_range, n_v: int, scan: list,
                    carry: _Carrier, on_curve: Callable[[float, str], float], crossings: dict[str, list[float]],
                    tol: float) -> SliceResult:
-    """A slice of the old map at the new design (see the module's step 4); NotWarm where it cannot be
-    carried (it is then computed again)."""
+    """A slice of the old map at the new design (see the module's step 4), ``scan`` the Hopf points at
+    its load at the new design; NotWarm where it cannot be carried (it is then computed again)."""
     clock = time.perf_counter()
     Fz = float(old["Fz"])
     computed_at = old.get("computed_at")
     if computed_at is None or design_distance(params, Parameters.from_dict(computed_at), config) > CARRY_DISTANCE:
         raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN was computed at a design more than "
                       f"{CARRY_DISTANCE:g} (relative) from this one")
-    scan = hopf_points(config, Fz, params=params, v_range=v_range).hopf_points
     if len(scan) != len(old["hopf_points"]):
         raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has {len(scan)} Hopf points, before "
                       f"{len(old['hopf_points'])}")
@@ -297,6 +298,37 @@ def compatible(start: dict[str, Any], config: Configuration | str, *, v_range, f
     return None
 
 
+@dataclass(frozen=True, eq=False)
+class SliceHopfUnit:
+    """The Hopf points of x = 0 at the slices' loads (the eigenvalue scan, as a cold slice locates
+    them): {Fz: Hopf points}. Run beside the curves instead of after them."""
+
+    config: Configuration
+    params: Parameters
+    loads: tuple[float, ...]
+    v_range: tuple[float, float]
+
+    def run(self) -> dict[float, list]:
+        return {Fz: hopf_points(self.config, Fz, params=self.params, v_range=self.v_range).hopf_points
+                for Fz in self.loads}
+
+    def describe(self) -> str:
+        return f"Hopf points at the {len(self.loads)} slices' loads"
+
+
+#: A curve half's cost per point it follows, by kind, relative to a fold curve's (the torus system has
+#: two periods: ~20 against ~14 ms a point on nes)
+COST_PER_POINT = {PointKind.TORUS: 1.5}
+
+
+def _priority(seed: CurveSeed, direction: int) -> float:
+    """The order a curve half's unit runs in (lowest first, after the Hopf curves' 0): its expected
+    cost, longest first; in the seeds' order where a seed has no guide (an older cache)."""
+    if seed.guides is None:
+        return 1.0
+    return 1.0 / (1.0 + len(seed.guides[direction]) * COST_PER_POINT.get(seed.kind, 1.0))
+
+
 def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
              progress: Callable[[float, str], None] | None = None, sketch: Sketch | None = None) -> StabilityMap:
     """The map of design ``params`` warmed from ``start`` (:meth:`StabilityMap.warm_start` of a map of
@@ -326,17 +358,24 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     # the marks beyond the first slices' loads are dropped from the curves afterwards (as a cold map's)
     marks = loads + tuple(sorted({float(s["Fz"]) for s in start["slices"]} - set(loads)))
     # each curve's two halves from its seed as two units (unit 2j + 1 towards higher Fz, 2j + 2 lower),
-    # so that the longest curve's halves run side by side
-    units += [(1, WarmUnit(config, params, seed, box, marks, direction)) for seed in seeds for direction in (1, -1)]
+    # so that the longest curve's halves run side by side; after the Hopf curves (drawn first), the
+    # longest first (the points each half follows, a torus point costing ~1.5 a fold point: measured
+    # on nes, the two workers' curves then end 0.1 s sooner than in the seeds' order)
+    units += [(_priority(seed, direction), WarmUnit(config, params, seed, box, marks, direction))
+              for seed in seeds for direction in (1, -1)]
+    # the slices' Hopf points at the new design, last (keyed -1 in the results)
+    scans = SliceHopfUnit(config, params, tuple(float(s["Fz"]) for s in start["slices"]), v_range)
+    units.append((2.0, scans))
     results: dict[int, Any] = {}
     index = {id(u): k for k, (_, u) in enumerate(units)}
+    index[id(scans)] = -1
 
     def curve_of(j: int) -> tuple[GearCycleCurve | None, str | None]:
         return joined_halves(results[2 * j + 1], results[2 * j + 2])
 
     def done(unit, result):
         results[index[id(unit)]] = result
-        if sketch is not None and 0 in results:
+        if sketch is not None and 0 in results and unit is not scans:
             found = []
             for j in range(len(seeds)):
                 halves = [results.get(2 * j + 1), results.get(2 * j + 2)]
@@ -395,7 +434,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
             if change:
                 raise NotWarm(f"the curves' arrangement changed on it: {change}")
             carry = _Carrier(old_boundaries, boundaries, Fz, v_range)
-            slices.append(_carried_slice(old, config, params, v_range, n_v, carry,
+            slices.append(_carried_slice(old, config, params, v_range, n_v, results[-1][Fz], carry,
                                          _on_curve(old_boundaries, boundaries, Fz, carry, tol),
                                          _crossings_of(curves, Fz), tol))
         except NotWarm as exc:
@@ -455,11 +494,14 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
                                                 "computed_again": [{"Fz": Fz, "why": why} for Fz, why in
                                                                    sorted(again.items())],
                                                 "added": added},
+                                     "curve_points": {"traced": sum(len(c.curve.p) for c in curves),
+                                                      "guided": sum(c.curve.guided for c in curves)},
                                      "method": "Hopf curves computed afresh; each fold and torus curve continued "
                                                "again from a point of the nearby design's curve (Newton at its "
-                                               "load, then traced both ways), the curves' kinds, closure and "
-                                               "codimension-2 points checked unchanged; a slice whose load the "
-                                               "curves cross in the same order carried with them (an end on a "
+                                               "load, then traced both ways, each step predicted from the nearby "
+                                               "curve's next point where that converges), the curves' kinds, "
+                                               "closure and codimension-2 points checked unchanged; a slice whose "
+                                               "load the curves cross in the same order carried with them (an end on a "
                                                "curve to its new crossing, a mode change kept in its interval), "
                                                "its Hopf points scanned again; the others computed again, and "
                                                "slices added through regions between the new curves that none "

@@ -31,6 +31,7 @@ from ..periodic_orbits import PeriodicOptions, hopf_guess, periodic_branch
 from ..results import ContinuationResult, SpecialPoint
 from . import codim2
 from .bordered import CycleCurveProblem, defining_system
+from .guide import Guide
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,7 @@ class CycleCurve(ContinuationResult):
     kappa: np.ndarray  # NS: cos of the torus angle; nan otherwise
     multipliers: np.ndarray  # (points, n), trivial first, then by decreasing modulus
     solutions: list[tuple[np.ndarray, np.ndarray]]  # (mesh points, cycle u = (x, T, p1)) per point
+    guided: int = 0  # points predicted from a nearby curve's (:mod:`.guide`)
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "p": self.p.tolist(), "period": self.period.tolist(),
@@ -86,7 +88,7 @@ def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[n
                 options: CycleCurveOptions | None = None, scale: np.ndarray | None = None,
                 p_scale: tuple[float, float] = (1.0, 1.0), kappa: float | None = None, ncol: int = 4,
                 directions: tuple[int, ...] = (1, -1), p2_marks: tuple[float, ...] = (),
-                progress: Callable[[float], None] | None = None) -> CycleCurve:
+                progress: Callable[[float], None] | None = None, guides: dict[int, Guide] | None = None) -> CycleCurve:
     """Continue a fold (LPC), period doubling (PD) or torus (NS) point of a cycle in (p1, p2).
 
     ``start`` = (mesh points, cycle u = (x at the nodes, T, p1)): a located special point of a
@@ -95,7 +97,9 @@ def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[n
     set the size of a unit step in the states and in (p1, p2). Traced in both directions
     (``directions``: +1 first increases p2); the two halves are joined into one curve. Where the
     curve turns in p2 a ``P2_TURN`` point is located, and where it crosses a value of ``p2_marks``
-    a ``P2_MARK`` point (both with the cycle's period and extremes).
+    a ``P2_MARK`` point (both with the cycle's period and extremes). ``guides``: {direction: the
+    points of the same curve at a nearby design that half follows (:class:`~.guide.Guide`, its first
+    point the one ``start`` is)}.
     """
     defining = defining_system(kind)
     kind = defining.kind
@@ -126,7 +130,7 @@ def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[n
         half_problem = problem if not halves else _fresh(problem, first.u)
         t = first.tangent if first.tangent[problem.n_x + 2] * direction >= 0 else -first.tangent
         rows, special, stop, steps = _trace(half_problem, CurvePoint(first.u.copy(), t), box, options,
-                                                      tuple(p2_marks), progress)
+                                            tuple(p2_marks), progress, (guides or {}).get(direction))
         on_mark = [m for m in p2_marks if abs(p2 - m) <= 1e-9 * problem.p_scale[1]]
         if direction > 0 and on_mark:
             # a start on a marked value (a slice's point, traced from its diagram) crosses it there;
@@ -142,7 +146,9 @@ def cycle_curve(system: TwoParameterField, kind: PointKind | str, start: tuple[n
         steps_total += steps
         if stop.reason is StopReason.CLOSED:
             break
-    return _join(kind, halves, stops, steps_total)
+    curve = _join(kind, halves, stops, steps_total)
+    curve.guided = sum(guides[d].taken for d in directions[:len(halves)] if d in (guides or {}))
+    return curve
 
 
 def start_beside(system: TwoParameterField, kind: PointKind | str, x_star: np.ndarray, p: np.ndarray, *,
@@ -222,7 +228,8 @@ def _amplitude(problem: CycleCurveProblem, xmax, xmin) -> float:
     return float(np.max(0.5 * (np.asarray(xmax) - np.asarray(xmin)) / problem.cycle.scale))
 
 
-def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCurveOptions, marks, progress):
+def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCurveOptions, marks, progress,
+           guide: Guide | None = None):
     copts = options.continuation
     n_x = problem.n_x
     rows: dict[str, list] = {k: [] for k in ("p", "T", "xmax", "xmin", "kappa", "mu", "solutions")}
@@ -230,6 +237,8 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
     mu = _record(problem, rows, start)
     tracer = Tracer(problem, start, copts, chord=lambda pr, a, b, h: _chord_ratio(pr, a, b, h, options.chord_tol))
     special: list[SpecialPoint] = []
+    if guide is not None:
+        guide.anchor(start, problem.mesh)
 
     def p_direction(point):
         t_p = point.tangent[n_x + 1:n_x + 3] * np.sqrt(problem.weights[n_x + 1:n_x + 3])
@@ -246,7 +255,15 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
     steps = 0
     for steps in range(1, copts.max_steps + 1):  # noqa: B007
         prev = tracer.point
-        adv = tracer.advance()
+        adv = guided = None
+        if guide is not None and (guided := guide.next(problem.mesh)) is not None:
+            adv = tracer.advance_to(*guided)
+            if adv is not None:
+                guide.took(adv[0], problem.mesh)
+        if adv is None:
+            adv = tracer.advance()
+            if adv is not None and guided is not None:
+                guide.skip_behind(adv[0], problem.mesh, problem.weights)
         if adv is None:
             stop = tracer.failed
             if zone_step > 0.0 and shrinking:  # Newton gave out where the cycles shrink onto the end
@@ -457,9 +474,9 @@ def join_halves(plus: CycleCurve, minus: CycleCurve) -> CycleCurve:
     return CycleCurve(plus.kind, joined(minus.p, plus.p), joined(minus.period, plus.period),
                       joined(minus.x_max, plus.x_max), joined(minus.x_min, plus.x_min),
                       joined(minus.kappa, plus.kappa), joined(minus.multipliers, plus.multipliers),
-                      [minus.solutions[i] for i in order] + list(plus.solutions), special_points=special,
-                      stops=list(plus.stops) + list(minus.stops), steps=plus.steps + minus.steps,
-                      closed=minus.closed)
+                      [minus.solutions[i] for i in order] + list(plus.solutions), plus.guided + minus.guided,
+                      special_points=special, stops=list(plus.stops) + list(minus.stops),
+                      steps=plus.steps + minus.steps, closed=minus.closed)
 
 
 def _join(kind: PointKind, halves, stops, steps) -> CycleCurve:
