@@ -7,6 +7,7 @@ import math
 from urllib.parse import urlencode
 
 import dash
+import numpy as np
 from dash import Input, Output, State, dcc, html, no_update
 
 from shimmy.continuation.kinds import PointKind
@@ -303,8 +304,11 @@ def figure(results, series=None, what="configuration"):
     regions = shaded.get("regions") or []
     # the regions as polygons (their edges on the curves at every row); the grid stays underneath,
     # transparent, for the hover text and the click that opens a time history
-    fig.add_heatmap(x=V, y=Fz, z=codes, zmin=0, zmax=n, colorscale=scale, showscale=False,
-                    opacity=0.0 if regions else 0.6, customdata=grid["types"], name="shimmy type", showlegend=False,
+    # as arrays, which plotly takes whole (as lists it checks every one of the 18 000 cells: 0.06-0.09 s of
+    # the figure's 0.11 s; sent as a typed array, the codes' JSON is smaller too)
+    fig.add_heatmap(x=np.asarray(V, float), y=np.asarray(Fz, float), z=np.asarray(codes, np.int8), zmin=0, zmax=n,
+                    colorscale=scale, showscale=False, opacity=0.0 if regions else 0.6,
+                    customdata=np.asarray(grid["types"], dtype=object), name="shimmy type", showlegend=False,
                     hovertemplate="V %{x:.4g} m/s<br>Fz %{y:.4g} kN<br>%{customdata}<extra>click: time history</extra>")
     _regions(fig, shaded, 0.6)
     _curves(fig, results, series, what)

@@ -92,8 +92,10 @@ def figures(pages):
     return {
         "bifurcation": pages["bifurcation"].figure([_diagram("nes"), _diagram("pd")]).to_dict(),
         "bifurcation designs": pages["bifurcation"].figure([_diagram(), _diagram()], series, what="design").to_dict(),
-        "stability map": pages["stability_map"].figure([_map("original"), _map("nes")]).to_dict(),
-        "stability map designs": pages["stability_map"].figure([_map(), _map()], series, what="design").to_dict(),
+        # as the browser gets them: plotly's JSON (the map's hover grid is sent as arrays, a typed one of codes)
+        "stability map": json.loads(pages["stability_map"].figure([_map("original"), _map("nes")]).to_json()),
+        "stability map designs": json.loads(pages["stability_map"].figure([_map(), _map()], series,
+                                                                          what="design").to_json()),
         "overview boundary": pages["overview"].boundary_figure([_hopf_curves("original"),
                                                                 _hopf_curves("nes")]).to_dict(),
         "overview intervals": pages["overview"].intervals_figure([stability, stability], ["A", "B"]).to_dict(),
