@@ -227,6 +227,26 @@ def test_point_at_a_level_of_one_unknown_is_the_circles_point_there():
     np.testing.assert_allclose(point_at(circle, below, a, 1, 0.0, options).u, [R, 0.0], atol=1e-12)
 
 
+def test_the_corrector_stops_without_a_residual_after_a_correction_within_tolerance():
+    """correct(): once F is within ``residual_tol`` and the correction within ``tol``, the corrected point
+    is returned without F evaluated there again (one residual per iteration, not one more): on the
+    circle, the point returned lies on it to the tolerance all the same."""
+    from shimmy.continuation.core import correct
+
+    class Counted(_Circle):
+        calls = 0
+
+        def residual(self, u):
+            Counted.calls += 1
+            return super().residual(u)
+
+    circle = Counted(2.0)
+    options = ContinuationOptions(tol=1e-9, residual_tol=1e-8)
+    u, iterations, _ = correct(circle, np.array([2.05, 0.3]), np.array([0.0, 1.0]), options)
+    assert Counted.calls == iterations and iterations >= 2
+    assert abs(u @ u - 4.0) <= options.residual_tol and u[1] == pytest.approx(0.3, abs=1e-15)
+
+
 def test_point_at_starts_from_the_cubic_through_both_points(monkeypatch):
     """point_at's Newton starts from the cubic through both points with their tangents, not from
     their chord: the same point (the circle's where x = c), in fewer iterations; a tangent that
