@@ -107,6 +107,22 @@ http {
             return 413 '{"error": "request body above the limit of %(max_body)d bytes", "field": "body", \
 "allowed": "at most %(max_body)d bytes"}';
         }
+        # A request line or a header line above large_client_header_buffers (8 kB): the API's refusal, not
+        # nginx's page. By URI: an error_page to a named location answered 500 here (the request not parsed).
+        error_page 414 /__shimmy_request_line_too_long;
+        location = /__shimmy_request_line_too_long {
+            internal;
+            default_type application/json;
+            return 414 '{"error": "request line (method, path and query) above the limit of 8192 bytes", \
+"field": "request line", "allowed": "at most 8192 bytes"}';
+        }
+        error_page 494 =431 /__shimmy_headers_too_large;
+        location = /__shimmy_headers_too_large {
+            internal;
+            default_type application/json;
+            return 431 '{"error": "request headers above the limit of 8192 bytes a line, 32768 in all", \
+"field": "headers", "allowed": "at most 8192 bytes a line, 32768 in all"}';
+        }
         error_page 502 503 =503 @app_unavailable;
         location @app_unavailable {
             default_type application/json;

@@ -315,6 +315,22 @@ def test_an_oversized_body_is_refused_413_by_the_proxy_in_the_apis_shape(proxied
           f"beyond -> 413, {limit} -> 200 from the app")
 
 
+def test_a_request_line_or_header_too_long_is_refused_by_the_proxy_in_the_apis_shape(proxied):
+    """Beyond nginx's header buffers (8 kB a line): 414 for the request line, 431 for a header, each in the
+    API's JSON shape naming what was too long (nginx's own HTML page before); just under them, the app
+    answers; the pages behind those answers are not reachable from outside."""
+    status, headers, answer = proxied.request("GET", "/api/v1/jobs?limit=" + "9" * 9000, headers=proxied.auth)
+    assert status == 414 and named(answer) and answer["field"] == "request line" and "8192" in answer["error"]
+    assert headers["Content-Type"] == "application/json"
+    status, headers, answer = proxied.request("GET", "/api/v1/health", headers={"X-Padding": "p" * 9000})
+    assert status == 431 and named(answer) and answer["field"] == "headers", answer
+    assert headers["Content-Type"] == "application/json"
+    status, _, answer = proxied.request("GET", "/api/v1/health", headers={"X-Padding": "p" * 7000})
+    assert status == 200, answer
+    for inside in ("/__shimmy_request_line_too_long", "/__shimmy_headers_too_large"):
+        assert proxied.request("GET", inside)[0] == 404
+
+
 def test_many_idle_connections_leave_the_service_prompt_and_are_closed(proxied):
     idle = [connect(proxied) for _ in range(300)]  # connected, nothing sent
     kept = []
