@@ -77,6 +77,15 @@ class Mesh:
         """(ntst, ncol + 1) index of the nodes of every interval."""
         return np.arange(self.ntst)[:, None] * self.ncol + np.arange(self.ncol + 1)[None, :]
 
+    def evaluate(self, X: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """x at arbitrary tau in [0, 1] (k, n) from node values X on this mesh (its polynomials)."""
+        tau = np.clip(np.asarray(tau, float), 0.0, 1.0)
+        j = np.clip(np.searchsorted(self.points, tau, side="right") - 1, 0, self.ntst - 1)
+        s = (tau - self.points[j]) / self.h[j]
+        E = basis(self.ncol).values(s)  # (k, m+1)
+        U = X[self.node_index[j]]  # (k, m+1, n)
+        return np.einsum("kl,kln->kn", E, U)
+
     @cached_property
     def node_weights(self) -> np.ndarray:
         """Trapezoidal weights of the nodes for integrals over tau in [0, 1]."""
@@ -406,12 +415,7 @@ class PeriodicProblem:
 
     def evaluate(self, X: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """x at arbitrary tau in [0, 1] (k, n) from node values X of this mesh."""
-        tau = np.clip(np.asarray(tau, float), 0.0, 1.0)
-        j = np.clip(np.searchsorted(self.mesh.points, tau, side="right") - 1, 0, self.mesh.ntst - 1)
-        s = (tau - self.mesh.points[j]) / self.mesh.h[j]
-        E = self.basis.values(s)  # (k, m+1)
-        U = X[self.mesh.node_index[j]]  # (k, m+1, n)
-        return np.einsum("kl,kln->kn", E, U)
+        return self.mesh.evaluate(X, tau)
 
     def adapted_mesh(self, u: np.ndarray, ntst: int | None = None) -> Mesh:
         """A mesh that equidistributes |x^(ncol)|^(1/(ncol+1)) (scaled), the error monitor of

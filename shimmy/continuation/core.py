@@ -377,11 +377,7 @@ class Tracer:
                 taken = self.h
                 if new.iterations <= 4 and angle <= 0.5 * opts.max_angle and chord <= 0.5:
                     self.h = min(self.h * opts.grow, opts.ds_max)
-                self.problem.accept(new.u)
-                self._last = (self.problem, new, self.point.tangent, taken)
-                self.point = new
-                self.cap = math.inf
-                return new, taken
+                return self._take(new, taken)
             if new is not None and angle <= opts.max_angle:  # refused for its chord: to ~0.8 of the limit
                 self.h *= min(opts.shrink, max(0.2, 0.9 / math.sqrt(chord)))
             else:
@@ -428,10 +424,14 @@ class Tracer:
         strays = self.chord is not None and self.chord(problem, self.point, new, h) > 1.0
         if self._turn(new) > opts.max_angle or strays:
             return None
-        problem.accept(new.u)
-        self._last = (problem, new, self.point.tangent, h)
-        self.point = new
         self.h = min(max(h, opts.ds_min), opts.ds_max)
+        return self._take(new, h)
+
+    def _take(self, new: CurvePoint, h: float) -> tuple[CurvePoint, float]:
+        """``new`` (reached by a step h) is the curve's next point."""
+        self.problem.accept(new.u)
+        self._last = (self.problem, new, self.point.tangent, h)
+        self.point = new
         self.cap = math.inf
         return new, h
 
@@ -587,20 +587,22 @@ def _hermite_at(a: CurvePoint, b: CurvePoint, index: int, value: float, theta: f
     h = weighted_norm(d, w)
     if not (h > 0.0 and np.sum(w * d * a.tangent) > 0.0 and np.sum(w * d * b.tangent) > 0.0):
         return None
-    p0, p1, m0, m1 = a.u[index], b.u[index], h * a.tangent[index], h * b.tangent[index]
+    ends = (a.u, h * a.tangent, b.u, h * b.tangent)  # the cubic's values and slopes at theta = 0 and 1
+
+    def cubic(theta, k=slice(None), slope=False):  # the cubic (or its slope in theta) at theta
+        t2 = theta * theta
+        basis = ((6 * t2 - 6 * theta, 3 * t2 - 4 * theta + 1, 6 * theta - 6 * t2, 3 * t2 - 2 * theta) if slope else
+                 (2 * t2 * theta - 3 * t2 + 1, t2 * theta - 2 * t2 + theta, 3 * t2 - 2 * t2 * theta, t2 * theta - t2))
+        return sum(c * e[k] for c, e in zip(basis, ends, strict=True))
+
     for _ in range(8):
-        s2, s3 = theta * theta, theta * theta * theta
-        f = (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + theta) * m0 + (-2 * s3 + 3 * s2) * p1 + (s3 - s2) * m1 - value
-        df = ((6 * s2 - 6 * theta) * p0 + (3 * s2 - 4 * theta + 1) * m0 + (-6 * s2 + 6 * theta) * p1
-              + (3 * s2 - 2 * theta) * m1)
+        df = cubic(theta, index, slope=True)
         if df == 0.0:
             return None
-        theta -= f / df
+        theta -= (cubic(theta, index) - value) / df
         if not 0.0 <= theta <= 1.0:
             return None
-    s2, s3 = theta * theta, theta * theta * theta
-    return ((2 * s3 - 3 * s2 + 1) * a.u + (s3 - 2 * s2 + theta) * h * a.tangent + (-2 * s3 + 3 * s2) * b.u
-            + (s3 - s2) * h * b.tangent)
+    return cubic(theta)
 
 
 def locate_between(problem: CurveProblem, a: CurvePoint, b: CurvePoint, g: Callable[[CurvePoint], float],

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..collocation import Mesh, basis
+from ..collocation import Mesh
 from ..core import CurvePoint, weighted_norm
 
 
@@ -49,12 +49,7 @@ def on_mesh(u: np.ndarray, source: Mesh, target: Mesh, n: int) -> np.ndarray:
     if source.points.size == target.points.size and np.array_equal(source.points, target.points):
         return u
     n_x = source.n_nodes * n
-    X = u[:n_x].reshape(source.n_nodes, n)
-    tau = target.node_times
-    j = np.clip(np.searchsorted(source.points, tau, side="right") - 1, 0, source.ntst - 1)
-    s = (tau - source.points[j]) / source.h[j]
-    E = basis(source.ncol).values(s)
-    return np.concatenate([np.einsum("kl,kln->kn", E, X[source.node_index[j]]).ravel(), u[n_x:]])
+    return np.concatenate([source.evaluate(u[:n_x].reshape(source.n_nodes, n), target.node_times).ravel(), u[n_x:]])
 
 
 def guide_points(curve, i: int, plus_to_last: bool) -> dict[int, list[tuple[np.ndarray, np.ndarray]]]:
@@ -99,14 +94,16 @@ class Guide:
     refused: int = 0
     taken: int = 0
     misses: int = 0  # points refused since the last one taken
-    _meshes: dict = field(default_factory=dict)
+    _moved: dict = field(default_factory=dict)  # k -> (mesh, old point k on it): each moved once a mesh
 
     def _old(self, k: int, mesh: Mesh) -> np.ndarray:
-        points, u = self.points[k]
-        source = self._meshes.get(k)
-        if source is None:
-            source = self._meshes[k] = Mesh(np.asarray(points, float), self.ncol)
-        return on_mesh(np.asarray(u, float), source, mesh, self.n)
+        """Old point k on ``mesh`` (next(), took() and the step after ask for the same point)."""
+        kept = self._moved.get(k)
+        if kept is None or kept[0] is not mesh:
+            points, u = self.points[k]
+            kept = self._moved[k] = (mesh, on_mesh(np.asarray(u, float), Mesh(np.asarray(points, float), self.ncol),
+                                                   mesh, self.n))
+        return kept[1]
 
     def anchor(self, point: CurvePoint, mesh: Mesh) -> None:
         """The trace's first point, the guide's first point corrected at the new design (a trace
