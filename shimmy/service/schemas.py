@@ -204,13 +204,13 @@ def _number_of(field: str, value: Any, low: float, high: float, unit: str = "") 
 
 def constraint(field: str, item: Any, default_Fz: float) -> dict[str, Any]:
     """One optimiser constraint as {figure, op, value, Fz} (Fz None for a figure not taken at a load)."""
-    if isinstance(item, str):
-        raw = item.replace(" ", "")
-        op = next((o for o in OPS if o in raw), None)
+    if isinstance(item, str):  # spaces around its parts allowed; a part refused is quoted as typed
+        op = next((o for o in OPS if o in item), None)
         if op is None:
             raise InvalidParameterError(field, item, CONSTRAINT_TEXT, "has no <= or >=")
-        left, right = raw.split(op, 1)
-        figure, at, fz = left.partition("@")
+        left, right = item.split(op, 1)
+        right = right.strip()
+        figure, at, fz = (part.strip() for part in left.partition("@"))
         try:
             value: Any = float(right)
         except ValueError:
@@ -247,11 +247,11 @@ def constraint(field: str, item: Any, default_Fz: float) -> dict[str, Any]:
 
 def tolerance(field: str, item: Any) -> dict[str, Any]:
     """One toleranced parameter as {name, relative, distribution}."""
-    if isinstance(item, str):
-        name, sep, rest = item.replace(" ", "").partition("=")
+    if isinstance(item, str):  # spaces around its parts allowed; a part refused is quoted as typed
+        name, sep, rest = (part.strip() for part in item.partition("="))
         if not sep:
             raise InvalidParameterError(field, item, TOLERANCE_TEXT, "has no =")
-        text, colon, dist = rest.partition(":")
+        text, colon, dist = (part.strip() for part in rest.partition(":"))
         try:
             relative: Any = float(text)
         except ValueError:

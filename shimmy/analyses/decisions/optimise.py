@@ -68,15 +68,17 @@ class Constraint:
 
     @classmethod
     def parse(cls, text: str, default_Fz: float) -> "Constraint":
-        """'max_psi<=0.02', 'max_psi@150000<=0.02' or 'min_shimmy_Fz>=80000' (values in the figure's unit)."""
-        raw = str(text).replace(" ", "")
+        """'max_psi<=0.02', 'max_psi@150000<=0.02' or 'min_shimmy_Fz>=80000' (values in the figure's unit;
+        spaces around the parts allowed). A part refused is quoted as typed ('0.02 extra', not '0.02extra')."""
+        raw = str(text)
         for op in ("<=", ">="):
             if op in raw:
                 left, right = raw.split(op, 1)
                 break
         else:
             raise InvalidParameterError("constraint", text, "FIGURE<=VALUE or FIGURE>=VALUE (FIGURE[@Fz in N])")
-        name, _, at = left.partition("@")
+        name, _, at = (part.strip() for part in left.partition("@"))
+        right = right.strip()
         if name not in FIGURES:
             raise unknown_name_error(name, FIGURES, "constraint figure")
         value = check_number("constraint", right, -1e12, 1e12, FIGURES[name].unit)

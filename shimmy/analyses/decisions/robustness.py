@@ -72,11 +72,12 @@ class Tolerance:
 
     @classmethod
     def parse(cls, text: str) -> "Tolerance":
-        """'k_lam=0.05' (normal, 5 % standard deviation) or 'k_s=0.05:uniform' (+-5 %)."""
-        name, sep, rest = str(text).replace(" ", "").partition("=")
+        """'k_lam=0.05' (normal, 5 % standard deviation) or 'k_s=0.05:uniform' (+-5 %); spaces around the
+        parts allowed, a part refused quoted as typed."""
+        name, sep, rest = (part.strip() for part in str(text).partition("="))
         if not sep:
             raise InvalidParameterError("tolerance", text, "NAME=REL or NAME=REL:normal|uniform")
-        value, _, dist = rest.partition(":")
+        value, _, dist = (part.strip() for part in rest.partition(":"))
         return cls.make(name, value, dist or "normal")
 
     @classmethod
