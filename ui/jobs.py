@@ -9,7 +9,9 @@ results become CSV rows.
 Nothing is computed in the web worker and no process is started by Dash: a Compute submits
 one job per uncached request through :mod:`shimmy.service.jobs`, the admission control the
 API uses (bounded queue, identical requests shared, a full queue refused with a message), and
-an interval reads the jobs' progress until every result is in the cache. The interval's
+an interval reads the jobs' progress until every result is in the cache (a read that finds nothing
+new waits briefly for the jobs to end, :data:`WAIT_S`, so that a result is drawn when it is ready
+rather than at the next read). The interval's
 callback only says so (a small answer that stops the interval); a second callback, triggered
 once by that, draws the results. Dash drops the answer of a callback whose input changed again
 while it ran (plotly/dash#1613), so a poll that drew a large figure more slowly than the
@@ -53,12 +55,30 @@ RELEASE_PATH = "_workbench/release"
 MAX_RELEASED = 256
 
 
-def controls(group: Group, label: str = "Compute", interval: int = 400) -> list:
+#: How often a page reads its jobs' progress while they run (ms).
+POLL_MS = 400
+#: A read that finds the page's jobs all running (or done, not all) and nothing new to draw waits up to
+#: this long (s) for one to end or a sketch to be due, reading the job store every WAIT_STEP_S: a job
+#: that ends meanwhile is drawn at once instead of at the next read (on average half an interval
+#: later). Less than the interval by a round trip: Dash drops the answer of a callback whose input
+#: changed while it was on its way (plotly/dash#1613); an answer dropped so is one that found nothing
+#: new (a change answers at once), and the next read finds the change. A queued job is not waited for.
+WAIT_S = 0.75 * POLL_MS / 1000
+WAIT_STEP_S = 0.02
+#: While a page follows the design by itself (a warm map of a second or two): its sketch is redrawn at
+#: most this often (s), and the veiled figure's clock only when its whole seconds change. Each redraw of
+#: the map figure takes the browser ~0.1 s of CPU and the server some, from the two cores the job's
+#: workers use: redrawn at every read (six to eight times a step) they made the nes warm job 2.4-2.5 s
+#: instead of 2.1-2.2 s. The first sketch (the new Hopf curves) is drawn as soon as it is known.
+LIVE_SKETCH_S = 1.0
+
+
+def controls(group: Group, label: str = "Compute") -> list:
     """The run and cancel buttons, the progress bar of a job and the interval that reads it."""
     return [html.Button(label, id=group.run),
             html.Button("Cancel", id=group.cancel, className="secondary", disabled=True),
             components.progress_bar(group),
-            dcc.Interval(id=group.poll, interval=interval, disabled=True)]
+            dcc.Interval(id=group.poll, interval=POLL_MS, disabled=True)]
 
 
 def stores(group: Group) -> list:
@@ -234,7 +254,19 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         watcher = _watcher(go)
         if go.get("cancelled"):  # the Cancel button let them go; the poll says so (no late progress line after it)
             return (*stopped("", "cancelled"), no_update, no_update)
-        current = [jobs.get(i) for i in ids]
+        live = bool(go.get("live")) and fading is not None
+        drawn_before = isinstance(sketched, dict) and sketched.get("jobs") == ids
+
+        def sketch_due(records) -> bool:  # a sketch grown since the page drew one, not held back
+            if sketch is None or any(job is None for job in records):
+                return False
+            sizes = [_size(job.get("sketch")) if job["status"] == "running" else 0 for job in records]
+            if not any(sizes) or (drawn_before and sketched.get("sizes") == sizes):
+                return False
+            last = _since(sketched.get("at")) if drawn_before else None
+            return not (live and last is not None and last < LIVE_SKETCH_S)
+
+        current = _awaited(ids, [jobs.get(i) for i in ids], sketch_due)
         if any(job is not None and _let_go(job, watcher) for job in current):
             return nothing + (no_update, no_update)
         for job in current:
@@ -258,18 +290,18 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         status = (f"{label}: {first['message']}{of}" if first["status"] == "running"
                   else f"{label}: queued ({jobs.counts()['running']} analyses running){of}")
         since = _since(go.get("asked"))
-        show_clock = fading if go.get("live") and fading is not None else clock
+        show_clock = fading if live else clock
+        if live and since is not None and int(since) == int(max(since - POLL_MS / 1000, 0.0)):
+            show_clock = None  # the veiled figure's clock is in whole seconds: redrawn only when they change
         drawn = (show_clock(since, _asked(wanted)) if show_clock is not None and since is not None
                  else (no_update,) * n_out)
         mark = no_update
-        if sketch is not None:
+        if sketch_due(current):
             sketches = [job.get("sketch") if job["status"] == "running" else None for job in current]
-            stamp = {"jobs": ids, "sizes": [_size(s) for s in sketches]}
-            drawn_before = isinstance(sketched, dict) and sketched.get("jobs") == ids
-            if any(sketches) and stamp != sketched:
-                drawn, mark = sketch(sketches, _shown(analysis, kept), bool(go.get("live"))), stamp
-            elif drawn_before:  # the sketch stays until the answer (no clock or veil over it)
-                drawn = (no_update,) * n_out
+            drawn = sketch(sketches, _shown(analysis, kept), bool(go.get("live")))
+            mark = {"jobs": ids, "sizes": [_size(s) for s in sketches], "at": time.time()}
+        elif drawn_before:  # the sketch stays until the answer (no clock or veil over it)
+            drawn = (no_update,) * n_out
         return (*drawn, *(no_update,) * (len(tail) + len(state) - 2), str(int(100 * fraction)), status, no_update,
                 mark)
 
@@ -379,6 +411,22 @@ def _shown(analysis: str, kept: Any) -> list[dict[str, Any]] | None:
     except InvalidParameterError:
         return None
     return None if any(r is None for r in results) else results
+
+
+def _awaited(ids: Sequence[str], current: list[dict[str, Any] | None],
+             due: Callable[[list[dict[str, Any] | None]], bool]) -> list[dict[str, Any] | None]:
+    """The jobs' records (``current``, as just read), read again every WAIT_STEP_S for up to WAIT_S
+    while all are running or done, not all done, and nothing is ``due`` to be drawn; as soon as one
+    changed status (ended, failed, was cancelled) or a sketch is due."""
+    statuses = [None if job is None else job["status"] for job in current]
+    deadline = time.monotonic() + WAIT_S
+    while (all(s in ("running", "done") for s in statuses) and "running" in statuses and not due(current)
+           and time.monotonic() < deadline):
+        time.sleep(WAIT_STEP_S)
+        current = [jobs.get(i) for i in ids]
+        if [None if job is None else job["status"] for job in current] != statuses:
+            break
+    return current
 
 
 def _fraction(job: dict[str, Any]) -> float:

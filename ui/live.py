@@ -72,5 +72,5 @@ def fading(title: str, seconds: float) -> Patch:
     patch = Patch()
     patch["layout"]["shapes"] = [VEIL]
     # the whole title (the house style's), not its text alone: a placeholder figure has none
-    patch["layout"]["title"] = style.title(f"{title}: {seconds:.0f} s so far (faint: the previous one)")
+    patch["layout"]["title"] = style.title(f"{title}: {int(seconds)} s so far (faint: the previous one)")
     return patch
