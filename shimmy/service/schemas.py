@@ -16,7 +16,7 @@ from ..model.configurations import Configuration, affects
 from ..errors import InvalidParameterError
 from . import settings
 from .request_fields import Field, field_key as _key, huge as _huge
-from ..analyses.decisions import design_space
+from ..analyses.decisions import design_space, spec_text
 from ..analyses.ground.ground_profiles import MAX_PROFILE_POINTS, PRESETS
 from ..analyses.ground import kicks
 from ..analyses.maps import margin_options
@@ -202,24 +202,25 @@ def _number_of(field: str, value: Any, low: float, high: float, unit: str = "") 
     return check_number(field, _huge(value), low, high, unit)
 
 
+def _read_number(typed: str) -> Any:
+    """A number part of a constraint or tolerance string as a float, or as typed (refused by name below)."""
+    text = spec_text.number_text(typed)
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def constraint(field: str, item: Any, default_Fz: float) -> dict[str, Any]:
     """One optimiser constraint as {figure, op, value, Fz} (Fz None for a figure not taken at a load)."""
-    if isinstance(item, str):  # spaces around its parts allowed; a part refused is quoted as typed
-        op = next((o for o in OPS if o in item), None)
-        if op is None:
+    if isinstance(item, str):  # spaces ignored; a part refused is quoted as typed (spec_text)
+        parts = spec_text.constraint_parts(item)
+        if parts is None:
             raise InvalidParameterError(field, item, CONSTRAINT_TEXT, "has no <= or >=")
-        left, right = item.split(op, 1)
-        right = right.strip()
-        figure, at, fz = (part.strip() for part in left.partition("@"))
-        try:
-            value: Any = float(right)
-        except ValueError:
-            value = right  # refused below, by name, as not a number
-        try:
-            given_fz: Any = float(fz) if at else None
-        except ValueError:
-            given_fz = fz
-        item = {"figure": figure, "op": op, "value": value, **({"Fz": given_fz} if at else {})}
+        typed, op, right, fz = parts
+        figure = spec_text.compact(typed)
+        item = {"figure": figure if figure in FIGURE_LIMITS else typed, "op": op, "value": _read_number(right),
+                **({"Fz": _read_number(fz)} if fz is not None else {})}
     elif isinstance(item, Mapping):
         _item_keys(field, item, ("figure", "op", "value", "Fz"))
         for key in ("figure", "op", "value"):
@@ -247,16 +248,14 @@ def constraint(field: str, item: Any, default_Fz: float) -> dict[str, Any]:
 
 def tolerance(field: str, item: Any) -> dict[str, Any]:
     """One toleranced parameter as {name, relative, distribution}."""
-    if isinstance(item, str):  # spaces around its parts allowed; a part refused is quoted as typed
-        name, sep, rest = (part.strip() for part in item.partition("="))
-        if not sep:
+    if isinstance(item, str):  # spaces ignored; a part refused is quoted as typed (spec_text)
+        parts = spec_text.tolerance_parts(item)
+        if parts is None:
             raise InvalidParameterError(field, item, TOLERANCE_TEXT, "has no =")
-        text, colon, dist = (part.strip() for part in rest.partition(":"))
-        try:
-            relative: Any = float(text)
-        except ValueError:
-            relative = text
-        item = {"name": name, "relative": relative, "distribution": dist if colon else "normal"}
+        typed, relative, dist = parts
+        name, read_dist = spec_text.compact(typed), spec_text.compact(dist or "")
+        item = {"name": name if name in PARAMETER_SPECS else typed, "relative": _read_number(relative),
+                "distribution": "normal" if dist is None else read_dist if read_dist in DISTRIBUTIONS else dist}
     elif isinstance(item, Mapping):
         _item_keys(field, item, ("name", "relative", "distribution"))
         for key in ("name", "relative"):

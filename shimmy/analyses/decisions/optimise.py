@@ -43,6 +43,7 @@ from ...model.configurations import Configuration, affects
 from ...model.equations import build_model
 from ...model.parameters import DEFAULT_FZ, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
 from ..core.executors import open_executor, run_units
+from . import spec_text
 from .design_space import DIFFERENTIABLE, FIGURES, Figure, device_parameters  # noqa: F401 (Figure: re-exported)
 from .summaries import constraint_text, optimise_summary
 from .sensitivity import (V_BAND, amplitude_sensitivity, coefficient_pairs, hopf_sensitivities,
@@ -69,20 +70,17 @@ class Constraint:
     @classmethod
     def parse(cls, text: str, default_Fz: float) -> "Constraint":
         """'max_psi<=0.02', 'max_psi@150000<=0.02' or 'min_shimmy_Fz>=80000' (values in the figure's unit;
-        spaces around the parts allowed). A part refused is quoted as typed ('0.02 extra', not '0.02extra')."""
-        raw = str(text)
-        for op in ("<=", ">="):
-            if op in raw:
-                left, right = raw.split(op, 1)
-                break
-        else:
+        spaces ignored). A part refused is quoted as typed ('0.02 extra', not '0.02extra')."""
+        parts = spec_text.constraint_parts(str(text))
+        if parts is None:
             raise InvalidParameterError("constraint", text, "FIGURE<=VALUE or FIGURE>=VALUE (FIGURE[@Fz in N])")
-        name, _, at = (part.strip() for part in left.partition("@"))
-        right = right.strip()
+        typed, op, right, at = parts
+        name = spec_text.compact(typed)
         if name not in FIGURES:
-            raise unknown_name_error(name, FIGURES, "constraint figure")
-        value = check_number("constraint", right, -1e12, 1e12, FIGURES[name].unit)
-        Fz = check_number("constraint Fz", at, *FZ_BOX, "N") if at else (default_Fz if FIGURES[name].at_load else None)
+            raise unknown_name_error(typed, FIGURES, "constraint figure")
+        value = check_number("constraint", spec_text.number_text(right), -1e12, 1e12, FIGURES[name].unit)
+        Fz = (check_number("constraint Fz", spec_text.number_text(at), *FZ_BOX, "N") if at is not None
+              else (default_Fz if FIGURES[name].at_load else None))
         return cls(name, op, value, Fz)
 
     def key(self) -> tuple[str, float | None]:

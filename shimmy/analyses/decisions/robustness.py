@@ -52,6 +52,7 @@ from ...errors import ConvergenceError, InvalidParameterError
 from ...model.configurations import OPERATING_POINTS, Configuration, affects
 from ...model.equations import build_model
 from ...model.parameters import DEFAULT_FZ, FZ_RANGE, PARAMETER_SPECS, Parameters, check_number, unknown_name_error
+from . import spec_text
 from .design_space import DISTRIBUTIONS, TOLERANCE_LIMITS
 from .summaries import robustness_summary
 from ..core.executors import open_executor, run_units
@@ -72,13 +73,16 @@ class Tolerance:
 
     @classmethod
     def parse(cls, text: str) -> "Tolerance":
-        """'k_lam=0.05' (normal, 5 % standard deviation) or 'k_s=0.05:uniform' (+-5 %); spaces around the
-        parts allowed, a part refused quoted as typed."""
-        name, sep, rest = (part.strip() for part in str(text).partition("="))
-        if not sep:
+        """'k_lam=0.05' (normal, 5 % standard deviation) or 'k_s=0.05:uniform' (+-5 %); spaces ignored, a
+        part refused quoted as typed."""
+        parts = spec_text.tolerance_parts(str(text))
+        if parts is None:
             raise InvalidParameterError("tolerance", text, "NAME=REL or NAME=REL:normal|uniform")
-        value, _, dist = (part.strip() for part in rest.partition(":"))
-        return cls.make(name, value, dist or "normal")
+        name, value, dist = parts
+        dist = dist or "normal"
+        read_name, read_dist = spec_text.compact(name), spec_text.compact(dist)
+        return cls.make(read_name if read_name in PARAMETER_SPECS else name, spec_text.number_text(value),
+                        read_dist if read_dist in DISTRIBUTIONS else dist)
 
     @classmethod
     def make(cls, name: str, relative: Any, distribution: str = "normal") -> "Tolerance":
