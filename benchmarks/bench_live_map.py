@@ -66,7 +66,7 @@ const timer = setInterval(() => {
     for (const m of marks) {
         if (!(m in seen) && (!(m in after) || after[m] in seen) && holds[m](s)) { seen[m] = performance.now() - t0; }
     }
-    if (marks[marks.length - 1] in seen) { clearInterval(timer); }
+    if (marks[marks.length - 1] in seen || performance.now() - t0 > 600000) { clearInterval(timer); }
 }, 20);
 return t0;
 """

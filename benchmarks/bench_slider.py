@@ -71,6 +71,8 @@ def main() -> None:
             t0 = time.perf_counter()
             while driver.execute_script(NES_TRACE) == before and time.perf_counter() - t0 < 10:
                 time.sleep(0.1)
+            if time.perf_counter() - t0 > 0.05:  # the change came late: its redraw may still be under way
+                time.sleep(0.8)
             log = driver.execute_script("return window.__log;")
             key = next(t for what, t in log if what == "key")
             doms = [t for what, t in log if what == "dom"]

@@ -57,13 +57,16 @@ MAX_RELEASED = 256
 
 #: How often a page reads its jobs' progress while they run (ms).
 POLL_MS = 400
-#: A read that finds the page's jobs all running (or done, not all) and nothing new to draw waits up to
-#: this long (s) for one to end or a sketch to be due, reading the job store every WAIT_STEP_S: a job
-#: that ends meanwhile is drawn at once instead of at the next read (on average half an interval
-#: later). Less than the interval by a round trip: Dash drops the answer of a callback whose input
-#: changed while it was on its way (plotly/dash#1613); an answer dropped so is one that found nothing
-#: new (a change answers at once), and the next read finds the change. A queued job is not waited for.
-WAIT_S = 0.75 * POLL_MS / 1000
+#: A read that finds the page's jobs all running (or some done) and nothing new to show waits up to this
+#: long (s) for something to show, reading the job store every WAIT_STEP_S: a job that ends meanwhile is
+#: drawn at once instead of at the next read (on average half an interval later). Half the interval,
+#: so that the answer is back before the next read is sent (Dash drops the answer of a callback whose
+#: input changed while it was on its way, plotly/dash#1613) unless the round trip takes over 0.2 s; and
+#: the wait ends at once when anything the answer shows changes (a status, the progress or its message,
+#: the clock's second; a sketch due), so that an answer dropped so is one that showed nothing new. While
+#: a page follows the design by itself (a step of a second or two) only a status ends it: the progress
+#: line may then lag by a read. A queued job is not waited for.
+WAIT_S = 0.5 * POLL_MS / 1000
 WAIT_STEP_S = 0.02
 #: While a page follows the design by itself (a warm map of a second or two): its sketch is redrawn at
 #: most this often (s), and the veiled figure's clock only when its whole seconds change. Each redraw of
@@ -158,7 +161,8 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
     ``sketch(sketches, previous, live)`` -> the outputs drawn from what the running jobs know so far
     (``job["sketch"]`` of each, None where a job has none; a map's curves before its shading), over
     ``previous``, the results shown until now (None if none), ``live`` where the run follows the design
-    by itself; redrawn each time a sketch grows, and in place of the clock and the fading once drawn.
+    by itself; redrawn each time a sketch grows (while the page follows the design by itself, at most every
+    LIVE_SKETCH_S), and in place of the clock and the fading once drawn.
     """
     store, files = group.requests, download.files
     error = error or group.error
@@ -255,18 +259,17 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         if go.get("cancelled"):  # the Cancel button let them go; the poll says so (no late progress line after it)
             return (*stopped("", "cancelled"), no_update, no_update)
         live = bool(go.get("live")) and fading is not None
-        drawn_before = isinstance(sketched, dict) and sketched.get("jobs") == ids
 
-        def sketch_due(records) -> bool:  # a sketch grown since the page drew one, not held back
-            if sketch is None or any(job is None for job in records):
-                return False
-            sizes = [_size(job.get("sketch")) if job["status"] == "running" else 0 for job in records]
-            if not any(sizes) or (drawn_before and sketched.get("sizes") == sizes):
-                return False
-            last = _since(sketched.get("at")) if drawn_before else None
-            return not (live and last is not None and last < LIVE_SKETCH_S)
+        def shows(records) -> list:  # what this read's answer would show (a live step: its statuses)
+            out = [None if job is None else job["status"] for job in records]
+            if live:
+                return out
+            since_now = _since(go.get("asked")) if clock is not None else None
+            return out + [None if job is None else (job.get("progress"), job.get("message")) for job in records] \
+                + [None if since_now is None else int(since_now)]
 
-        current = _awaited(ids, [jobs.get(i) for i in ids], sketch_due)
+        current = _awaited(ids, [jobs.get(i) for i in ids], shows,
+                           lambda records: sketch is not None and _sketch_due(records, ids, sketched, live))
         if any(job is not None and _let_go(job, watcher) for job in current):
             return nothing + (no_update, no_update)
         for job in current:
@@ -291,17 +294,22 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
                   else f"{label}: queued ({jobs.counts()['running']} analyses running){of}")
         since = _since(go.get("asked"))
         show_clock = fading if live else clock
-        if live and since is not None and int(since) == int(max(since - POLL_MS / 1000, 0.0)):
-            show_clock = None  # the veiled figure's clock is in whole seconds: redrawn only when they change
+        mark = no_update
+        if live and since is not None:  # the veiled figure's clock: redrawn only when its whole seconds change
+            second = _clock_drawn(sketched, ids)
+            if int(since) == (0 if second is None else second):  # (the run's first answer drew 0 s)
+                show_clock = None
+            else:
+                same = isinstance(sketched, dict) and sketched.get("jobs") == list(ids)
+                mark = {**(sketched if same else {"jobs": ids}), "clock": int(since)}
         drawn = (show_clock(since, _asked(wanted)) if show_clock is not None and since is not None
                  else (no_update,) * n_out)
-        mark = no_update
-        if sketch_due(current):
+        if sketch is not None and _sketch_due(current, ids, sketched, live):
             sketches = [job.get("sketch") if job["status"] == "running" else None for job in current]
             drawn = sketch(sketches, _shown(analysis, kept), bool(go.get("live")))
             mark = {"jobs": ids, "sizes": [_size(s) for s in sketches], "at": time.time()}
-        elif drawn_before:  # the sketch stays until the answer (no clock or veil over it)
-            drawn = (no_update,) * n_out
+        elif _sketch_drawn(sketched, ids):  # the sketch stays until the answer (no clock or veil over it)
+            drawn, mark = (no_update,) * n_out, no_update
         return (*drawn, *(no_update,) * (len(tail) + len(state) - 2), str(int(100 * fraction)), status, no_update,
                 mark)
 
@@ -413,20 +421,49 @@ def _shown(analysis: str, kept: Any) -> list[dict[str, Any]] | None:
     return None if any(r is None for r in results) else results
 
 
-def _awaited(ids: Sequence[str], current: list[dict[str, Any] | None],
-             due: Callable[[list[dict[str, Any] | None]], bool]) -> list[dict[str, Any] | None]:
-    """The jobs' records (``current``, as just read), read again every WAIT_STEP_S for up to WAIT_S
-    while all are running or done, not all done, and nothing is ``due`` to be drawn; as soon as one
-    changed status (ended, failed, was cancelled) or a sketch is due."""
+def _awaited(ids: Sequence[str], current: list[dict[str, Any] | None], shows: Callable[[list], list],
+             due: Callable[[list], bool]) -> list[dict[str, Any] | None]:
+    """The jobs' records (``current``, as just read), read again (:func:`~shimmy.service.jobs.peek`) every
+    WAIT_STEP_S for up to WAIT_S while all are running or done, not all done, and nothing is ``due`` to be
+    drawn; as soon as what the answer ``shows`` changes, or a sketch is due."""
     statuses = [None if job is None else job["status"] for job in current]
+    if not (all(s in ("running", "done") for s in statuses) and "running" in statuses):
+        return current
+    before = shows(current)
     deadline = time.monotonic() + WAIT_S
-    while (all(s in ("running", "done") for s in statuses) and "running" in statuses and not due(current)
-           and time.monotonic() < deadline):
+    while not due(current) and time.monotonic() < deadline:
         time.sleep(WAIT_STEP_S)
-        current = [jobs.get(i) for i in ids]
-        if [None if job is None else job["status"] for job in current] != statuses:
+        current = [jobs.peek(i) for i in ids]
+        if shows(current) != before:
             break
     return current
+
+
+def _sketch_drawn(sketched: Any, ids: Sequence[str]) -> bool:
+    """Whether the page drew a sketch of these jobs (the stamp of the last one it drew)."""
+    return isinstance(sketched, dict) and sketched.get("jobs") == list(ids) and "sizes" in sketched
+
+
+def _sketch_due(records: list[dict[str, Any] | None], ids: Sequence[str], sketched: Any, live: bool) -> bool:
+    """Whether the running jobs' sketches grew since the page drew them (``sketched``: the stamp of the
+    last one drawn) and may be drawn now: at once, but while the page follows the design by itself at
+    most every LIVE_SKETCH_S."""
+    if any(job is None for job in records):
+        return False
+    sizes = [_size(job.get("sketch")) if job["status"] == "running" else 0 for job in records]
+    drawn = _sketch_drawn(sketched, ids)
+    if not any(sizes) or (drawn and sketched.get("sizes") == sizes):
+        return False
+    last = _since(sketched.get("at")) if drawn else None
+    return not (live and last is not None and last < LIVE_SKETCH_S)
+
+
+def _clock_drawn(sketched: Any, ids: Sequence[str]) -> int | None:
+    """The whole seconds the veiled figure's clock last showed for these jobs (None: not drawn since)."""
+    if not (isinstance(sketched, dict) and sketched.get("jobs") == list(ids)):
+        return None
+    shown = sketched.get("clock")
+    return shown if isinstance(shown, int) and not isinstance(shown, bool) else None
 
 
 def _fraction(job: dict[str, Any]) -> float:

@@ -187,6 +187,11 @@ def get(job_id: str) -> dict[str, Any] | None:
     return store().get(("job", job_id))
 
 
+def peek(job_id: str) -> dict[str, Any] | None:
+    """The job's record as stored, without :func:`get`'s settling and starting (a read in a tight loop)."""
+    return store().get(("job", job_id))
+
+
 def _check_watcher(watcher: Any) -> None:
     if not isinstance(watcher, str) or not 0 < len(watcher) <= 64:
         raise InvalidParameterError("watcher", watcher, "a token of 1 to 64 characters",

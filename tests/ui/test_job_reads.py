@@ -1,6 +1,7 @@
-"""How a page's read of its jobs waits (ui.jobs._awaited): on the real job store, a read that finds its
-job running and nothing new to draw waits for the job to end and answers as soon as it does; it does not
-wait for a queued job, nor when something is due to be drawn, and never longer than WAIT_S."""
+"""How a page reads its jobs (ui.jobs): on the real job store, a read that finds its job running and
+nothing new to show waits for something to show and answers as soon as there is (the job's end, its
+progress); it does not wait for a queued job, nor when a sketch is due, and never longer than WAIT_S. While
+a page follows the design by itself its sketch is redrawn at most every LIVE_SKETCH_S."""
 
 from __future__ import annotations
 
@@ -21,54 +22,89 @@ def job(tmp_path, monkeypatch):
     return jobs.submit_canonical("map", schemas.validate("map", {"config": "nes", "resolution": 3}), "view-1")["id"]
 
 
-@pytest.fixture
-def reads(monkeypatch):
-    """How many times the job store is read through ui.jobs (the real reads, counted)."""
-    count = [0]
-    real = jobs.get
-
-    def get(job_id):
-        count[0] += 1
-        return real(job_id)
-
-    monkeypatch.setattr(page_jobs.jobs, "get", get)
-    return count
+def _statuses(records):
+    return [None if r is None else r["status"] for r in records]
 
 
-def _never_due(_records) -> bool:
+def _progress(records):
+    return [None if r is None else (r["status"], r["progress"], r["message"]) for r in records]
+
+
+def _never(_records) -> bool:
     return False
 
 
-def test_a_running_job_that_ends_is_answered_as_soon_as_it_does(job, reads, monkeypatch):
+def test_a_running_job_that_ends_is_answered_as_soon_as_it_does(job, monkeypatch):
     monkeypatch.setattr(page_jobs, "WAIT_S", 60.0)  # far longer than the job takes to end below
     jobs.update(job, status="running")
     ender = threading.Timer(0.2, lambda: jobs.update(job, status="done"))
     clock = time.monotonic()
     ender.start()
     try:
-        records = page_jobs._awaited([job], [jobs.get(job)], _never_due)
+        records = page_jobs._awaited([job], [jobs.get(job)], _statuses, _never)
     finally:
         ender.join()
     assert records[0]["status"] == "done"
     assert time.monotonic() - clock < 30.0  # answered at the change, not at the end of the wait
-    assert reads[0] >= 2
 
 
-def test_nothing_new_is_answered_after_the_wait(job, reads, monkeypatch):
+def test_progress_ends_the_wait_where_the_page_shows_it(job, monkeypatch):
+    monkeypatch.setattr(page_jobs, "WAIT_S", 60.0)
+    jobs.update(job, status="running", progress=0.1, message="Hopf curves")
+    mover = threading.Timer(0.2, lambda: jobs.update(job, progress=0.5, message="slices"))
+    clock = time.monotonic()
+    mover.start()
+    try:
+        records = page_jobs._awaited([job], [jobs.get(job)], _progress, _never)
+    finally:
+        mover.join()
+    assert (records[0]["status"], records[0]["message"]) == ("running", "slices")
+    assert time.monotonic() - clock < 30.0
+
+
+def test_nothing_new_is_answered_after_the_wait(job, monkeypatch):
     monkeypatch.setattr(page_jobs, "WAIT_S", 0.1)
     jobs.update(job, status="running")
     clock = time.monotonic()
-    records = page_jobs._awaited([job], [jobs.get(job)], _never_due)
-    assert records[0]["status"] == "running" and time.monotonic() - clock >= 0.1
-    assert reads[0] >= 2  # read again while it waited
+    records = page_jobs._awaited([job], [jobs.get(job)], _progress, _never)
+    assert records[0]["status"] == "running" and 0.1 <= time.monotonic() - clock < 30.0
 
 
-def test_a_queued_job_or_something_to_draw_is_answered_at_once(job, reads, monkeypatch):
+def test_a_queued_job_or_a_sketch_due_is_answered_at_once(job, monkeypatch):
     monkeypatch.setattr(page_jobs, "WAIT_S", 60.0)
+    reads = [0]
+    real = jobs.peek
+
+    def peek(job_id):  # the real read, counted
+        reads[0] += 1
+        return real(job_id)
+
+    monkeypatch.setattr(page_jobs.jobs, "peek", peek)
     first = [jobs.get(job)]
-    assert page_jobs._awaited([job], first, _never_due) == first  # queued: not waited for
+    assert page_jobs._awaited([job], first, _statuses, _never) == first  # queued: not waited for
     jobs.update(job, status="running")
     running = [jobs.get(job)]
-    assert page_jobs._awaited([job], running, lambda records: True) == running  # a sketch due: drawn now
-    assert reads[0] == 2  # the two reads above, none while answering
+    assert page_jobs._awaited([job], running, _statuses, lambda records: True) == running  # drawn now
+    assert reads[0] == 0
 
+
+def test_a_live_pages_sketch_is_redrawn_at_most_every_live_sketch_s():
+    ids = ["a"]
+    grown = [{"status": "running", "sketch": {"hopf_curves": [[1, 2], [3]], "fold_curves": [[4]]}}]  # size 4
+    assert page_jobs._sketch_due(grown, ids, None, live=True)  # the first: at once
+    now = {"jobs": ids, "sizes": [4], "at": time.time()}
+    assert not page_jobs._sketch_due(grown, ids, now, live=True)  # nothing new
+    smaller = {**now, "sizes": [2]}
+    assert not page_jobs._sketch_due(grown, ids, smaller, live=True)  # grown, but drawn just now
+    assert page_jobs._sketch_due(grown, ids, smaller, live=False)  # a page that is not live: at once
+    earlier = {**smaller, "at": time.time() - 2 * page_jobs.LIVE_SKETCH_S}
+    assert page_jobs._sketch_due(grown, ids, earlier, live=True)
+    assert not page_jobs._sketch_due([{"status": "queued"}], ids, None, live=True)  # no sketch yet
+    assert not page_jobs._sketch_due([None], ids, None, live=False)
+
+
+def test_the_veiled_clock_remembers_its_second_per_run():
+    assert page_jobs._clock_drawn({"jobs": ["a"], "clock": 2}, ["a"]) == 2
+    assert page_jobs._clock_drawn({"jobs": ["b"], "clock": 2}, ["a"]) is None  # another run's
+    assert page_jobs._clock_drawn({"jobs": ["a"], "clock": True}, ["a"]) is None  # not a second
+    assert page_jobs._clock_drawn(None, ["a"]) is None
