@@ -28,8 +28,9 @@
 #   SHIMMY_REBUILD_BASE=1  make the debootstrap root and the base image again
 #   SHIMMY_SKIP_SMOKE=1    build only
 #   SHIMMY_DEBIAN_MIRROR   Debian mirror for debootstrap (default: the one apt uses here)
-# Disk: about 4 GB in the work folder (vfs keeps a full copy of every layer); rm -rf it to
-# start over. Build-time mount points stay behind in the image as empty entries
+# Disk: about 7 GB in the work folder (vfs keeps a full copy of every layer: ~0.8 GB each); the
+# images an earlier build left untagged are removed before each build (they grew the folder by ~7 GB
+# a build until the disk was full: 64 GB after a day of runs); rm -rf it to start over. Build-time mount points stay behind in the image as empty entries
 # (/etc/pip.conf, /opt/pypi, ...): buildah 1.28 does not remove them; a docker build has none.
 # Inspect the result with the same storage flags, e.g.:
 #   buildah --root "$SHIMMY_BUILD_WORK/storage" --runroot "$SHIMMY_BUILD_WORK/run" \
@@ -282,6 +283,9 @@ while read -r p; do add_mount "$p"; done < <(
     sed -n 's/^[a-z-]* = //p' "$pipconf" | tr ' ' '\n' | sed -n 's#^file://##p; s#^\(/.*\)#\1#p' \
         | sed 's#/simple/*$##' | sort -u)
 
+# The images of earlier builds that lost their tag to a later one (their layers are no cache for this
+# build's context); an intermediate layer of a tagged image is kept (the cache of the unchanged steps).
+"${B[@]}" rmi --prune >/dev/null 2>&1 || true
 build_args=(build --isolation chroot --format docker --layers --pull=never
             -f "$repo/Dockerfile" -t "$image" "${volumes[@]}" "$repo")
 echo "buildah ${build_args[*]}"
