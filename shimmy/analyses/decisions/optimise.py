@@ -73,7 +73,8 @@ class Constraint:
         spaces ignored). A part refused is quoted as typed ('0.02 extra', not '0.02extra')."""
         parts = spec_text.constraint_parts(str(text))
         if parts is None:
-            raise InvalidParameterError("constraint", text, "FIGURE<=VALUE or FIGURE>=VALUE (FIGURE[@Fz in N])")
+            raise InvalidParameterError("constraint", text, "FIGURE<=VALUE or FIGURE>=VALUE (FIGURE[@Fz in N])",
+                                        "has no <= or >=")
         typed, op, right, at = parts
         name = spec_text.compact(typed)
         if name not in FIGURES:

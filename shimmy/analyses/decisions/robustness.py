@@ -77,7 +77,7 @@ class Tolerance:
         part refused quoted as typed."""
         parts = spec_text.tolerance_parts(str(text))
         if parts is None:
-            raise InvalidParameterError("tolerance", text, "NAME=REL or NAME=REL:normal|uniform")
+            raise InvalidParameterError("tolerance", text, "NAME=REL or NAME=REL:normal|uniform", "has no =")
         name, value, dist = parts
         dist = dist or "normal"
         read_name, read_dist = spec_text.compact(name), spec_text.compact(dist)

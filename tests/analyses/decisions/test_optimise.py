@@ -128,7 +128,7 @@ def test_constraints_and_options_are_checked_naming_the_field():
     # spaces ignored in reading (as ever), a refused part quoted as typed, its spaces kept
     assert Constraint.parse(" max_psi @ 200 000 < = 0.02 ", 150e3) == Constraint("max_psi", "<=", 0.02, 200e3)
     for bad, typed in (("max_psi <= 0.02 extra", "'0.02 extra'"), ("max_psi @ 150 kN <= 0.02", "'150 kN'"),
-                       ("max _psy <= 1", "'max _psy'")):
+                       ("max _psy <= 1", "'max _psy'"), ("max_psi = 0.02", "'max_psi = 0.02' has no <= or >=")):
         with pytest.raises(InvalidParameterError) as info:
             Constraint.parse(bad, 150e3)
         assert typed in str(info.value)
@@ -202,5 +202,7 @@ def test_tolerances_are_checked_naming_the_field():
     assert Tolerance.parse(" k_s = 0.05 : uni form ") == Tolerance.parse("k_s=0.05:uniform")
     with pytest.raises(InvalidParameterError, match="'0.05 extra'"):  # quoted as typed, its space kept
         Tolerance.parse("k_s = 0.05 extra")
+    with pytest.raises(InvalidParameterError, match="'k_s 0.05' has no ="):
+        Tolerance.parse("k_s 0.05")
     with pytest.raises(InvalidParameterError, match="tolerance"):
         robustness("nes", [])
