@@ -92,6 +92,8 @@ class Group:
 #: dash.page_container's Location: Dash Pages' router replaces the page when its path or query changes.
 PAGES_LOCATION = "_pages_location"
 URL_UPDATE = "url-update"  # a page's partial updates of the address
+# the design panel's (a store of its own: two writers' updates of one store in one render keep only the last)
+URL_DESIGN_UPDATE = "url-design-update"
 URL_SINK = "url-sink"  # the address as the updater left it
 DESIGN_TOGGLE = "design-toggle"
 DESIGN_PANEL = "design-panel"

@@ -89,7 +89,7 @@ def design_panel(query: dict[str, str], page_id: str, shown: bool = True) -> htm
                                        if shown else "; ".join(problems))
     return html.Aside([
         dcc.Store(id=ids.design_store(page_id), data=state.design_request(material, values)),
-        dcc.Store(id=ids.URL_UPDATE), html.Div(id=ids.URL_SINK, hidden=True),
+        dcc.Store(id=ids.URL_UPDATE), dcc.Store(id=ids.URL_DESIGN_UPDATE), html.Div(id=ids.URL_SINK, hidden=True),
         html.H2("Design"),
         html.Div(summary, id=ids.DESIGN_ERROR, className="error", role="alert"),
         html.Div([html.Label("PD material", htmlFor=ids.MATERIAL),
@@ -159,19 +159,26 @@ def shell() -> html.Div:
 
 
 # The address bar carries the design and the page state. Callbacks send partial updates
-# {key: value, or null to drop it} to the page's "url-update" store; this merges them into
-# the current query with history.replaceState (no navigation, no page re-render) and keeps
-# the navigation links carrying the design keys.
+# {key: value, or null to drop it} to the page's "url-update" store, the design panel to its own
+# "url-design-update" (the design panel's update of a slider step and a page's answer to the step
+# before, written to one store in one render, kept only the last: the address then missed the
+# design's last step); this merges the ones that changed into the current query with
+# history.replaceState (no navigation, no page re-render) and keeps the navigation links carrying
+# the design keys.
 dash.clientside_callback(
     """
-    function(update) {
-        if (!update) { return window.dash_clientside.no_update; }
+    function(update, design) {
+        const C = window.dash_clientside;
+        const fired = ((C.callback_context && C.callback_context.triggered) || []).map(t => t.prop_id);
+        const updates = [[%s, update], [%s, design]]
+            .filter(([id, u]) => u && fired.includes(id + ".data")).map(([id, u]) => u);
+        if (!updates.length) { return C.no_update; }
         // written in a task of its own: a slider step's requests are sent first, the address follows
         return new Promise(resolve => setTimeout(() => {
-            let s = window.dash_clientside.no_update;  // (resolved whatever happens: never left pending)
+            let s = C.no_update;  // (resolved whatever happens: never left pending)
             try {
                 const params = new URLSearchParams(window.location.search);
-                for (const [k, v] of Object.entries(update)) {
+                for (const [k, v] of updates.flatMap(u => Object.entries(u))) {
                     if (v === null || v === undefined || v === "") { params.delete(k); } else { params.set(k, String(v)); }
                 }
                 s = params.toString();
@@ -186,9 +193,10 @@ dash.clientside_callback(
             } finally { resolve(s); }
         }, 0));
     }
-    """ % json.dumps([*PARAMETER_SPECS, "material"]),
+    """ % (json.dumps(ids.URL_UPDATE), json.dumps(ids.URL_DESIGN_UPDATE), json.dumps([*PARAMETER_SPECS, "material"])),
     Output(ids.URL_SINK, "children"),
     Input(ids.URL_UPDATE, "data"),
+    Input(ids.URL_DESIGN_UPDATE, "data"),
 )
 
 
@@ -307,7 +315,7 @@ dash.clientside_callback(
     Output(ids.param(ALL), "value"),
     Output(ids.param_box(ALL), "value"),
     Output(ids.MATERIAL, "value"),
-    Output(ids.URL_UPDATE, "data", allow_duplicate=True),
+    Output(ids.URL_DESIGN_UPDATE, "data"),
     Output(ids.design_store(ALL), "data"),
     Input(ids.param(ALL), "value"),
     Input(ids.param_box(ALL), "value"),

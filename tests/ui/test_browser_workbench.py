@@ -71,6 +71,18 @@ def test_slider_steps_are_engineering_steps_without_float_noise(server, browser,
     assert severe(browser) == []
 
 
+def test_a_page_and_the_design_panel_updating_the_address_at_once_both_land(server, browser):
+    """The design panel's update of the address and a page's, written in one render, both reach it
+    (through one store the second overwrote the first: the address missed a slider's last step)."""
+    open_page(browser, server, "/?r2=0.0853")
+    browser.execute_script("const C = window.dash_clientside;"
+                           "C.set_props('url-update', {data: {Fz: '123'}});"
+                           "C.set_props('url-design-update', {data: {r2: '0.0811'}});")
+    wait_for(lambda: "Fz=123" in browser.current_url and "r2=0.0811" in browser.current_url, timeout=10,
+             what=lambda: f"both updates in the address (it reads {browser.current_url})")
+    assert severe(browser) == []
+
+
 def test_advanced_values_are_kept_while_their_section_is_closed(server, browser):
     """The advanced boxes are rendered when their section is first opened: until then the design keeps
     their values from the address (a slider step does not drop them), and opened they show them."""
