@@ -218,8 +218,7 @@ def constraint(field: str, item: Any, default_Fz: float) -> dict[str, Any]:
         if parts is None:
             raise InvalidParameterError(field, item, CONSTRAINT_TEXT, "has no <= or >=")
         typed, op, right, fz = parts
-        figure = spec_text.compact(typed)
-        item = {"figure": figure if figure in FIGURE_LIMITS else typed, "op": op, "value": _read_number(right),
+        item = {"figure": spec_text.name_text(typed, FIGURE_LIMITS), "op": op, "value": _read_number(right),
                 **({"Fz": _read_number(fz)} if fz is not None else {})}
     elif isinstance(item, Mapping):
         _item_keys(field, item, ("figure", "op", "value", "Fz"))
@@ -253,9 +252,8 @@ def tolerance(field: str, item: Any) -> dict[str, Any]:
         if parts is None:
             raise InvalidParameterError(field, item, TOLERANCE_TEXT, "has no =")
         typed, relative, dist = parts
-        name, read_dist = spec_text.compact(typed), spec_text.compact(dist or "")
-        item = {"name": name if name in PARAMETER_SPECS else typed, "relative": _read_number(relative),
-                "distribution": "normal" if dist is None else read_dist if read_dist in DISTRIBUTIONS else dist}
+        item = {"name": spec_text.name_text(typed, PARAMETER_SPECS), "relative": _read_number(relative),
+                "distribution": "normal" if dist is None else spec_text.name_text(dist, DISTRIBUTIONS)}
     elif isinstance(item, Mapping):
         _item_keys(field, item, ("name", "relative", "distribution"))
         for key in ("name", "relative"):

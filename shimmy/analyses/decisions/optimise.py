@@ -76,9 +76,9 @@ class Constraint:
             raise InvalidParameterError("constraint", text, "FIGURE<=VALUE or FIGURE>=VALUE (FIGURE[@Fz in N])",
                                         "has no <= or >=")
         typed, op, right, at = parts
-        name = spec_text.compact(typed)
+        name = spec_text.name_text(typed, FIGURES)
         if name not in FIGURES:
-            raise unknown_name_error(typed, FIGURES, "constraint figure")
+            raise unknown_name_error(name, FIGURES, "constraint figure")
         value = check_number("constraint", spec_text.number_text(right), -1e12, 1e12, FIGURES[name].unit)
         Fz = (check_number("constraint Fz", spec_text.number_text(at), *FZ_BOX, "N") if at is not None
               else (default_Fz if FIGURES[name].at_load else None))

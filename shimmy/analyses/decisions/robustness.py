@@ -79,10 +79,8 @@ class Tolerance:
         if parts is None:
             raise InvalidParameterError("tolerance", text, "NAME=REL or NAME=REL:normal|uniform", "has no =")
         name, value, dist = parts
-        dist = dist or "normal"
-        read_name, read_dist = spec_text.compact(name), spec_text.compact(dist)
-        return cls.make(read_name if read_name in PARAMETER_SPECS else name, spec_text.number_text(value),
-                        read_dist if read_dist in DISTRIBUTIONS else dist)
+        return cls.make(spec_text.name_text(name, PARAMETER_SPECS), spec_text.number_text(value),
+                        spec_text.name_text(dist or "normal", DISTRIBUTIONS))
 
     @classmethod
     def make(cls, name: str, relative: Any, distribution: str = "normal") -> "Tolerance":

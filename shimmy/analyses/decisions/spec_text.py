@@ -37,6 +37,13 @@ def tolerance_parts(text: str) -> tuple[str, str, str | None] | None:
     return name.strip(), relative.strip(), dist.strip() if colon else None
 
 
+def name_text(typed: str, names) -> str:
+    """A name part as read (spaces dropped: 'max _psi' -> 'max_psi') if it is one of ``names``, else as typed
+    (to be refused quoting it)."""
+    read = compact(typed)
+    return read if read in names else typed
+
+
 def number_text(typed: str) -> str:
     """A number part as read (spaces dropped: '150 000' -> '150000') if it is one, else as typed (to be
     refused quoting it)."""
