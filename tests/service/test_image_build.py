@@ -1,9 +1,11 @@
 """The Dockerfile, unchanged, builds offline with buildah and the image passes its smoke test.
 
 No Docker engine runs here; scripts/build_image_offline.sh builds with buildah (chroot
-isolation, vfs storage, a debootstrap Debian base) and smoke-tests the image with
-`buildah run`: imports, the warmed numba cache, gunicorn answering /api/v1/health, and a
-Dask worker running a simulation. About 4 minutes from scratch, 1.5 with the base reused.
+isolation, overlay storage where the kernel mounts one, else vfs; a debootstrap Debian base) and
+smoke-tests the image with `buildah run`: imports, the warmed numba cache, gunicorn answering
+/api/v1/health, and a Dask worker running a simulation. With overlay, measured on a 2-core machine:
+2.5 minutes from scratch, 30 s after a change of the sources with the base reused (vfs: 3.3 minutes
+and 100 s).
 """
 
 import os
