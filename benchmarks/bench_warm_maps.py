@@ -1,6 +1,7 @@
 """Warm maps against cold maps (the live-maps issue's performance figures).
 
     python benchmarks/bench_warm_maps.py [--configs nes,nes_pd] [--steps e_p,r2,k_s,a_p] [--repeats 1]
+    python benchmarks/bench_warm_maps.py --configs nes --walk 12 [--walk-step 0.02]
 
 For each configuration: its cold map at the nominal design (the cached one), then for each slider
 step (e_p +10 %, r2 -0.005 m, k_s +10 %, a_p +0.05) the cold map of the stepped design and its map
@@ -9,6 +10,12 @@ per core), ``--repeats`` times each, medians. Prints the seconds, the ratio warm
 slices the warm map carried / computed again / added, and the share of equal shading cells
 (warm against cold; the issue's bar: >= 99.5 %). Maps over V 1-200 m/s, Fz 10-900 kN, the
 default resolution and grid.
+
+``--walk N``: a slider walk instead: N steps of e_p by ``--walk-step`` (relative) from the nominal
+design, each map warmed from the one before (as the service warms from the nearest cached design),
+printing each step's seconds and its slices carried / computed again / added: a slice is carried
+only within ``CARRY_DISTANCE`` of the design its diagram was computed at, so the walk computes them
+all again every CARRY_DISTANCE / step steps.
 """
 
 from __future__ import annotations
@@ -40,7 +47,12 @@ def main() -> None:
     parser.add_argument("--configs", default="original,nes,pd,nes_pd")
     parser.add_argument("--steps", default=",".join(STEPS))
     parser.add_argument("--repeats", type=int, default=1)
+    parser.add_argument("--walk", type=int, default=0, help="steps of a walk in e_p (0: the slider steps)")
+    parser.add_argument("--walk-step", type=float, default=0.02, help="a walk's step, relative")
     args = parser.parse_args()
+    if args.walk:
+        walk(args.configs.split(","), args.walk, args.walk_step)
+        return
     print(f"machine: {os.cpu_count()} cores; executor: {describe()}")
     print(f"{'config':8} {'step':5} {'cold s':>8} {'warm s':>8} {'ratio':>6} {'carried/again/added':>20} "
           f"{'equal cells':>11}")
@@ -68,6 +80,34 @@ def main() -> None:
                 equal = float((np.array(cold.shading) == np.array(warm.shading)).mean())
                 print(f"{config:8} {name:5} {c:8.2f} {w:8.2f} {w / c:6.3f} {slices:>20} {100 * equal:10.2f}%",
                       flush=True)
+
+
+def walk(configs: list[str], steps: int, step: float) -> None:
+    """Each configuration's walk of ``steps`` e_p steps, each map warmed from the one before."""
+    from shimmy.analyses.maps.warm_map import CARRY_DISTANCE
+
+    print(f"machine: {os.cpu_count()} cores; executor: {describe()}; CARRY_DISTANCE {CARRY_DISTANCE:g}")
+    nominal = Parameters()
+    with open_executor() as pool:
+        stability_map("original", fz_range=(1.0e4, 3.0e4), resolution=3, executor=pool)  # workers warm
+        for config in configs:
+            t, here = timed(lambda: stability_map(config, params=nominal, executor=pool))
+            print(f"{config:8} step  0 e_p {nominal.nes.e_p:.6g}: cold {t:6.2f} s", flush=True)
+            times = []
+            for k in range(1, steps + 1):
+                params = nominal.with_overrides({"e_p": round(nominal.nes.e_p * (1.0 + step) ** k, 10)})
+                start = json.loads(json.dumps(here.warm_start()))
+                t, here = timed(lambda: stability_map(config, params=params, executor=pool, warm_from=start))
+                times.append(t)
+                info = here.warmed_from
+                if info is None:
+                    slices = f"cold: {here.warm_refused}"
+                else:
+                    s = info["slices"]
+                    slices = f"{s['carried']}/{len(s['computed_again'])}/{len(s['added'])} carried/again/added"
+                print(f"{config:8} step {k:2d} e_p {params.nes.e_p:.6g}: {t:6.2f} s  {slices}", flush=True)
+            print(f"{config:8} walk: median {statistics.median(times):.2f} s, longest {max(times):.2f} s, "
+                  f"total {sum(times):.1f} s", flush=True)
 
 
 if __name__ == "__main__":
