@@ -14,8 +14,10 @@ default resolution and grid.
 ``--walk N``: a slider walk instead: N steps of e_p by ``--walk-step`` (relative) from the nominal
 design, each map warmed from the one before (as the service warms from the nearest cached design),
 printing each step's seconds and its slices carried / computed again / added: a slice is carried
-only within ``CARRY_DISTANCE`` of the design its diagram was computed at, so the walk computes them
-all again every CARRY_DISTANCE / step steps.
+only within ``CARRY_DISTANCE`` of the design its diagram was computed at (``design_distance``:
+relative to the larger value), so the walk computes them all again at its first step farther than
+that (+2 % steps: step 6, 0.112 from the nominal e_p; step 5 is 0.094). Configurations without the
+NES (e_p not in their model) are left out.
 """
 
 from __future__ import annotations
@@ -51,6 +53,8 @@ def main() -> None:
     parser.add_argument("--walk-step", type=float, default=0.02, help="a walk's step, relative")
     args = parser.parse_args()
     if args.walk:
+        if args.walk < 0 or args.walk_step <= 0:
+            parser.error("--walk must be a number of steps >= 1 and --walk-step > 0")
         walk(args.configs.split(","), args.walk, args.walk_step)
         return
     print(f"machine: {os.cpu_count()} cores; executor: {describe()}")
@@ -85,6 +89,9 @@ def main() -> None:
 def walk(configs: list[str], steps: int, step: float) -> None:
     """Each configuration's walk of ``steps`` e_p steps, each map warmed from the one before."""
     from shimmy.analyses.maps.warm_map import CARRY_DISTANCE
+    from shimmy.model.configurations import affects
+
+    configs = [c for c in configs if affects("e_p", c)]
 
     print(f"machine: {os.cpu_count()} cores; executor: {describe()}; CARRY_DISTANCE {CARRY_DISTANCE:g}")
     nominal = Parameters()

@@ -66,20 +66,13 @@ overlay_mounts() {
     d="$(mktemp -d "$work/overlay-probe.XXXXXX")" || return 1
     mkdir -p "$d/lower" "$d/upper" "$d/work" "$d/merged"
     if mount -t overlay overlay -o "lowerdir=$d/lower,upperdir=$d/upper,workdir=$d/work" "$d/merged" 2>/dev/null; then
-        umount "$d/merged"
+        umount "$d/merged" || return 1
         rm -rf "$d"
         return 0
     fi
     rm -rf "$d"
     return 1
 }
-mkdir -p "$work"
-driver="${SHIMMY_STORAGE_DRIVER:-}"
-if [ -z "$driver" ]; then
-    if [ "$(id -u)" -eq 0 ] && overlay_mounts; then driver=overlay; else driver=vfs; fi
-fi
-case "$driver" in overlay|vfs) ;; *) echo "SHIMMY_STORAGE_DRIVER=$driver: overlay or vfs" >&2; exit 2 ;; esac
-B=(buildah --root "$work/storage-$driver" --runroot "$work/run-$driver" --storage-driver "$driver")
 # chroot isolation for `buildah run` too: the OCI runtime (crun) cannot create containers
 # on hosts with hybrid cgroups, and the build already relies on chroot.
 export BUILDAH_ISOLATION=chroot
@@ -112,12 +105,26 @@ cleanup() {
 trap cleanup EXIT
 
 [ "$(id -u)" -eq 0 ] || die "run as root (debootstrap, chroot and buildah's storage need it)"
-echo "buildah storage: $driver ($work/storage-$driver)"
-# The storage of the script's runs before the driver was chosen (vfs, in $work/storage): its images are no
-# cache for either folder now; ~7 GB and more.
-if [ -d "$work/storage" ]; then
-    echo "removing the storage of earlier runs: $work/storage"
-    rm -rf "$work/storage" "$work/run"
+mkdir -p "$work"
+rm -rf --one-file-system "$work"/overlay-probe.*  # of a run interrupted while probing
+driver="${SHIMMY_STORAGE_DRIVER:-}"
+how="SHIMMY_STORAGE_DRIVER"
+if [ -z "$driver" ]; then
+    if overlay_mounts; then driver=overlay; else driver=vfs; fi
+    how="probed: an overlay $([ "$driver" = overlay ] && echo mounts || echo does not mount) in $work"
+fi
+case "$driver" in overlay|vfs) ;; *) die "SHIMMY_STORAGE_DRIVER=$driver: overlay or vfs" ;; esac
+B=(buildah --root "$work/storage-$driver" --runroot "$work/run-$driver" --storage-driver "$driver")
+echo "buildah storage: $driver ($how), $work/storage-$driver"
+# The vfs storage of this script's runs before the driver was chosen ($work/storage, with its run folder):
+# deleted, not moved (its layers' records hold their paths); ~7 GB and more. Only a folder that holds
+# buildah's vfs storage is removed.
+if [ -d "$work/storage/vfs-layers" ] || [ -d "$work/storage/vfs-images" ]; then
+    echo "removing the vfs storage of earlier runs: $work/storage"
+    rm -rf --one-file-system "$work/storage"
+    if [ -d "$work/run/vfs-layers" ] || [ -d "$work/run/vfs-containers" ]; then
+        rm -rf --one-file-system "$work/run"
+    fi
 fi
 
 # ---------------------------------------------------------------- 1. tools

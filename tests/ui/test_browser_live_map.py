@@ -45,7 +45,7 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
     assert len(first) == 1
 
     # one step of e_p (+10 %): computed by itself, warmed from the cached map, the old map faint meanwhile
-    box = by_id(browser, pattern("e_p", "param-box"))
+    box = wait_for(lambda: by_id(browser, pattern("e_p", "param-box")), what="the e_p box")
     type_into(box, "0.00132")
     wait_for(lambda: _faded(browser) or "New design's map" in _title(browser)
              or "Making the new design's map" in _title(browser), timeout=30,
@@ -89,7 +89,7 @@ def test_the_overview_boundary_follows_the_design(server, browser):
     browser.get(server.base + "/?e_p=0.0015")
     wait_for(lambda: browser.find_elements(By.ID, "ov-boundary-graph"), what="the boundary figure")
     idle(browser)
-    type_into(by_id(browser, pattern("e_p", "param-box")), "0.0016")
+    type_into(wait_for(lambda: by_id(browser, pattern("e_p", "param-box")), what="the e_p box"), "0.0016")
 
     def boundary_jobs():
         return [j for i, j in job_records(server).items() if i not in before and j["analysis"] == "hopf_curves"]
@@ -124,7 +124,8 @@ def test_a_held_slider_starts_nothing_until_it_is_let_go(server, browser):
     wait_for(lambda: browser.find_elements(By.ID, "ov-boundary-graph"), what="the boundary figure")
     idle(browser)
     before = set(job_records(server))
-    slider = by_id(browser, pattern("e_p", "param"))
+    # dcc.Slider's code is loaded lazily (a chunk of its own): under load the slider is drawn after the figures
+    slider = wait_for(lambda: by_id(browser, pattern("e_p", "param")), what="the e_p slider")
     handle = slider.find_element(By.CSS_SELECTOR, "[role='slider']")
     width = slider.size["width"]
     drag = ActionChains(browser).click_and_hold(handle)
