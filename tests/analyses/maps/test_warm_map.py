@@ -167,11 +167,16 @@ def test_warm_slices_are_the_cold_slices_at_their_curves(pair, request):
 @BOTH
 def test_warm_shading_equals_the_cold_shading(pair, request):
     _, cold, warm, _ = request.getfixturevalue(pair)
+    _same_shading(cold, warm)
+
+
+def _same_shading(cold, warm) -> None:
+    """The issue's bar: at least 99.5 % of the cells equal, each differing cell beside a change of type
+    in the cold map (an edge of a region)."""
     a, b = np.array(cold.shading), np.array(warm.shading)
     assert a.shape == b.shape
-    differ = np.argwhere(a != b)
     assert (a == b).mean() >= 0.995, (a == b).mean()
-    for i, j in differ:  # each beside a change of type in the cold map (an edge of a region)
+    for i, j in np.argwhere(a != b):
         around = {a[i2, j2] for i2 in range(max(i - 1, 0), min(i + 2, a.shape[0]))
                   for j2 in range(max(j - 1, 0), min(j + 2, a.shape[1]))}
         assert len(around) > 1, (i, j, a[i, j], b[i, j])
@@ -282,8 +287,9 @@ def test_a_damper_step_of_pd_is_warmed_to_the_cold_maps_arrangement_and_shading(
             if p.get("located") and q.get("located") and not (c["kind"] == "NS" and p["kind"] == "LPNS"):
                 assert _close(p["V"], q["V"], 1.0, CODIM2_V_REL) and _close(p["Fz"], q["Fz"], 1e3, CODIM2_REL), (p, q)
     assert _close(cold.min_shimmy_Fz, warm.min_shimmy_Fz, 1e3)
-    a, b = np.array(cold.shading), np.array(warm.shading)
-    assert (a == b).mean() >= 0.995, (a == b).mean()
+    # (its carried slices keep their Both -> Lateral ends near 300 kN where the nominal diagrams put them:
+    # 1.4 and 2.0 m/s from the cold map's at 288.4 and 293.4 kN, within a cell of that edge)
+    _same_shading(cold, warm)
 
 
 def test_slices_computed_far_from_this_design_are_computed_again(maps):
