@@ -140,6 +140,17 @@ def by_id(driver, element_id):
     return driver.execute_script("return document.getElementById(arguments[0])", element_id)
 
 
+def slider_handle(driver, name: str | None = None):
+    """The handle (role slider) of parameter ``name``'s slider, or of the page's first slider; waited for:
+    dcc.Slider's code is a chunk loaded lazily, under load drawn after the page's figures."""
+    def find():
+        root = driver if name is None else by_id(driver, pattern(name, "param"))
+        found = [] if root is None else root.find_elements(By.CSS_SELECTOR, "[role='slider']")
+        return found[0] if found else None
+
+    return wait_for(find, what=f"the {name or 'first'} slider")
+
+
 def pattern(name: str, kind: str) -> str:
     """The DOM id of a pattern-matching component {"type": kind, "name": name}."""
     return '{"name":"%s","type":"%s"}' % (name, kind)

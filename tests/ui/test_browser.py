@@ -17,7 +17,7 @@ from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
 from browser import (DOWNLOADS, PAGES, SHOTS, browser_fixture, idle, job_records, on_figure, severe,  # noqa: E402
-                     table_rows, text_of, trace_count, wait_for)
+                     slider_handle, table_rows, text_of, trace_count, wait_for)
 
 browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)
 
@@ -160,7 +160,7 @@ def test_slider_move_updates_the_linear_stability_figure_and_the_url(server, bro
     browser.get(server.base + "/")
     before = wait_for(lambda: _nes_onset(browser), what="the Hopf table")
     traces_before = wait_for(lambda: browser.execute_script(NES_TRACE), what="the growth-rate figure")
-    handle = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]  # r2
+    handle = slider_handle(browser, "r2")
     handle.click()
     for _ in range(20):
         handle.send_keys(Keys.ARROW_RIGHT)

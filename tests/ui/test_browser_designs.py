@@ -18,7 +18,7 @@ from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
 from browser import (DOWNLOADS, SHOTS, browser_fixture, by_id, idle, open_page, severe, text_of,  # noqa: E402
-                     trace_count, type_into, wait_for)
+                     slider_handle, trace_count, type_into, wait_for)
 
 browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)  # the profile of test_browser.py
 
@@ -250,7 +250,7 @@ def test_the_overview_comparison_follows_the_slider_only_with_the_current_design
     _tick(browser, "current design", A[0])
     first = wait_for(lambda: len(_comparison(browser)) > 1 and _comparison(browser), timeout=20,
                      what="the comparison of the current design and A")
-    handle = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]  # r2
+    handle = slider_handle(browser, "r2")
     handle.click()
     for _ in range(10):
         handle.send_keys(Keys.ARROW_LEFT)
@@ -270,7 +270,7 @@ def test_the_overview_comparison_follows_the_slider_only_with_the_current_design
     assert "current design" not in text_of(browser, "ov-cmp-designs")
     browser.execute_script("""window.__asked = []; const f = window.fetch;
         window.fetch = function(url, opts) { window.__asked.push((opts && opts.body) || ''); return f.apply(this, arguments); };""")
-    handle = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]
+    handle = slider_handle(browser, "r2")
     handle.click()
     for _ in range(5):
         handle.send_keys(Keys.ARROW_LEFT)

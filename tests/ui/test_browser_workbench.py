@@ -15,7 +15,7 @@ pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 from browser import (PAGES, SHOTS, browser_fixture, by_id, idle, open_page, pattern, severe,  # noqa: E402
-                     text_of, trace_count, type_into, wait_for)
+                     slider_handle, text_of, trace_count, type_into, wait_for)
 
 #: Headless Chromium as in test_browser.py, with a profile of its own.
 browser = browser_fixture("chromium-profile-workbench", "1440,900")
@@ -32,7 +32,7 @@ def test_design_box_slider_and_url_stay_in_sync(server, browser):
     assert box.get_attribute("value") == "0.08"  # the value is visible before any drag
     type_into(box, "0.0853")
     wait_for(lambda: "r2=0.0853" in browser.current_url, timeout=10, what="the URL to carry the typed r2")
-    slider = browser.find_elements(By.CSS_SELECTOR, "[role='slider']")[0]
+    slider = slider_handle(browser, "r2")
     assert float(slider.get_attribute("aria-valuenow")) == pytest.approx(0.0853)
     slider.click()
     slider.send_keys(Keys.HOME)
@@ -57,7 +57,7 @@ def test_slider_steps_are_engineering_steps_without_float_noise(server, browser,
     open_page(browser, server, f"/?{name}={start}")
     box = wait_for(lambda: by_id(browser, pattern(name, "param-box")), what=f"the {name} box")
     assert box.get_attribute("value") == start  # typed (here: in the address) precision kept
-    slider = by_id(browser, pattern(name, "param")).find_element(By.CSS_SELECTOR, "[role='slider']")
+    slider = slider_handle(browser, name)
     slider.click()
     slider.send_keys(Keys.HOME)
     for _ in range(moves):
@@ -88,7 +88,7 @@ def test_advanced_values_are_kept_while_their_section_is_closed(server, browser)
     their values from the address (a slider step does not drop them), and opened they show them."""
     open_page(browser, server, "/?k_psi=400000")
     assert by_id(browser, pattern("k_psi", "param")) is None
-    slider = by_id(browser, pattern("r2", "param")).find_element(By.CSS_SELECTOR, "[role='slider']")
+    slider = slider_handle(browser, "r2")
     slider.click()
     slider.send_keys(Keys.ARROW_RIGHT)
     wait_for(lambda: "r2=" in browser.current_url, timeout=30, what="the step in the address")
