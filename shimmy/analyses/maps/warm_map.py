@@ -39,7 +39,11 @@ little: the curves move, but where their arrangement stays the same the regions 
 The result's ``methods.warmed_from`` names the design warmed from, the parameters changed and the
 slices carried, computed again and added. What the checks cannot see: a curve born away from a GH
 or double-Hopf point between the two designs (an isola appearing) is found only by a cold map, as
-it is by a cold map only where a slice's diagram meets it.
+it is by a cold map only where a slice's diagram meets it. Nor do they see a carried slice's
+mode-change ends move (where a stable cycle's torsional share crosses 0.8 or 0.2, on no curve): they
+stay where the slice's diagram put them, within ``CARRY_DISTANCE`` of its design. Measured against
+cold maps, one slider step moves some of them by 2-4 m/s, and a few cells (up to 12 of 18 000) then
+differ away from any edge of the cold map's regions (docs/benchmarks.md, "A slider walk").
 """
 
 from __future__ import annotations
