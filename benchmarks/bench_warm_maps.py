@@ -8,7 +8,8 @@ step (e_p +10 %, r2 -0.005 m, k_s +10 %, a_p +0.05) the cold map of the stepped 
 warmed from the nominal one, in the same process on the same pool (default executor: one worker
 per core), ``--repeats`` times each, medians. Prints the seconds, the ratio warm / cold, how many
 slices the warm map carried / computed again / added, and the share of equal shading cells
-(warm against cold; the issue's bar: >= 99.5 %). Maps over V 1-200 m/s, Fz 10-900 kN, the
+(warm against cold; the issue's bar: >= 99.5 %) and the differing cells away from every edge of the
+cold map's regions (``map_shading.cells_off_edges``; the bar: none). Maps over V 1-200 m/s, Fz 10-900 kN, the
 default resolution and grid.
 
 ``--walk N``: a slider walk instead: N steps of e_p by ``--walk-step`` (relative) from the nominal
@@ -31,6 +32,7 @@ import time
 import numpy as np
 
 from shimmy.analyses.core.executors import describe, open_executor
+from shimmy.analyses.maps import map_shading
 from shimmy.analyses.maps.stability_map import stability_map
 from shimmy.model.parameters import Parameters
 
@@ -59,7 +61,7 @@ def main() -> None:
         return
     print(f"machine: {os.cpu_count()} cores; executor: {describe()}")
     print(f"{'config':8} {'step':5} {'cold s':>8} {'warm s':>8} {'ratio':>6} {'carried/again/added':>20} "
-          f"{'equal cells':>11}")
+          f"{'equal cells':>11} {'off edges':>9}")
     nominal = Parameters()
     with open_executor() as pool:
         stability_map("original", fz_range=(1.0e4, 3.0e4), resolution=3, executor=pool)  # workers warm
@@ -82,8 +84,9 @@ def main() -> None:
                     s = info["slices"]
                     slices = f"{s['carried']}/{len(s['computed_again'])}/{len(s['added'])}"
                 equal = float((np.array(cold.shading) == np.array(warm.shading)).mean())
-                print(f"{config:8} {name:5} {c:8.2f} {w:8.2f} {w / c:6.3f} {slices:>20} {100 * equal:10.2f}%",
-                      flush=True)
+                off = len(map_shading.cells_off_edges(cold.shading, warm.shading))
+                print(f"{config:8} {name:5} {c:8.2f} {w:8.2f} {w / c:6.3f} {slices:>20} {100 * equal:10.2f}% "
+                      f"{off:9d}", flush=True)
 
 
 def walk(configs: list[str], steps: int, step: float) -> None:

@@ -370,3 +370,20 @@ def polygon_area(polygon: dict[str, Any]) -> float:
     """Area (m/s x N) of a polygon, by the shoelace formula."""
     x, y = np.asarray(polygon["V"], float), np.asarray(polygon["Fz"], float)
     return float(0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+
+
+def cells_off_edges(reference: Sequence[Sequence[str]], other: Sequence[Sequence[str]]) -> list[tuple[int, int]]:
+    """The cells (row, column) where ``other``'s grid differs from ``reference``'s away from every edge
+    of ``reference``'s regions: its eight neighbours (those inside the grid) all of the cell's type. A
+    warm map's grid against the cold map's of the same design should have none (a cell differing beside
+    an edge is the curves' or the slices' rounding)."""
+    a, b = np.asarray(reference), np.asarray(other)
+    if a.shape != b.shape:
+        raise ValueError(f"grids of shapes {a.shape} and {b.shape}")
+    padded = np.pad(a, 1, mode="edge")  # a border cell's outside neighbours: copies of cells it has
+    rows, cols = a.shape
+    uniform = np.ones(a.shape, bool)
+    for di in (0, 1, 2):
+        for dj in (0, 1, 2):
+            uniform &= padded[di:di + rows, dj:dj + cols] == a
+    return [(int(i), int(j)) for i, j in np.argwhere(uniform & (a != b))]

@@ -14,6 +14,7 @@ import json
 import numpy as np
 import pytest
 
+from shimmy.analyses.maps import map_shading
 from shimmy.analyses.maps.stability_map import stability_map
 from shimmy.analyses.maps.warm_map import NotWarm, arrangement_change, warm_map
 from shimmy.analyses.diagrams.bifurcation import BifurcationOptions
@@ -176,10 +177,23 @@ def _same_shading(cold, warm) -> None:
     a, b = np.array(cold.shading), np.array(warm.shading)
     assert a.shape == b.shape
     assert (a == b).mean() >= 0.995, (a == b).mean()
-    for i, j in np.argwhere(a != b):
-        around = {a[i2, j2] for i2 in range(max(i - 1, 0), min(i + 2, a.shape[0]))
-                  for j2 in range(max(j - 1, 0), min(j + 2, a.shape[1]))}
-        assert len(around) > 1, (i, j, a[i, j], b[i, j])
+    off = map_shading.cells_off_edges(a, b)
+    assert off == [], [(i, j, a[i, j], b[i, j]) for i, j in off[:10]]
+
+
+def test_cells_off_edges_are_differing_cells_with_a_uniform_neighbourhood():
+    """Against the neighbourhood read cell by cell (the rule as the tests wrote it before)."""
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        a = rng.choice(["Stable", "Torsion", "Lateral"], size=(9, 7), p=[0.8, 0.1, 0.1])
+        b = np.where(rng.random(a.shape) < 0.2, "Both", a)
+        want = [(i, j) for i, j in np.argwhere(a != b)
+                if len({a[i2, j2] for i2 in range(max(i - 1, 0), min(i + 2, a.shape[0]))
+                        for j2 in range(max(j - 1, 0), min(j + 2, a.shape[1]))}) == 1]
+        assert map_shading.cells_off_edges(a, b) == want
+    assert map_shading.cells_off_edges([["Stable"]], [["Torsion"]]) == [(0, 0)]  # a lone cell: no edge
+    with pytest.raises(ValueError):
+        map_shading.cells_off_edges([["Stable"]], [["Stable", "Stable"]])
 
 
 def test_a_map_of_other_options_is_computed_cold_and_says_why(maps):
