@@ -77,16 +77,19 @@ def main() -> None:
                     t, warm = timed(lambda: stability_map(config, params=params, executor=pool, warm_from=start))
                     warms.append(t)
                 c, w = statistics.median(colds), statistics.median(warms)
-                info = warm.warmed_from
-                if info is None:
-                    slices = f"cold: {warm.warm_refused[:40]}"
-                else:
-                    s = info["slices"]
-                    slices = f"{s['carried']}/{len(s['computed_again'])}/{len(s['added'])}"
+                slices = slice_counts(warm) or f"cold: {warm.warm_refused[:40]}"
                 equal = float((np.array(cold.shading) == np.array(warm.shading)).mean())
                 off = len(map_shading.cells_off_edges(cold.shading, warm.shading))
                 print(f"{config:8} {name:5} {c:8.2f} {w:8.2f} {w / c:6.3f} {slices:>20} {100 * equal:10.2f}% "
                       f"{off:9d}", flush=True)
+
+
+def slice_counts(smap) -> str:
+    """A warm map's slices "carried/computed again/added"; empty for a map computed cold."""
+    if smap.warmed_from is None:
+        return ""
+    s = smap.warmed_from["slices"]
+    return f"{s['carried']}/{len(s['computed_again'])}/{len(s['added'])}"
 
 
 def walk(configs: list[str], steps: int, step: float) -> None:
@@ -109,12 +112,8 @@ def walk(configs: list[str], steps: int, step: float) -> None:
                 start = json.loads(json.dumps(here.warm_start()))
                 t, here = timed(lambda: stability_map(config, params=params, executor=pool, warm_from=start))
                 times.append(t)
-                info = here.warmed_from
-                if info is None:
-                    slices = f"cold: {here.warm_refused}"
-                else:
-                    s = info["slices"]
-                    slices = f"{s['carried']}/{len(s['computed_again'])}/{len(s['added'])} carried/again/added"
+                counts = slice_counts(here)
+                slices = f"{counts} carried/again/added" if counts else f"cold: {here.warm_refused}"
                 print(f"{config:8} step {k:2d} e_p {params.nes.e_p:.6g}: {t:6.2f} s  {slices}", flush=True)
             print(f"{config:8} walk: median {statistics.median(times):.2f} s, longest {max(times):.2f} s, "
                   f"total {sum(times):.1f} s", flush=True)
