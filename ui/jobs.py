@@ -314,11 +314,14 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
                 mark)
 
     @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(group.ready, "data"),
-                   prevent_initial_call=True)
-    def show(ready):
-        """The results of the jobs the poll found done, drawn (once per ready signal)."""
+                   State(group.go, "data"), prevent_initial_call=True)
+    def show(ready, go):
+        """The results of the jobs the poll found done, drawn (once per ready signal), unless a later action
+        of the page let them go between the poll and this draw (a cached answer to new controls drawn
+        already, or other jobs asked for): the page's store no longer waits for them, or the service says
+        its watcher is gone. Drawn then, they would replace the newer answer with the older one."""
         ids, wanted = _waiting(ready)
-        if not ids:
+        if not ids or not _still_awaited(ready, go):
             return nothing
         try:  # the requests came back through the browser's JSON (150000.0 as 150000): canonical again
             wanted = canonical(analysis, wanted)
@@ -398,6 +401,16 @@ def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:
             or len(wanted) > settings.MAX_PAGE_REQUESTS or not all(isinstance(i, str) and len(i) < 64 for i in ids)):
         return [], []
     return ids, wanted
+
+
+def _still_awaited(ready: Any, go: Any) -> bool:
+    """Whether the page still waits for the jobs the poll found done (``ready``): its store of the jobs it
+    waits for (``go``) names the same jobs for the same watcher, and the service has not seen that watcher
+    let any of them go (a later action of the page, whose answer the page may have drawn already)."""
+    ids, watcher = _waiting(ready)[0], _watcher(ready)
+    if not ids or _waiting(go)[0] != ids or _watcher(go) != watcher:
+        return False
+    return not any(job is not None and _let_go(job, watcher) for job in map(jobs.peek, ids))
 
 
 def _size(sketch: Any) -> int:

@@ -99,7 +99,9 @@ def test_margins_of_a_bistable_point_and_a_run_from_the_torsional_threshold(serv
     wait_for(lambda: "V = 50 m/s," in (on_figure(browser, "th-series", TITLE) or "")
              and "torsional limit cycle" in text_of(browser, "th-settled")
              and f"psi0 = {start:g} rad" in text_of(browser, "th-settled"), timeout=240,
-             what="the run from the kick at the margins' point")
+             what=lambda: "the run from the kick at the margins' point (figure: "
+             + repr(on_figure(browser, "th-series", TITLE)) + "; settled: " + text_of(browser, "th-settled")
+             + "; status: " + text_of(browser, "th-status") + ")")
     assert severe(browser) == []
 
 

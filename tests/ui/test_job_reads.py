@@ -108,3 +108,19 @@ def test_the_veiled_clock_remembers_its_second_per_run():
     assert page_jobs._clock_drawn({"jobs": ["b"], "clock": 2}, ["a"]) is None  # another run's
     assert page_jobs._clock_drawn({"jobs": ["a"], "clock": True}, ["a"]) is None  # not a second
     assert page_jobs._clock_drawn(None, ["a"]) is None
+
+
+def test_results_found_done_are_drawn_only_while_the_page_still_waits_for_them(job):
+    """The poll found the job done and signalled its draw; before the draw, a later action of the page (a cached
+    answer to new controls, drawn at once) let the job go. Drawn then, the older answer would replace it."""
+    jobs.update(job, status="done")
+    go = {"jobs": [job], "requests": [{"config": "nes"}], "watcher": "view-1", "asked": time.time()}
+    ready = {**go, "tick": 3}
+    assert page_jobs._still_awaited(ready, go)
+    assert not page_jobs._still_awaited(ready, None)  # the later action's answer: the page waits for nothing
+    assert not page_jobs._still_awaited(ready, {**go, "jobs": ["other"], "watcher": "view-2"})  # other jobs
+    assert not page_jobs._still_awaited(ready, {**go, "watcher": "view-2"})  # the same job, asked again
+    assert not page_jobs._still_awaited({**ready, "jobs": []}, {**go, "jobs": []})
+    # the store not yet changed in the browser, but the service has seen the page let the job go
+    jobs.release(job, "view-1")
+    assert not page_jobs._still_awaited(ready, go)
