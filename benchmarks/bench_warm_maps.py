@@ -4,7 +4,8 @@
     python benchmarks/bench_warm_maps.py --configs nes --walk 12 [--walk-step 0.02]
 
 For each configuration: its cold map at the nominal design (the cached one), then for each slider
-step (e_p +10 %, r2 -0.005 m, k_s +10 %, a_p +0.05) the cold map of the stepped design and its map
+step (e_p +10 %, r2 -0.005 m, k_s +10 %, a_p +0.05; by name also a_p-, k_s- the other way and rho_p +10 %)
+the cold map of the stepped design and its map
 warmed from the nominal one, in the same process on the same pool (default executor: one worker
 per core), ``--repeats`` times each, medians. Prints the seconds, the ratio warm / cold, how many
 slices the warm map carried / computed again / added, and the share of equal shading cells
@@ -38,6 +39,10 @@ from shimmy.model.parameters import Parameters
 
 STEPS = {"e_p": lambda p: {"e_p": round(p.nes.e_p * 1.1, 10)}, "r2": lambda p: {"r2": round(p.nes.r2 - 0.005, 10)},
          "k_s": lambda p: {"k_s": round(p.nes.k_s * 1.1, 10)}, "a_p": lambda p: {"a_p": round(p.pd.a_p + 0.05, 10)}}
+#: other steps, by name with --steps: the slider's steps the other way, and the particle density
+MORE_STEPS = {"a_p-": lambda p: {"a_p": round(p.pd.a_p - 0.05, 10)},
+              "k_s-": lambda p: {"k_s": round(p.nes.k_s * 0.9, 10)},
+              "rho_p": lambda p: {"rho_p": round(p.pd.rho_p * 1.1, 10)}}
 
 
 def timed(run):
@@ -69,7 +74,7 @@ def main() -> None:
             base = stability_map(config, params=nominal, executor=pool)
             start = json.loads(json.dumps(base.warm_start()))
             for name in args.steps.split(","):
-                params = nominal.with_overrides(STEPS[name](nominal))
+                params = nominal.with_overrides({**STEPS, **MORE_STEPS}[name](nominal))
                 colds, warms = [], []
                 for _ in range(args.repeats):
                     t, cold = timed(lambda: stability_map(config, params=params, executor=pool))

@@ -853,6 +853,26 @@ def test_peak_of_an_orbit_is_located_on_the_collocation_polynomial(phase):
     assert amplitude >= sampled
 
 
+@pytest.mark.parametrize("phase", [0.0, 0.3217, 0.999])
+def test_extremes_of_an_orbit_are_its_polynomials_largest_and_smallest_values(phase):
+    """x(tau) = 0.4 + 1.1 sin(2 pi s) + 0.5 cos(6 pi s), s = tau - phase, on an uneven mesh: no symmetry,
+    max and min at no sample; against the polynomials evaluated on a dense grid (their own extremes)."""
+    system = ALL_SYSTEMS["hopf_supercritical"]()  # the field does not enter: only the node values
+    points = np.sort(np.concatenate([[0.0, 1.0], np.random.default_rng(2).uniform(0.02, 0.98, 23)]))
+    mesh = Mesh(points, 4)
+    problem = PeriodicProblem(system, mesh, np.ones(system.n), 1.0, 1.0)
+    X = np.zeros((mesh.n_nodes, system.n))
+    s = mesh.node_times - phase
+    X[:, 1] = 0.4 + 1.1 * np.sin(2 * np.pi * s) + 0.5 * np.cos(6 * np.pi * s)
+    u = problem.pack(X, 1.0, 0.0)
+    high, low = problem.extremes(u, 1)
+    dense = problem.evaluate(X, np.linspace(0.0, 1.0, 400001))[:, 1]
+    assert high == pytest.approx(dense.max(), rel=1e-10) and low == pytest.approx(dense.min(), rel=1e-10)
+    sampled = problem.sample(u)[1][:, 1]
+    assert high >= sampled.max() and low <= sampled.min()
+    assert high > sampled.max() + 1e-7 or low < sampled.min() - 1e-7  # the samples miss them
+
+
 class _FlatWithNoise:
     """One equation 1e-8 (u0 - 1) = 0 whose evaluation carries rounding-like noise of size
     ``noise`` that flips sign at every call: Newton's corrections are noise / 1e-8."""

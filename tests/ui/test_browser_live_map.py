@@ -53,7 +53,10 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
     browser.save_screenshot(str(SHOTS / "live-map-fading-1440.png"))
     # the new design's curves as they come, over the previous map (its regions and curves faint)
     wait_for(lambda: "Making the new design's map" in _title(browser), timeout=120, interval=0.1,
-             what="the new design's curves over the previous map")
+             what=lambda: "the new design's curves over the previous map (the figure's title: "
+             f"{_title(browser)!r}; status: {text_of(browser, 'map-status')!r}; the jobs: "
+             + "; ".join(f"{j['analysis']} {j['status']} {j['message']}" for i, j in job_records(server).items()
+                         if i not in before and i not in first) + ")")
     assert on_figure(browser, "map-graph", "return g.data.filter(t => (t.name || '').indexOf('(previous)') >= 0)"
                                            ".length;") > 0
     browser.save_screenshot(str(SHOTS / "live-map-sketch-warm-1440.png"))

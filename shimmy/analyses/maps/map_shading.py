@@ -63,6 +63,39 @@ def crossings(curves: Sequence[Curve], Fz: float) -> list[tuple[float, tuple[str
     return out
 
 
+def with_points(p: np.ndarray, points: Sequence[tuple[float, float]], reach: float = 0.01) -> np.ndarray:
+    """The polyline ``p`` (k, 2) in (V, Fz) with located points of its curve (crossings of the slices'
+    loads) put in as vertices, each into the segment that crosses its load nearest to it (within
+    ``reach`` of its V, relative, at least 0.01 m/s; else left out), so that the curve crosses each such
+    load where the point was located, not on a chord: 5 mm/s off a fold curve's crossing of 603.3 kN
+    (nes), which a slice's interval ended at, left a piece of the next region 1e-3 of its interval wide
+    inside it, and whether the shading kept such a sliver hung on the chord."""
+    p = np.asarray(p, float).reshape(-1, 2)
+    if len(p) < 2 or not len(points):
+        return p
+    inserts: list[tuple[int, float, float]] = []
+    a, b = p[:-1], p[1:]
+    for V, Fz in points:
+        if np.any((np.abs(p[:, 0] - V) <= 1e-12 * max(abs(V), 1.0)) & (p[:, 1] == Fz)):
+            continue  # a vertex already
+        span = (a[:, 1] - Fz) * (b[:, 1] - Fz) <= 0.0
+        span &= a[:, 1] != b[:, 1]
+        ks = np.nonzero(span)[0]
+        if ks.size == 0:
+            continue
+        f = (Fz - a[ks, 1]) / (b[ks, 1] - a[ks, 1])
+        chord = a[ks, 0] + f * (b[ks, 0] - a[ks, 0])
+        j = int(np.argmin(np.abs(chord - V)))
+        if abs(chord[j] - V) <= max(reach * abs(V), 0.01):
+            inserts.append((int(ks[j]), float(f[j]), (V, Fz)))
+    if not inserts:
+        return p
+    rows = list(map(tuple, p))
+    for k, _, point in sorted(inserts, key=lambda t: (t[0], t[1]), reverse=True):
+        rows.insert(k + 1, point)
+    return np.array(rows, float)
+
+
 def named_intervals(curves: Sequence[Curve], Fz: float, v_range: tuple[float, float]):
     """[(V_low, V_high, name)] between consecutive crossings of the load inside the speed range."""
     v_min, v_max = v_range

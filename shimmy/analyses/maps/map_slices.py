@@ -26,6 +26,8 @@ from ...version import __version__
 from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
 from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from ..diagrams.cycle_curves import starts_of_diagram
+from ..diagrams.mode_changes import ModeChange, locate_mode_changes
+from .map_shading import type_at
 from ...model.units import kn, mm
 
 SHIMMY_TYPES = tuple(ShimmyType)
@@ -153,6 +155,9 @@ class SliceResult:
     #: the design (parameters) its diagram was computed at (a warm start's record: a carried slice
     #: keeps its own; not in :meth:`to_dict`)
     computed_at: dict[str, float] | None = field(default=None, repr=False)
+    #: the located mode changes its intervals end at, with their cycles (a warm start's record: a
+    #: carried slice's relocated at its new design; not in :meth:`to_dict`)
+    mode_changes: list[ModeChange] = field(default_factory=list, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         return {"Fz": self.Fz, "hopf_points": self.hopf_points, "special_points": self.special_points,
@@ -190,8 +195,8 @@ def _slice_types(result: BifurcationResult, fine: np.ndarray, coarse_step: int, 
 def _intervals(fine: np.ndarray, types: list[str], critical: list[float] = ()) -> list[dict[str, Any]]:
     """Maximal V intervals of one type other than Stable. An end between two grid points moves to
     the located Hopf / fold / torus point between them, if there is one (exact), else to the
-    middle between them (within half a fine step: a cycle's mode changing), so that two
-    intervals that meet share their end."""
+    middle between them (a cycle's mode changing: :func:`map_slice` then moves it to the located
+    change, :func:`at_mode_changes`), so that two intervals that meet share their end."""
     crit = np.sort(np.asarray(list(critical), float))
 
     def snap(inside: int, outside: int) -> float:
@@ -245,9 +250,51 @@ def map_slice(config: Configuration | str, Fz: float, *, params: Parameters, v_r
             for h in result.hopf.hopf_points]
     special = _special_points(result)
     critical = [h["V"] for h in hopf] + [p["V"] for p in special]
-    return SliceResult(Fz, coarse, types_fine[::FINE], hopf, special, _intervals(fine, types_fine, critical),
+    intervals = _intervals(fine, types_fine, critical)
+    changes: list[ModeChange] = []
+    if _mode_ends(intervals, critical, fine):
+        intervals, changes = at_mode_changes(intervals, locate_mode_changes(result), critical, fine)
+        if changes:
+            types_fine = [type_at(intervals, float(v)) for v in fine]
+    return SliceResult(Fz, coarse, types_fine[::FINE], hopf, special, intervals,
                        type_lengths(fine, types_fine), result.max_psi, result.max_psi_V, simulated,
-                       list(result.warnings), time.perf_counter() - clock, starts_of_diagram(result, Fz))
+                       list(result.warnings), time.perf_counter() - clock, starts_of_diagram(result, Fz),
+                       mode_changes=changes)
+
+
+def _mode_ends(intervals: list[dict[str, Any]], critical, fine: np.ndarray) -> list[float]:
+    """The intervals' inner ends at no located point: where a cycle's mode changes (a fine-grid midpoint)."""
+    exact = set(critical) | {float(fine[0]), float(fine[-1])}
+    return sorted({v for iv in intervals for v in (iv["V_start"], iv["V_end"]) if v not in exact})
+
+
+def at_mode_changes(intervals: list[dict[str, Any]], changes: list[ModeChange], critical,
+                    fine: np.ndarray) -> tuple[list[dict[str, Any]], list[ModeChange]]:
+    """The intervals with each end where a cycle's mode changes (:func:`_intervals` put it halfway between
+    the fine-grid points around the diagram's change) moved to the located change it stands for: the
+    nearest one located between the diagram's two points around it (a fine step either side), each used
+    once, moved only as far as the ends beside it allow. (The intervals, the changes used.)"""
+    step = float(fine[1] - fine[0]) if fine.size > 1 else 0.0
+    ends = _mode_ends(intervals, critical, fine)
+    others = sorted({v for iv in intervals for v in (iv["V_start"], iv["V_end"])})
+    moved: dict[float, float] = {}
+    used: list[ModeChange] = []
+    for end in ends:
+        near = [c for c in changes if c not in used and
+                min(c.bracket) - step <= end <= max(c.bracket) + step]
+        if not near:
+            continue
+        change = min(near, key=lambda c: abs(c.V - end))
+        lo, hi = sorted((end, change.V))
+        if any(lo < v < hi for v in others if v != end):
+            continue  # it would pass another end: left where it was
+        moved[end] = change.V
+        used.append(change)
+    if not moved:
+        return intervals, []
+    out = [{**iv, "V_start": moved.get(iv["V_start"], iv["V_start"]), "V_end": moved.get(iv["V_end"], iv["V_end"])}
+           for iv in intervals]
+    return out, used
 
 
 # --------------------------------------------------------------------------- classify

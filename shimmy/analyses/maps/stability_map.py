@@ -183,24 +183,29 @@ class StabilityMap:
 
     def boundaries(self) -> list[tuple[str, np.ndarray]]:
         """The region boundaries as named polylines in (V, Fz): ``hopf<i>`` for the Hopf curves, then
-        the kind and index of each fold and torus curve (``LPC2``), as the shading names them."""
+        the kind and index of each fold and torus curve (``LPC2``), as the shading names them, with their
+        located crossings of the slices' loads as vertices (:func:`curve_boundaries`)."""
         out = [(f"hopf{i}", c.p) for i, c in enumerate(self.hopf.curves)]
         for i, c in enumerate(self.cycles["curves"]):
             points = self.cycles[KEY_OF_KIND[c["kind"]]][_index_of_kind(self.cycles["curves"], i)]
-            out.append((f"{c['kind']}{i}", np.array([[q["V"], q["Fz"]] for q in points], float).reshape(-1, 2)))
+            polyline = np.array([[q["V"], q["Fz"]] for q in points], float).reshape(-1, 2)
+            located = [(x["V"], x["Fz"]) for x in c["crossings"]]
+            out.append((f"{c['kind']}{i}", map_shading.with_points(polyline, located)))
         return out
 
     def warm_start(self) -> dict[str, Any]:
         """What a map of a nearby design is warmed from (:func:`shimmy.analyses.maps.warm_map.warm_map`),
         JSON-ready: the plane, grid and options, the boundaries, the slices' intervals, the arrangement
         (curve counts, GH and double-Hopf points, each cycle curve's closure and codimension-2
-        points) and a seed on each fold and torus curve."""
+        points), a seed on each fold and torus curve and, per slice, the mode changes its intervals end
+        at with their cycles."""
         options = self.options or BifurcationOptions(mesh_check=False)
         return {"config": self.config.value, "params": self.params.to_dict(), "v_range": list(self.v_range),
                 "fz_range": list(self.fz_range), "resolution": self.resolution, "n_v": self.n_v,
                 "options": dataclasses.asdict(options), "rows": self.shading_Fz.tolist(),
                 "boundaries": [[name, p.tolist()] for name, p in self.boundaries()],
-                "slices": [s.to_dict() | {"computed_at": s.computed_at or self.params.to_dict()} for s in self.slices],
+                "slices": [s.to_dict() | {"computed_at": s.computed_at or self.params.to_dict(),
+                                          "mode_changes": [c.to_dict() for c in s.mode_changes]} for s in self.slices],
                 "arrangement": arrangement(self.hopf, self.cycles),
                 "seeds": [seed.to_dict() for seed in self.seeds], "version": __version__}
 
@@ -474,9 +479,13 @@ def _boundaries(hopf: HopfCurvesResult, search: CurveSearch) -> list[tuple[str, 
 
 def curve_boundaries(hopf: HopfCurvesResult, curves: Sequence[GearCycleCurve]) -> list[tuple[str, np.ndarray]]:
     """The region boundaries: every Hopf, fold and torus curve as a polyline in (V, Fz), named
-    ``hopf<i>``, then the kind and index of each cycle curve (``LPC2``), as the shading names them."""
+    ``hopf<i>``, then the kind and index of each cycle curve (``LPC2``), as the shading names them; a
+    cycle curve's located crossings of the slices' loads put in as vertices
+    (:func:`~shimmy.analyses.maps.map_shading.with_points`)."""
     out = [(f"hopf{i}", c.p) for i, c in enumerate(hopf.curves)]
-    out += [(f"{c.kind}{i}", c.curve.p) for i, c in enumerate(curves)]
+    out += [(f"{c.kind}{i}", map_shading.with_points(c.curve.p, [(float(q.p), float(q.data["p2"]))
+                                                                 for q in c.curve.points_of(PointKind.P2_MARK)]))
+            for i, c in enumerate(curves)]
     return out
 
 

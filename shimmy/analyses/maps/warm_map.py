@@ -23,15 +23,17 @@ little: the curves move, but where their arrangement stays the same the regions 
 4. **The slices are carried where the curves cross their load in the same order as before**
    (:func:`arrangement_change`: two crossings may swap only where they lie within half a grid cell,
    their order being the polylines' rounding): each slice's intervals move with the curves (an end
-   on a curve to that curve's new crossing, an end where a cycle's mode changes stays, held in its
-   interval between the curves), its Hopf points are located again by the eigenvalue scan, its
+   on a curve to that curve's new crossing, an end where a cycle's mode changes to that change
+   located again on its cycle at the new design, :func:`~shimmy.analyses.diagrams.mode_changes.relocate`,
+   beside the curves' traces), its Hopf points are located again by the eigenvalue scan, its
    fold and torus points are the new curves' located crossings of its load (each point moved with
    its curve's drawn crossing, then matched to the located crossing within half a cell of there, or
    else to the one crossing between there and where it was; a point the slice lists twice, found on
    two of its branches, matched once). Its diagram is not
    recomputed, so it reports no largest amplitude (``max_psi`` None, ``"carried": true``). A slice
    whose load the curves now cross otherwise, or with a Hopf point more or less, or with a point
-   on no curve of the map (a period doubling), is computed again; and, as a cold map does, a slice
+   on no curve of the map (a period doubling), or a mode change not found again, is computed again;
+   and, as a cold map does, a slice
    is added through each region between the new curves that no slice crosses. A fold or torus point
    of a slice computed again that lies on no curve is continued as a cold map continues it: a curve
    the map lacks makes the map cold; none (no such point converges there) is the cold map's warning.
@@ -39,11 +41,14 @@ little: the curves move, but where their arrangement stays the same the regions 
 The result's ``methods.warmed_from`` names the design warmed from, the parameters changed and the
 slices carried, computed again and added. What the checks cannot see: a curve born away from a GH
 or double-Hopf point between the two designs (an isola appearing) is found only by a cold map, as
-it is by a cold map only where a slice's diagram meets it. Nor do they see a carried slice's
-mode-change ends move (where a stable cycle's torsional share crosses 0.8 or 0.2, on no curve): they
-stay where the slice's diagram put them, within ``CARRY_DISTANCE`` of its design. Measured against
-cold maps, one slider step moves some of them by 2-4 m/s, and a few cells (up to 12 of 18 000) then
-differ away from any edge of the cold map's regions (docs/benchmarks.md, "A slider walk").
+it is by a cold map only where a slice's diagram meets it. Nor do they see a mode change appear or
+vanish on a carried slice (a stable cycle's torsional share reaching 0.8 or 0.2 at a new place, on no
+curve): a slice is carried only within ``CARRY_DISTANCE`` of the design its diagram was computed at.
+The mode changes it has are exact at the new design: a cold slice locates them on its diagram's
+branches (:func:`~shimmy.analyses.diagrams.mode_changes.locate_mode_changes`) and a carried one again
+from their cycles, the two to 1e-5 m/s. (Kept where the slice's diagram put them, they were 1.4-5 m/s
+off after one slider step of the damper's filling ratio, and cells differed away from any edge of the
+cold map's regions: 12 of 18 000 on nes_pd at a_p + 0.05.)
 """
 
 from __future__ import annotations
@@ -65,6 +70,7 @@ from ..diagrams.bifurcation import V_SCALE, BifurcationOptions
 from ..diagrams.cycle_curves import (FZ_SCALE, KINDS, CurveSearch, CurveSeed, GearCycleCurve, WarmUnit,
                                      continue_start, joined_halves, reversed_curve, same_curve)
 from ..diagrams.hopf_curves import HopfCurvesResult
+from ..diagrams.mode_changes import ModeChange, relocate
 from . import map_shading
 from .map_slices import FINE, SliceResult, speed_grids, type_lengths
 from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, HopfCurvesUnit, SliceUnit, Sketch, StabilityMap,
@@ -78,9 +84,9 @@ ON_CURVES = (PointKind.FOLD_OF_CYCLES, PointKind.TORUS)
 #: point the slice's diagram found on two of its branches (measured: 0.024 m/s apart, a cell ~2 m/s).
 DUPLICATE = 0.1
 #: A slice is carried only within this largest relative parameter change from the design its
-#: diagram was computed at (a mode change inside an interval stays where that diagram put it: the
-#: farther the design, the farther it may be off); farther, it is computed again. One slider step of
-#: 10 % is carried once; a walk of several steps recomputes its slices every 10 %.
+#: diagram was computed at (a mode change appearing or vanishing between the curves is seen only by a
+#: diagram); farther, it is computed again. One slider step of 10 % is carried once; a walk of several
+#: steps recomputes its slices every 10 %.
 CARRY_DISTANCE = 0.1
 
 
@@ -142,10 +148,9 @@ def _labels(labels) -> str:
 
 class _Carrier:
     """Moves speeds at one load with the curves. A curve's crossing goes to that curve's crossing at
-    the new design; any other speed (an interval's end where a cycle's mode changes, on the slice's
-    fine grid) stays where it was, held inside the same interval between the curves. (Moving it in
-    proportion to its interval moved ends that a cold map leaves where they were: a mode change at
-    a fine-grid midpoint moves only when the design moves it a fine step.)"""
+    the new design; any other speed (an interval's end at a mode change not located on its cycle, from
+    an older cache: on the slice's fine grid; a simulated speed) stays where it was, held inside the same
+    interval between the curves."""
 
     def __init__(self, old_curves, new_curves, Fz: float, v_range):
         new = {label: V for V, label in map_shading.crossings(new_curves, Fz)}
@@ -201,9 +206,11 @@ def _on_curve(old_boundaries, new_boundaries, Fz: float, carry: _Carrier, tol: f
 
 def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameters, v_range, n_v: int, scan: list,
                    carry: _Carrier, on_curve: Callable[[float, str], float], crossings: dict[str, list[float]],
-                   tol: float) -> SliceResult:
+                   tol: float, changes: list[tuple[ModeChange, ModeChange | None]] = ()) -> SliceResult:
     """A slice of the old map at the new design (see the module's step 4), ``scan`` the Hopf points at
-    its load at the new design; NotWarm where it cannot be carried (it is then computed again)."""
+    its load at the new design, ``changes`` the mode changes its intervals end at, (as they were, as
+    located again at the new design: None where not found); NotWarm where it cannot be carried (it is then
+    computed again)."""
     clock = time.perf_counter()
     Fz = float(old["Fz"])
     computed_at = old.get("computed_at")
@@ -244,9 +251,15 @@ def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameter
         V = min(located, key=lambda x: abs(x - V))
         taken[V] = q["V"]
         special.append({"kind": q["kind"], "V": V, "mode": q["mode"]})
-    # an interval's end at one of the slice's located points goes to that point at the new design
-    exact = list(zip([h["V"] for h in old["hopf_points"]] + [q["V"] for q in old["special_points"]],
-                     [h["V"] for h in hopf] + [q["V"] for q in special], strict=True))
+    for was, now in changes:
+        if now is None:
+            raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN has a mode change at V = {was.V:.5g} m/s (torsional "
+                          f"share {was.threshold:g}) that was not found again at this design")
+    # an interval's end at one of the slice's located points, or at a located mode change, goes to that point
+    # at the new design
+    exact = list(zip([h["V"] for h in old["hopf_points"]] + [q["V"] for q in old["special_points"]]
+                     + [was.V for was, _ in changes],
+                     [h["V"] for h in hopf] + [q["V"] for q in special] + [now.V for _, now in changes], strict=True))
 
     def moved(V: float) -> float:
         for was, now in exact:
@@ -267,7 +280,8 @@ def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameter
     return SliceResult(Fz, coarse, fine_types[::FINE], hopf, special, intervals, type_lengths(fine, fine_types), None,
                        None, [carry(v) for v in old["simulated_V"]],
                        [f"{w} (at the design the slice was computed at)" for w in old["warnings"]],
-                       time.perf_counter() - clock, carried=True, computed_at=computed_at)
+                       time.perf_counter() - clock, carried=True, computed_at=computed_at,
+                       mode_changes=[now for _, now in changes])
 
 
 def _off_curve(q: dict[str, Any], s: SliceResult, config: Configuration, params: Parameters, box, marks,
@@ -320,6 +334,24 @@ class SliceHopfUnit:
         return f"Hopf points at the {len(self.loads)} slices' loads"
 
 
+@dataclass(frozen=True, eq=False)
+class ModeChangesUnit:
+    """The mode changes a slice's intervals end at, located again at the new design
+    (:func:`~shimmy.analyses.diagrams.mode_changes.relocate`; None where one is not found). Run beside the
+    curves: they need only the design."""
+
+    config: Configuration
+    params: Parameters
+    changes: tuple[ModeChange, ...]
+    exact_nes: bool
+
+    def run(self) -> list[ModeChange | None]:
+        return [relocate(c, self.config, self.params, exact_nes=self.exact_nes) for c in self.changes]
+
+    def describe(self) -> str:
+        return f"{len(self.changes)} mode change(s) at Fz = {kn(self.changes[0].Fz)} located again"
+
+
 #: A curve half's cost per point it follows, by kind, relative to a fold curve's (the torus system has
 #: two periods: ~20 against ~14 ms a point on nes)
 COST_PER_POINT = {PointKind.TORUS: 1.5}
@@ -370,16 +402,22 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     # the slices' Hopf points at the new design, last (keyed -1 in the results)
     scans = SliceHopfUnit(config, params, tuple(float(s["Fz"]) for s in start["slices"]), v_range)
     units.append((2.0, scans))
+    # the mode changes the slices' intervals end at, slice by slice (keyed -2, -3, ...)
+    relocations = {float(s["Fz"]): ModeChangesUnit(config, params, tuple(map(ModeChange.from_dict, s["mode_changes"])),
+                                                   options.exact_nes)
+                   for s in start["slices"] if s.get("mode_changes")}
+    units += [(2.0, unit) for unit in relocations.values()]
     results: dict[int, Any] = {}
     index = {id(u): k for k, (_, u) in enumerate(units)}
     index[id(scans)] = -1
+    index.update({id(unit): -2 - k for k, unit in enumerate(relocations.values())})
 
     def curve_of(j: int) -> tuple[GearCycleCurve | None, str | None]:
         return joined_halves(results[2 * j + 1], results[2 * j + 2])
 
     def done(unit, result):
         results[index[id(unit)]] = result
-        if sketch is not None and 0 in results and unit is not scans:
+        if sketch is not None and 0 in results and index[id(unit)] >= 0:
             found = []
             for j in range(len(seeds)):
                 halves = [results.get(2 * j + 1), results.get(2 * j + 2)]
@@ -438,12 +476,14 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
             if change:
                 raise NotWarm(f"the curves' arrangement changed on it: {change}")
             carry = _Carrier(old_boundaries, boundaries, Fz, v_range)
+            unit = relocations.get(Fz)
+            moved_changes = [] if unit is None else list(zip(unit.changes, results[index[id(unit)]], strict=True))
             slices.append(_carried_slice(old, config, params, v_range, n_v, results[-1][Fz], carry,
                                          _on_curve(old_boundaries, boundaries, Fz, carry, tol),
-                                         _crossings_of(curves, Fz), tol))
+                                         _crossings_of(curves, Fz), tol, moved_changes))
         except NotWarm as exc:
             again[Fz] = exc.reason
-    # regions between the new curves that no slice crosses: slices through them, as a cold map adds
+    # regions between the new curves that no slice crosses: slices through them, as a cold map adds them
     loads_now = [float(s["Fz"]) for s in start["slices"]]
     added: list[float] = []
     for _ in range(COVERAGE_ROUNDS):
@@ -506,7 +546,8 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
                                                "curve's next point where that converges), the curves' kinds, "
                                                "closure and codimension-2 points checked unchanged; a slice whose "
                                                "load the curves cross in the same order carried with them (an end on a "
-                                               "curve to its new crossing, a mode change kept in its interval), "
+                                               "curve to its new crossing, a mode change to the same change "
+                                               "located again on its cycle), "
                                                "its Hopf points scanned again; the others computed again, and "
                                                "slices added through regions between the new curves that none "
                                                "crosses"})

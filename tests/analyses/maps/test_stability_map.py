@@ -401,6 +401,29 @@ def test_shading_changes_only_at_the_curves_or_where_the_slices_change():
     assert lengths["Torsion"] == pytest.approx(edge - change) and lengths["Stable"] == pytest.approx(200.0 - edge)
 
 
+def test_a_curves_located_crossings_are_vertices_of_its_polyline():
+    """A curve Fz = 9e5 - 1e3 (V - 30)^2 N that turns at 900 kN, drawn as a polyline with a vertex every
+    2.5 m/s (its chords cross a load up to ~0.1 m/s off the curve), its located crossings of two loads put
+    in (two each, either side of the turn): the polyline crosses those loads exactly there, and every other
+    load as before; a point far off every chord (another curve's) is left out."""
+    V = np.arange(0.0, 60.01, 2.5)
+    curve = np.column_stack([V, 9e5 - 1e3 * (V - 30.0) ** 2])
+    loads = [6e5, 8.3e5]
+    located = [(30.0 + side * np.sqrt((9e5 - F) / 1e3), F) for F in loads for side in (-1.0, 1.0)]
+    for F in loads:
+        chords = [x for x, _ in map_shading.crossings([("c", curve)], F)]
+        wanted = sorted(v for v, f in located if f == F)
+        assert len(chords) == 2 and 0.01 < max(abs(a - b) for a, b in zip(chords, wanted))  # the chords miss
+    drawn = map_shading.with_points(curve, located + [(95.0, loads[0])])
+    assert len(drawn) == len(curve) + len(located)
+    for F in loads:
+        assert [x for x, _ in map_shading.crossings([("c", drawn)], F)] == sorted(v for v, f in located if f == F)
+    for F in (3e5, 7e5, 8.9e5):
+        assert map_shading.crossings([("c", drawn)], F) == map_shading.crossings([("c", curve)], F)
+    assert np.array_equal(map_shading.with_points(curve, []), curve)
+    assert np.array_equal(map_shading.with_points(drawn, located), drawn)  # vertices already
+
+
 def test_region_polygons_follow_the_rows_and_split_where_a_region_does():
     """A wedge of Torsion opening upwards between two boundaries, and above a load a Lateral
     island splitting it: the polygons' areas are the trapezoid rule over the rows, and each
@@ -586,3 +609,4 @@ def test_a_mode_piece_one_slice_lacks_narrows_linearly_instead_of_a_staircase(up
         (a, b), = [(a, b) for a, b, t in row if t == "Both"]
         mid = (0.5 * (a + b) - 1.0) / (50.0 + Fz / 1e4 - 1.0)
         assert mid == pytest.approx(lower_mid + w * (target - lower_mid), rel=1e-9)
+

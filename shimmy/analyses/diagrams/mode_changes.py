@@ -1,0 +1,213 @@
+"""Where a stable cycle's mode changes, located exactly on its branch.
+
+A cycle is torsional where its torsional share of elastic energy, k_psi A_psi^2 / (k_psi A_psi^2 +
+k_delta A_delta^2) with A the half peak-to-peak amplitudes of psi and delta over the orbit, is at least
+0.8, lateral where it is at most 0.2, both in between (:func:`~shimmy.analyses.core.response.mode_of`).
+A diagram gives the mode at its continuation points, 2-4 m/s apart where the mode changes; a map that
+put the change halfway between two points (or at a fine grid point) was off by up to half a step, and
+a map warmed from it could not tell how the change moved with the design.
+
+:func:`locate_mode_changes` finds each change on a diagram's stable stretches: the arclength along the
+branch, from the computed point before it, at which the share equals the threshold (Brent's method on
+points corrected by the continuation's own corrector, ends known from the diagram). :func:`relocate`
+finds the same change at a nearby design: the cycle of the change corrected at its speed (Newton with V
+held), then the root of the share along the new branch by the secant method. Both converge the speed
+to :data:`V_TOL` (m/s). The amplitudes are the orbit's extremes on its collocation polynomial
+(:meth:`~shimmy.continuation.collocation.PeriodicProblem.extremes`), not its samples, so that the speed
+found does not depend on the mesh beyond the collocation's own error: located at a design from that
+design's diagram and relocated there from a nearby design's, one change agrees to 1e-7 m/s, at worst
+7e-6 m/s (pd, a_p 0.9 -> 0.81: other meshes).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ...continuation import ContinuationOptions, CurvePoint
+from ...continuation.collocation import Mesh, PeriodicProblem
+from ...continuation.core import step
+from ...model.configurations import Configuration
+from ...model.equations import build_model
+from ...model.parameters import Parameters
+from ..core.response import LATERAL_SHARE, TORSION_SHARE, torsional_share
+from .bifurcation import STATE_SCALE, T_SCALE, V_SCALE, BifurcationResult, _restore, at_fixed_speed, gear_field
+
+#: The speed of a located change is converged to this (m/s).
+V_TOL = 1e-7
+#: Trials of the secant method of :func:`relocate` at most (each one a corrector run).
+MAX_TRIALS = 16
+THRESHOLDS = (TORSION_SHARE, LATERAL_SHARE)
+
+
+@dataclass(frozen=True, eq=False)
+class ModeChange:
+    """A stable cycle's mode change at (V, Fz): the share crosses ``threshold`` there; ``mesh``, ``ncol``
+    and ``u`` (X, T, V) its cycle; ``span`` the arclength of the diagram's step it lay in (the scale of a
+    relocation's trial steps)."""
+
+    V: float
+    Fz: float
+    threshold: float
+    mesh: np.ndarray
+    ncol: int
+    u: np.ndarray
+    span: float
+
+    #: the speeds of the diagram's two points it lies between (the change itself where it was relocated)
+    bracket: tuple[float, float] = (math.nan, math.nan)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"V": self.V, "Fz": self.Fz, "threshold": self.threshold, "mesh": self.mesh.tolist(),
+                "ncol": self.ncol, "u": self.u.tolist(), "span": self.span}
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> ModeChange:
+        return cls(float(d["V"]), float(d["Fz"]), float(d["threshold"]), np.asarray(d["mesh"], float),
+                   int(d["ncol"]), np.asarray(d["u"], float), float(d["span"]), (float(d["V"]), float(d["V"])))
+
+
+def share_of(problem: PeriodicProblem, u: np.ndarray, k_psi: float, k_delta: float) -> float:
+    """The torsional share of the cycle ``u``, its amplitudes as the diagram measures them."""
+    psi_max, psi_min = problem.extremes(u, 0)
+    delta_max, delta_min = problem.extremes(u, 2)
+    return float(torsional_share(0.5 * (psi_max - psi_min), 0.5 * (delta_max - delta_min), k_psi, k_delta))
+
+
+def _system(config: Configuration, params: Parameters, Fz: float, exact_nes: bool):
+    model = build_model(config, params, exact_nes=exact_nes)
+    return gear_field(model, Fz), STATE_SCALE[:model.n_states]
+
+
+def _options(result: BifurcationResult) -> ContinuationOptions:
+    return ContinuationOptions(ds=result.options.ds, ds_max=result.options.ds_max)
+
+
+def locate_mode_changes(result: BifurcationResult) -> list[ModeChange]:
+    """Every change of mode between two consecutive stable points of the diagram's periodic branches
+    (a loop's closing step left out), by speed; a step whose change does not converge is left out (its
+    points' modes stand, as before)."""
+    system, scale = _system(result.config, result.params, result.Fz, result.options.exact_nes)
+    gear = result.params.gear
+    copts = _options(result)
+    found = []
+    for b in result.branches:
+        raw = b.raw
+        if b.kind != "periodic" or raw is None or raw.p.size < 2:
+            continue
+        share = torsional_share(0.5 * (raw.x_max[:, 0] - raw.x_min[:, 0]), 0.5 * (raw.x_max[:, 2] - raw.x_min[:, 2]),
+                                gear.k_psi, gear.k_delta)
+        for i in range(raw.p.size - 1):
+            if not (raw.stable[i] and raw.stable[i + 1]) or not np.isfinite(share[i:i + 2]).all():
+                continue
+            for threshold in THRESHOLDS:
+                g0, g1 = share[i] - threshold, share[i + 1] - threshold
+                if g0 * g1 >= 0.0 or g0 == g1:
+                    continue
+                change = _on_step(system, scale, raw, i, threshold, (g0, g1), copts, gear, result.Fz)
+                if change is not None:
+                    found.append(change)
+    return sorted(found, key=lambda c: c.V)
+
+
+def _on_step(system, scale, raw, i: int, threshold: float, ends: tuple[float, float], copts, gear,
+             Fz: float) -> ModeChange | None:
+    problem, start, span = _restore(system, raw, i, scale)
+    if span <= 0.0:
+        return None
+    tried: dict[float, CurvePoint] = {}
+
+    def g(h: float) -> float:
+        if h <= 0.0:
+            return ends[0]
+        if h >= span:
+            return ends[1]
+        point = step(problem, start, h, copts, with_tangent=False)
+        if point is None:
+            raise _NoPoint
+        tried[h] = point
+        return share_of(problem, point.u, gear.k_psi, gear.k_delta) - threshold
+
+    # the speed moves at most |dV/ds| h: a tolerance in h that is one of V_TOL in V
+    rate = abs(raw.p[i + 1] - raw.p[i]) / span
+    try:
+        h = brentq(g, 0.0, span, xtol=V_TOL / max(rate, 1e-12) / 4.0, rtol=4 * np.finfo(float).eps, maxiter=60)
+    except (_NoPoint, RuntimeError, ValueError):
+        return None
+    point = tried.get(h) or (step(problem, start, h, copts, with_tangent=False) if 0.0 < h < span else None)
+    if point is None:
+        return None
+    return ModeChange(float(point.u[-1]), float(Fz), float(threshold), problem.mesh.points.copy(), raw.ncol,
+                      point.u.copy(), float(span), (float(raw.p[i]), float(raw.p[i + 1])))
+
+
+class _NoPoint(Exception):
+    """A trial step's corrector did not converge."""
+
+
+def relocate(change: ModeChange, config: Configuration, params: Parameters, *, exact_nes: bool = False,
+             options: ContinuationOptions | None = None) -> ModeChange | None:
+    """The mode change ``change`` (located at a nearby design) at the design ``params``, same load and
+    threshold: its cycle corrected with V held, then the secant method along the new branch to V_TOL;
+    None if a correction fails or the secant method does not converge in MAX_TRIALS trials or strays
+    more than four of the diagram's steps from where it began (the change is then no longer that one)."""
+    system, scale = _system(config, params, change.Fz, exact_nes)
+    problem = PeriodicProblem(system, Mesh(change.mesh, change.ncol), scale, T_SCALE, V_SCALE)
+    problem.accept(change.u)
+    copts = options or ContinuationOptions()
+    start = at_fixed_speed(problem, change.u, copts)
+    if start is None:
+        return None
+    problem.accept(start.u)
+    gear = params.gear
+
+    def g(point: CurvePoint) -> float:
+        return share_of(problem, point.u, gear.k_psi, gear.k_delta) - change.threshold
+
+    root = _secant(lambda h: step(problem, start, h, copts, with_tangent=False), g, start, change.span)
+    if root is None:
+        return None
+    V = float(root.u[-1])
+    return ModeChange(V, change.Fz, change.threshold, change.mesh, change.ncol, root.u.copy(), change.span, (V, V))
+
+
+def _secant(at: Callable[[float], CurvePoint | None], g: Callable[[CurvePoint], float], start: CurvePoint,
+            span: float) -> CurvePoint | None:
+    """The point at arclength h from ``start`` where g = 0, by the secant method from h = 0 and span / 8;
+    converged when a step moves V by at most V_TOL."""
+    h0, g0, p0 = 0.0, g(start), start
+    if g0 == 0.0:
+        return start
+    h1 = math.copysign(span / 8.0, -g0 * _slope_sign(at, g, span, g0))
+    p1 = at(h1)
+    if p1 is None:
+        return None
+    g1 = g(p1)
+    for _ in range(MAX_TRIALS):
+        if g1 == 0.0:
+            return p1
+        if g1 == g0:
+            return None
+        h2 = h1 - g1 * (h1 - h0) / (g1 - g0)
+        if not abs(h2) <= 4.0 * span:
+            return None
+        p2 = at(h2)
+        if p2 is None:
+            return None
+        if abs(p2.u[-1] - p1.u[-1]) <= V_TOL:
+            return p2
+        h0, g0, p0 = h1, g1, p1
+        h1, g1, p1 = h2, g(p2), p2
+    return None
+
+
+def _slope_sign(at, g, span: float, g0: float) -> float:
+    """+1 if g grows along the tangent from the start (a small trial step), -1 if it falls."""
+    trial = at(span / 64.0)
+    if trial is None:
+        return 1.0
+    return 1.0 if g(trial) >= g0 else -1.0

@@ -1,0 +1,96 @@
+"""Mode changes of stable cycles located on their branches (shimmy.analyses.diagrams.mode_changes).
+
+Independent checks: the torsional share of the located cycle corrected again, with V held, on a mesh of
+twice the intervals (the collocation's convergence: the threshold to 1e-6); the located change lies
+between the diagram's two points whose modes differ; relocated at its own design it stays (to the
+tolerance); relocated at a nearby design it is the change that design's own diagram locates (to the
+meshes' difference, 1e-5 m/s), although it moved by metres per second; a map slice's interval ends
+there.
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from shimmy.analyses.core.response import mode_of, torsional_share
+from shimmy.analyses.diagrams.bifurcation import (STATE_SCALE, T_SCALE, V_SCALE, BifurcationOptions,
+                                                  at_fixed_speed, bifurcation, gear_field)
+from shimmy.analyses.diagrams.mode_changes import V_TOL, ModeChange, locate_mode_changes, relocate, share_of
+from shimmy.analyses.maps.map_slices import map_slice
+from shimmy.continuation import ContinuationOptions
+from shimmy.continuation.collocation import Mesh, PeriodicProblem
+from shimmy.model.equations import build_model
+from shimmy.model.parameters import Parameters
+
+V_RANGE = (1.0, 150.0)
+OPTIONS = BifurcationOptions(mesh_check=False)
+
+
+@pytest.fixture(scope="module")
+def nes():
+    """nes at 288.4 kN: its cycle from the Hopf point turns from both to lateral near 24 m/s."""
+    result = bifurcation("nes", 288.4e3, v_range=V_RANGE, options=OPTIONS)
+    return result, locate_mode_changes(result)
+
+
+def test_a_located_change_is_where_the_share_crosses_its_threshold(nes):
+    result, changes = nes
+    assert len(changes) == 1
+    change = changes[0]
+    assert change.threshold == 0.2 and 20.0 < change.V < 30.0
+    lo, hi = sorted(change.bracket)
+    assert lo < change.V < hi
+    # the diagram's points either side: stable, modes differing
+    b = next(b for b in result.branches if b.kind == "periodic" and b.raw is not None
+             and any(np.isclose(b.raw.p, change.bracket[0])))
+    raw = b.raw
+    i = int(np.argmin(np.abs(raw.p - change.bracket[0])))
+    gear = result.params.gear
+    share = torsional_share(0.5 * (raw.x_max[:, 0] - raw.x_min[:, 0]), 0.5 * (raw.x_max[:, 2] - raw.x_min[:, 2]),
+                            gear.k_psi, gear.k_delta)
+    assert raw.stable[i] and raw.stable[i + 1] and mode_of(share[i]) != mode_of(share[i + 1])
+    # the cycle at the change, corrected again with V held on a mesh of twice the intervals
+    model = build_model(result.config, result.params)
+    system = gear_field(model, result.Fz)
+    scale = STATE_SCALE[:model.n_states]
+    coarse = PeriodicProblem(system, Mesh(change.mesh, change.ncol), scale, T_SCALE, V_SCALE)
+    fine = PeriodicProblem(system, coarse.adapted_mesh(change.u, 2 * coarse.mesh.ntst), scale, T_SCALE, V_SCALE)
+    u = coarse.transfer(fine, change.u)
+    fine.accept(u)
+    point = at_fixed_speed(fine, u, ContinuationOptions())
+    assert point is not None and point.u[-1] == pytest.approx(change.V, abs=1e-12)
+    assert share_of(coarse, change.u, gear.k_psi, gear.k_delta) == pytest.approx(0.2, abs=1e-9)
+    assert share_of(fine, point.u, gear.k_psi, gear.k_delta) == pytest.approx(0.2, abs=1e-6)
+
+
+def test_a_change_relocated_at_its_own_design_stays(nes):
+    result, changes = nes
+    again = relocate(changes[0], result.config, result.params)
+    assert again is not None and abs(again.V - changes[0].V) <= 10 * V_TOL
+    back = ModeChange.from_dict(json.loads(json.dumps(changes[0].to_dict())))  # as a warm start stores it
+    assert back.V == changes[0].V and np.array_equal(back.u, changes[0].u) and back.span == changes[0].span
+
+
+@pytest.mark.parametrize("a_p", [0.85, 0.81])
+def test_a_change_relocated_at_a_nearby_design_is_the_one_located_there(a_p):
+    """pd at 306.7 kN: lowering the filling ratio from 0.9 moves its both -> lateral change by 1.5-4.7 m/s."""
+    before = locate_mode_changes(bifurcation("pd", 306.7e3, v_range=V_RANGE, options=OPTIONS))
+    params = Parameters().with_overrides({"a_p": a_p})
+    after = locate_mode_changes(bifurcation("pd", 306.7e3, v_range=V_RANGE, params=params, options=OPTIONS))
+    assert len(before) == len(after) == 1
+    moved = relocate(before[0], "pd", params)
+    assert moved is not None and abs(after[0].V - before[0].V) > 1.0
+    assert moved.V == pytest.approx(after[0].V, abs=1e-5)
+
+
+def test_a_slice_interval_ends_at_the_located_change(nes):
+    result, changes = nes
+    s = map_slice("nes", result.Fz, params=result.params, v_range=V_RANGE, n_v=60, result=result)
+    ends = {v for iv in s.intervals for v in (iv["V_start"], iv["V_end"])}
+    assert changes[0].V in ends
+    assert [c.V for c in s.mode_changes] == [changes[0].V]
+    before = [iv for iv in s.intervals if iv["V_end"] == changes[0].V]
+    after = [iv for iv in s.intervals if iv["V_start"] == changes[0].V]
+    assert len(before) == len(after) == 1 and before[0]["type"] != after[0]["type"]
+    assert s.lengths[before[0]["type"]] > 0 and s.lengths[after[0]["type"]] > 0
