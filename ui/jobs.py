@@ -319,10 +319,14 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         """The results of the jobs the poll found done, drawn (once per ready signal), unless a later action
         of the page let them go between the poll and this draw (a cached answer to new controls drawn
         already, or other jobs asked for): the page's store no longer waits for them, or the service says
-        its watcher is gone. Drawn then, they would replace the newer answer with the older one."""
+        its watcher is gone. Drawn then, they would replace the newer answer with the older one. Where the
+        store still names them and only the service saw them let go, the Cancel button raced the poll: the
+        page says "cancelled" and its controls come back."""
         ids, wanted = _waiting(ready)
-        if not ids or not _still_awaited(ready, go):
-            return nothing
+        if not ids or _waiting(go)[0] != ids or _watcher(go) != _watcher(ready):
+            return nothing  # a later action of the page asked for other jobs or drew an answer: its state stands
+        if not _still_awaited(ready, go):  # the page still names them, the service saw them let go: a Cancel
+            return stopped("", "cancelled")  # that raced this poll (the poll is off: nobody else says so)
         try:  # the requests came back through the browser's JSON (150000.0 as 150000): canonical again
             wanted = canonical(analysis, wanted)
             names = None if labels is None else _names(ready.get("labels"), wanted)

@@ -567,7 +567,7 @@ def _join(down: PeriodicBranch, up: PeriodicBranch) -> PeriodicBranch:
                                  for way, half in (("decreasing V", down), ("increasing V", up)) for s in half.stops])
 
 
-def _restore(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray,
+def restore_point(system: VectorField, raw: PeriodicBranch, i: int, scale: np.ndarray,
              to: int | None = None) -> tuple[PeriodicProblem, CurvePoint, float]:
     """The problem on point i's mesh, the point with its tangent oriented towards point ``to``
     (default i + 1), and the arclength to that point."""
@@ -605,7 +605,7 @@ def cycle_at(result: BifurcationResult, branch: int, V: float, max_psi: float | 
 
         crossings.sort(key=distance)
     for i in crossings:
-        problem, start, h = _restore(system, raw, i, scale)
+        problem, start, h = restore_point(system, raw, i, scale)
         if raw.p[i] == V:
             point = start
         else:
@@ -720,7 +720,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
     copts = ContinuationOptions(ds=options.ds, ds_max=options.ds_max)
     lo = max(i - 1, 0)
     if 0 < i < raw.p.size - 1 and raw.stable[lo] and raw.stable[i + 1]:
-        problem, start, span = _restore(system, raw, lo, scale, to=i + 1)
+        problem, start, span = restore_point(system, raw, lo, scale, to=i + 1)
         _, a_opt, point = largest_peak_along(problem, start, 0.0, span, copts, xatol=1e-5 * span)
         if point is not None and a_opt >= amp:
             amp, V = a_opt, float(point.u[-1])
@@ -736,7 +736,7 @@ def _maximum(system, branches: list[Branch], options: BifurcationOptions, scale,
         orbit = MaximumOrbit(raw.solutions[i][0], raw.ncol, raw.solutions[i][1].copy(), False)
     mesh_check = None
     if options.mesh_check:
-        problem, start, _ = _restore(system, raw, i, scale)
+        problem, start, _ = restore_point(system, raw, i, scale)
         point = i_point or start
         fine = PeriodicProblem(system, problem.adapted_mesh(point.u, 2 * problem.mesh.ntst), scale, T_SCALE,
                                V_SCALE)

@@ -35,7 +35,8 @@ from ...model.configurations import Configuration
 from ...model.equations import build_model
 from ...model.parameters import Parameters
 from ..core.response import LATERAL_SHARE, TORSION_SHARE, torsional_share
-from .bifurcation import STATE_SCALE, T_SCALE, V_SCALE, BifurcationResult, _restore, at_fixed_speed, gear_field
+from .bifurcation import (STATE_SCALE, T_SCALE, V_SCALE, BifurcationResult, at_fixed_speed, gear_field,
+                          restore_point)
 
 #: The speed of a located change is converged to this (m/s).
 V_TOL = 1e-7
@@ -63,12 +64,13 @@ class ModeChange:
 
     def to_dict(self) -> dict[str, Any]:
         return {"V": self.V, "Fz": self.Fz, "threshold": self.threshold, "mesh": self.mesh.tolist(),
-                "ncol": self.ncol, "u": self.u.tolist(), "span": self.span}
+                "ncol": self.ncol, "u": self.u.tolist(), "span": self.span, "bracket": list(self.bracket)}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> ModeChange:
         return cls(float(d["V"]), float(d["Fz"]), float(d["threshold"]), np.asarray(d["mesh"], float),
-                   int(d["ncol"]), np.asarray(d["u"], float), float(d["span"]), (float(d["V"]), float(d["V"])))
+                   int(d["ncol"]), np.asarray(d["u"], float), float(d["span"]),
+                   tuple(float(v) for v in d.get("bracket", (d["V"], d["V"]))))
 
 
 def share_of(problem: PeriodicProblem, u: np.ndarray, k_psi: float, k_delta: float) -> float:
@@ -116,7 +118,7 @@ def locate_mode_changes(result: BifurcationResult) -> list[ModeChange]:
 
 def _on_step(system, scale, raw, i: int, threshold: float, ends: tuple[float, float], copts, gear,
              Fz: float) -> ModeChange | None:
-    problem, start, span = _restore(system, raw, i, scale)
+    problem, start, span = restore_point(system, raw, i, scale)
     if span <= 0.0:
         return None
     tried: dict[float, CurvePoint] = {}

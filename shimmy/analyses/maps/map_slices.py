@@ -23,7 +23,7 @@ from ...errors import InvalidParameterError
 from ...model.configurations import Configuration
 from ...model.parameters import DIAGRAM_V_RANGE, V_RANGE, Parameters, check_operating_point, check_range
 from ...version import __version__
-from ..core.response import Mode, ResponseType, ShimmyType, shimmy_type
+from ..core.response import LATERAL_SHARE, TORSION_SHARE, Mode, ResponseType, ShimmyType, shimmy_type
 from ..diagrams.bifurcation import BifurcationOptions, BifurcationResult, bifurcation
 from ..diagrams.cycle_curves import starts_of_diagram
 from ..diagrams.mode_changes import ModeChange, locate_mode_changes
@@ -270,31 +270,42 @@ def _mode_ends(intervals: list[dict[str, Any]], critical, fine: np.ndarray) -> l
 
 def at_mode_changes(intervals: list[dict[str, Any]], changes: list[ModeChange], critical,
                     fine: np.ndarray) -> tuple[list[dict[str, Any]], list[ModeChange]]:
-    """The intervals with each end where a cycle's mode changes (:func:`_intervals` put it halfway between
-    the fine-grid points around the diagram's change) moved to the located change it stands for: the
-    nearest one located between the diagram's two points around it (a fine step either side), each used
-    once, moved only as far as the ends beside it allow. (The intervals, the changes used.)"""
+    """The intervals with each end where a cycle's mode changes (put halfway between the fine-grid points
+    around the diagram's change) moved to the located change it stands for: the nearest one located
+    between the diagram's two points around it (a fine step either side) whose threshold fits the types
+    either side (Torsion | Both: 0.8, Both | Lateral: 0.2, any other pair: either), each used once, moved
+    only as far as the ends beside it, where they stand by then, allow. (The intervals, the changes used.)"""
     step = float(fine[1] - fine[0]) if fine.size > 1 else 0.0
     ends = _mode_ends(intervals, critical, fine)
-    others = sorted({v for iv in intervals for v in (iv["V_start"], iv["V_end"])})
-    moved: dict[float, float] = {}
+    where = {v: v for iv in intervals for v in (iv["V_start"], iv["V_end"])}  # each end: where it stands now
     used: list[ModeChange] = []
     for end in ends:
-        near = [c for c in changes if c not in used and
-                min(c.bracket) - step <= end <= max(c.bracket) + step]
+        allowed = _thresholds(intervals, end)
+        near = [c for c in changes if c not in used and c.threshold in allowed
+                and min(c.bracket) - step <= end <= max(c.bracket) + step]
         if not near:
             continue
         change = min(near, key=lambda c: abs(c.V - end))
         lo, hi = sorted((end, change.V))
-        if any(lo < v < hi for v in others if v != end):
-            continue  # it would pass another end: left where it was
-        moved[end] = change.V
+        if any(lo <= v <= hi for was, v in where.items() if was != end):
+            continue  # it would reach another end: left where it was
+        where[end] = change.V
         used.append(change)
-    if not moved:
+    if not used:
         return intervals, []
-    out = [{**iv, "V_start": moved.get(iv["V_start"], iv["V_start"]), "V_end": moved.get(iv["V_end"], iv["V_end"])}
-           for iv in intervals]
-    return out, used
+    return [{**iv, "V_start": where[iv["V_start"]], "V_end": where[iv["V_end"]]} for iv in intervals], used
+
+
+def _thresholds(intervals: list[dict[str, Any]], end: float) -> set[float]:
+    """The torsional shares whose crossing can change the type at ``end`` (the types either side)."""
+    below = next((str(iv["type"]) for iv in intervals if iv["V_end"] == end), "Stable")
+    above = next((str(iv["type"]) for iv in intervals if iv["V_start"] == end), "Stable")
+    pair = {below, above}
+    if pair == {ShimmyType.TORSION.value, ShimmyType.BOTH.value}:
+        return {TORSION_SHARE}
+    if pair == {ShimmyType.BOTH.value, ShimmyType.LATERAL.value}:
+        return {LATERAL_SHARE}
+    return {TORSION_SHARE, LATERAL_SHARE}
 
 
 # --------------------------------------------------------------------------- classify

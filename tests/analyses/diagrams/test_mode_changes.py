@@ -17,7 +17,7 @@ from shimmy.analyses.core.response import mode_of, torsional_share
 from shimmy.analyses.diagrams.bifurcation import (STATE_SCALE, T_SCALE, V_SCALE, BifurcationOptions,
                                                   at_fixed_speed, bifurcation, gear_field)
 from shimmy.analyses.diagrams.mode_changes import V_TOL, ModeChange, locate_mode_changes, relocate, share_of
-from shimmy.analyses.maps.map_slices import map_slice
+from shimmy.analyses.maps.map_slices import at_mode_changes, map_slice
 from shimmy.continuation import ContinuationOptions
 from shimmy.continuation.collocation import Mesh, PeriodicProblem
 from shimmy.model.equations import build_model
@@ -94,3 +94,34 @@ def test_a_slice_interval_ends_at_the_located_change(nes):
     after = [iv for iv in s.intervals if iv["V_start"] == changes[0].V]
     assert len(before) == len(after) == 1 and before[0]["type"] != after[0]["type"]
     assert s.lengths[before[0]["type"]] > 0 and s.lengths[after[0]["type"]] > 0
+
+
+def _change(V: float, threshold: float, bracket: tuple[float, float]) -> ModeChange:
+    return ModeChange(V, 3e5, threshold, np.zeros(2), 4, np.zeros(3), 0.1, bracket)
+
+
+def test_ends_move_to_changes_of_their_own_threshold_and_never_past_each_other():
+    """Synthetic slices on a fine grid of 0.1 m/s: an end goes only to a change whose threshold fits the
+    types either side (Torsion | Both: 0.8, Both | Lateral: 0.2), and two ends never cross (checked where
+    each stands once moved)."""
+    fine = np.linspace(0.0, 20.0, 201)
+    # a Torsion | Both end with only a 0.2 crossing near it: left where it was
+    intervals = [{"type": "Torsion", "V_start": 0.0, "V_end": 10.05}, {"type": "Both", "V_start": 10.05, "V_end": 20.0}]
+    out, used = at_mode_changes(intervals, [_change(10.9, 0.2, (10.0, 11.5))], [], fine)
+    assert out == intervals and used == []
+    out, used = at_mode_changes(intervals, [_change(10.9, 0.2, (10.0, 11.5)), _change(10.3, 0.8, (10.0, 11.5))],
+                                [], fine)
+    assert out[0]["V_end"] == out[1]["V_start"] == 10.3 and [c.V for c in used] == [10.3]
+    # one step from 0.85 to 0.15: each end to its own threshold's change
+    three = [{"type": "Torsion", "V_start": 0.0, "V_end": 10.25}, {"type": "Both", "V_start": 10.25, "V_end": 10.45},
+             {"type": "Lateral", "V_start": 10.45, "V_end": 20.0}]
+    out, used = at_mode_changes(three, [_change(10.1, 0.8, (9.5, 11.0)), _change(10.3, 0.2, (9.5, 11.0))], [], fine)
+    assert [(iv["V_start"], iv["V_end"]) for iv in out] == [(0.0, 10.1), (10.1, 10.3), (10.3, 20.0)]
+    # two changes that would make the ends cross: the second is left where it was
+    crossing = [{"type": "Torsion", "V_start": 0.0, "V_end": 10.05}, {"type": "Both", "V_start": 10.05, "V_end": 10.55},
+                {"type": "Lateral", "V_start": 10.55, "V_end": 20.0}]
+    out, used = at_mode_changes(crossing, [_change(10.5, 0.8, (9.0, 10.6)), _change(10.2, 0.2, (10.18, 12.0))], [],
+                                fine)
+    assert all(iv["V_start"] <= iv["V_end"] for iv in out)
+    assert all(a["V_end"] <= b["V_start"] for a, b in zip(out, out[1:]))
+    assert len(used) == 1
