@@ -110,25 +110,25 @@ def locate_mode_changes(result: BifurcationResult) -> list[ModeChange]:
                 g0, g1 = share[i] - threshold, share[i + 1] - threshold
                 if g0 * g1 >= 0.0 or g0 == g1:
                     continue
-                change = _on_step(system, scale, raw, i, threshold, (g0, g1), copts, gear, result.Fz)
+                change = _on_step(system, scale, raw, i, threshold, copts, gear, result.Fz)
                 if change is not None:
                     found.append(change)
     return sorted(found, key=lambda c: c.V)
 
 
-def _on_step(system, scale, raw, i: int, threshold: float, ends: tuple[float, float], copts, gear,
-             Fz: float) -> ModeChange | None:
+def _on_step(system, scale, raw, i: int, threshold: float, copts, gear, Fz: float) -> ModeChange | None:
+    """The change in the diagram's step from point i (a step whose points' sampled shares lie either side
+    of the threshold). The search's own ends are the start's share and the share at the step's full length
+    along its tangent, on the polynomial extremes as every trial (the samples differ from them by up to
+    ~1e-5): a step whose ends do not bracket the threshold so measured has no change (None; its interval end
+    stays at the fine-grid midpoint)."""
     problem, start, span = restore_point(system, raw, i, scale)
     if span <= 0.0:
         return None
     tried: dict[float, CurvePoint] = {}
 
     def g(h: float) -> float:
-        if h <= 0.0:
-            return ends[0]
-        if h >= span:
-            return ends[1]
-        point = step(problem, start, h, copts, with_tangent=False)
+        point = start if h == 0.0 else step(problem, start, h, copts, with_tangent=False)
         if point is None:
             raise _NoPoint
         tried[h] = point
@@ -140,8 +140,8 @@ def _on_step(system, scale, raw, i: int, threshold: float, ends: tuple[float, fl
         h = brentq(g, 0.0, span, xtol=V_TOL / max(rate, 1e-12) / 4.0, rtol=4 * np.finfo(float).eps, maxiter=60)
     except (_NoPoint, RuntimeError, ValueError):
         return None
-    point = tried.get(h) or (step(problem, start, h, copts, with_tangent=False) if 0.0 < h < span else None)
-    if point is None:
+    point = tried.get(h) or step(problem, start, h, copts, with_tangent=False)
+    if point is None or not 0.0 < h < span:
         return None
     return ModeChange(float(point.u[-1]), float(Fz), float(threshold), problem.mesh.points.copy(), raw.ncol,
                       point.u.copy(), float(span), (float(raw.p[i]), float(raw.p[i + 1])))

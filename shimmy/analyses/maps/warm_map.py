@@ -204,6 +204,14 @@ def _on_curve(old_boundaries, new_boundaries, Fz: float, carry: _Carrier, tol: f
     return moved
 
 
+def _near(old: dict[str, Any], params: Parameters, config: Configuration) -> bool:
+    """Whether a slice of the old map was computed within CARRY_DISTANCE of ``params`` (else it is computed
+    again, not carried)."""
+    computed_at = old.get("computed_at")
+    return computed_at is not None and \
+        design_distance(params, Parameters.from_dict(computed_at), config) <= CARRY_DISTANCE
+
+
 def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameters, v_range, n_v: int, scan: list,
                    carry: _Carrier, on_curve: Callable[[float, str], float], crossings: dict[str, list[float]],
                    tol: float, changes: list[tuple[ModeChange, ModeChange | None]] = ()) -> SliceResult:
@@ -214,7 +222,7 @@ def _carried_slice(old: dict[str, Any], config: Configuration, params: Parameter
     clock = time.perf_counter()
     Fz = float(old["Fz"])
     computed_at = old.get("computed_at")
-    if computed_at is None or design_distance(params, Parameters.from_dict(computed_at), config) > CARRY_DISTANCE:
+    if not _near(old, params, config):
         raise NotWarm(f"the slice at Fz = {Fz / 1e3:.4g} kN was computed at a design more than "
                       f"{CARRY_DISTANCE:g} (relative) from this one")
     if len(scan) != len(old["hopf_points"]):
@@ -405,7 +413,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     # the mode changes the slices' intervals end at, slice by slice (keyed -2, -3, ...)
     relocations = {float(s["Fz"]): ModeChangesUnit(config, params, tuple(map(ModeChange.from_dict, s["mode_changes"])),
                                                    options.exact_nes)
-                   for s in start["slices"] if s.get("mode_changes")}
+                   for s in start["slices"] if s.get("mode_changes") and _near(s, params, config)}
     units += [(2.0, unit) for unit in relocations.values()]
     results: dict[int, Any] = {}
     index = {id(u): k for k, (_, u) in enumerate(units)}
