@@ -179,12 +179,12 @@ def relocate(change: ModeChange, config: Configuration, params: Parameters, *, e
 
 def _secant(at: Callable[[float], CurvePoint | None], g: Callable[[CurvePoint], float], start: CurvePoint,
             span: float) -> CurvePoint | None:
-    """The point at arclength h from ``start`` where g = 0, by the secant method from h = 0 and span / 8;
+    """The point at arclength h from ``start`` where g = 0, by the secant method from h = 0 and span / 64;
     converged when a step moves V by at most V_TOL."""
-    h0, g0, p0 = 0.0, g(start), start
+    h0, g0 = 0.0, g(start)
     if g0 == 0.0:
         return start
-    h1 = math.copysign(span / 8.0, -g0 * _slope_sign(at, g, span, g0))
+    h1 = span / 64.0
     p1 = at(h1)
     if p1 is None:
         return None
@@ -202,14 +202,6 @@ def _secant(at: Callable[[float], CurvePoint | None], g: Callable[[CurvePoint], 
             return None
         if abs(p2.u[-1] - p1.u[-1]) <= V_TOL:
             return p2
-        h0, g0, p0 = h1, g1, p1
+        h0, g0 = h1, g1
         h1, g1, p1 = h2, g(p2), p2
     return None
-
-
-def _slope_sign(at, g, span: float, g0: float) -> float:
-    """+1 if g grows along the tangent from the start (a small trial step), -1 if it falls."""
-    trial = at(span / 64.0)
-    if trial is None:
-        return 1.0
-    return 1.0 if g(trial) >= g0 else -1.0
