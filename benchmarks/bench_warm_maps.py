@@ -64,6 +64,10 @@ def main() -> None:
             parser.error("--walk must be a number of steps >= 1 and --walk-step > 0")
         walk(args.configs.split(","), args.walk, args.walk_step)
         return
+    unknown = [name for name in args.steps.split(",") if name not in {**STEPS, **MORE_STEPS}]
+    if unknown:
+        parser.error(f"--steps: unknown step(s) {', '.join(map(repr, unknown))}; known: "
+                     f"{', '.join({**STEPS, **MORE_STEPS})}")
     print(f"machine: {os.cpu_count()} cores; executor: {describe()}")
     print(f"{'config':8} {'step':5} {'cold s':>8} {'warm s':>8} {'ratio':>6} {'carried/again/added':>20} "
           f"{'equal cells':>11} {'off edges':>9}")

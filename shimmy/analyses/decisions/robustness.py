@@ -80,7 +80,7 @@ class Tolerance:
             raise InvalidParameterError("tolerance", text, "NAME=REL or NAME=REL:normal|uniform", "has no =")
         name, value, dist = parts
         return cls.make(spec_text.name_text(name, PARAMETER_SPECS), spec_text.number_text(value),
-                        spec_text.name_text(dist or "normal", DISTRIBUTIONS))
+                        spec_text.name_text("normal" if dist is None else dist, DISTRIBUTIONS))
 
     @classmethod
     def make(cls, name: str, relative: Any, distribution: str = "normal") -> "Tolerance":

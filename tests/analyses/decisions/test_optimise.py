@@ -199,6 +199,8 @@ def test_tolerances_are_checked_naming_the_field():
         Tolerance.parse("n=0.05")
     with pytest.raises(InvalidParameterError, match="distribution"):
         Tolerance.parse("k_s=0.05:cauchy")
+    with pytest.raises(InvalidParameterError, match="distribution=''"):  # a ':' with nothing after it: not normal
+        Tolerance.parse("k_s=0.05:")
     assert Tolerance.parse(" k_s = 0.05 : uni form ") == Tolerance.parse("k_s=0.05:uniform")
     with pytest.raises(InvalidParameterError, match="'0.05 extra'"):  # quoted as typed, its space kept
         Tolerance.parse("k_s = 0.05 extra")
