@@ -21,6 +21,7 @@ design's diagram and relocated there from a nearby design's, one change agrees t
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -204,4 +205,56 @@ def _secant(at: Callable[[float], CurvePoint | None], g: Callable[[CurvePoint], 
             return p2
         h0, g0 = h1, g1
         h1, g1, p1 = h2, g(p2), p2
+    return None
+
+
+#: :func:`follow_load`: the largest deviation (m/s) of the true curve of a change from the chord between two
+#: of its points (estimated from the secant predictor's error)
+CHORD_TOL = 0.02
+#: ... a step whose chord errs by more than this many times CHORD_TOL is taken again, shorter
+CHORD_REFUSE = 2.0
+#: ... the steps at most (a change that needs more is given up: None)
+MAX_LOAD_STEPS = 64
+
+
+def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params: Parameters, *,
+                exact_nes: bool = False, chord: float = CHORD_TOL) -> list[ModeChange] | None:
+    """The mode change ``change`` followed in the load, at the same design, from its load to ``Fz_to``: the
+    curve of the change in (V, Fz) by natural continuation in Fz, each point the change relocated at the next
+    load (:func:`relocate`) from a secant predictor of its cycle (the two points before it extrapolated to
+    the new load). The step is set so that the curve deviates from the chord between two points by about
+    ``chord`` m/s: the secant predictor's error in V is ~V''/2 h (h + h_before), the chord's ~V''/8 h^2; a
+    step whose estimate exceeds CHORD_REFUSE x ``chord`` is taken again at half its length. The first step
+    is an eighth of the way. Returns the points after ``change``, the last at ``Fz_to``; None where a
+    relocation fails at a step of 1e-3 of the way or less (the change turns back in the load, or its cycle
+    ends between), or after MAX_LOAD_STEPS steps."""
+    way = float(Fz_to) - change.Fz
+    if way == 0.0:
+        return []
+    h = 0.125 * way
+    points = [change]
+    for _ in range(MAX_LOAD_STEPS):
+        last = points[-1]
+        remaining = float(Fz_to) - last.Fz
+        if abs(h) >= abs(remaining) or abs(remaining) < 1.3 * abs(h):  # no sliver of a last step
+            h = remaining
+        Fz = float(Fz_to) if h == remaining else last.Fz + h
+        u = last.u
+        if len(points) >= 2:  # the secant through the last two points (one mesh: relocate keeps it)
+            before = points[-2]
+            u = last.u + (Fz - last.Fz) / (last.Fz - before.Fz) * (last.u - before.u)
+        new = relocate(dataclasses.replace(last, Fz=Fz, V=float(u[-1]), u=u), config, params, exact_nes=exact_nes)
+        # the predictor errs by ~V''/2 h (h + h_before), the chord by ~V''/8 h^2
+        deviation = abs(new.V - u[-1]) * abs(h) / (4.0 * (abs(h) + abs(last.Fz - points[-2].Fz))) \
+            if new is not None and len(points) >= 2 else 0.0
+        if new is None or deviation > CHORD_REFUSE * chord:
+            if abs(h) <= 1e-3 * abs(way):
+                return None
+            h *= 0.5
+            continue
+        points.append(new)
+        if Fz == float(Fz_to):
+            return points[1:]
+        if len(points) >= 3:
+            h *= min(max(math.sqrt(chord / max(deviation, 1e-12)), 0.5), 2.0)
     return None

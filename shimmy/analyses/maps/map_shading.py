@@ -11,7 +11,9 @@ interval takes the types of that interval on the slices that have it, as fractio
 interval: the nearest slice below and above the row that have it, their breakpoints (mode
 changes) interpolated linearly in Fz where both show the same sequence of types or one has a
 piece the other lacks (it narrows linearly to where it vanishes: no staircase), else the
-nearer one. A region that no slice crosses (pinched between curves between two slice loads) is
+nearer one. A breakpoint that a mode change's curve joins to the other slice's
+(:mod:`~shimmy.analyses.maps.mode_links`) is read off that curve instead, also where the row reads one
+slice alone. A region that no slice crosses (pinched between curves between two slice loads) is
 what :func:`uncovered` reports, so that the map classifies a slice through it; one left over
 (thinner than a grid cell or smaller than the map's threshold) is read off the nearest slice at
 the same speed, and counted.
@@ -221,14 +223,94 @@ class _Slices:
         return _pieces(self.slices[k].intervals, a, b)
 
 
+class _Links:
+    """Mode changes' curves between two slices' loads (``links``: (k, 2) (V, Fz) polylines by ascending
+    Fz, :mod:`~shimmy.analyses.maps.mode_links`), found by their ends."""
+
+    def __init__(self, links: Sequence[np.ndarray]):
+        self.by_loads: dict[tuple[float, float], list[np.ndarray]] = defaultdict(list)
+        self.by_end: dict[float, list[tuple[float, np.ndarray]]] = defaultdict(list)
+        for p in links:
+            p = np.asarray(p, float).reshape(-1, 2)
+            if len(p) >= 2 and p[-1, 1] > p[0, 1]:
+                self.by_loads[(float(p[0, 1]), float(p[-1, 1]))].append(p)
+                self.by_end[float(p[0, 1])].append((float(p[0, 0]), p))
+                self.by_end[float(p[-1, 1])].append((float(p[-1, 0]), p))
+
+    def through(self, F: float, V: float, Fz: float) -> float | None:
+        """V at load ``Fz`` on a link with an end at (V, F) whose other end lies at or beyond ``Fz``, if
+        there is one."""
+        for end, p in self.by_end.get(float(F), ()):
+            if abs(end - V) <= 1e-9 * max(abs(V), 1.0) and p[0, 1] <= Fz <= p[-1, 1]:
+                return float(np.interp(Fz, p[:, 1], p[:, 0]))
+        return None
+
+    def speed(self, F0: float, V0: float, F1: float, V1: float, Fz: float) -> float | None:
+        """V at load ``Fz`` on the link from (V0, F0) to (V1, F1), if there is one (ends within 1e-9 of
+        the speeds, relative, at least 1e-9 m/s)."""
+        for p in self.by_loads.get((float(F0), float(F1)), ()):
+            if abs(p[0, 0] - V0) <= 1e-9 * max(abs(V0), 1.0) and abs(p[-1, 0] - V1) <= 1e-9 * max(abs(V1), 1.0):
+                return float(np.interp(Fz, p[:, 1], p[:, 0]))
+        return None
+
+
+def _along_links(parts, pair, ends: tuple[tuple[float, float], tuple[float, float]], loads: tuple[float, float],
+                 row: tuple[float, float], Fz: float, links: _Links):
+    """The interpolated ``parts`` of a row's interval ``row`` (between slices at ``loads`` whose aligned
+    pieces are ``pair``, on their intervals ``ends``) with each breakpoint that a link joins on the two
+    slices, or that a link from one of them reaches the row from, put where the link crosses the row (kept
+    between its neighbours: a piece whose end the link carries past its other end vanishes)."""
+    lo, hi = row
+    if hi <= lo:
+        return parts
+    out = [list(p) for p in parts]
+    (a0, b0), (a1, b1) = ends
+    for j in range(len(parts) - 1):
+        V0 = a0 + pair[0][j][1] * (b0 - a0)
+        V1 = a1 + pair[1][j][1] * (b1 - a1)
+        V = links.speed(loads[0], V0, loads[1], V1, Fz)
+        if V is None:  # a link from either slice's breakpoint that ends elsewhere (open) and reaches the row
+            V = links.through(loads[0], V0, Fz)
+            V = links.through(loads[1], V1, Fz) if V is None else V
+        if V is None:
+            continue
+        f = min(max((V - lo) / (hi - lo), out[j][0]), out[j + 1][1])
+        out[j][1] = out[j + 1][0] = f
+    return [tuple(p) for p in out]
+
+
+def _through_links(parts, end: tuple[float, float], load: float, row: tuple[float, float], Fz: float,
+                   links: _Links):
+    """The ``parts`` of one slice (at ``load``, its interval ``end``) read for a row's interval ``row``
+    (at ``Fz``), each breakpoint from which a link reaches the row's load put where the link crosses the
+    row (kept between its neighbours): the slice's mode change followed to the row, where the next slice
+    with its change lies in another region (the curves between them cross otherwise)."""
+    lo, hi = row
+    if hi <= lo:
+        return parts
+    out = [list(p) for p in parts]
+    a, b = end
+    for j in range(len(parts) - 1):
+        V = links.through(load, a + parts[j][1] * (b - a), Fz)
+        if V is None:
+            continue
+        f = min(max((V - lo) / (hi - lo), out[j][0]), out[j + 1][1])
+        out[j][1] = out[j + 1][0] = f
+    return [tuple(p) for p in out]
+
+
 def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequence[float],
-                 v_range: tuple[float, float]) -> tuple[list[list[Segment]], int]:
+                 v_range: tuple[float, float], links: Sequence[np.ndarray] = ()) -> tuple[list[list[Segment]], int]:
     """Each row's segments (V_low, V_high, type), merged, covering the speed range; and how many
     row intervals lie in a region no slice crosses (read off the nearest slice at the same speed
     instead). ``slices`` carry ``Fz`` and ``intervals`` (see
-    :class:`~shimmy.analyses.maps.map_slices.SliceResult`)."""
+    :class:`~shimmy.analyses.maps.map_slices.SliceResult`). ``links``: the curves of mode changes between
+    consecutive slices ((V, Fz) polylines by ascending Fz, :mod:`~shimmy.analyses.maps.mode_links`): a
+    breakpoint of two slices that a link joins is read off the link at each row between them, not
+    interpolated."""
     regions = labelled(curves, [float(f) for f in fz_rows] + [float(s.Fz) for s in slices], v_range)
     known = _Slices(slices, regions)
+    joined = _Links(links)
     rows, fallbacks = [], 0
     for Fz in fz_rows:
         segments: list[list] = []
@@ -245,10 +327,16 @@ def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequen
                 if pair is not None:
                     w = (Fz - known.loads[k0]) / (known.loads[k1] - known.loads[k0])
                     parts = _interpolated(*pair, float(w))
-                elif p0 is not None and (p1 is None or Fz - known.loads[k0] <= known.loads[k1] - Fz):
-                    parts = p0
+                    if joined.by_loads:
+                        parts = _along_links(parts, pair, (known.named[k0][region], known.named[k1][region]),
+                                             (float(known.loads[k0]), float(known.loads[k1])), (lo, hi), float(Fz),
+                                             joined)
                 else:
-                    parts = p1
+                    k = k0 if p0 is not None and (p1 is None or Fz - known.loads[k0] <= known.loads[k1] - Fz) else k1
+                    parts = p0 if k == k0 else p1
+                    if joined.by_end:
+                        parts = _through_links(parts, known.named[k][region], float(known.loads[k]), (lo, hi),
+                                               float(Fz), joined)
             else:
                 fallbacks += 1
                 near = known.slices[int(np.argmin(np.abs(known.loads - Fz)))]

@@ -59,6 +59,7 @@ from ..core.executors import name_of, open_executor, run_dynamic
 from ..diagrams.hopf_curves import HopfCurvesResult, hopf_curves
 from ...model.parameters import DEFAULT_MAP_SLICES, FZ_RANGE, V_RANGE, Parameters, check_number, check_range
 from .map_slices import DEFAULT_V_RANGE, SliceResult, map_slice
+from .mode_links import ModeLink, ModeLinksUnit, follows, links_unit, polylines
 from .summaries import map_summary, write_map_csv
 from ...model.units import kn
 
@@ -121,6 +122,9 @@ class StabilityMap:
     warmed_from: dict[str, Any] | None = None
     #: why a map asked to be warmed was computed cold, else None
     warm_refused: str | None = None
+    #: the curves of the slices' mode changes between consecutive slices (:mod:`~.mode_links`; in
+    #: :meth:`warm_start`, not in :meth:`to_dict`: the shading is read along them)
+    mode_links: list[ModeLink] = field(default_factory=list, repr=False)
 
     @property
     def min_shimmy_Fz(self) -> float | None:
@@ -207,7 +211,8 @@ class StabilityMap:
                 "slices": [s.to_dict() | {"computed_at": s.computed_at or self.params.to_dict(),
                                           "mode_changes": [c.to_dict() for c in s.mode_changes]} for s in self.slices],
                 "arrangement": arrangement(self.hopf, self.cycles),
-                "seeds": [seed.to_dict() for seed in self.seeds], "version": __version__}
+                "seeds": [seed.to_dict() for seed in self.seeds],
+                "links": [link.to_dict() for link in self.mode_links], "version": __version__}
 
     def write_csv(self, path) -> None:
         """The shading (the map's answer on its fine grid): one row per (Fz, V)
@@ -259,8 +264,8 @@ class SliceUnit:
         return f"slice at Fz = {self.Fz / 1e3:.4g} kN"
 
 
-#: A unit of a map: its Hopf curves, a slice, or a unit of its curve search.
-MapUnit = HopfCurvesUnit | SliceUnit | SearchUnit
+#: A unit of a map: its Hopf curves, a slice, a unit of its curve search, or the links of two slices' mode changes.
+MapUnit = HopfCurvesUnit | SliceUnit | SearchUnit | ModeLinksUnit
 
 
 class _MapBuild:
@@ -285,6 +290,7 @@ class _MapBuild:
         self.slices: list[SliceResult] = []
         self.slice_loads = [float(f) for f in self.loads]
         self.rounds = 0
+        self.links: list[ModeLink] | None = None  # None until the slices are all done: then followed
         self.search.expect_sources(len(self.loads))
         self.pending = 0  # units submitted or queued and not finished
         self.finished_at = 0.0  # s after the start when its last unit finished
@@ -318,8 +324,14 @@ class _MapBuild:
 
     def done(self, unit: MapUnit, result: Any, elapsed: float) -> list[tuple[int, MapUnit]]:
         """The units that a finished unit's result adds: curves from its starts, coverage slices
-        once the curves as they stand are all continued."""
+        once the curves as they stand are all continued, the links of the slices' mode changes once
+        every slice is done."""
         self.pending -= 1
+        if isinstance(unit, ModeLinksUnit):
+            self.links += result
+            if self.pending == 0:
+                self.finished_at = elapsed
+            return []
         if isinstance(unit, HopfCurvesUnit):
             self.hopf = result
             more = [(0, u) for u in self.search.start_units(result)] + [(0, u) for u in self.search.continuations()]
@@ -331,6 +343,10 @@ class _MapBuild:
             more = [(0, u) for u in search_done(self.search, unit, result)]
         if self.search.idle() and self.hopf is not None:  # the curves as they stand
             more += self._coverage()
+        if not more and self.pending == 0 and self.links is None:  # every slice done: their mode changes' links
+            self.links = []
+            more = [(2, links_unit(a, b, only, self.config, self.params, self.options.exact_nes))
+                    for a, b, only in follows(self.slices)]
         if not more and self.pending == 0:
             self.finished_at = elapsed
         if self.sketch is not None and self.hopf is not None \
@@ -349,7 +365,9 @@ class _MapBuild:
         warnings = list(hopf.warnings) + list(cycles.pop("warnings"))
         for s in slices:
             warnings += [f"Fz = {kn(s.Fz)}: {w}" for w in s.warnings]
-        segments, fallbacks = map_shading.row_segments(slices, _boundaries(hopf, self.search), rows, (v_min, v_max))
+        links = sorted(self.links or [], key=lambda link: (link.loads, link.start))
+        segments, fallbacks = map_shading.row_segments(slices, _boundaries(hopf, self.search), rows, (v_min, v_max),
+                                                       polylines(links))
         V = slices[0].V
         return StabilityMap(self.config, self.params, self.v_range, self.fz_range, V,
                             np.array([s.Fz for s in slices]), [s.types for s in slices], slices, hopf, cycles, rows,
@@ -357,7 +375,8 @@ class _MapBuild:
                             map_shading.polygons(segments, rows), lowest_shimmy(hopf, cycles, slices), executor,
                             self.finished_at + time.perf_counter() - clock, warnings, resolution=self.resolution,
                             n_v=self.n_v, options=self.options,
-                            seeds=[CurveSeed.of(c, self.config.n_states) for c in self.search.result(0.0).curves])
+                            seeds=[CurveSeed.of(c, self.config.n_states) for c in self.search.result(0.0).curves],
+                            mode_links=links)
 
 
 def _tagged_unit(tagged: tuple[int, MapUnit]) -> Any:

@@ -34,7 +34,10 @@ little: the curves move, but where their arrangement stays the same the regions 
    whose load the curves now cross otherwise, or with a Hopf point more or less, or with a point
    on no curve of the map (a period doubling), or a mode change not found again, is computed again;
    and, as a cold map does, a slice
-   is added through each region between the new curves that no slice crosses. A fold or torus point
+   is added through each region between the new curves that no slice crosses. The curves of the mode
+   changes between two carried slices (:mod:`~shimmy.analyses.maps.mode_links`) are carried too: their
+   inner points relocated at their loads beside the curves' traces; those next to a slice computed again
+   or added are followed afresh. A fold or torus point
    of a slice computed again that lies on no curve is continued as a cold map continues it: a curve
    the map lacks makes the map cold; none (no such point converges there) is the cold map's warning.
 
@@ -73,6 +76,7 @@ from ..diagrams.hopf_curves import HopfCurvesResult
 from ..diagrams.mode_changes import ModeChange, relocate
 from . import map_shading
 from .map_slices import FINE, SliceResult, speed_grids, type_lengths
+from .mode_links import LinkPointsUnit, carried_link, follows, links_unit, polylines
 from .stability_map import (COVERAGE_AREA, COVERAGE_ROUNDS, HopfCurvesUnit, SliceUnit, Sketch, StabilityMap,
                             arrangement, curve_boundaries, lowest_shimmy, sketch_of)
 from ...model.units import kn
@@ -415,10 +419,20 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
                                                    options.exact_nes)
                    for s in start["slices"] if s.get("mode_changes") and _near(s, params, config)}
     units += [(2.0, unit) for unit in relocations.values()]
+    # the inner points of the links between two such slices, link by link (keyed -1000, -1001, ...)
+    near_loads = {float(s["Fz"]) for s in start["slices"] if _near(s, params, config)}
+    old_links: dict[tuple[float, float], list[dict[str, Any]]] = {}
+    for link in start.get("links", []):
+        if all(float(f) in near_loads for f in link["loads"]):
+            old_links.setdefault(tuple(float(f) for f in link["loads"]), []).append(link)
+    moving = {loads: LinkPointsUnit(config, params, tuple(links), options.exact_nes)
+              for loads, links in old_links.items() if any(link["points"] for link in links)}
+    units += [(2.0, unit) for unit in moving.values()]
     results: dict[int, Any] = {}
     index = {id(u): k for k, (_, u) in enumerate(units)}
     index[id(scans)] = -1
     index.update({id(unit): -2 - k for k, unit in enumerate(relocations.values())})
+    index.update({id(unit): -1000 - k for k, unit in enumerate(moving.values())})
 
     def curve_of(j: int) -> tuple[GearCycleCurve | None, str | None]:
         return joined_halves(results[2 * j + 1], results[2 * j + 2])
@@ -520,6 +534,26 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
             s.computed_at = params.to_dict()
         slices += computed
     slices.sort(key=lambda s: s.Fz)
+    links, follow = [], []
+    for a, b, only in follows(slices):  # links between carried slices carried, the others followed afresh
+        carried = set()
+        if a.carried and b.carried:
+            unit = moving.get((a.Fz, b.Fz))
+            olds = [old for old in old_links.get((a.Fz, b.Fz), []) if old["start"] in only]
+            for old in olds:
+                moved = results[index[id(unit)]][unit.links.index(old)] if unit is not None else []
+                link = carried_link(old, moved, a, b)
+                if link is not None:
+                    links.append(link)
+                    carried.add(link.start)
+        rest = [i for i in only if i not in carried]
+        if rest:
+            follow.append((2, links_unit(a, b, rest, config, params, options.exact_nes)))
+    if follow:
+        report(0.95, f"mode changes followed between {len(follow)} pair(s) of slices")
+        run_dynamic(run_work_unit, follow, executor, lambda unit, result: links.extend(result) or [],
+                    lambda f, m: None, describe_work_unit)
+    links.sort(key=lambda link: (link.loads, link.start))
     report(0.95, "the shading read off the slices along the curves")
     for c in curves:
         c.curve.special_points = [q for q in c.curve.special_points if q.kind != PointKind.P2_MARK
@@ -528,7 +562,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
     warnings = list(hopf.warnings) + list(cycles.pop("warnings")) + warnings_off
     for s in slices:
         warnings += [f"Fz = {kn(s.Fz)}: {w}" for w in s.warnings]
-    segments, fallbacks = map_shading.row_segments(slices, boundaries, rows, v_range)
+    segments, fallbacks = map_shading.row_segments(slices, boundaries, rows, v_range, polylines(links))
     V = slices[0].V
     elapsed = time.perf_counter() - clock
     cycles["elapsed_s"] = elapsed
@@ -540,7 +574,7 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
                         # the end amplitudes of the cold map's traces, not of these (each warm map would
                         # reach half as far again towards the codimension-2 points)
                         seeds=[dataclasses.replace(CurveSeed.of(c, config.n_states), end_amplitudes=ends[id(c)])
-                               for c in curves],
+                               for c in curves], mode_links=links,
                         warmed_from={"params": start["params"], "changed": _changed(old_params, params),
                                      "slices": {"carried": len(start["slices"]) - len(again),
                                                 "computed_again": [{"Fz": Fz, "why": why} for Fz, why in

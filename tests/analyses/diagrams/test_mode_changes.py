@@ -5,9 +5,12 @@ twice the intervals (the collocation's convergence: the threshold to 1e-6); the 
 between the diagram's two points whose modes differ; relocated at its own design it stays (to the
 tolerance); relocated at a nearby design it is the change that design's own diagram locates (to the
 meshes' difference, 1e-5 m/s), although it moved by metres per second; a map slice's interval ends
-there.
+there. A change followed in the load (``follow_load``) ends on the change the diagram at the other load
+locates (1e-5 m/s), each of its points stays where it is when relocated at its own load, and the curve
+between two points lies within the chord tolerance of their chord (points relocated at the loads halfway).
 """
 
+import dataclasses
 import json
 
 import numpy as np
@@ -16,7 +19,8 @@ import pytest
 from shimmy.analyses.core.response import mode_of, torsional_share
 from shimmy.analyses.diagrams.bifurcation import (STATE_SCALE, T_SCALE, V_SCALE, BifurcationOptions,
                                                   at_fixed_speed, bifurcation, gear_field)
-from shimmy.analyses.diagrams.mode_changes import V_TOL, ModeChange, locate_mode_changes, relocate, share_of
+from shimmy.analyses.diagrams.mode_changes import (CHORD_TOL, V_TOL, ModeChange, follow_load, locate_mode_changes,
+                                                  relocate, share_of)
 from shimmy.analyses.maps.map_slices import at_mode_changes, map_slice
 from shimmy.continuation import ContinuationOptions
 from shimmy.continuation.collocation import Mesh, PeriodicProblem
@@ -82,6 +86,39 @@ def test_a_change_relocated_at_a_nearby_design_is_the_one_located_there(a_p):
     moved = relocate(before[0], "pd", params)
     assert moved is not None and abs(after[0].V - before[0].V) > 1.0
     assert moved.V == pytest.approx(after[0].V, abs=1e-5)
+
+
+def test_a_change_followed_in_the_load_ends_on_the_change_located_there(nes):
+    """nes: the both -> lateral change at 288.4 kN followed to 306.7 kN (where it lies 3.2 m/s lower) and on to
+    405.6 kN (down to ~11.5 m/s, bending: the map's rows put it 8 m/s off before they followed it)."""
+    result, changes = nes
+    there = locate_mode_changes(bifurcation("nes", 306.7e3, v_range=V_RANGE, options=OPTIONS))
+    assert [c.threshold for c in there] == [0.2]
+    followed = follow_load(changes[0], 306.7e3, result.config, result.params)
+    assert followed is not None and followed[-1].Fz == 306.7e3 and abs(followed[-1].V - changes[0].V) > 3.0
+    assert followed[-1].V == pytest.approx(there[0].V, abs=1e-5)
+    longer = follow_load(there[0], 405.6e3, result.config, result.params)
+    assert longer is not None and 10.0 < longer[-1].V < 13.0
+    gear = result.params.gear
+    for before, point in zip([there[0], *longer[:-1]], longer, strict=True):
+        assert before.Fz < point.Fz and point.threshold == 0.2
+        again = relocate(point, result.config, result.params)  # a point of the curve: stays
+        assert again is not None and abs(again.V - point.V) <= 10 * V_TOL
+        model = build_model(result.config, result.params)
+        problem = PeriodicProblem(gear_field(model, point.Fz), Mesh(point.mesh, point.ncol),
+                                  STATE_SCALE[:model.n_states], T_SCALE, V_SCALE)
+        assert share_of(problem, point.u, gear.k_psi, gear.k_delta) == pytest.approx(0.2, abs=1e-9)
+        half = relocate(dataclasses.replace(before, Fz=0.5 * (before.Fz + point.Fz)), result.config, result.params)
+        assert half is not None and abs(half.V - 0.5 * (before.V + point.V)) <= 3 * CHORD_TOL
+
+
+def test_a_change_followed_where_its_curve_does_not_reach_gives_none(nes):
+    """Followed down from 288.4 kN the change reaches 250 kN (35.2 m/s) but not 200 kN: a relocation there
+    fails at every step down to 1e-3 of the way, and the follow says so (None), it does not return a point
+    of another change."""
+    result, changes = nes
+    assert follow_load(changes[0], 200e3, result.config, result.params) is None
+    assert follow_load(changes[0], changes[0].Fz, result.config, result.params) == []
 
 
 def test_a_slice_interval_ends_at_the_located_change(nes):

@@ -610,3 +610,85 @@ def test_a_mode_piece_one_slice_lacks_narrows_linearly_instead_of_a_staircase(up
         mid = (0.5 * (a + b) - 1.0) / (50.0 + Fz / 1e4 - 1.0)
         assert mid == pytest.approx(lower_mid + w * (target - lower_mid), rel=1e-9)
 
+
+
+def test_a_mode_change_joined_by_a_link_is_read_off_the_link_between_the_slices():
+    """Two slices with a change from Both to Torsion at 20 and 40 m/s inside the interval below a curve, and
+    the change's curve between them (a link) bending to 25 m/s halfway: the rows put the change on the link
+    (interpolated along its polyline), not on the straight line between the slices (30 m/s halfway)."""
+    curve = ("b", np.array([[50.0, 0.0], [150.0, 1.0e6]]))
+    slices = [_Slice(1e5, [{"type": "Both", "V_start": 1.0, "V_end": 20.0},
+                           {"type": "Torsion", "V_start": 20.0, "V_end": 60.0}]),
+              _Slice(3e5, [{"type": "Both", "V_start": 1.0, "V_end": 40.0},
+                           {"type": "Torsion", "V_start": 40.0, "V_end": 80.0}])]
+    link = np.array([[20.0, 1e5], [25.0, 2e5], [40.0, 3e5]])
+    loads = [1.5e5, 2e5, 2.5e5]
+    rows, fallbacks = map_shading.row_segments(slices, [curve], loads, (1.0, 200.0), [link])
+    assert fallbacks == 0
+    for Fz, row in zip(loads, rows, strict=True):
+        assert [t for _, _, t in row] == ["Both", "Torsion", "Stable"]
+        assert row[0][1] == pytest.approx(float(np.interp(Fz, link[:, 1], link[:, 0])), rel=1e-12)
+        assert row[1][1] == pytest.approx(50.0 + Fz / 1e4)  # the curve's crossing, as without the link
+    # a link with neither end at the slices' changes is not this change's: the straight line again
+    other = np.array([[21.0, 1e5], [25.0, 2e5], [41.0, 3e5]])
+    plain, _ = map_shading.row_segments(slices, [curve], loads, (1.0, 200.0))
+    assert map_shading.row_segments(slices, [curve], loads, (1.0, 200.0), [other])[0] == plain
+    # one followed down from the upper slice's change that ends elsewhere (open): read off it all the same
+    down = np.array([[21.0, 1e5], [25.0, 2e5], [40.0, 3e5]])
+    rows, _ = map_shading.row_segments(slices, [curve], loads, (1.0, 200.0), [down])
+    assert [row[0][1] for row in rows] == pytest.approx([np.interp(Fz, down[:, 1], down[:, 0]) for Fz in loads])
+
+
+def test_a_change_followed_into_a_row_of_another_region_is_read_off_its_link():
+    """The lower slice's change (Both to Torsion at 20 m/s) has a link up to 30 m/s at the upper slice's load,
+    where a second curve has entered the interval (above 1.6e5 N): the rows below 1.6e5 N lie in a region only
+    the lower slice crosses and read it alone, putting the change where the link crosses them (22.5 m/s at
+    1.5e5 N; the slice's own fraction of the interval put it at 20); the rows above read the upper slice
+    alone, and put its change on the link too (24 m/s at 1.8e5 N, where its fraction of [1, 45] put it at 30).
+    A link whose end is not at a slice's change is not used."""
+    edge = ("b", np.array([[50.0, 0.0], [50.0, 1.0e6]]))
+    inner = ("c", np.array([[45.0, 1.6e5], [45.0, 1.0e6]]))
+    slices = [_Slice(1e5, [{"type": "Both", "V_start": 1.0, "V_end": 20.0},
+                           {"type": "Torsion", "V_start": 20.0, "V_end": 50.0}]),
+              _Slice(3e5, [{"type": "Both", "V_start": 1.0, "V_end": 30.0},
+                           {"type": "Torsion", "V_start": 30.0, "V_end": 45.0}])]
+    link = np.array([[20.0, 1e5], [30.0, 3e5]])
+    loads = [1.5e5, 1.8e5, 2.5e5]
+    rows, _ = map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0), [link])
+    plain, _ = map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0))
+    assert plain[0][0] == (1.0, pytest.approx(20.0), "Both")
+    assert rows[0] == [(1.0, pytest.approx(22.5), "Both"), (pytest.approx(22.5), 50.0, "Torsion"),
+                       (50.0, 200.0, "Stable")]
+    for Fz, row, old in zip(loads[1:], rows[1:], plain[1:], strict=True):
+        assert old[0] == (1.0, pytest.approx(30.0), "Both")
+        V = float(np.interp(Fz, link[:, 1], link[:, 0]))
+        assert row == [(1.0, pytest.approx(V), "Both"), (pytest.approx(V), 45.0, "Torsion")] + old[2:]
+    # a link from elsewhere (20.5 m/s at the lower load): the lower slice's rows do not take it
+    moved = np.array([[20.5, 1e5], [30.0, 3e5]])
+    assert map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0), [moved])[0][0] == plain[0]
+
+
+def test_a_mode_piece_ends_where_its_open_link_meets_its_other_end():
+    """Both between Torsion and Lateral on the lower slice only; its right end's change followed up (an open
+    link: the upper slice has no such change) runs left, from 40 m/s to 10 m/s at the upper load: the rows put
+    that end on the link, and the piece vanishes at the row where the link has passed its left end (which
+    narrows linearly, as without a link)."""
+    curve = ("b", np.array([[50.0, 0.0], [150.0, 1.0e6]]))
+    lower = [{"type": "Torsion", "V_start": 1.0, "V_end": 20.0}, {"type": "Both", "V_start": 20.0, "V_end": 40.0},
+             {"type": "Lateral", "V_start": 40.0, "V_end": 60.0}]
+    upper = [{"type": "Torsion", "V_start": 1.0, "V_end": 30.0}, {"type": "Lateral", "V_start": 30.0, "V_end": 80.0}]
+    slices = [_Slice(1e5, lower), _Slice(3e5, upper)]
+    link = np.array([[40.0, 1e5], [10.0, 3e5]])
+    loads = [1.5e5, 2e5, 2.5e5]
+    rows, _ = map_shading.row_segments(slices, [curve], loads, (1.0, 200.0), [link])
+    plain, _ = map_shading.row_segments(slices, [curve], loads, (1.0, 200.0))
+    for Fz, row, old in zip(loads, rows, plain, strict=True):
+        (a, b), = [(a, b) for a, b, t in old if t == "Both"]
+        on_link = float(np.interp(Fz, link[:, 1], link[:, 0]))
+        both = [(x, y) for x, y, t in row if t == "Both"]
+        if on_link > a:  # the link's end is right of the left end: the piece from there to the link
+            assert both == [(pytest.approx(a), pytest.approx(on_link))]
+        else:  # passed it: gone, Torsion meets Lateral where the left end was
+            assert both == [] and [t for _, _, t in row] == ["Torsion", "Lateral", "Stable"]
+            assert row[0][1] == pytest.approx(a)
+    assert [bool([1 for _, _, t in row if t == "Both"]) for row in rows] == [True, True, False]

@@ -9,12 +9,15 @@ differing cell beside a change of type in the cold map's row or column (within o
 region's edge).
 """
 
+import dataclasses
 import json
 
 import numpy as np
 import pytest
 
+from shimmy.analyses.diagrams.mode_changes import CHORD_TOL, relocate
 from shimmy.analyses.maps import map_shading
+from shimmy.analyses.maps.mode_links import polylines
 from shimmy.analyses.maps.stability_map import stability_map
 from shimmy.analyses.maps.warm_map import NotWarm, arrangement_change, warm_map
 from shimmy.analyses.diagrams.bifurcation import BifurcationOptions
@@ -174,6 +177,49 @@ def test_warm_slices_are_the_cold_slices_at_their_curves(pair, request):
 def test_warm_shading_equals_the_cold_shading(pair, request):
     _, cold, warm, _ = request.getfixturevalue(pair)
     _same_shading(cold, warm)
+
+
+@BOTH
+def test_warm_links_are_the_cold_links(pair, request):
+    """The curves of the mode changes between consecutive slices: the same changes followed and joined, each
+    warm link's points (those other than the slices' changes relocated at their loads) on the cold link's
+    polyline to the chords' tolerance, its ends the slices' changes (1e-5 m/s, as the slices'), an open
+    link's far end the cold one's (its followed point there: 1e-5 m/s)."""
+    _, cold, warm, _ = request.getfixturevalue(pair)
+    assert cold.mode_links, "the map has mode changes joined between slices"
+    key = [(link.loads, link.start, link.end, link.threshold) for link in cold.mode_links]
+    assert key == [(link.loads, link.start, link.end, link.threshold) for link in warm.mode_links]
+    for c, w in zip(cold.mode_links, warm.mode_links, strict=True):
+        line = c.polyline()
+        for point in w.points:
+            assert abs(point.V - np.interp(point.Fz, line[:, 1], line[:, 0])) <= 3 * CHORD_TOL, (c.loads, point.Fz)
+        for a, b in ((c.points[0], w.points[0]), (c.points[-1], w.points[-1])):
+            assert a.Fz == b.Fz and abs(a.V - b.V) <= 1e-5 * max(a.V, 1.0)
+
+
+def test_rows_between_two_slices_end_a_mode_where_its_change_lies(maps):
+    """At the row halfway between the ends of each joined link (the cold map of nes at e_p + 10 %), the change
+    relocated at the row's load (independently: from the link's nearest point) is an end of a segment of
+    the row to the chords' tolerance; without the links the rows put them up to metres per second off."""
+    _, cold, _, _ = maps
+    rows = cold.shading_Fz
+    with_links, _ = map_shading.row_segments(cold.slices, cold.boundaries(), rows, cold.v_range,
+                                             polylines(cold.mode_links))
+    without, _ = map_shading.row_segments(cold.slices, cold.boundaries(), rows, cold.v_range)
+    worst = 0.0
+    for link in [link for link in cold.mode_links if link.joined]:  # an open one's piece may end before it
+        lo, hi = sorted(link.loads)
+        inside = [k for k, f in enumerate(rows) if lo < f < hi]
+        if not inside:
+            continue
+        k = inside[len(inside) // 2]
+        near = min(link.points, key=lambda c: abs(c.Fz - rows[k]))
+        true = relocate(dataclasses.replace(near, Fz=float(rows[k])), cold.config, cold.params)
+        assert true is not None
+        ends = np.array([seg[1] for seg in with_links[k][:-1]])
+        assert np.min(np.abs(ends - true.V)) <= 3 * CHORD_TOL, (rows[k], true.V, ends)
+        worst = max(worst, float(np.min(np.abs(np.array([seg[1] for seg in without[k][:-1]]) - true.V))))
+    assert worst > 0.1  # the straight lines between the slices were off
 
 
 def _same_shading(cold, warm) -> None:
