@@ -31,6 +31,7 @@ from scipy.optimize import brentq
 
 from ...continuation import ContinuationOptions, CurvePoint
 from ...continuation.collocation import Mesh, PeriodicProblem
+from ...continuation.cycle_curves.guide import decode, encode
 from ...continuation.core import step
 from ...model.configurations import Configuration
 from ...model.equations import build_model
@@ -63,15 +64,20 @@ class ModeChange:
     #: the speeds of the diagram's two points it lies between (the change itself where it was relocated)
     bracket: tuple[float, float] = (math.nan, math.nan)
 
-    def to_dict(self) -> dict[str, Any]:
-        return {"V": self.V, "Fz": self.Fz, "threshold": self.threshold, "mesh": self.mesh.tolist(),
-                "ncol": self.ncol, "u": self.u.tolist(), "span": self.span, "bracket": list(self.bracket)}
+    def to_dict(self, compact: bool = False) -> dict[str, Any]:
+        """JSON-ready; ``compact``: the cycle as base64 float32 (a start for :func:`relocate`, which corrects
+        it: a quarter of the size as text; the mesh exact)."""
+        cycle = {"mesh": self.mesh.tolist(), "u": encode(self.u) if compact else self.u.tolist()}
+        return {"V": self.V, "Fz": self.Fz, "threshold": self.threshold, **cycle, "ncol": self.ncol,
+                "span": self.span, "bracket": list(self.bracket)}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> ModeChange:
-        return cls(float(d["V"]), float(d["Fz"]), float(d["threshold"]), np.asarray(d["mesh"], float),
-                   int(d["ncol"]), np.asarray(d["u"], float), float(d["span"]),
-                   tuple(float(v) for v in d.get("bracket", (d["V"], d["V"]))))
+        def array(x) -> np.ndarray:
+            return decode(x) if isinstance(x, str) else np.asarray(x, float)
+
+        return cls(float(d["V"]), float(d["Fz"]), float(d["threshold"]), array(d["mesh"]), int(d["ncol"]),
+                   array(d["u"]), float(d["span"]), tuple(float(v) for v in d.get("bracket", (d["V"], d["V"]))))
 
 
 def share_of(problem: PeriodicProblem, u: np.ndarray, k_psi: float, k_delta: float) -> float:
@@ -226,8 +232,8 @@ def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params:
     ``chord`` m/s: the secant predictor's error in V is ~V''/2 h (h + h_before), the chord's ~V''/8 h^2; a
     step whose estimate exceeds CHORD_REFUSE x ``chord`` is taken again at half its length. The first step
     is an eighth of the way. Returns the points after ``change``, the last at ``Fz_to``; None where a
-    relocation fails at a step of 1e-3 of the way or less (the change turns back in the load, or its cycle
-    ends between), or after MAX_LOAD_STEPS steps."""
+    relocation fails, or the chord's estimate stays too large, at a step of 1/64 of the way or less (the
+    change turns back in the load, or its cycle ends between), or after MAX_LOAD_STEPS steps."""
     way = float(Fz_to) - change.Fz
     if way == 0.0:
         return []
@@ -248,7 +254,7 @@ def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params:
         deviation = abs(new.V - u[-1]) * abs(h) / (4.0 * (abs(h) + abs(last.Fz - points[-2].Fz))) \
             if new is not None and len(points) >= 2 else 0.0
         if new is None or deviation > CHORD_REFUSE * chord:
-            if abs(h) <= 1e-3 * abs(way):
+            if abs(h) <= abs(way) / 64.0:
                 return None
             h *= 0.5
             continue

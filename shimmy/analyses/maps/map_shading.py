@@ -224,79 +224,93 @@ class _Slices:
 
 
 class _Links:
-    """Mode changes' curves between two slices' loads (``links``: (k, 2) (V, Fz) polylines by ascending
-    Fz, :mod:`~shimmy.analyses.maps.mode_links`), found by their ends."""
+    """Mode changes' curves between two slices' loads (``links``: (k, 2) (V, Fz) polylines, taken by
+    ascending Fz, :mod:`~shimmy.analyses.maps.mode_links`), found by their ends."""
 
     def __init__(self, links: Sequence[np.ndarray]):
         self.by_loads: dict[tuple[float, float], list[np.ndarray]] = defaultdict(list)
         self.by_end: dict[float, list[tuple[float, np.ndarray]]] = defaultdict(list)
         for p in links:
             p = np.asarray(p, float).reshape(-1, 2)
+            if len(p) >= 2 and p[-1, 1] < p[0, 1]:
+                p = p[::-1]
             if len(p) >= 2 and p[-1, 1] > p[0, 1]:
                 self.by_loads[(float(p[0, 1]), float(p[-1, 1]))].append(p)
                 self.by_end[float(p[0, 1])].append((float(p[0, 0]), p))
                 self.by_end[float(p[-1, 1])].append((float(p[-1, 0]), p))
 
-    def through(self, F: float, V: float, Fz: float) -> float | None:
+    def through(self, F: float, V: float, Fz: float, used: set) -> float | None:
         """V at load ``Fz`` on a link with an end at (V, F) whose other end lies at or beyond ``Fz``, if
-        there is one."""
+        there is one (and not in ``used``: ids of links taken already; it is added)."""
         for end, p in self.by_end.get(float(F), ()):
-            if abs(end - V) <= 1e-9 * max(abs(V), 1.0) and p[0, 1] <= Fz <= p[-1, 1]:
+            if id(p) not in used and abs(end - V) <= 1e-9 * max(abs(V), 1.0) and p[0, 1] <= Fz <= p[-1, 1]:
+                used.add(id(p))
                 return float(np.interp(Fz, p[:, 1], p[:, 0]))
         return None
 
-    def speed(self, F0: float, V0: float, F1: float, V1: float, Fz: float) -> float | None:
+    def speed(self, F0: float, V0: float, F1: float, V1: float, Fz: float, used: set) -> float | None:
         """V at load ``Fz`` on the link from (V0, F0) to (V1, F1), if there is one (ends within 1e-9 of
-        the speeds, relative, at least 1e-9 m/s)."""
+        the speeds, relative, at least 1e-9 m/s; not in ``used``, to which it is added)."""
         for p in self.by_loads.get((float(F0), float(F1)), ()):
-            if abs(p[0, 0] - V0) <= 1e-9 * max(abs(V0), 1.0) and abs(p[-1, 0] - V1) <= 1e-9 * max(abs(V1), 1.0):
+            if id(p) not in used and abs(p[0, 0] - V0) <= 1e-9 * max(abs(V0), 1.0) \
+                    and abs(p[-1, 0] - V1) <= 1e-9 * max(abs(V1), 1.0):
+                used.add(id(p))
                 return float(np.interp(Fz, p[:, 1], p[:, 0]))
         return None
+
+
+def _placed(parts, speeds: list[float | None], row: tuple[float, float]):
+    """``parts`` with breakpoint j at ``speeds[j]`` (m/s on the row's interval ``row``) where that is not
+    None, every breakpoint then kept at or right of the one before (all placed first, then ordered: a
+    piece whose end a link carries past its other end has zero width)."""
+    lo, hi = row
+    cuts = [p[1] for p in parts[:-1]]
+    cuts = [min(max((V - lo) / (hi - lo), 0.0), 1.0) if V is not None else f for V, f in zip(speeds, cuts, strict=True)]
+    cuts = list(np.maximum.accumulate(cuts)) if cuts else []
+    edges = [0.0, *cuts, 1.0]
+    return [(float(edges[k]), float(edges[k + 1]), parts[k][2]) for k in range(len(parts))]
 
 
 def _along_links(parts, pair, ends: tuple[tuple[float, float], tuple[float, float]], loads: tuple[float, float],
                  row: tuple[float, float], Fz: float, links: _Links):
     """The interpolated ``parts`` of a row's interval ``row`` (between slices at ``loads`` whose aligned
     pieces are ``pair``, on their intervals ``ends``) with each breakpoint that a link joins on the two
-    slices, or that a link from one of them reaches the row from, put where the link crosses the row (kept
-    between its neighbours: a piece whose end the link carries past its other end vanishes)."""
+    slices, or that a link from one of them reaches the row from, put where the link crosses the row
+    (:func:`_placed`). A breakpoint beside a piece that one slice lacks (put back there at zero width,
+    :func:`_with_vanished`) is not looked up on that slice: its two ends are one speed there, and a link
+    from it belongs to one of them at most; each link is used once."""
     lo, hi = row
     if hi <= lo:
         return parts
-    out = [list(p) for p in parts]
     (a0, b0), (a1, b1) = ends
+    used: set = set()
+    speeds: list[float | None] = []
     for j in range(len(parts) - 1):
         V0 = a0 + pair[0][j][1] * (b0 - a0)
         V1 = a1 + pair[1][j][1] * (b1 - a1)
-        V = links.speed(loads[0], V0, loads[1], V1, Fz)
-        if V is None:  # a link from either slice's breakpoint that ends elsewhere (open) and reaches the row
-            V = links.through(loads[0], V0, Fz)
-            V = links.through(loads[1], V1, Fz) if V is None else V
-        if V is None:
-            continue
-        f = min(max((V - lo) / (hi - lo), out[j][0]), out[j + 1][1])
-        out[j][1] = out[j + 1][0] = f
-    return [tuple(p) for p in out]
+        whole = [pair[k][j][1] > pair[k][j][0] and pair[k][j + 1][1] > pair[k][j + 1][0] for k in (0, 1)]
+        V = links.speed(loads[0], V0, loads[1], V1, Fz, used) if all(whole) else None
+        if V is None and whole[0]:  # an open link from a slice's breakpoint that reaches the row
+            V = links.through(loads[0], V0, Fz, used)
+        if V is None and whole[1]:
+            V = links.through(loads[1], V1, Fz, used)
+        speeds.append(V)
+    return _placed(parts, speeds, row)
 
 
 def _through_links(parts, end: tuple[float, float], load: float, row: tuple[float, float], Fz: float,
                    links: _Links):
     """The ``parts`` of one slice (at ``load``, its interval ``end``) read for a row's interval ``row``
     (at ``Fz``), each breakpoint from which a link reaches the row's load put where the link crosses the
-    row (kept between its neighbours): the slice's mode change followed to the row, where the next slice
-    with its change lies in another region (the curves between them cross otherwise)."""
+    row (:func:`_placed`): the slice's mode change followed to the row, where the next slice with its
+    change lies in another region (the curves between them cross otherwise)."""
     lo, hi = row
     if hi <= lo:
         return parts
-    out = [list(p) for p in parts]
     a, b = end
-    for j in range(len(parts) - 1):
-        V = links.through(load, a + parts[j][1] * (b - a), Fz)
-        if V is None:
-            continue
-        f = min(max((V - lo) / (hi - lo), out[j][0]), out[j + 1][1])
-        out[j][1] = out[j + 1][0] = f
-    return [tuple(p) for p in out]
+    used: set = set()
+    return _placed(parts, [links.through(load, a + parts[j][1] * (b - a), Fz, used) for j in range(len(parts) - 1)],
+                   row)
 
 
 def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequence[float],

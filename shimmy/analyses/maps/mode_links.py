@@ -19,11 +19,13 @@ linearly to where the next slice puts the mode's neighbours). Every change of a 
 next slice's load; a change of the upper slice whose threshold the lower slice has no change of is also
 followed down. :func:`~shimmy.analyses.maps.map_shading.row_segments` reads a breakpoint off the link that
 joins it on both slices, or that starts at it and reaches the row's load. A change whose curve the follow
-loses (its relocation fails: it turns back in the load) has no link, and is interpolated as before.
+loses (its relocation fails: it turns back in the load) has no curve (a *lost* record), and is
+interpolated as before.
 
 A warm map relocates a link's points other than the slices' changes at the new design, at their loads
 (:class:`LinkPointsUnit`), between the two carried slices' relocated changes; links from or to slices
-computed again or added are followed afresh.
+computed again or added are followed afresh; a change lost at the nearby design is not followed again
+(each such follow cost 0.3-1 s, after the slices).
 """
 
 from __future__ import annotations
@@ -42,23 +44,28 @@ from ..diagrams.mode_changes import ModeChange, follow_load, relocate
 #: are located to 1e-7 m/s (measured 2e-9 to 8e-8 m/s apart on nes), changes of one threshold on one slice
 #: lie metres per second apart.
 MATCH = 1e-3
+#: ``ModeLink.end`` of an open link, and of a change the follow lost (a record, so that a warm map does
+#: not follow it again: no points beyond the change)
+OPEN, LOST = -1, -2
 
 
 @dataclass(frozen=True, eq=False)
 class ModeLink:
     """The curve of a mode change from one slice's load to the next slice's: ``points`` in the order followed,
     the first the slice's change number ``start`` (in its ``mode_changes``), the last at the other slice's load:
-    that slice's change number ``end`` (joined), or the followed point (open: ``end`` -1)."""
+    that slice's change number ``end`` (joined), or the followed point (open: ``end`` OPEN). ``end`` LOST:
+    the follow lost the change (``points`` the change alone, ``to`` the other slice's load)."""
 
     threshold: float
     start: int
     end: int
     points: tuple[ModeChange, ...]
+    to: float | None = None  # the other slice's load where the follow lost the change
 
     @property
     def loads(self) -> tuple[float, float]:
         """(from, to): the loads of the slice followed from and of the one followed to."""
-        return self.points[0].Fz, self.points[-1].Fz
+        return self.points[0].Fz, self.points[-1].Fz if self.to is None else self.to
 
     @property
     def joined(self) -> bool:
@@ -71,24 +78,26 @@ class ModeLink:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: the points other than the slices' changes, with their cycles."""
-        moved = self.points[1:-1] if self.joined else self.points[1:]
+        moved = self.points[1:-1] if self.joined else self.points[1:]  # a lost one: none
         return {"threshold": self.threshold, "start": self.start, "end": self.end, "loads": list(self.loads),
-                "points": [c.to_dict() for c in moved]}
+                "points": [c.to_dict(compact=True) for c in moved]}
 
 
 def link_of(change: ModeChange, start: int, others: Sequence[ModeChange], followed: list[ModeChange] | None) -> \
         ModeLink | None:
     """The link of ``change`` (number ``start`` on its slice) from the points ``followed`` to the other slice's
     load (:func:`follow_load`): joined to the other slice's change of the same threshold it reached (within
-    MATCH), else open; None if the follow did not reach the load."""
-    if not followed:
+    MATCH), else open; lost if the follow did not reach the load (``followed`` None)."""
+    if followed is None:
         return None
+    if not followed:
+        raise ValueError("a follow to another load has points")
     end = followed[-1]
     near = [(abs(u.V - end.V), j) for j, u in enumerate(others) if u.threshold == change.threshold]
     if near and min(near)[0] <= MATCH:
         j = min(near)[1]
         return ModeLink(change.threshold, start, j, (change, *followed[:-1], others[j]))
-    return ModeLink(change.threshold, start, -1, (change, *followed))
+    return ModeLink(change.threshold, start, OPEN, (change, *followed))
 
 
 def follows(slices: Sequence[Any]) -> list[tuple[Any, Any, list[int]]]:
@@ -125,8 +134,7 @@ class ModeLinksUnit:
             change = self.changes[i]
             followed = follow_load(change, self.Fz_to, self.config, self.params, exact_nes=self.exact_nes)
             link = link_of(change, i, self.others, followed)
-            if link is not None:
-                out.append(link)
+            out.append(link if link is not None else ModeLink(change.threshold, i, LOST, (change,), self.Fz_to))
         return out
 
     def describe(self) -> str:
@@ -180,8 +188,10 @@ def carried_link(old: dict[str, Any], moved: list[ModeChange] | None, source: An
     first = source.mode_changes[start]
     if first is None or first.threshold != threshold:
         return None
-    if end < 0:
-        return ModeLink(threshold, start, -1, (first, *moved)) if moved else None
+    if end == LOST:  # lost there: not followed again (a follow that loses a change costs ~0.3-1 s)
+        return ModeLink(threshold, start, LOST, (first,), float(target.Fz))
+    if end == OPEN:  # open: joined now if its end reached a change of the other slice, as a cold map joins it
+        return link_of(first, start, target.mode_changes, moved) if moved else None
     last = target.mode_changes[end]
     if last is None or last.threshold != threshold:
         return None
@@ -189,5 +199,6 @@ def carried_link(old: dict[str, Any], moved: list[ModeChange] | None, source: An
 
 
 def polylines(links: Sequence[ModeLink]) -> list[np.ndarray]:
-    """The links as (V, Fz) polylines, for :func:`~shimmy.analyses.maps.map_shading.row_segments`."""
-    return [link.polyline() for link in links]
+    """The links as (V, Fz) polylines, for :func:`~shimmy.analyses.maps.map_shading.row_segments` (a lost
+    change's none)."""
+    return [link.polyline() for link in links if link.end != LOST]

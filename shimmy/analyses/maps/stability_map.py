@@ -23,13 +23,14 @@ How a map is built (what :func:`stability_map` returns says the same in ``method
   between the curves that none of them crosses (:func:`map_shading.uncovered`).
 * **Shading and region polygons** are read off the slices along the curves
   (:mod:`shimmy.analyses.maps.map_shading`): each row interval between two boundary crossings takes
-  the types of the same interval on the nearest slices (mode changes inside it interpolated
-  in Fz), on 180 rows (at least four per slice); the polygons chain the rows' segments.
+  the types of the same interval on the nearest slices (a mode change inside it on its curve followed
+  in Fz between the slices, :mod:`shimmy.analyses.maps.mode_links`; interpolated where none was
+  followed), on 180 rows (at least four per slice); the polygons chain the rows' segments.
 
 :func:`~shimmy.analyses.maps.map_slices.classify` (in :mod:`.map_slices`, with the slices) runs
 exactly the slice computation at one Fz and reads the answer at V: at a slice load it gives the
 map's answer; between slices it agrees with the shading wherever the type is set by the curves (a
-mode change inside a region is interpolated by the shading).
+mode change inside a region is followed between the slices to the chords' tolerance, ~0.02 m/s).
 
 All units of a map (the Hopf curves, branches beside codimension-2 points, curve continuations,
 slices) go through :mod:`shimmy.analyses.core.executors` (a local process pool, or a Dask cluster),
@@ -176,8 +177,10 @@ class StabilityMap:
                              "Floquet multipliers, cycle modes); a time simulation where none is stable; slices "
                              "evenly spaced plus one through each region between the curves that they miss",
                     "shading": "each row's intervals between the Hopf, fold and torus curves take the types of the "
-                               "same interval on the nearest slices, as fractions of it (mode changes inside it "
-                               "interpolated in Fz between the slices below and above)",
+                               "same interval on the nearest slices, as fractions of it; a mode change inside it "
+                               "on its curve, followed in Fz from the slice's located change to the next slice's "
+                               "load (interpolated in Fz between the slices below and above where none was "
+                               "followed)",
                     "regions": "polygons of the shading's row segments between consecutive rows, one per region "
                                "until it splits or merges; their edges are the curves' crossings of the rows"}
                 | ({} if self.warmed_from is None else {"warmed_from": self.warmed_from})
@@ -424,7 +427,8 @@ def stability_maps(configs: Sequence[Configuration | str], *, params: Parameters
 
     units = [(priority, (k, unit)) for k, b in enumerate(builds) for priority, unit in b.first_units()]
     run_dynamic(_tagged_unit, units, executor, done, report, describe,
-                lambda tagged: "slices" if isinstance(tagged[1], SliceUnit) else "curve units")
+                lambda tagged: "slices" if isinstance(tagged[1], SliceUnit)
+                else "mode changes followed" if isinstance(tagged[1], ModeLinksUnit) else "curve units")
     maps = [b.result(type(executor).__name__) for b in builds]
     report(1.0, "done")
     return maps

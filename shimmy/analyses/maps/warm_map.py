@@ -539,9 +539,10 @@ def warm_map(start: dict[str, Any], *, params: Parameters, executor=None,
         carried = set()
         if a.carried and b.carried:
             unit = moving.get((a.Fz, b.Fz))
-            olds = [old for old in old_links.get((a.Fz, b.Fz), []) if old["start"] in only]
-            for old in olds:
-                moved = results[index[id(unit)]][unit.links.index(old)] if unit is not None else []
+            for k, old in enumerate(old_links.get((a.Fz, b.Fz), [])):
+                if old["start"] not in only:
+                    continue
+                moved = results[index[id(unit)]][k] if unit is not None else []
                 link = carried_link(old, moved, a, b)
                 if link is not None:
                     links.append(link)

@@ -692,3 +692,37 @@ def test_a_mode_piece_ends_where_its_open_link_meets_its_other_end():
             assert both == [] and [t for _, _, t in row] == ["Torsion", "Lateral", "Stable"]
             assert row[0][1] == pytest.approx(a)
     assert [bool([1 for _, _, t in row if t == "Both"]) for row in rows] == [True, True, False]
+
+
+def test_links_place_every_breakpoint_before_ordering_them():
+    """Two changes whose links both bend right of the straight lines (20 -> 37 -> 40 and 25 -> 42 -> 45): the
+    row halfway puts each on its link (37 and 42), the first not held left of where the straight line put
+    the second (35)."""
+    curve = ("b", np.array([[100.0, 0.0], [100.0, 1.0e6]]))
+    slices = [_Slice(1e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 20.0},
+                           {"type": "Both", "V_start": 20.0, "V_end": 25.0},
+                           {"type": "Lateral", "V_start": 25.0, "V_end": 100.0}]),
+              _Slice(3e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 40.0},
+                           {"type": "Both", "V_start": 40.0, "V_end": 45.0},
+                           {"type": "Lateral", "V_start": 45.0, "V_end": 100.0}])]
+    links = [np.array([[20.0, 1e5], [37.0, 2e5], [40.0, 3e5]]), np.array([[25.0, 1e5], [42.0, 2e5], [45.0, 3e5]])]
+    rows, _ = map_shading.row_segments(slices, [curve], [2e5], (1.0, 200.0), links)
+    assert rows[0][:3] == [(1.0, pytest.approx(37.0), "Torsion"), (pytest.approx(37.0), pytest.approx(42.0), "Both"),
+                           (pytest.approx(42.0), 100.0, "Lateral")]
+
+
+def test_a_piece_one_slice_lacks_keeps_both_of_its_links():
+    """Both (40-50 m/s) on the upper slice only, the lower slice's Torsion | Lateral edge at 30 m/s: the 0.8
+    change joined from 30 to 40 (through 35), the 0.2 change at 50 followed down (open) through 45 at the
+    row: the row's Both piece runs from 35 to 45. (Looked up on the lower slice, where the piece is put back
+    at zero width at 30 m/s, both its ends took the first link there, and the piece vanished.)"""
+    curve = ("b", np.array([[100.0, 0.0], [100.0, 1.0e6]]))
+    slices = [_Slice(1e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 30.0},
+                           {"type": "Lateral", "V_start": 30.0, "V_end": 100.0}]),
+              _Slice(3e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 40.0},
+                           {"type": "Both", "V_start": 40.0, "V_end": 50.0},
+                           {"type": "Lateral", "V_start": 50.0, "V_end": 100.0}])]
+    links = [np.array([[30.0, 1e5], [35.0, 2e5], [40.0, 3e5]]), np.array([[60.0, 1e5], [45.0, 2e5], [50.0, 3e5]])]
+    rows, _ = map_shading.row_segments(slices, [curve], [2e5], (1.0, 200.0), links)
+    assert rows[0][:3] == [(1.0, pytest.approx(35.0), "Torsion"), (pytest.approx(35.0), pytest.approx(45.0), "Both"),
+                           (pytest.approx(45.0), 100.0, "Lateral")]

@@ -216,8 +216,11 @@ def test_rows_between_two_slices_end_a_mode_where_its_change_lies(maps):
         near = min(link.points, key=lambda c: abs(c.Fz - rows[k]))
         true = relocate(dataclasses.replace(near, Fz=float(rows[k])), cold.config, cold.params)
         assert true is not None
-        ends = np.array([seg[1] for seg in with_links[k][:-1]])
-        assert np.min(np.abs(ends - true.V)) <= 3 * CHORD_TOL, (rows[k], true.V, ends)
+        # the row's ends other than the curves' crossings (a mode's piece may end on a curve nearby)
+        crossed = [V for V, _ in map_shading.crossings(cold.boundaries(), float(rows[k]))]
+        ends = np.array([seg[1] for seg in with_links[k][:-1]
+                         if not any(abs(seg[1] - V) <= 1e-9 * max(V, 1.0) for V in crossed)])
+        assert ends.size and np.min(np.abs(ends - true.V)) <= 3 * CHORD_TOL, (rows[k], true.V, ends)
         worst = max(worst, float(np.min(np.abs(np.array([seg[1] for seg in without[k][:-1]]) - true.V))))
     assert worst > 0.1  # the straight lines between the slices were off
 
