@@ -5,6 +5,8 @@ make of a page. The test modules import it (pytest puts their folder on sys.path
 
 from __future__ import annotations
 
+import json
+
 import os
 import time
 from pathlib import Path
@@ -187,3 +189,36 @@ def on_figure(driver, graph_id: str, script: str):
     """``script`` on the drawn figure ``g`` of a dcc.Graph (null until Plotly has drawn it)."""
     return driver.execute_script(f"const g = document.querySelector('#{graph_id} .js-plotly-plot');"
                                  f"if (!g || !g.data) {{ return null; }} {script}")
+
+
+#: The page's own record of a figure's titles (title and subtitle, joined by ' | '), read every 25 ms, each with
+#: the value of an expression on the figure ``g`` at that time: a state that lasts less than a WebDriver round
+#: trip on a loaded machine (a sketch's title while a warm map is made) is seen all the same.
+_RECORD_TITLES = """
+const id = arguments[0], extra = new Function('g', 'return (' + arguments[1] + ');');
+window.__titles = window.__titles || {};
+const seen = window.__titles[id] = window.__titles[id] || [];
+if (window.__titleTimers && window.__titleTimers[id]) { return; }
+window.__titleTimers = window.__titleTimers || {};
+window.__titleTimers[id] = setInterval(() => {
+    const g = document.querySelector('#' + id + ' .js-plotly-plot');
+    if (!g || !g.layout) { return; }
+    const t = g.layout.title || {};
+    const text = (t.text || '') + (t.subtitle && t.subtitle.text ? ' | ' + t.subtitle.text : '');
+    const value = JSON.stringify(extra(g));
+    const last = seen[seen.length - 1];
+    if (!last || last[0] !== text || last[1] !== value) { seen.push([text, value]); }
+}, 25);
+"""
+
+
+def record_titles(driver, graph_id: str, extra: str = "null") -> None:
+    """Start the page's record of the figure ``graph_id``'s titles, each with the value of the JavaScript
+    expression ``extra`` on the figure ``g`` (:func:`titles_seen`); again after a page load."""
+    driver.execute_script(_RECORD_TITLES, graph_id, extra)
+
+
+def titles_seen(driver, graph_id: str) -> list[tuple[str, object]]:
+    """(title, value of the ``extra`` expression) as the figure showed them since :func:`record_titles`, in order."""
+    rows = driver.execute_script("return (window.__titles || {})[arguments[0]] || [];", graph_id) or []
+    return [(text, json.loads(value)) for text, value in rows]

@@ -12,8 +12,8 @@ selenium = pytest.importorskip("selenium")
 from selenium.webdriver.common.by import By  # noqa: E402
 
 from ui import live  # noqa: E402
-from browser import (SHOTS, browser_fixture, by_id, idle, job_records, on_figure, pattern, severe,  # noqa: E402
-                     text_of, type_into, wait_for)
+from browser import (SHOTS, browser_fixture, by_id, idle, job_records, on_figure, pattern, record_titles,  # noqa: E402
+                     severe, text_of, titles_seen, type_into, wait_for)
 
 browser = browser_fixture("chromium-live-map", "1440,900")
 PAGE = "/stability-map?shade=nes&fz_min=300&fz_max=900&resolution=4"
@@ -22,6 +22,11 @@ PAGE = "/stability-map?shade=nes&fz_min=300&fz_max=900&resolution=4"
 def _title(browser) -> str:
     return on_figure(browser, "map-graph", "const t = g.layout.title || {}; return (t.text || '') + "
                                            "(t.subtitle && t.subtitle.text ? ' | ' + t.subtitle.text : '');") or ""
+
+
+def _seen(browser, text: str) -> bool:
+    """Whether the map figure has shown a title with ``text`` since its titles were recorded (or shows one)."""
+    return any(text in t for t, _ in titles_seen(browser, "map-graph")) or text in _title(browser)
 
 
 def _faded(browser) -> bool:
@@ -34,13 +39,21 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
     browser.get(server.base + PAGE + "&e_p=0.0012")
     run = wait_for(lambda: browser.find_elements(By.ID, "map-run"), what="the Compute button")[0]
     idle(browser)
+    # the page's record of the titles, each with the shaded regions and the previous map's traces drawn then:
+    # a title shown briefly is seen on a loaded machine
+    record_titles(browser, "map-graph", "[g.data.filter(t => t.fill === 'toself').length, "
+                                        "g.data.filter(t => (t.name || '').indexOf('(previous)') >= 0).length]")
     run.click()
     # the curves are drawn as they are known, before the slices and the shading
-    wait_for(lambda: "Making the map | Hopf curves" in _title(browser), timeout=240, interval=0.1,
-             what="the first map's curves before its shading")
-    assert on_figure(browser, "map-graph", "return g.data.filter(t => t.fill === 'toself').length;") == 0
-    browser.save_screenshot(str(SHOTS / "live-map-sketch-1440.png"))
+    wait_for(lambda: _seen(browser, "Making the map | Hopf curves"), timeout=240, interval=0.1,
+             what=lambda: f"the first map's curves before its shading (titles: {titles_seen(browser, 'map-graph')})")
+    if "Making the map | Hopf curves" in _title(browser):
+        browser.save_screenshot(str(SHOTS / "live-map-sketch-1440.png"))
     wait_for(lambda: "Shimmy type of" in _title(browser), timeout=240, what="the first map")
+    titles = titles_seen(browser, "map-graph")
+    sketches = [k for k, (t, _) in enumerate(titles) if "Making the map | Hopf curves" in t]
+    assert sketches and all(titles[k][1][0] == 0 for k in sketches), titles  # no region shaded while sketched
+    assert sketches[0] < next(k for k, (t, _) in enumerate(titles) if "Shimmy type of" in t), titles
     first = [i for i in job_records(server) if i not in before]
     assert len(first) == 1
 
@@ -52,14 +65,16 @@ def test_the_map_follows_a_design_step_by_itself(server, browser):
              interval=0.05, what="the previous map faint while the next is made")
     browser.save_screenshot(str(SHOTS / "live-map-fading-1440.png"))
     # the new design's curves as they come, over the previous map (its regions and curves faint)
-    wait_for(lambda: "Making the new design's map" in _title(browser), timeout=120, interval=0.1,
+    wait_for(lambda: _seen(browser, "Making the new design's map"), timeout=120, interval=0.1,
              what=lambda: "the new design's curves over the previous map (the figure's title: "
              f"{_title(browser)!r}; status: {text_of(browser, 'map-status')!r}; the jobs: "
              + "; ".join(f"{j['analysis']} {j['status']} {j['message']}" for i, j in job_records(server).items()
                          if i not in before and i not in first) + ")")
-    assert on_figure(browser, "map-graph", "return g.data.filter(t => (t.name || '').indexOf('(previous)') >= 0)"
-                                           ".length;") > 0
-    browser.save_screenshot(str(SHOTS / "live-map-sketch-warm-1440.png"))
+    # drawn over the previous map's faint regions and curves
+    warm_sketches = [extra for t, extra in titles_seen(browser, "map-graph") if "Making the new design's map" in t]
+    assert warm_sketches and all(extra[1] > 0 for extra in warm_sketches), warm_sketches
+    if "Making the new design's map" in _title(browser):
+        browser.save_screenshot(str(SHOTS / "live-map-sketch-warm-1440.png"))
     wait_for(lambda: "Shimmy type of" in _title(browser) and not _faded(browser), timeout=240,
              what="the warmed map")
     second = [j for i, j in job_records(server).items() if i not in before and i not in first]
