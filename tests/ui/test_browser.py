@@ -16,8 +16,8 @@ from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
-from browser import (DOWNLOADS, PAGES, SHOTS, browser_fixture, idle, job_records, on_figure, severe,  # noqa: E402
-                     slider_handle, table_rows, text_of, trace_count, wait_for)
+from browser import (DOWNLOADS, PAGES, SHOTS, browser_fixture, by_id, idle, job_records, on_figure, pattern,  # noqa: E402
+                     severe, slider_handle, table_rows, text_of, trace_count, wait_for)
 
 browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)
 
@@ -169,7 +169,13 @@ def test_slider_move_updates_the_linear_stability_figure_and_the_url(server, bro
     traces_after = wait_for(lambda: (t := browser.execute_script(NES_TRACE)) != traces_before and t,
                             timeout=20, what="the NES growth-rate trace to change")
     assert traces_after != traces_before
-    wait_for(lambda: "r2=" in browser.current_url, timeout=10, what="the URL to carry r2")
+    idle(browser)
+    # the address is written after a step's requests are sent: wait for the last step's value there (read
+    # at an earlier step, the link reproduced that step's design: NES + PD's onset against the original's
+    # was +0.797 there against +0.798 at the last one)
+    box = by_id(browser, pattern("r2", "param-box"))
+    wait_for(lambda: f"r2={box.get_attribute('value')}" in browser.current_url, timeout=10,
+             what=lambda: f"the URL to carry r2 = {box.get_attribute('value')} ({browser.current_url})")
     idle(browser)
     stepped = table_rows(browser, "#ov-hopf-table tbody tr")
     # The link reproduces the view: the whole table.

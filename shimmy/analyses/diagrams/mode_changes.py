@@ -231,7 +231,7 @@ def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params:
     the new load). The step is set so that the curve deviates from the chord between two points by about
     ``chord`` m/s: the secant predictor's error in V is ~V''/2 h (h + h_before), the chord's ~V''/8 h^2; a
     step whose estimate exceeds CHORD_REFUSE x ``chord`` is taken again at half its length. The first step
-    is an eighth of the way. Returns the points after ``change``, the last at ``Fz_to``; None where a
+    is an eighth of the way, its chord checked once the second is taken (a midpoint put in where needed). Returns the points after ``change``, the last at ``Fz_to``; None where a
     relocation fails, or the chord's estimate stays too large, at a step of 1/64 of the way or less (the
     change turns back in the load, or its cycle ends between), or after MAX_LOAD_STEPS steps."""
     way = float(Fz_to) - change.Fz
@@ -259,8 +259,30 @@ def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params:
             h *= 0.5
             continue
         points.append(new)
+        if len(points) == 3 and not _first_chord_kept(points, chord, config, params, exact_nes):
+            return None
         if Fz == float(Fz_to):
             return points[1:]
         if len(points) >= 3:
             h *= min(max(math.sqrt(chord / max(deviation, 1e-12)), 0.5), 2.0)
     return None
+
+
+def _first_chord_kept(points: list[ModeChange], chord: float, config, params, exact_nes: bool) -> bool:
+    """The first step of a follow (from a constant predictor: no estimate of its chord's error) checked
+    once the second is taken: V'' from the three points' divided differences, the chord's error ~V''/8 h^2;
+    above CHORD_REFUSE x ``chord`` its midpoint is relocated and put in (``points`` changed in place). False
+    if that relocation fails (the first point may be another change's)."""
+    (F0, V0), (F1, V1), (F2, V2) = ((c.Fz, c.V) for c in points)
+    curvature = 2.0 * ((V2 - V1) / (F2 - F1) - (V1 - V0) / (F1 - F0)) / (F2 - F0)
+    error = abs(curvature) * (F1 - F0) ** 2 / 8.0
+    if error <= CHORD_REFUSE * chord:
+        return True
+    start, end = points[0], points[1]
+    u = 0.5 * (start.u + end.u)
+    mid = relocate(dataclasses.replace(end, Fz=0.5 * (F0 + F1), V=float(u[-1]), u=u), config, params,
+                   exact_nes=exact_nes)
+    if mid is None or abs(mid.V - 0.5 * (V0 + V1)) > 2.0 * error + 0.5 * abs(V1 - V0):
+        return False
+    points.insert(1, mid)
+    return True

@@ -110,6 +110,13 @@ def test_a_change_followed_in_the_load_ends_on_the_change_located_there(nes):
         assert share_of(problem, point.u, gear.k_psi, gear.k_delta) == pytest.approx(0.2, abs=1e-9)
         half = relocate(dataclasses.replace(before, Fz=0.5 * (before.Fz + point.Fz)), result.config, result.params)
         assert half is not None and abs(half.V - 0.5 * (before.V + point.V)) <= 3 * CHORD_TOL
+    # a tighter chord: more points, each chord within twice it of the curve, the first step's too (its chord
+    # is checked once the second step is taken: a midpoint put in)
+    fine = follow_load(there[0], 405.6e3, result.config, result.params, chord=0.005)
+    assert fine is not None and len(fine) > len(longer) and fine[-1].V == pytest.approx(longer[-1].V, abs=1e-6)
+    for before, point in zip([there[0], *fine[:-1]], fine, strict=True):
+        half = relocate(dataclasses.replace(before, Fz=0.5 * (before.Fz + point.Fz)), result.config, result.params)
+        assert half is not None and abs(half.V - 0.5 * (before.V + point.V)) <= 2 * 0.005, (before.Fz, point.Fz)
 
 
 def test_a_change_followed_where_its_curve_does_not_reach_gives_none(nes):
