@@ -545,6 +545,70 @@ def test_a_guided_trace_follows_the_nearby_curve_to_the_same_curve_and_points(c,
         assert with_guide <= 1.1 * without, (with_guide, without)
 
 
+def test_a_guided_trace_passes_over_old_points_its_chords_do_not_need():
+    """A nearby curve traced with a tolerance 10x tighter (chord_tol 5e-4: 3x as many points) guides a trace
+    at the default 5e-3: the trace passes over the old points its chords can do without (one step through
+    several of them, :data:`~shimmy.continuation.cycle_curves.tracing.PASS_SHARE`), so it has fewer points
+    than the guide, nearly all guided, and still every chord within the tolerance of the exact curve
+    (b1 = -b2^2 / (4 c): its deviation from each chord at the chord's middle in b2), with the special points
+    of the trace without a guide."""
+    from shimmy.continuation.cycle_curves.guide import Guide, guide_points
+
+    kw = dict(box=BOX, scale=np.ones(2), p_scale=(1.0, 1.0), p2_marks=(0.25,))
+    guess, shape = hopf_guess(np.zeros(2), 0.0, 1.0, np.array([1.0, -1j]), Mesh.uniform(20, 4), 0.0)
+    branch = periodic_branch(_bautin(1.0).at(0.5), guess, p_range=(-1.0, 1.0), options=PeriodicOptions(ntst=20, ncol=4),
+                             scale=np.ones(2), p_scale=1.0, direction=shape)
+    start = [q for q in branch.special_points if q.kind == "LPC"][0].solution
+    turning = ContinuationOptions(ds=0.05, ds_max=0.5, max_steps=300, max_angle=0.3)  # the gear's curves' limit
+    old = cycle_curve(_bautin(1.0), "LPC", start, 0.5, options=CycleCurveOptions(chord_tol=5e-4, continuation=turning),
+                      **kw)
+    i = len(old.p) // 2
+    points = guide_points(old, i, bool(old.p[i + 1, 1] > old.p[i - 1, 1]))
+    guides = {way: Guide(points[way], 4, 2) for way in (1, -1)}
+    c = 1.02
+    options = CycleCurveOptions(continuation=turning)
+    guided = cycle_curve(_bautin(c), "LPC", old.solutions[i], float(old.p[i, 1]), guides=guides, options=options, **kw)
+    alone = cycle_curve(_bautin(c), "LPC", old.solutions[i], float(old.p[i, 1]), options=options, **kw)
+    assert len(guided.p) < 0.6 * len(old.p) and guided.guided >= 0.8 * len(guided.p), (len(guided.p), len(old.p))
+    b1, b2 = guided.p[:, 0], guided.p[:, 1]
+    np.testing.assert_allclose(b1, -b2 ** 2 / (4 * c), atol=1e-8)
+    middle = 0.5 * (b2[1:] + b2[:-1])
+    allowed = 5e-3 * np.maximum(np.maximum(np.abs(b1[1:]), np.abs(b1[:-1])), 0.1)
+    assert np.all(np.abs(-middle ** 2 / (4 * c) - 0.5 * (b1[1:] + b1[:-1])) <= allowed)
+    assert [q.kind for q in guided.special_points] == [q.kind for q in alone.special_points]
+    for a, b in zip(guided.special_points, alone.special_points, strict=True):
+        if a.kind != "ZA":  # (where a trace stops short of GH depends on its steps)
+            assert a.p == pytest.approx(b.p, abs=1e-7) and a.data["p2"] == pytest.approx(b.data["p2"], abs=1e-7)
+
+
+
+def test_a_guide_passes_over_points_only_where_allowed_and_retries_the_next_one():
+    """Guide.next's bookkeeping with a given test: it goes to the last point before the first that does not
+    pass (at most REACH ahead), the shift and ``at`` move to the point taken; after a refused step over points
+    ``shorter`` goes back to the next point (once), and after a refused point it goes point by point."""
+    from shimmy.continuation.core import CurvePoint
+    from shimmy.continuation.cycle_curves.guide import REACH, Guide
+
+    mesh = Mesh.uniform(2, 1)
+    points = [(mesh.points, np.array([0.0, 0.0, 0.0, 0.0, 1.0, float(k), 0.0])) for k in range(12)]
+    guide = Guide(points, 1, 1)
+    guide.anchor(CurvePoint(points[0][1] + 0.5, np.zeros(7)), mesh)
+    asked = []
+
+    def passes(a, b):
+        asked.append((a, b))
+        return b - a <= 2  # passing over one point at a time
+
+    predictor, _ = guide.next(mesh, passes)
+    assert guide.k == 2 and asked == [(0, 2), (0, 3)] and predictor[5] == 2.0 + 0.5
+    guide.took(CurvePoint(points[2][1] + 0.25, np.zeros(7)), mesh)
+    assert (guide.at, guide.k) == (2, 3)
+    predictor, _ = guide.next(mesh, lambda a, b: True)
+    assert guide.k == 2 + REACH and predictor[5] == 2.0 + REACH + 0.25
+    assert guide.shorter() and guide.k == 3 and not guide.shorter()
+    guide.skip_behind(CurvePoint(points[3][1] + 0.25, np.eye(7)[5]), mesh, np.ones(7))  # refused: one by one
+    assert guide.misses == 1 and guide.next(mesh, lambda a, b: True) is not None and guide.k == guide.at + 1
+
 def test_a_point_moves_to_another_mesh_on_its_collocation_polynomials():
     """on_mesh: x on the source mesh's nodes evaluated at the target's, exactly for a polynomial of
     the collocation degree; the scalars after x kept; float32 encoding round-trips to 1e-7."""

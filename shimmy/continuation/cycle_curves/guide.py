@@ -15,8 +15,9 @@ its length. Each point is taken only where the tracer takes a step (converged, a
 chord within the tracer's limits: :meth:`~shimmy.continuation.core.Tracer.advance_to`), so a point
 of a guided trace is a point of the curve to the same tolerance as any other, and the trace's
 checks (the box, the zero-amplitude end, closure, turns, marks, codimension-2 points) are the
-same. Where a guided point is refused, the tracer takes that step itself and the guide resumes
-at its first point ahead; once its points are used up, or it stopped helping (``GIVE_UP``,
+same. A step may pass over old points the drawn polyline does not need (:meth:`Guide.next`); refused,
+it is taken again to the next old point. Where a guided point is refused, the tracer takes that step
+itself and the guide resumes at its first point ahead; once its points are used up, or it stopped helping (``GIVE_UP``,
 ``SLOW``), the tracer goes on alone (a curve that grew is traced on to its new end).
 
 Old points are stored in float32 (:func:`encode`): a predictor needs no more, and the warm start
@@ -27,6 +28,7 @@ from __future__ import annotations
 
 import base64
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -77,6 +79,9 @@ def guide_points(curve, i: int, plus_to_last: bool) -> dict[int, list[tuple[np.n
 #: iterations and the refused ones up to 8 factorisations each, twice the unguided trace's work.
 GIVE_UP = 2
 SLOW = 6
+#: A guided step goes at most this many old points ahead, passing over at most REACH - 1 of them (those the
+#: drawn polyline does not need: see :meth:`Guide.next`)
+REACH = 4
 
 
 @dataclass
@@ -120,13 +125,32 @@ class Guide:
         source, d = self.shift
         return on_mesh(d, source, mesh, self.n)
 
-    def next(self, mesh: Mesh) -> tuple[np.ndarray, np.ndarray] | None:
+    def next(self, mesh: Mesh,
+             passes: Callable[[int, int], bool] | None = None) -> tuple[np.ndarray, np.ndarray] | None:
         """(predictor, the old curve's chord into it) for the next point on ``mesh``; None once the
-        guide is used up."""
+        guide is used up. ``passes(a, b)``: whether a step may go from old point a straight to old point
+        b > a + 1, passing over the points between (the trace's own test); the next point is then the
+        last b of a + 2, a + 3, ... (at most a + ``REACH``) before the first that does not pass, except right
+        after a refused point (the trace resumes point by point)."""
         if self.shift is None or self.k >= len(self.points):
             return None
+        if passes is not None and self.misses == 0:
+            while self.k + 1 < len(self.points) and self.k + 1 - self.at <= REACH and passes(self.at, self.k + 1):
+                self.k += 1
         old = self._old(self.k, mesh)
         return old + self._shift(mesh), old - self._old(self.at, mesh)
+
+    def shorter(self) -> bool:
+        """After a refused step that passed over old points: the next old point instead (True), or
+        False where the step went to the next one already."""
+        if self.k <= self.at + 1:
+            return False
+        self.k = self.at + 1
+        return True
+
+    def olds(self, a: int, b: int, mesh: Mesh) -> np.ndarray:
+        """Old points a..b on ``mesh``, one row each."""
+        return np.array([self._old(k, mesh) for k in range(a, b + 1)])
 
     def took(self, point: CurvePoint, mesh: Mesh) -> None:
         """The predicted point was taken (``point``): the shift is its, the guide moves on (or stops,

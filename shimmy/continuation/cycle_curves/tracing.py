@@ -22,7 +22,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ..collocation import Mesh
-from ..core import ContinuationOptions, CurvePoint, Tracer, locate_between, point_at, step, tangent, weighted_norm
+from ..core import (GUIDED_CAP, ContinuationOptions, CurvePoint, Tracer, locate_between, point_at, step, tangent,
+                    weighted_norm)
 from ..errors import ContinuationError, ConvergenceError, InvalidInputError
 from ..fields import TwoParameterField
 from ..kinds import PointKind, Stop, StopReason
@@ -228,6 +229,42 @@ def _amplitude(problem: CycleCurveProblem, xmax, xmin) -> float:
     return float(np.max(0.5 * (np.asarray(xmax) - np.asarray(xmin)) / problem.cycle.scale))
 
 
+#: A warm trace passes over the old curve's points (:meth:`~.guide.Guide.next`) where the tracer's own
+#: limits would let one step do it with this much to spare: the step's chord (:func:`_chord_ratio`) and its
+#: turn at most PASS_SHARE of their limits, its length at most PASS_SHARE of the longest step. The cold
+#: trace's steps grew slowly (1.4x a step) and were shortened where Newton struggled, so that most of its
+#: chords stray far less than allowed (nes, e_p + 10 %: median 0.09 of the tolerance).
+PASS_SHARE = 0.7
+
+
+def _passes(problem_of: Callable[[], CycleCurveProblem], tracer: Tracer, guide: Guide, chord_tol: float):
+    """The test whether a guided step may go from old point a (where the trace is) straight to old point b,
+    passing over the points between (see ``PASS_SHARE``): the tangent at a the trace's own, the one at b
+    the old points' central difference there (exact on a uniformly curving stretch; b the old curve's last
+    point: not passed to)."""
+    def passes(a: int, b: int) -> bool:
+        if b + 1 >= len(guide.points):
+            return False
+        problem = problem_of()
+        w = problem.weights
+        u = guide.olds(a, b + 1, problem.mesh)
+        h = weighted_norm(u[-2] - u[0], w)
+        limit = min(tracer.options.ds_max, GUIDED_CAP * tracer.cap)
+        if not 0.0 < h <= PASS_SHARE * limit:
+            return False
+        t_a = tracer.point.tangent
+        t_b = u[-1] - u[-3]
+        size = weighted_norm(t_b, w)
+        if not size > 0.0:
+            return False
+        t_b = t_b / size
+        cos = float(np.sum(w * t_a * t_b)) / max(weighted_norm(t_a, w), 1e-300)
+        if math.acos(max(-1.0, min(1.0, cos))) > PASS_SHARE * tracer.options.max_angle:
+            return False
+        return _chord_ratio(problem, CurvePoint(u[0], t_a), CurvePoint(u[-2], t_b), h, chord_tol) <= PASS_SHARE
+    return passes
+
+
 def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCurveOptions, marks, progress,
            guide: Guide | None = None):
     copts = options.continuation
@@ -239,6 +276,7 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
     special: list[SpecialPoint] = []
     if guide is not None:
         guide.anchor(start, problem.mesh)
+        passes = _passes(lambda: problem, tracer, guide, options.chord_tol)
 
     def p_direction(point):
         t_p = point.tangent[n_x + 1:n_x + 3] * np.sqrt(problem.weights[n_x + 1:n_x + 3])
@@ -256,8 +294,10 @@ def _trace(problem: CycleCurveProblem, start: CurvePoint, box, options: CycleCur
     for steps in range(1, copts.max_steps + 1):  # noqa: B007
         prev = tracer.point
         adv = guided = None
-        if guide is not None and (guided := guide.next(problem.mesh)) is not None:
+        if guide is not None and (guided := guide.next(problem.mesh, passes)) is not None:
             adv = tracer.advance_to(*guided)
+            if adv is None and guide.shorter():  # a step over old points refused: to the next one
+                adv = tracer.advance_to(*guide.next(problem.mesh))
             if adv is not None:
                 guide.took(adv[0], problem.mesh)
         if adv is None:
