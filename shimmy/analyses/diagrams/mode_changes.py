@@ -221,6 +221,11 @@ CHORD_TOL = 0.02
 CHORD_REFUSE = 2.0
 #: ... the steps at most (a change that needs more is given up: None)
 MAX_LOAD_STEPS = 64
+#: ... and the shortest step, as a share of the way: a change whose relocation fails, or whose chord stays
+#: too curved, at a step this short is given up (None). At 1/64 a change followed from 248.7 kN down to
+#: 233.7 kN on nes_pd (a_p 0.95) was lost 153 N short of its end, where its curve steepens towards a turn
+#: in the load (dV/dFz -0.7 -> -4 m/s per kN), which a follow from 238.7 kN (a shorter way) reached.
+MIN_STEP_SHARE = 1.0 / 256.0
 
 
 def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params: Parameters, *,
@@ -232,11 +237,23 @@ def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params:
     ``chord`` m/s: the secant predictor's error in V is ~V''/2 h (h + h_before), the chord's ~V''/8 h^2; a
     step whose estimate exceeds CHORD_REFUSE x ``chord`` is taken again at half its length. The first step
     is an eighth of the way, its chord checked once the second is taken (a midpoint put in where needed). Returns the points after ``change``, the last at ``Fz_to``; None where a
-    relocation fails, or the chord's estimate stays too large, at a step of 1/64 of the way or less (the
+    relocation fails, or the chord's estimate stays too large, at a step of MIN_STEP_SHARE of the way or less (the
     change turns back in the load, or its cycle ends between), or after MAX_LOAD_STEPS steps."""
+    points, reached = follow_as_far(change, Fz_to, config, params, exact_nes=exact_nes, chord=chord)
+    return points if reached else None
+
+
+def follow_as_far(change: ModeChange, Fz_to: float, config: Configuration, params: Parameters, *,
+                  exact_nes: bool = False, chord: float = CHORD_TOL,
+                  min_step: float | None = None) -> tuple[list[ModeChange], bool]:
+    """:func:`follow_load`'s points after ``change`` as far as the follow got, and whether it reached
+    ``Fz_to`` (a follow that gives up also returns the points before the step it gave up on: where a
+    warm map resumes it). ``min_step`` (N): the step it gives up at, MIN_STEP_SHARE of the way by default
+    (a follow resumed part way keeps the whole way's)."""
     way = float(Fz_to) - change.Fz
     if way == 0.0:
-        return []
+        return [], True
+    shortest = abs(way) * MIN_STEP_SHARE if min_step is None else float(min_step)
     h = 0.125 * way
     points = [change]
     for _ in range(MAX_LOAD_STEPS):
@@ -254,18 +271,18 @@ def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params:
         deviation = abs(new.V - u[-1]) * abs(h) / (4.0 * (abs(h) + abs(last.Fz - points[-2].Fz))) \
             if new is not None and len(points) >= 2 else 0.0
         if new is None or deviation > CHORD_REFUSE * chord:
-            if abs(h) <= abs(way) / 64.0:
-                return None
+            if abs(h) <= shortest:  # (a first point whose chord was not checked: none kept, see below)
+                return (points[1:] if len(points) >= 3 else []), False
             h *= 0.5
             continue
         points.append(new)
         if len(points) == 3 and not _first_chord_kept(points, chord, config, params, exact_nes):
-            return None
+            return [], False  # (its first point may be another change's)
         if Fz == float(Fz_to):
-            return points[1:]
+            return points[1:], True
         if len(points) >= 3:
             h *= min(max(math.sqrt(chord / max(deviation, 1e-12)), 0.5), 2.0)
-    return None
+    return (points[1:] if len(points) >= 3 else []), False
 
 
 def _first_chord_kept(points: list[ModeChange], chord: float, config, params, exact_nes: bool) -> bool:

@@ -19,13 +19,16 @@ linearly to where the next slice puts the mode's neighbours). Every change of a 
 next slice's load; a change of the upper slice whose threshold the lower slice has no change of is also
 followed down. :func:`~shimmy.analyses.maps.map_shading.row_segments` reads a breakpoint off the link that
 joins it on both slices, or that starts at it and reaches the row's load. A change whose curve the follow
-loses (its relocation fails: it turns back in the load) has no curve (a *lost* record), and is
-interpolated as before.
+loses (its relocation fails: it turns back in the load) has no curve (a *lost* record, with the last point
+the follow reached), and is interpolated as before.
 
 A warm map relocates a link's points other than the slices' changes at the new design, at their loads
 (:class:`LinkPointsUnit`), between the two carried slices' relocated changes; links from or to slices
-computed again or added are followed afresh; a change lost at the nearby design is not followed again
-(each such follow cost 0.3-1 s, after the slices).
+computed again or added are followed afresh. A change lost at the nearby design is resumed from the last
+point that follow reached, relocated (a whole follow that loses a change costs 0.3-1 s; resumed, a few
+relocations): lost again, it stays lost; if it now reaches the other slice's load it is followed afresh
+from its slice, as a cold map follows it (nes_pd, a_p 0.9 -> 0.95: a change of 248.7 kN lost on the way
+down to 233.7 kN at the nearby design reaches it at the new one).
 """
 
 from __future__ import annotations
@@ -38,14 +41,15 @@ import numpy as np
 from ...model.configurations import Configuration
 from ...model.parameters import Parameters
 from ...model.units import kn
-from ..diagrams.mode_changes import ModeChange, follow_load, relocate
+from ..diagrams.mode_changes import MIN_STEP_SHARE, ModeChange, follow_as_far, relocate
 
 #: The end of a followed change and the other slice's change it is taken for lie within this (m/s): both
 #: are located to 1e-7 m/s (measured 2e-9 to 8e-8 m/s apart on nes), changes of one threshold on one slice
 #: lie metres per second apart.
 MATCH = 1e-3
-#: ``ModeLink.end`` of an open link, and of a change the follow lost (a record, so that a warm map does
-#: not follow it again: no points beyond the change)
+#: ``ModeLink.end`` of an open link, and of a change the follow lost (a record, so that a warm map resumes
+#: the follow where it gave up instead of following it again: its points the change and the last one
+#: reached, if any)
 OPEN, LOST = -1, -2
 
 
@@ -54,7 +58,8 @@ class ModeLink:
     """The curve of a mode change from one slice's load to the next slice's: ``points`` in the order followed,
     the first the slice's change number ``start`` (in its ``mode_changes``), the last at the other slice's load:
     that slice's change number ``end`` (joined), or the followed point (open: ``end`` OPEN). ``end`` LOST:
-    the follow lost the change (``points`` the change alone, ``to`` the other slice's load)."""
+    the follow lost the change (``points`` the change and the last point the follow reached, if any; ``to``
+    the other slice's load)."""
 
     threshold: float
     start: int
@@ -78,7 +83,7 @@ class ModeLink:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: the points other than the slices' changes, with their cycles."""
-        moved = self.points[1:-1] if self.joined else self.points[1:]  # a lost one: none
+        moved = self.points[1:-1] if self.joined else self.points[1:]  # a lost one: its last point reached
         return {"threshold": self.threshold, "start": self.start, "end": self.end, "loads": list(self.loads),
                 "points": [c.to_dict(compact=True) for c in moved]}
 
@@ -132,9 +137,10 @@ class ModeLinksUnit:
         out = []
         for i in self.only:
             change = self.changes[i]
-            followed = follow_load(change, self.Fz_to, self.config, self.params, exact_nes=self.exact_nes)
-            link = link_of(change, i, self.others, followed)
-            out.append(link if link is not None else ModeLink(change.threshold, i, LOST, (change,), self.Fz_to))
+            followed, reached = follow_as_far(change, self.Fz_to, self.config, self.params, exact_nes=self.exact_nes)
+            link = link_of(change, i, self.others, followed if reached else None)
+            out.append(link if link is not None else
+                       ModeLink(change.threshold, i, LOST, (change, *followed[-1:]), self.Fz_to))
         return out
 
     def describe(self) -> str:
@@ -153,7 +159,9 @@ def links_unit(source: Any, target: Any, only: Sequence[int], config: Configurat
 class LinkPointsUnit:
     """A nearby design's links' points other than the slices' changes relocated at this design, each at its
     load (:func:`~shimmy.analyses.diagrams.mode_changes.relocate`): per link, the points, or None if one was
-    not found."""
+    not found. A lost link's follow is resumed from its last point reached, relocated: the last point this
+    follow reaches if it is lost again, or None if it reaches the other slice's load or that point is not
+    found again (the link is then followed afresh, from its slice, as a cold map follows it)."""
 
     config: Configuration
     params: Parameters
@@ -163,6 +171,9 @@ class LinkPointsUnit:
     def run(self) -> list[list[ModeChange] | None]:
         out: list[list[ModeChange] | None] = []
         for link in self.links:
+            if link["end"] == LOST:
+                out.append(self._resumed(link))
+                continue
             moved: list[ModeChange] | None = []
             for d in link["points"]:
                 c = relocate(ModeChange.from_dict(d), self.config, self.params, exact_nes=self.exact_nes)
@@ -172,6 +183,17 @@ class LinkPointsUnit:
                 moved.append(c)
             out.append(moved)
         return out
+
+    def _resumed(self, link: dict[str, Any]) -> list[ModeChange] | None:
+        if not link["points"]:
+            return []
+        last = relocate(ModeChange.from_dict(link["points"][-1]), self.config, self.params, exact_nes=self.exact_nes)
+        if last is None:
+            return None
+        lo, hi = (float(f) for f in link["loads"])
+        followed, reached = follow_as_far(last, hi, self.config, self.params, exact_nes=self.exact_nes,
+                                          min_step=abs(hi - lo) * MIN_STEP_SHARE)
+        return None if reached else [last, *followed][-1:]
 
     def describe(self) -> str:
         lo, hi = self.links[0]["loads"]
@@ -188,8 +210,8 @@ def carried_link(old: dict[str, Any], moved: list[ModeChange] | None, source: An
     first = source.mode_changes[start]
     if first is None or first.threshold != threshold:
         return None
-    if end == LOST:  # lost there: not followed again (a follow that loses a change costs ~0.3-1 s)
-        return ModeLink(threshold, start, LOST, (first,), float(target.Fz))
+    if end == LOST:  # lost again where the follow was resumed (see LinkPointsUnit): not followed again
+        return ModeLink(threshold, start, LOST, (first, *moved), float(target.Fz))
     if end == OPEN:  # open: joined now if its end reached a change of the other slice, as a cold map joins it
         return link_of(first, start, target.mode_changes, moved) if moved else None
     last = target.mode_changes[end]

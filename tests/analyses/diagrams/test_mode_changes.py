@@ -121,7 +121,7 @@ def test_a_change_followed_in_the_load_ends_on_the_change_located_there(nes):
 
 def test_a_change_followed_where_its_curve_does_not_reach_gives_none(nes):
     """Followed down from 288.4 kN the change reaches 250 kN (35.2 m/s) but not 200 kN: a relocation there
-    fails at every step down to 1/64 of the way, and the follow says so (None), it does not return a point
+    fails at every step down to MIN_STEP_SHARE of the way, and the follow says so (None), it does not return a point
     of another change."""
     result, changes = nes
     reached = follow_load(changes[0], 250e3, result.config, result.params)

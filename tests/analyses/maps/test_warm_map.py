@@ -17,7 +17,7 @@ import pytest
 
 from shimmy.analyses.diagrams.mode_changes import CHORD_TOL, relocate
 from shimmy.analyses.maps import map_shading
-from shimmy.analyses.maps.mode_links import polylines
+from shimmy.analyses.maps.mode_links import LOST, polylines
 from shimmy.analyses.maps.stability_map import stability_map
 from shimmy.analyses.maps.warm_map import NotWarm, arrangement_change, warm_map
 from shimmy.analyses.diagrams.bifurcation import BifurcationOptions
@@ -190,6 +190,11 @@ def test_warm_links_are_the_cold_links(pair, request):
     key = [(link.loads, link.start, link.end, link.threshold) for link in cold.mode_links]
     assert key == [(link.loads, link.start, link.end, link.threshold) for link in warm.mode_links]
     for c, w in zip(cold.mode_links, warm.mode_links, strict=True):
+        if c.end == LOST:
+            # no curve: the change, and the last point a follow reached (the warm one where the nearby design's
+            # follow gave up, resumed here: not where this design's own follow gave up)
+            assert c.points[0].Fz == w.points[0].Fz and abs(c.points[0].V - w.points[0].V) <= 1e-5 * c.points[0].V
+            continue
         line = c.polyline()
         for point in w.points:
             assert abs(point.V - np.interp(point.Fz, line[:, 1], line[:, 0])) <= 3 * CHORD_TOL, (c.loads, point.Fz)
