@@ -91,8 +91,9 @@ class ModeLink:
 def link_of(change: ModeChange, start: int, others: Sequence[ModeChange], followed: list[ModeChange] | None) -> \
         ModeLink | None:
     """The link of ``change`` (number ``start`` on its slice) from the points ``followed`` to the other slice's
-    load (:func:`follow_load`): joined to the other slice's change of the same threshold it reached (within
-    MATCH), else open; lost if the follow did not reach the load (``followed`` None)."""
+    load (:func:`~shimmy.analyses.diagrams.mode_changes.follow_load`): joined to the other slice's change of the
+    same threshold it reached (within MATCH), else open; lost if the follow did not reach the load (``followed``
+    None)."""
     if followed is None:
         return None
     if not followed:
