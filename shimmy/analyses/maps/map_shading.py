@@ -299,18 +299,64 @@ def _along_links(parts, pair, ends: tuple[tuple[float, float], tuple[float, floa
 
 
 def _through_links(parts, end: tuple[float, float], load: float, row: tuple[float, float], Fz: float,
-                   links: _Links):
+                   links: _Links, used: set):
     """The ``parts`` of one slice (at ``load``, its interval ``end``) read for a row's interval ``row``
     (at ``Fz``), each breakpoint from which a link reaches the row's load put where the link crosses the
     row (:func:`_placed`): the slice's mode change followed to the row, where the next slice with its
-    change lies in another region (the curves between them cross otherwise)."""
+    change lies in another region (the curves between them cross otherwise). The links taken are added to
+    ``used``."""
     lo, hi = row
     if hi <= lo:
         return parts
     a, b = end
-    used: set = set()
     return _placed(parts, [links.through(load, a + parts[j][1] * (b - a), Fz, used) for j in range(len(parts) - 1)],
                    row)
+
+
+def _change_types(slice_: Any, V: float) -> tuple[str, str] | None:
+    """(type left, type right) of a slice's change of type at speed V (an interval ending there and the next
+    starting there, of other types), or None if the slice has no such change at V (within 1e-9)."""
+    tol = 1e-9 * max(abs(V), 1.0)
+    ivs = slice_.intervals
+    for left, right in zip(ivs[:-1], ivs[1:]):
+        if abs(left["V_end"] - V) <= tol and abs(right["V_start"] - V) <= tol and left["type"] != right["type"]:
+            return left["type"], right["type"]
+    return None
+
+
+def _crossing_links(parts, load: float, row: tuple[float, float], Fz: float, links: _Links, known: "_Slices",
+                    used: set):
+    """The ``parts`` of a row's interval ``row`` read off the one slice (at ``load``) that crosses its region,
+    with the changes of other slices whose links cross the row inside the interval put in: a link (not in
+    ``used``) from a change of type on another slice (its two types there) crossing the row's load at V
+    splits the part it falls in at V, into the change's left type up to V and its right type after (only a
+    part of one of those types). The slice read may lack the mode the change bounds, where the curves
+    between it and the change's slice differ: nes_pd (rho_p 8580 kg/m^3) between 233.7 and 248.7 kN, the
+    lateral piece of 248.7 kN whose left end's change runs down to 46 m/s at 233.7 kN, where no lateral
+    piece is left."""
+    lo, hi = row
+    if hi <= lo:
+        return parts
+    for F, ends in links.by_end.items():
+        if F == load:
+            continue
+        k = int(np.argmin(np.abs(known.loads - F)))
+        if known.loads[k] != F:
+            continue
+        for end, p in ends:
+            if id(p) in used or not p[0, 1] < Fz < p[-1, 1]:
+                continue
+            types = _change_types(known.slices[k], end)
+            V = float(np.interp(Fz, p[:, 1], p[:, 0]))
+            if types is None or not lo < V < hi:
+                continue
+            f = (V - lo) / (hi - lo)
+            for j, (f0, f1, t) in enumerate(parts):
+                if f0 < f < f1 and t in types:
+                    parts = [*parts[:j], (f0, f, types[0]), (f, f1, types[1]), *parts[j + 1:]]
+                    used.add(id(p))
+                    break
+    return parts
 
 
 def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequence[float],
@@ -349,8 +395,11 @@ def row_segments(slices: Sequence[Any], curves: Sequence[Curve], fz_rows: Sequen
                     k = k0 if p0 is not None and (p1 is None or Fz - known.loads[k0] <= known.loads[k1] - Fz) else k1
                     parts = p0 if k == k0 else p1
                     if joined.by_end:
+                        used: set = set()
                         parts = _through_links(parts, known.named[k][region], float(known.loads[k]), (lo, hi),
-                                               float(Fz), joined)
+                                               float(Fz), joined, used)
+                        parts = _crossing_links(parts, float(known.loads[k]), (lo, hi), float(Fz), joined, known,
+                                                used)
             else:
                 fallbacks += 1
                 near = known.slices[int(np.argmin(np.abs(known.loads - Fz)))]

@@ -663,9 +663,36 @@ def test_a_change_followed_into_a_row_of_another_region_is_read_off_its_link():
         assert old[0] == (1.0, pytest.approx(30.0), "Both")
         V = float(np.interp(Fz, link[:, 1], link[:, 0]))
         assert row == [(1.0, pytest.approx(V), "Both"), (pytest.approx(V), 45.0, "Torsion")] + old[2:]
-    # a link from elsewhere (20.5 m/s at the lower load): the lower slice's rows do not take it
-    moved = np.array([[20.5, 1e5], [30.0, 3e5]])
-    assert map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0), [moved])[0][0] == plain[0]
+    # a link from elsewhere (neither end at a slice's change): no row takes it
+    moved = np.array([[20.5, 1e5], [30.5, 3e5]])
+    assert map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0), [moved])[0] == plain
+
+
+def test_a_change_followed_into_a_region_its_slice_does_not_cross_splits_the_rows_there():
+    """The upper slice's Both | Lateral change (30 m/s) followed down to the lower load (open: the lower slice has
+    no Lateral piece, its change's curve ends at 45 m/s inside the lower slice's Both), while a second curve
+    enters the interval only above 1.6e5 N: the rows below 1.6e5 N lie in a region only the lower slice crosses
+    (all Both there) and take the change where its link crosses them (41.25 m/s at 1.5e5 N), Both left of it
+    and Lateral right of it, as on the upper slice; before, the row was Both throughout (nes_pd at rho_p
+    8580 kg/m^3 between 233.7 and 248.7 kN: 8 cells of the warm map off the cold map's edges). A link whose
+    upper end is not at a change of the upper slice splits nothing."""
+    edge = ("b", np.array([[100.0, 0.0], [100.0, 1.0e6]]))
+    inner = ("c", np.array([[60.0, 1.6e5], [60.0, 1.0e6]]))
+    slices = [_Slice(1e5, [{"type": "Both", "V_start": 1.0, "V_end": 100.0}]),
+              _Slice(3e5, [{"type": "Both", "V_start": 1.0, "V_end": 30.0},
+                           {"type": "Lateral", "V_start": 30.0, "V_end": 60.0},
+                           {"type": "Torsion", "V_start": 60.0, "V_end": 100.0}])]
+    link = np.array([[45.0, 1e5], [30.0, 3e5]])
+    loads = [1.5e5, 2.5e5]
+    rows, _ = map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0), [link])
+    plain, _ = map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0))
+    assert plain[0] == [(1.0, 100.0, "Both"), (100.0, 200.0, "Stable")]
+    assert rows[0] == [(1.0, pytest.approx(41.25), "Both"), (pytest.approx(41.25), 100.0, "Lateral"),
+                       (100.0, 200.0, "Stable")]
+    V = float(np.interp(2.5e5, link[:, 1], link[:, 0]))  # above: read off the upper slice's change's link
+    assert rows[1][:2] == [(1.0, pytest.approx(V), "Both"), (pytest.approx(V), 60.0, "Lateral")]
+    elsewhere = np.array([[45.0, 1e5], [31.0, 3e5]])
+    assert map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0), [elsewhere])[0][0] == plain[0]
 
 
 def test_a_mode_piece_ends_where_its_open_link_meets_its_other_end():
