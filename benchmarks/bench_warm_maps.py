@@ -13,6 +13,10 @@ slices the warm map carried / computed again / added, and the share of equal sha
 cold map's regions (``map_shading.cells_off_edges``; the bar: none). Maps over V 1-200 m/s, Fz 10-900 kN, the
 default resolution and grid.
 
+``--breakdown``: each warm map's work besides, in seconds summed over its units as the workers ran them
+(the Hopf curves; the fold and torus curve halves, with the points traced / guided; the slices computed
+again or added; the rest: the Hopf scans, mode changes and links) and the pool's busy share of the wall time.
+
 ``--walk N``: a slider walk instead: N steps of e_p by ``--walk-step`` (relative) from the nominal
 design, each map warmed from the one before (as the service warms from the nearest cached design),
 printing each step's seconds and its slices carried / computed again / added: a slice is carried
@@ -28,12 +32,13 @@ import argparse
 import json
 import os
 import statistics
+import tempfile
 import time
 
 import numpy as np
 
-from shimmy.analyses.core.executors import describe, open_executor
-from shimmy.analyses.maps import map_shading
+from shimmy.analyses.core.executors import describe, open_executor, worker_count
+from shimmy.analyses.maps import map_shading, warm_map
 from shimmy.analyses.maps.stability_map import stability_map
 from shimmy.model.parameters import Parameters
 
@@ -43,6 +48,36 @@ STEPS = {"e_p": lambda p: {"e_p": round(p.nes.e_p * 1.1, 10)}, "r2": lambda p: {
 MORE_STEPS = {"a_p-": lambda p: {"a_p": round(p.pd.a_p - 0.05, 10)},
               "k_s-": lambda p: {"k_s": round(p.nes.k_s * 0.9, 10)},
               "rho_p": lambda p: {"rho_p": round(p.pd.rho_p * 1.1, 10)}}
+
+
+#: --breakdown: the file each unit's (description, seconds in its worker) is appended to
+UNIT_LOG = os.path.join(tempfile.gettempdir(), f"bench-warm-units-{os.getpid()}.jsonl")
+_run_unit = warm_map.run_work_unit
+
+
+def logged_unit(unit):
+    """A warm map's unit run as before, its seconds in the worker appended to UNIT_LOG (a forked worker
+    resolves this function in its copy of this module)."""
+    clock = time.perf_counter()
+    out = _run_unit(unit)
+    with open(UNIT_LOG, "a") as f:
+        f.write(json.dumps([warm_map.describe_work_unit(unit), time.perf_counter() - clock]) + "\n")
+    return out
+
+
+def breakdown(smap, wall: float) -> str:
+    """The last warm map's work by kind (UNIT_LOG's lines since it was emptied)."""
+    kinds = {"Hopf curves": 0.0, "curves": 0.0, "slices": 0.0, "rest": 0.0}
+    with open(UNIT_LOG) as f:
+        for line in f:
+            what, seconds = json.loads(line)
+            kind = ("Hopf curves" if what.startswith("Hopf curves") else "curves" if "nearby design again" in what
+                    else "slices" if what.startswith("slice at") else "rest")
+            kinds[kind] += seconds
+    points = smap.warmed_from["curve_points"] if smap.warmed_from else {}
+    work, n = sum(kinds.values()), worker_count()
+    return (f"    work: {', '.join(f'{k} {v:.2f} s' for k, v in kinds.items())}; curve points traced/guided "
+            f"{points.get('traced')}/{points.get('guided')}; pool busy {work / (n * wall):.0%} of {n} x {wall:.2f} s")
 
 
 def timed(run):
@@ -57,6 +92,7 @@ def main() -> None:
     parser.add_argument("--steps", default=",".join(STEPS))
     parser.add_argument("--repeats", type=int, default=1)
     parser.add_argument("--walk", type=int, default=0, help="steps of a walk in e_p (0: the slider steps)")
+    parser.add_argument("--breakdown", action="store_true", help="each warm map's work by kind of unit")
     parser.add_argument("--walk-step", type=float, default=0.02, help="a walk's step, relative")
     args = parser.parse_args()
     if args.walk:
@@ -72,6 +108,8 @@ def main() -> None:
     print(f"{'config':8} {'step':5} {'cold s':>8} {'warm s':>8} {'ratio':>6} {'carried/again/added':>20} "
           f"{'equal cells':>11} {'off edges':>9}")
     nominal = Parameters()
+    if args.breakdown:
+        warm_map.run_work_unit = logged_unit  # before the pool forks its workers
     with open_executor() as pool:
         stability_map("original", fz_range=(1.0e4, 3.0e4), resolution=3, executor=pool)  # workers warm
         for config in args.configs.split(","):
@@ -83,14 +121,20 @@ def main() -> None:
                 for _ in range(args.repeats):
                     t, cold = timed(lambda: stability_map(config, params=params, executor=pool))
                     colds.append(t)
+                    if args.breakdown:
+                        open(UNIT_LOG, "w").close()
                     t, warm = timed(lambda: stability_map(config, params=params, executor=pool, warm_from=start))
                     warms.append(t)
+                    if args.breakdown:
+                        print(breakdown(warm, t), flush=True)
                 c, w = statistics.median(colds), statistics.median(warms)
                 slices = slice_counts(warm) or f"cold: {warm.warm_refused[:40]}"
                 equal = float((np.array(cold.shading) == np.array(warm.shading)).mean())
                 off = len(map_shading.cells_off_edges(cold.shading, warm.shading))
                 print(f"{config:8} {name:5} {c:8.2f} {w:8.2f} {w / c:6.3f} {slices:>20} {100 * equal:10.2f}% "
                       f"{off:9d}", flush=True)
+    if args.breakdown and os.path.exists(UNIT_LOG):
+        os.remove(UNIT_LOG)
 
 
 def slice_counts(smap) -> str:
