@@ -327,35 +327,50 @@ def _change_types(slice_: Any, V: float) -> tuple[str, str] | None:
 def _crossing_links(parts, load: float, row: tuple[float, float], Fz: float, links: _Links, known: "_Slices",
                     used: set):
     """The ``parts`` of a row's interval ``row`` read off the one slice (at ``load``) that crosses its region,
-    with the changes of other slices whose links cross the row inside the interval put in: a link (not in
-    ``used``) from a change of type on another slice (its two types there) crossing the row's load at V
-    splits the part it falls in at V, into the change's left type up to V and its right type after (only a
-    part of one of those types). The slice read may lack the mode the change bounds, where the curves
-    between it and the change's slice differ: nes_pd (rho_p 8580 kg/m^3) between 233.7 and 248.7 kN, the
-    lateral piece of 248.7 kN whose left end's change runs down to 46 m/s at 233.7 kN, where no lateral
-    piece is left."""
+    with the changes of the next slice whose links come down (or up) into the interval put in: a link (not in
+    ``used``) from a change of type on that slice (its two types there) whose end at ``load`` is no change of
+    the slice read (open there), crossing the row's load at V inside the interval, splits the part it falls
+    in at V into the change's left type up to V and its right type after, where that part is of one of those
+    types (repeated until no link splits: one split can make the part another link falls in one of its types).
+    The slice read may lack the mode the change bounds, where the curves between it and the change's slice
+    differ: nes_pd (rho_p 8580 kg/m^3) between 233.7 and 248.7 kN, the lateral piece of 248.7 kN whose left
+    end's change runs down to 46 m/s at 233.7 kN, where no lateral piece is left. The other type runs on to
+    the part's end (the region's edge or the slice read's next change): where the piece ends between the
+    slices is not known there."""
     lo, hi = row
     if hi <= lo:
         return parts
-    for F, ends in links.by_end.items():
-        if F == load:
+    k_read = np.flatnonzero(known.loads == load)
+    if not len(k_read):
+        return parts
+    read = known.slices[int(k_read[0])]
+    waiting = []
+    for (F0, F1), ps in links.by_loads.items():
+        if not (F0 < Fz < F1 and load in (F0, F1)):
             continue
-        k = int(np.argmin(np.abs(known.loads - F)))
-        if known.loads[k] != F:
+        k_far = np.flatnonzero(known.loads == (F1 if load == F0 else F0))
+        if not len(k_far):
             continue
-        for end, p in ends:
-            if id(p) in used or not p[0, 1] < Fz < p[-1, 1]:
+        for p in ps:
+            near, far = (p[0], p[-1]) if load == F0 else (p[-1], p[0])
+            if id(p) in used or _change_types(read, float(near[0])) is not None:
                 continue
-            types = _change_types(known.slices[k], end)
+            types = _change_types(known.slices[int(k_far[0])], float(far[0]))
             V = float(np.interp(Fz, p[:, 1], p[:, 0]))
-            if types is None or not lo < V < hi:
-                continue
-            f = (V - lo) / (hi - lo)
-            for j, (f0, f1, t) in enumerate(parts):
-                if f0 < f < f1 and t in types:
-                    parts = [*parts[:j], (f0, f, types[0]), (f, f1, types[1]), *parts[j + 1:]]
-                    used.add(id(p))
-                    break
+            if types is not None and lo < V < hi:
+                waiting.append(((V - lo) / (hi - lo), types, id(p)))
+    while waiting:
+        for item in waiting:
+            f, types, ident = item
+            j = next((j for j, (f0, f1, t) in enumerate(parts) if f0 < f < f1 and t in types), None)
+            if j is not None:
+                f0, f1, _ = parts[j]
+                parts = [*parts[:j], (f0, f, types[0]), (f, f1, types[1]), *parts[j + 1:]]
+                used.add(ident)
+                waiting.remove(item)
+                break
+        else:
+            break
     return parts
 
 

@@ -695,6 +695,30 @@ def test_a_change_followed_into_a_region_its_slice_does_not_cross_splits_the_row
     assert map_shading.row_segments(slices, [edge, inner], loads, (1.0, 200.0), [elsewhere])[0][0] == plain[0]
 
 
+def test_changes_crossing_a_row_read_off_one_slice_are_all_put_in_whatever_their_order():
+    """As above with two changes of the upper slice followed down into a row whose region only the lower slice
+    (all Torsion there) crosses: Both | Lateral (30 m/s, down to 40) and Lateral | Torsion (60 m/s, down to 70)
+    cross the row at 37.5 and 67.5 m/s; the row is Both, Lateral, Torsion, with the links given in either
+    order (the first split makes the part the other falls in one of its types). A link whose end at the lower
+    slice is a change of that slice is its own (read by the slice's breakpoints), not split in here."""
+    edge = ("b", np.array([[100.0, 0.0], [100.0, 1.0e6]]))
+    inner = ("c", np.array([[80.0, 1.6e5], [80.0, 1.0e6]]))
+    slices = [_Slice(1e5, [{"type": "Torsion", "V_start": 1.0, "V_end": 100.0}]),
+              _Slice(3e5, [{"type": "Both", "V_start": 1.0, "V_end": 30.0},
+                           {"type": "Lateral", "V_start": 30.0, "V_end": 60.0},
+                           {"type": "Torsion", "V_start": 60.0, "V_end": 100.0}])]
+    left, right = np.array([[40.0, 1e5], [30.0, 3e5]]), np.array([[70.0, 1e5], [60.0, 3e5]])
+    for links in ([left, right], [right, left]):
+        rows, _ = map_shading.row_segments(slices, [edge, inner], [1.5e5], (1.0, 200.0), links)
+        assert rows[0] == [(1.0, pytest.approx(37.5), "Both"), (pytest.approx(37.5), pytest.approx(67.5), "Lateral"),
+                           (pytest.approx(67.5), 100.0, "Torsion"), (100.0, 200.0, "Stable")]
+    lower = [{"type": "Both", "V_start": 1.0, "V_end": 40.0}, {"type": "Torsion", "V_start": 40.0, "V_end": 100.0}]
+    own = [_Slice(1e5, lower), slices[1]]  # the left link ends on the lower slice's own change now
+    rows, _ = map_shading.row_segments(own, [edge, inner], [1.5e5], (1.0, 200.0), [left])
+    plain, _ = map_shading.row_segments(own, [edge, inner], [1.5e5], (1.0, 200.0))
+    assert [t for _, _, t in rows[0]] == [t for _, _, t in plain[0]] == ["Both", "Torsion", "Stable"]
+
+
 def test_a_mode_piece_ends_where_its_open_link_meets_its_other_end():
     """Both between Torsion and Lateral on the lower slice only; its right end's change followed up (an open
     link: the upper slice has no such change) runs left, from 40 m/s to 10 m/s at the upper load: the rows put
