@@ -236,9 +236,10 @@ def follow_load(change: ModeChange, Fz_to: float, config: Configuration, params:
     the new load). The step is set so that the curve deviates from the chord between two points by about
     ``chord`` m/s: the secant predictor's error in V is ~V''/2 h (h + h_before), the chord's ~V''/8 h^2; a
     step whose estimate exceeds CHORD_REFUSE x ``chord`` is taken again at half its length. The first step
-    is an eighth of the way, its chord checked once the second is taken (a midpoint put in where needed). Returns the points after ``change``, the last at ``Fz_to``; None where a
-    relocation fails, or the chord's estimate stays too large, at a step of MIN_STEP_SHARE of the way or less (the
-    change turns back in the load, or its cycle ends between), or after MAX_LOAD_STEPS steps."""
+    is an eighth of the way, its chord checked once the second is taken (a midpoint put in where needed).
+    Returns the points after ``change``, the last at ``Fz_to``; None where a relocation fails, or the chord's
+    estimate stays too large, at a step of MIN_STEP_SHARE of the way or less (the change turns back in the
+    load, or its cycle ends between), or after MAX_LOAD_STEPS steps."""
     points, reached = follow_as_far(change, Fz_to, config, params, exact_nes=exact_nes, chord=chord)
     return points if reached else None
 

@@ -37,9 +37,10 @@ little: the curves move, but where their arrangement stays the same the regions 
    is added through each region between the new curves that no slice crosses. The curves of the mode
    changes between two carried slices (:mod:`~shimmy.analyses.maps.mode_links`) are carried too: their
    inner points relocated at their loads beside the curves' traces, a change lost at the nearby design
-   resumed where its follow gave up; those next to a slice computed again or added are followed afresh. A fold or torus point
-   of a slice computed again that lies on no curve is continued as a cold map continues it: a curve
-   the map lacks makes the map cold; none (no such point converges there) is the cold map's warning.
+   resumed where its follow gave up; those next to a slice computed again or added are followed afresh. A
+   fold or torus point of a slice computed again that lies on no curve is continued as a cold map continues
+   it: a curve the map lacks makes the map cold; none (no such point converges there) is the cold map's
+   warning.
 
 The result's ``methods.warmed_from`` names the design warmed from, the parameters changed and the
 slices carried, computed again and added. What the checks cannot see: a curve born away from a GH
