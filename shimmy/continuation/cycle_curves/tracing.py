@@ -252,16 +252,14 @@ def _passes(problem_of: Callable[[], CycleCurveProblem], tracer: Tracer, guide: 
         limit = min(tracer.options.ds_max, GUIDED_CAP * tracer.cap)
         if not 0.0 < h <= PASS_SHARE * limit:
             return False
-        t_a = tracer.point.tangent
         t_b = u[-1] - u[-3]
         size = weighted_norm(t_b, w)
         if not size > 0.0:
             return False
-        t_b = t_b / size
-        cos = float(np.sum(w * t_a * t_b)) / max(weighted_norm(t_a, w), 1e-300)
-        if math.acos(max(-1.0, min(1.0, cos))) > PASS_SHARE * tracer.options.max_angle:
+        end = CurvePoint(u[-2], t_b / size)
+        if tracer._turn(end) > PASS_SHARE * tracer.options.max_angle:  # the tracer's own measure of a turn
             return False
-        return _chord_ratio(problem, CurvePoint(u[0], t_a), CurvePoint(u[-2], t_b), h, chord_tol) <= PASS_SHARE
+        return _chord_ratio(problem, CurvePoint(u[0], tracer.point.tangent), end, h, chord_tol) <= PASS_SHARE
     return passes
 
 
