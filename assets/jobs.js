@@ -38,6 +38,24 @@ pair told twice (already released by a later action of the page, or finished) ch
             while (waiting.size > LIMIT) { waiting.delete(waiting.keys().next().value); }
         },
         // Dash Pages' router is replacing the page (a navigation inside the workbench)
-        left: function () { leave(); }
+        left: function () { leave(); },
+        // A read of the page's jobs has landed (ui/jobs.py: landing): its updated values by their place, applied
+        // only if the page still waits for the jobs that read was of (a later action of the page that landed
+        // first, a cached answer drawn at once, stands).
+        landed: function (landed, go) {
+            const skip = window.dash_clientside.no_update;
+            if (!landed || !Number.isInteger(landed.n) || !Array.isArray(landed.set)) {
+                throw window.dash_clientside.PreventUpdate;
+            }
+            const out = new Array(landed.n).fill(skip);
+            const now = go && typeof go.watcher === "string" ? go.watcher : null;
+            if ((landed.watcher === undefined ? null : landed.watcher) !== now) { return out; }
+            landed.set.forEach(function (pair) {
+                if (Array.isArray(pair) && Number.isInteger(pair[0]) && pair[0] >= 0 && pair[0] < landed.n) {
+                    out[pair[0]] = pair[1];
+                }
+            });
+            return out;
+        }
     };
 })();

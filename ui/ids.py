@@ -63,6 +63,14 @@ class Group:
         return self._id("sketched")
 
     @property
+    def landed(self) -> str:
+        return self._id("landed")
+
+    @property
+    def drawn(self) -> str:
+        return self._id("drawn")
+
+    @property
     def error(self) -> str:
         return self._id("error")
 

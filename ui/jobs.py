@@ -16,7 +16,8 @@ callback only says so (a small answer that stops the interval); a second callbac
 once by that, draws the results. Dash drops the answer of a callback whose input changed again
 while it ran (plotly/dash#1613), so a poll that drew a large figure more slowly than the
 interval (a loaded machine, a long time history) was dropped on every tick and the page never
-showed its result. At most
+showed its result. Both answers reach the page through a check in the browser (:func:`landing`): one
+that lands after a later action of the page (its answer already drawn) is dropped. At most
 ``MAX_PAGE_REQUESTS`` requests per action. The requests of the last answer are kept in a
 store so that the downloads serialise exactly what is drawn, from the cache (a download never
 computes).
@@ -86,9 +87,10 @@ def controls(group: Group, label: str = "Compute") -> list:
 
 def stores(group: Group) -> list:
     """The store of the shown results' requests, the ids of the jobs being waited for, the jobs
-    whose results are ready to be drawn, and what of the jobs' sketches is drawn."""
+    whose results are ready to be drawn, what of the jobs' sketches is drawn, and the answers of a read
+    of the jobs and of a draw of their results on their way to the page (:func:`landing`)."""
     return [dcc.Store(id=group.requests), dcc.Store(id=group.go), dcc.Store(id=group.ready),
-            dcc.Store(id=group.sketched)]
+            dcc.Store(id=group.sketched), dcc.Store(id=group.landed), dcc.Store(id=group.drawn)]
 
 
 @dataclass(frozen=True)
@@ -243,15 +245,29 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         return (tuple(busy) + (no_update,) * len(tail) + (go, False, True, False)
                 + tuple(True for _ in lock) + ("0", f"queued: {_asked(wanted)}"))
 
-    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Output(group.ready, "data"),
-                   Output(group.sketched, "data"), Input(group.poll, "n_intervals"), State(group.go, "data"),
-                   State(group.progress, "value"), State(group.sketched, "data"), State(store, "data"),
-                   prevent_initial_call=True)
+    # The answers of poll and show land through the page's check (landing); each through its own store, so that
+    # the chain poll -> ready -> show -> page has no loop (Dash holds a callback back while any callback running
+    # could still change one of its inputs: show, in a loop back to its own ready, would wait for ever).
+    page = [_duplicate(o) for o in [*outputs, *tail, *state]]
+    dash.clientside_callback(ClientsideFunction("jobs", "landed"), *page, Output(group.ready, "data"),
+                             Output(group.sketched, "data"), Input(group.landed, "data"), State(group.go, "data"),
+                             prevent_initial_call=True)
+    dash.clientside_callback(ClientsideFunction("jobs", "landed"), *page,
+                             Input(group.drawn, "data"), State(group.go, "data"), prevent_initial_call=True)
+
+    @dash.callback(Output(group.landed, "data"), Input(group.poll, "n_intervals"),
+                   State(group.go, "data"), State(group.progress, "value"), State(group.sketched, "data"),
+                   State(store, "data"), prevent_initial_call=True)
     def poll(_n, go, shown_progress, sketched, kept):
         """Progress of the page's jobs; once every result is in the cache, the interval stops and
         the ready store tells :func:`show` to draw them. A poll that finds its jobs let go by a later
         action of the page changes nothing: that action wrote the page's state. While they run, what
-        they know so far is drawn by ``sketch`` each time it grows."""
+        they know so far is drawn by ``sketch`` each time it grows. The answer lands through
+        :func:`landing` (dropped there if a later action of the page came first)."""
+        return landing(go, read(_n, go, shown_progress, sketched, kept))
+
+    def read(_n, go, shown_progress, sketched, kept):
+        """What :func:`poll` answers: the page's outputs, its state, the ready and sketched stores."""
         ids, wanted = _waiting(go)
         if not ids:
             return (no_update,) * (n_out + len(tail)) + idle + (no_update, no_update, no_update, no_update)
@@ -313,15 +329,20 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
         return (*drawn, *(no_update,) * (len(tail) + len(state) - 2), str(int(100 * fraction)), status, no_update,
                 mark)
 
-    @dash.callback(*(_duplicate(o) for o in [*outputs, *tail, *state]), Input(group.ready, "data"),
-                   State(group.go, "data"), prevent_initial_call=True)
+    @dash.callback(Output(group.drawn, "data"), Input(group.ready, "data"), State(group.go, "data"),
+                   prevent_initial_call=True)
     def show(ready, go):
         """The results of the jobs the poll found done, drawn (once per ready signal), unless a later action
         of the page let them go between the poll and this draw (a cached answer to new controls drawn
         already, or other jobs asked for): the page's store no longer waits for them, or the service says
         its watcher is gone. Drawn then, they would replace the newer answer with the older one. Where the
         store still names them and only the service saw them let go, the Cancel button raced the poll: the
-        page says "cancelled" and its controls come back."""
+        page says "cancelled" and its controls come back. A later action that comes while this draw is on
+        its way is seen by :func:`landing`."""
+        return landing(go, draw(ready, go))
+
+    def draw(ready, go):
+        """What :func:`show` answers: the page's outputs and state."""
         ids, wanted = _waiting(ready)
         if not ids or _waiting(go)[0] != ids or _watcher(go) != _watcher(ready):
             return nothing  # a later action of the page asked for other jobs or drew an answer: its state stands
@@ -394,6 +415,22 @@ def _asked(wanted: list[dict[str, Any]]) -> str:
     what = ", ".join(configs) if configs else f"{len(wanted)} analysis" + ("" if len(wanted) == 1 else "es")
     each = " each" if len(wanted) > 1 else ""
     return what + (f", {slices.pop()} Fz slices{each}" if len(slices) == 1 else "")
+
+
+def landing(go: Any, values: Sequence[Any]) -> dict[str, Any]:
+    """A read of the page's jobs or a draw of their results on its way to the page: ``values`` (one per output
+    of its check: the page's outputs, its state, after a read the ready and sketched stores), sent as the updated
+    ones by their place, with the
+    watcher of the jobs read (``go`` as the read found it). The page applies them only if its store still
+    names that watcher when they land (``jobs.landed`` in ``assets/jobs.js``).
+
+    Dash orders nothing between two callbacks that write the same outputs: a cached answer drawn at once by a
+    later action (a typed speed back to one computed before) could land before the draw of the jobs it let go
+    that was already on its way, and that draw, landing last, replaced the newer answer with the older one
+    (the figure of 51 m/s under boxes saying 50). The page applies callbacks' answers one at a time, so the
+    check there sees every action that landed before."""
+    changed = [[k, v] for k, v in enumerate(values) if v is not no_update]
+    return {"watcher": _watcher(go), "n": len(values), "set": changed, "id": uuid.uuid4().hex}
 
 
 def _waiting(go: Any) -> tuple[list[str], list[dict[str, Any]]]:

@@ -6,8 +6,10 @@ runs as root). Screenshots of every page go to screenshots/ (not committed) for 
 
 from __future__ import annotations
 
+import json
 import re
 import time
+import urllib.request
 from urllib.parse import parse_qs, urlparse
 
 import pytest
@@ -17,8 +19,8 @@ from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 
-from browser import (DOWNLOADS, PAGES, SHOTS, browser_fixture, by_id, idle, job_records, on_figure, pattern,  # noqa: E402
-                     severe, slider_handle, table_rows, text_of, trace_count, wait_for)
+from browser import (DOWNLOADS, PAGES, SHOTS, browser_fixture, by_id, idle, job_records, on_figure,  # noqa: E402
+                     open_page, pattern, severe, slider_handle, table_rows, text_of, trace_count, wait_for)
 
 browser = browser_fixture("chromium-profile", "1500,1100", DOWNLOADS)
 
@@ -336,4 +338,36 @@ def test_a_result_slower_to_arrive_than_the_poll_interval_is_still_drawn(server,
     finally:
         browser.delete_network_conditions()
     assert trace_count(browser, "th-series") > 0
+    assert severe(browser) == []
+
+
+def _gate_outputs(server, store: str) -> int:
+    """How many outputs the page's check of answers landing through ``store`` writes (Dash's callback map)."""
+    with urllib.request.urlopen(server.base + "/_dash-dependencies", timeout=30) as answer:
+        callbacks = json.load(answer)
+    gate = next(c for c in callbacks if any(i["id"] == store for i in c["inputs"]))
+    return gate["output"].count("...") + 1 if gate["output"].startswith("..") else 1
+
+
+def test_an_answer_landing_after_a_later_action_of_the_page_is_dropped(server, browser):
+    """A draw of jobs the page has let go that lands after the later action's answer (a speed typed back to
+    one computed before: its cached answer drawn at once) would replace the newer answer with the older one.
+    The page applies an answer of its reads only if its store still names the jobs' watcher when it lands."""
+    open_page(browser, server, "/time-history?config=original&V=47&Fz=190")
+    n = _gate_outputs(server, "th-drawn")
+    assert n > 10  # the page's outputs and its job state
+    browser.execute_script("window.dash_clientside.set_props('th-go', {data: {jobs: [], requests: [],"
+                           " watcher: 'the-later-action'}});")
+
+    def land(watcher, k, value):
+        browser.execute_script("window.dash_clientside.set_props('th-drawn', {data: arguments[0]});",
+                               {"watcher": watcher, "n": n, "set": [[k, value]], "id": f"{watcher}-{k}"})
+
+    land("an-earlier-action", n - 1, "the older answer")  # the status line (the last of the page's state)
+    land("the-later-action", n - 2, "42")  # the progress bar's value, of the jobs the page waits for
+    wait_for(lambda: browser.find_element(By.ID, "th-progress").get_attribute("value") == "42", timeout=30,
+             what="the answer of the jobs the page waits for")
+    assert text_of(browser, "th-status") != "the older answer"
+    land("the-later-action", n - 1, "the newer answer")
+    wait_for(lambda: text_of(browser, "th-status") == "the newer answer", timeout=30, what="the status line")
     assert severe(browser) == []

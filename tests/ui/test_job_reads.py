@@ -1,7 +1,8 @@
 """How a page reads its jobs (ui.jobs): on the real job store, a read that finds its job running and
 nothing new to show waits for something to show and answers as soon as there is (the job's end, its
 progress); it does not wait for a queued job, nor when a sketch is due, and never longer than WAIT_S. While
-a page follows the design by itself its sketch is redrawn at most every LIVE_SKETCH_S."""
+a page follows the design by itself its sketch is redrawn at most every LIVE_SKETCH_S. An answer on its way names
+the watcher of the jobs it read (the page drops it if a later action came first)."""
 
 from __future__ import annotations
 
@@ -124,3 +125,13 @@ def test_results_found_done_are_drawn_only_while_the_page_still_waits_for_them(j
     # the store not yet changed in the browser, but the service has seen the page let the job go
     jobs.release(job, "view-1")
     assert not page_jobs._still_awaited(ready, go)
+
+
+def test_an_answer_on_its_way_names_the_watcher_it_was_of_and_only_what_it_updates():
+    figure = {"data": [{"x": [1.0], "y": [2.0]}], "layout": {}}
+    landed = page_jobs.landing({"jobs": ["a"], "requests": [{}], "watcher": "view-1"},
+                               (figure, page_jobs.no_update, "", None, page_jobs.no_update))
+    assert landed["watcher"] == "view-1" and landed["n"] == 5
+    assert landed["set"] == [[0, figure], [2, ""], [3, None]]  # an empty line and a cleared store are updates
+    assert page_jobs.landing(None, (page_jobs.no_update,))["watcher"] is None  # the page waited for nothing
+    assert page_jobs.landing(None, ())["id"] != page_jobs.landing(None, ())["id"]  # each lands, even if equal
