@@ -237,6 +237,20 @@ def _options():
     return Response(status=204, headers={"Allow": ", ".join([*methods, "OPTIONS"])})
 
 
+@api.before_request
+def _no_stray_query():
+    """A query parameter is refused where the endpoint takes none (every one but GET /jobs; health, which
+    probes may stamp, ignores it): an analysis reads its JSON body only, so ``POST /hopf?config=nes`` would
+    otherwise answer for the body's configuration without a word."""
+    takes = {f"{api.name}.{name}" for name in ("list_jobs", "health", "_unmatched")}  # (no endpoint: 404/405)
+    if not request.args or request.method == "OPTIONS" or request.endpoint in takes:
+        return None
+    key = next(iter(request.args))
+    where = "the JSON body" if request.method in ("POST", "PUT", "PATCH") else "the path"
+    return error(f"query parameter {reprlib.repr(key)} is not taken by {request.method} {request.path} (it "
+                 f"reads {where} only)", "query parameter", "none", 422)
+
+
 @api.get("/health")
 def health():
     """ok (200), or degraded (503) when the cache cannot store and return a value."""

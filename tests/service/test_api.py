@@ -183,6 +183,17 @@ def test_unknown_paths_methods_and_jobs(server):
     assert status == 422 and body["field"] == "status" and "2 times" in body["error"], body
     status, _, body = server.request("GET", "/api/v1/jobs?status=done&limit=5")
     assert status == 200 and len(body["jobs"]) <= 5, body
+    # where an endpoint takes no query parameter, one is refused, not ignored (the body says the analysis)
+    for method, path, sent in (("POST", "/api/v1/hopf?config=nes", {"config": "original"}),
+                               ("GET", "/api/v1/parameters?name=r2", None), ("GET", "/api/v1/jobs/abc?x=1", None),
+                               ("POST", "/api/v1/jobs?analysis=map", {"analysis": "map", "config": "nes"})):
+        status, _, body = server.request(method, path, sent)
+        assert status == 422 and body["field"] == "query parameter" and body["allowed"] == "none", (path, body)
+        assert repr(path.split("?")[1].split("=")[0]) in body["error"], body
+    status, _, body = server.request("GET", "/api/v1/health?probe=1")  # a probe may stamp its request
+    assert status == 200 and body["status"] == "ok"
+    status, _, body = server.request("GET", "/api/v1/nothing?x=1")
+    assert status == 404 and body["field"] == "path"
     status, headers, body = server.request("GET", "/api/v1/simulate")
     assert status == 405 and body["allowed"] == "POST" and headers["Allow"] == "POST"
     status, headers, body = server.request("PUT", "/api/v1/jobs/abc", {})
