@@ -86,6 +86,11 @@ def raw(server, method: str, path: str, body: bytes | None = None, headers: dict
         conn.close()
 
 
+def _workers_ready(cache_dir, workers: int = 2) -> bool:
+    """Every web worker of the server logging into ``cache_dir`` has loaded its kernels (gunicorn.conf.py)."""
+    return (cache_dir / "gunicorn.log").read_text().count("kernels loaded") >= workers
+
+
 def until(predicate, timeout=60.0, what="condition", every=0.2):
     deadline = time.time() + timeout
     while time.time() < deadline:
@@ -521,10 +526,15 @@ def test_queued_and_running_jobs_survive_a_restart_and_run_after_it(tmp_path):
     server = start_server(tmp_path, limits)
     quick = [{"analysis": "simulate", "config": "nes", "V": 41 + k, "Fz": 150000, "t_end": 3} for k in range(2)]
     try:
-        _, _, long_job = server.request("POST", "/api/v1/jobs", {**LONG, "Fz": 320000})
+        # every web worker serving first: one still loading its kernels holds the stop back for seconds (it
+        # takes gunicorn's signal after), long enough for a job of a few seconds to end before the stop (CI)
+        until(lambda: _workers_ready(tmp_path), 120, "the web workers to load their kernels")
+        # a job that runs for many seconds (a cold map), not a diagram of two: still running at the stop
+        _, _, long_job = server.request("POST", "/api/v1/jobs", {"analysis": "map", "config": "original"})
         until(lambda: server.request("GET", f"/api/v1/jobs/{long_job['id']}")[2]["status"] == "running", 60,
               "the long job to run")
         queued = [server.request("POST", "/api/v1/jobs", q)[2]["id"] for q in quick]
+        assert server.request("GET", f"/api/v1/jobs/{long_job['id']}")[2]["status"] == "running"
     finally:
         stop_server(server)  # graceful: the running job's process ends, the job waits queued again
     with cache_env(tmp_path):
