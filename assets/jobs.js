@@ -24,6 +24,12 @@ pair told twice (already released by a later action of the page, or finished) ch
                              body: body}).catch(function () { /* the page is gone: nobody to tell */ });
     }
 
+    // the watcher of a go store (or of an answer on its way), as ui/jobs.py's _watcher reads it
+    function watcherOf(go) {
+        const w = go && typeof go === "object" ? go.watcher : null;
+        return typeof w === "string" && w.length > 0 && w.length <= 64 ? w : null;
+    }
+
     window.addEventListener("pagehide", leave);
     window.dash_clientside = window.dash_clientside || {};
     window.dash_clientside.jobs = {
@@ -47,9 +53,11 @@ pair told twice (already released by a later action of the page, or finished) ch
             if (!landed || !Number.isInteger(landed.n) || !Array.isArray(landed.set)) {
                 throw window.dash_clientside.PreventUpdate;
             }
+            // dropped whole (a clientside callback's no_update still re-renders each output it declares)
+            if (watcherOf(landed) !== watcherOf(go) || !landed.set.length) {
+                throw window.dash_clientside.PreventUpdate;
+            }
             const out = new Array(landed.n).fill(skip);
-            const now = go && typeof go.watcher === "string" ? go.watcher : null;
-            if ((landed.watcher === undefined ? null : landed.watcher) !== now) { return out; }
             landed.set.forEach(function (pair) {
                 if (Array.isArray(pair) && Number.isInteger(pair[0]) && pair[0] >= 0 && pair[0] < landed.n) {
                     out[pair[0]] = pair[1];
