@@ -49,15 +49,12 @@ pair told twice (already released by a later action of the page, or finished) ch
         // only if the page still waits for the jobs that read was of (a later action of the page that landed
         // first, a cached answer drawn at once, stands).
         landed: function (landed, go) {
-            const skip = window.dash_clientside.no_update;
-            if (!landed || !Number.isInteger(landed.n) || !Array.isArray(landed.set)) {
+            // dropped whole, not answered no_update (Dash re-renders each output a clientside callback declares)
+            if (!landed || !Number.isInteger(landed.n) || !Array.isArray(landed.set) || !landed.set.length
+                    || watcherOf(landed) !== watcherOf(go)) {
                 throw window.dash_clientside.PreventUpdate;
             }
-            // dropped whole (a clientside callback's no_update still re-renders each output it declares)
-            if (watcherOf(landed) !== watcherOf(go) || !landed.set.length) {
-                throw window.dash_clientside.PreventUpdate;
-            }
-            const out = new Array(landed.n).fill(skip);
+            const out = new Array(landed.n).fill(window.dash_clientside.no_update);
             landed.set.forEach(function (pair) {
                 if (Array.isArray(pair) && Number.isInteger(pair[0]) && pair[0] >= 0 && pair[0] < landed.n) {
                     out[pair[0]] = pair[1];

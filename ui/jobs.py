@@ -363,9 +363,8 @@ def register(group: Group, analysis: str, *, requests: Callable[..., list[dict[s
                    Output(group.go, "data", allow_duplicate=True),
                    Input(group.cancel, "n_clicks"), State(group.go, "data"), prevent_initial_call=True)
     def cancel(_n, go):
-        """Let the jobs go (the service cancels those nobody else waits for); the poll, the one writer
-        of the page's job state, then says "cancelled" (a poll already on its way cannot overwrite it
-        with a progress line)."""
+        """Let the jobs go (the service cancels those nobody else waits for); the poll's next read then says
+        "cancelled" (a read already on its way may still say their progress, not after that one)."""
         ids, _ = _waiting(go)
         _release(ids, _watcher(go))
         if not ids:
@@ -419,10 +418,10 @@ def _asked(wanted: list[dict[str, Any]]) -> str:
 
 def landing(go: Any, values: Sequence[Any]) -> dict[str, Any]:
     """A read of the page's jobs or a draw of their results on its way to the page: ``values`` (one per output
-    of its check: the page's outputs, its state, after a read the ready and sketched stores), sent as the updated
-    ones by their place, with the
-    watcher of the jobs read (``go`` as the read found it). The page applies them only if its store still
-    names that watcher when they land (``jobs.landed`` in ``assets/jobs.js``).
+    of its check: the page's outputs, its state, after a read the ready and sketched stores), sent as the
+    updated ones by their place, with the watcher of the jobs read (``go`` as the read found it). The page
+    applies them only if its store still names that watcher when they land (``jobs.landed`` in
+    ``assets/jobs.js``).
 
     Dash orders nothing between two callbacks that write the same outputs: a cached answer drawn at once by a
     later action (a typed speed back to one computed before) could land before the draw of the jobs it let go

@@ -237,13 +237,16 @@ def _options():
     return Response(status=204, headers={"Allow": ", ".join([*methods, "OPTIONS"])})
 
 
+#: The endpoints a query string reaches: GET /jobs reads its own; health ignores one; no endpoint (404/405).
+_QUERY_TAKEN = frozenset(f"{api.name}.{name}" for name in ("list_jobs", "health", "_unmatched"))
+
+
 @api.before_request
 def _no_stray_query():
     """A query parameter is refused where the endpoint takes none (every one but GET /jobs; health, which
     probes may stamp, ignores it): an analysis reads its JSON body only, so ``POST /hopf?config=nes`` would
     otherwise answer for the body's configuration without a word."""
-    takes = {f"{api.name}.{name}" for name in ("list_jobs", "health", "_unmatched")}  # (no endpoint: 404/405)
-    if not request.args or request.method == "OPTIONS" or request.endpoint in takes:
+    if not request.args or request.method == "OPTIONS" or request.endpoint in _QUERY_TAKEN:
         return None
     key = next(iter(request.args))
     where = "the JSON body" if request.method in ("POST", "PUT", "PATCH") else "the path"
